@@ -1,0 +1,18 @@
+// Loading a Configuration from TOML. Every key must be known, of the right type and valid;
+// anything else is an InputError naming the file, the key and what is wrong.
+#pragma once
+
+#include <string>
+
+#include "engine/configuration.hpp"
+
+namespace bellows {
+
+/// Applies the TOML text on top of `config` (keys not given keep their values).
+void apply_config_toml(const std::string& toml_text, const std::string& source_name, Configuration& config);
+/// Reads a TOML file on top of the defaults.
+Configuration load_config_file(const std::string& path);
+/// The configuration as TOML, every key with its value: a starting point for a lab's own file.
+std::string config_to_toml(const Configuration& config);
+
+}  // namespace bellows

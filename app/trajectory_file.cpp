@@ -1,0 +1,78 @@
+#include "app/trajectory_file.hpp"
+
+#include <charconv>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "engine/errors.hpp"
+
+namespace bellows {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return "";
+  return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
+}
+
+double parse_number(const std::string& field, const std::string& where) {
+  const std::string text = trim(field);
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    throw InputError(where + ": '" + text + "' is not a number");
+  }
+  return value;
+}
+
+}  // namespace
+
+Trajectory parse_trajectory_csv(const std::string& text, const std::string& source_name, double sample_time_s,
+                                const TrajectoryLimits& limits) {
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || trim(line) != "time_s,angle_deg") {
+    throw InputError("trajectory " + source_name + ": line 1: the header must be 'time_s,angle_deg', found '" +
+                     trim(line) + "'");
+  }
+  std::vector<double> times, angles;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (trim(line).empty()) continue;
+    const std::string where = "trajectory " + source_name + ": line " + std::to_string(line_number);
+    const auto comma = line.find(',');
+    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos) {
+      throw InputError(where + ": expected two fields 'time_s,angle_deg'");
+    }
+    times.push_back(parse_number(line.substr(0, comma), where));
+    angles.push_back(parse_number(line.substr(comma + 1), where));
+  }
+  const std::string name = std::filesystem::path(source_name).stem().string();
+  try {
+    return trajectory_from_samples(name, times, angles, sample_time_s, limits);
+  } catch (const InputError& error) {
+    throw InputError("trajectory " + source_name + ": " + error.what());
+  }
+}
+
+Trajectory load_trajectory_file(const std::string& path, double sample_time_s, const TrajectoryLimits& limits) {
+  std::ifstream in(path);
+  if (!in) throw InputError("trajectory " + path + ": cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_trajectory_csv(text.str(), path, sample_time_s, limits);
+}
+
+Trajectory resolve_trajectory(const std::string& name_or_path, double sample_time_s, const TrajectoryLimits& limits) {
+  const bool looks_like_file =
+      name_or_path.find('/') != std::string::npos || std::filesystem::path(name_or_path).extension() == ".csv";
+  if (looks_like_file) return load_trajectory_file(name_or_path, sample_time_s, limits);
+  Trajectory trajectory = library_trajectory(name_or_path, sample_time_s);
+  validate_trajectory(trajectory, limits);
+  return trajectory;
+}
+
+}  // namespace bellows

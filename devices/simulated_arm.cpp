@@ -1,0 +1,165 @@
+#include "devices/simulated_arm.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "engine/valve_flow.hpp"
+
+namespace bellows {
+namespace {
+constexpr double kPaPerBar = 1e5;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+}  // namespace
+
+SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
+    : params_(params), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
+  state_.chamber_Pa = {params.gas.ambient_bar * kPaPerBar, params.gas.ambient_bar * kPaPerBar};
+  state_.command = ValveCommand::vented();
+  state_.noise = noise_.state();
+}
+
+SimulatedArm::State SimulatedArm::state() const {
+  State s = state_;
+  s.noise = noise_.state();
+  return s;
+}
+
+void SimulatedArm::set_state(const State& state) {
+  state_ = state;
+  noise_.set_state(state.noise);
+}
+
+double SimulatedArm::chamber_volume_m3(int actuator) const {
+  const double sign = actuator == 0 ? 1.0 : -1.0;
+  return params_.volume_l * 1e-3 * (1.0 + sign * params_.volume_gain_per_rad * state_.angle_rad);
+}
+
+double SimulatedArm::air_mass_kg() const {
+  const double rt = params_.gas.gas_constant_J_per_kgK * params_.gas.temperature_K;
+  return (state_.chamber_Pa[0] * chamber_volume_m3(0) + state_.chamber_Pa[1] * chamber_volume_m3(1)) / rt;
+}
+
+SensorReading SimulatedArm::read_sensors() {
+  SensorReading r;
+  r.time_s = state_.time_s;
+  const double resolution_rad = params_.encoder_resolution_deg * kRadPerDeg;
+  r.angle_rad = resolution_rad > 0.0 ? std::round(state_.angle_rad / resolution_rad) * resolution_rad
+                                     : state_.angle_rad;
+  for (int i = 0; i < kActuatorCount; ++i) {
+    r.chamber_bar[i] = state_.chamber_Pa[i] / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
+  }
+  r.supply_bar = supply_Pa_ / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
+  r.temperature_K = params_.gas.temperature_K;
+  return r;
+}
+
+void SimulatedArm::write_valves(const ValveCommand& command) {
+  for (int i = 0; i < kActuatorCount; ++i) {
+    state_.command.inlet_duty[i] = std::clamp(command.inlet_duty[i], 0.0, 1.0);
+    state_.command.outlet_duty[i] = std::clamp(command.outlet_duty[i], 0.0, 1.0);
+    if (!std::isfinite(command.inlet_duty[i])) state_.command.inlet_duty[i] = 0.0;
+    if (!std::isfinite(command.outlet_duty[i])) state_.command.outlet_duty[i] = 1.0;
+  }
+  state_.pwm_phase_s = 0.0;  // a new command starts a new PWM period
+}
+
+void SimulatedArm::vent() { write_valves(ValveCommand::vented()); }
+
+SimulatedArm::Openings SimulatedArm::openings_at(double phase_s) const {
+  Openings open;
+  const double period = params_.pwm_period_s;
+  for (int i = 0; i < kActuatorCount; ++i) {
+    open.inlet[i] = phase_s < state_.command.inlet_duty[i] * period;
+    open.outlet[i] = phase_s < state_.command.outlet_duty[i] * period;
+  }
+  return open;
+}
+
+double SimulatedArm::time_to_next_switch(double phase_s) const {
+  const double period = params_.pwm_period_s;
+  double next = period - phase_s;  // the period restarts and every valve with duty > 0 opens
+  for (int i = 0; i < kActuatorCount; ++i) {
+    for (double duty : {state_.command.inlet_duty[i], state_.command.outlet_duty[i]}) {
+      const double edge = duty * period - phase_s;
+      if (edge > 0.0) next = std::min(next, edge);
+    }
+  }
+  return next;
+}
+
+SimulatedArm::Physical SimulatedArm::derivative(const Physical& x, const Openings& open) const {
+  const PlantParameters& p = params_;
+  const double rt = p.gas.gas_constant_J_per_kgK * p.gas.temperature_K;
+  const double ambient_Pa = p.gas.ambient_bar * kPaPerBar;
+  const double v0 = p.volume_l * 1e-3;
+  const double chamber[2] = {x.pa_Pa, x.pb_Pa};
+  double pressure_rate[2];
+  for (int i = 0; i < kActuatorCount; ++i) {
+    const double sign = i == 0 ? 1.0 : -1.0;
+    const double volume = v0 * (1.0 + sign * p.volume_gain_per_rad * x.angle_rad);
+    const double volume_rate = sign * v0 * p.volume_gain_per_rad * x.velocity_rad_per_s;
+    double mass_flow = 0.0;
+    if (open.inlet[i]) {
+      mass_flow += p.valves_per_port * iso6358_mass_flow_kg_per_s(supply_Pa_, chamber[i], p.valve_conductance_m3_per_sPa,
+                                                                 p.valve_critical_ratio,
+                                                                 p.gas.reference_density_kg_per_m3);
+    }
+    if (open.outlet[i]) {
+      mass_flow -= p.valves_per_port * iso6358_mass_flow_kg_per_s(chamber[i], ambient_Pa, p.valve_conductance_m3_per_sPa,
+                                                                 p.valve_critical_ratio,
+                                                                 p.gas.reference_density_kg_per_m3);
+    }
+    // Full gas law: the shrinking bellows is compressed and pushes back.
+    pressure_rate[i] = mass_flow * rt / volume - chamber[i] * volume_rate / volume;
+  }
+  const double w0 = p.omega0_rad_per_s;
+  const double dp_bar = (x.pa_Pa - x.pb_Pa) / kPaPerBar;
+  double acceleration = w0 * w0 * (p.kappa_rad_per_bar * dp_bar - x.angle_rad - x.creep_rad) -
+                        2.0 * p.damping * w0 * x.velocity_rad_per_s;
+  const double stop_rad = p.hard_stop_deg * kRadPerDeg;
+  const double beyond = std::abs(x.angle_rad) - stop_rad;
+  if (beyond > 0.0) {
+    const double direction = x.angle_rad > 0.0 ? 1.0 : -1.0;
+    acceleration -= direction * p.hard_stop_stiffness_per_s2 * beyond + p.hard_stop_damping_per_s * x.velocity_rad_per_s;
+  }
+  return {x.velocity_rad_per_s, acceleration, (p.creep_gain * x.angle_rad - x.creep_rad) / p.creep_tau_s,
+          pressure_rate[0], pressure_rate[1]};
+}
+
+void SimulatedArm::integrate(double h, const Openings& open) {
+  // Classical RK4 with the valve openings constant over the step (steps end on switching edges).
+  const Physical x{state_.angle_rad, state_.angular_velocity_rad_per_s, state_.creep_rad, state_.chamber_Pa[0],
+                   state_.chamber_Pa[1]};
+  auto axpy = [](const Physical& a, double k, const Physical& d) {
+    return Physical{a.angle_rad + k * d.angle_rad, a.velocity_rad_per_s + k * d.velocity_rad_per_s,
+                    a.creep_rad + k * d.creep_rad, a.pa_Pa + k * d.pa_Pa, a.pb_Pa + k * d.pb_Pa};
+  };
+  const Physical k1 = derivative(x, open);
+  const Physical k2 = derivative(axpy(x, h / 2, k1), open);
+  const Physical k3 = derivative(axpy(x, h / 2, k2), open);
+  const Physical k4 = derivative(axpy(x, h, k3), open);
+  auto combine = [&](double Physical::*f) { return x.*f + h / 6.0 * (k1.*f + 2.0 * k2.*f + 2.0 * k3.*f + k4.*f); };
+  state_.angle_rad = combine(&Physical::angle_rad);
+  state_.angular_velocity_rad_per_s = combine(&Physical::velocity_rad_per_s);
+  state_.creep_rad = combine(&Physical::creep_rad);
+  state_.chamber_Pa[0] = std::max(1.0, combine(&Physical::pa_Pa));
+  state_.chamber_Pa[1] = std::max(1.0, combine(&Physical::pb_Pa));
+}
+
+void SimulatedArm::advance(double dt_s) {
+  // Tolerance so that float drift never produces sliver steps at period boundaries.
+  constexpr double kEpsilon_s = 1e-12;
+  const double period = params_.pwm_period_s;
+  double remaining = dt_s;
+  while (remaining > kEpsilon_s) {
+    if (state_.pwm_phase_s >= period - kEpsilon_s) state_.pwm_phase_s = 0.0;  // PWM repeats
+    const double h = std::min({params_.integration_step_s, remaining, time_to_next_switch(state_.pwm_phase_s)});
+    integrate(h, openings_at(state_.pwm_phase_s));
+    state_.pwm_phase_s += h;
+    state_.time_s += h;
+    remaining -= h;
+  }
+}
+
+}  // namespace bellows

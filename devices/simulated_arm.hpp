@@ -1,0 +1,69 @@
+// The simulated arm (spec section 4): two bellows fed by switching valves with real PWM timing,
+// ISO 6358 flow, angle-dependent volumes with the full gas law, a second-order arm with creep and
+// hard stops, a quantized encoder and noisy pressure sensors. Fixed internal step, deterministic
+// for a given seed; its whole state can be read and written, so a run can be resumed exactly.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "devices/gaussian_noise.hpp"
+#include "engine/device.hpp"
+#include "engine/parameters.hpp"
+
+namespace bellows {
+
+class SimulatedArm final : public Device {
+ public:
+  /// Everything that evolves: physics, the PWM period in progress and the noise generator.
+  struct State {
+    double time_s = 0.0;
+    double angle_rad = 0.0;
+    double angular_velocity_rad_per_s = 0.0;
+    double creep_rad = 0.0;                        // z of the viscoelastic creep
+    std::array<double, kActuatorCount> chamber_Pa{};
+    double pwm_phase_s = 0.0;                      // time since the current PWM period began
+    ValveCommand command{};                        // duty cycles of the current period
+    GaussianNoise::State noise{};
+  };
+
+  explicit SimulatedArm(const PlantParameters& params, std::uint64_t seed = 1);
+
+  SensorReading read_sensors() override;
+  void write_valves(const ValveCommand& command) override;
+  void vent() override;
+  void advance(double dt_s) override;
+  const char* name() const override { return "sim"; }
+
+  const PlantParameters& parameters() const { return params_; }
+  State state() const;
+  void set_state(const State& state);
+
+  /// Air mass in both chambers (kg), from the gas law: for conservation checks.
+  double air_mass_kg() const;
+  /// Volume of chamber `actuator` (m^3) at the current angle.
+  double chamber_volume_m3(int actuator) const;
+  /// Supply pressure currently available (Pa); a fault can lower it.
+  double supply_Pa() const { return supply_Pa_; }
+  void set_supply_bar(double supply_bar) { supply_Pa_ = supply_bar * 1e5; }
+
+ private:
+  struct Physical {  // the integrated part of the state
+    double angle_rad, velocity_rad_per_s, creep_rad, pa_Pa, pb_Pa;
+  };
+  struct Openings {
+    std::array<bool, kActuatorCount> inlet{}, outlet{};
+  };
+
+  Physical derivative(const Physical& x, const Openings& open) const;
+  void integrate(double h_s, const Openings& open);
+  Openings openings_at(double phase_s) const;
+  double time_to_next_switch(double phase_s) const;
+
+  PlantParameters params_;
+  double supply_Pa_;
+  State state_;
+  GaussianNoise noise_;
+};
+
+}  // namespace bellows

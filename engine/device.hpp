@@ -1,0 +1,51 @@
+// The device interface: what the engine needs from a rig, simulated or real.
+// devices/ implements it; the engine never knows which one it drives.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace bellows {
+
+inline constexpr int kActuatorCount = 2;  // A (index 0) and B (index 1)
+
+/// One reading of every sensor, taken at the start of a tick.
+struct SensorReading {
+  double time_s = 0.0;        // device time of the reading
+  double angle_rad = 0.0;     // encoder, quantized by the device
+  std::array<double, kActuatorCount> chamber_bar{};  // absolute pressures of A and B
+  double supply_bar = 0.0;    // absolute supply pressure
+  double temperature_K = 0.0; // supply temperature
+};
+
+/// The full desired valve state for one PWM period: duty cycles in [0, 1] per actuator.
+struct ValveCommand {
+  std::array<double, kActuatorCount> inlet_duty{};
+  std::array<double, kActuatorCount> outlet_duty{};
+
+  /// Inlets closed, outlets fully open: the safe state.
+  static ValveCommand vented() {
+    ValveCommand c;
+    c.outlet_duty = {1.0, 1.0};
+    return c;
+  }
+};
+
+/// A rig. Calls come from the engine thread only; implementations must not block for long.
+class Device {
+ public:
+  virtual ~Device() = default;
+  /// Latest sensor values.
+  virtual SensorReading read_sensors() = 0;
+  /// Apply a valve command for the coming PWM period. Duty cycles are clamped to [0, 1].
+  virtual void write_valves(const ValveCommand& command) = 0;
+  /// Close every inlet and open every outlet at once.
+  virtual void vent() = 0;
+  /// Let device time pass by `dt_s`. A simulated device integrates its physics here;
+  /// a real rig ignores it (its time passes on its own).
+  virtual void advance(double dt_s) = 0;
+  /// A short human name, e.g. "sim" or "lcm".
+  virtual const char* name() const = 0;
+};
+
+}  // namespace bellows

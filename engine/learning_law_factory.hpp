@@ -1,0 +1,20 @@
+// Builds the learning law a configuration names (`[ilc] law`).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/arm_model.hpp"
+#include "engine/configuration.hpp"
+#include "engine/learning_law.hpp"
+
+namespace bellows {
+
+/// The law names `[ilc] law` accepts.
+std::vector<std::string> learning_law_names();
+
+/// Throws InputError for an unknown name or weights the law cannot use.
+std::unique_ptr<LearningLaw> make_learning_law(const Configuration& config, const DiscreteArmModel& model, int samples);
+
+}  // namespace bellows

@@ -1,0 +1,84 @@
+// Every physics and control number of the reference system, with the spec's defaults.
+// The engine reads these; loading them from TOML is app/'s business (engine knows no files).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace bellows {
+
+/// Physical constants of air, shared by the plant and the controller's valve model.
+struct GasParameters {
+  double gas_constant_J_per_kgK = 287.05;
+  double temperature_K = 293.15;
+  double reference_density_kg_per_m3 = 1.185;  // rho0 of ISO 6358
+  double ambient_bar = 1.01325;                // p0
+};
+
+/// The simulated arm (spec section 4): the truth the controllers do not know exactly.
+struct PlantParameters {
+  double kappa_rad_per_bar = 7.91;
+  double omega0_rad_per_s = 14.14;
+  double damping = 0.31;
+  double volume_l = 0.45;               // V0, average volume of one bellows
+  double volume_gain_per_rad = 0.35;    // beta: V = V0 (1 +- beta alpha)
+  double valve_conductance_m3_per_sPa = 3.0e-9;  // C of one valve
+  double valve_critical_ratio = 0.35;   // b
+  int valves_per_port = 2;              // 2 inlets and 2 outlets per actuator
+  double creep_gain = 0.25;             // c_z
+  double creep_tau_s = 0.8;             // tau_z
+  double supply_bar = 3.0;              // absolute supply pressure
+  double encoder_resolution_deg = 0.1;
+  double pressure_noise_bar = 0.5e-3;   // sigma of the Gaussian pressure-sensor noise
+  double hard_stop_deg = 95.0;
+  double hard_stop_stiffness_per_s2 = 1.0e4;  // stiff spring beyond the stop (angular accel per rad)
+  double hard_stop_damping_per_s = 140.0;
+  double integration_step_s = 1.0e-4;   // fixed internal step
+  double pwm_period_s = 1.0 / 200.0;
+  GasParameters gas{};
+};
+
+/// The nominal model (spec section 2) that the ILC and the diagnostics use.
+struct ModelParameters {
+  double kappa_rad_per_bar = 7.91;
+  double omega0_rad_per_s = 14.14;
+  double damping = 0.31;
+};
+
+/// Controllers (spec section 3).
+struct ControllerParameters {
+  // PID with feed-forward at the ILC rate, normalized units (angle/pi, pressure/1 bar).
+  double k_ff = 0.4;
+  double k_p = 0.3;
+  double k_i_per_s = 0.3;
+  double k_d_s = 0.01;
+  double integrator_limit_bar = 0.4;  // anti-windup bound on k_i * integral(e)
+  // Pressure controllers at the tick rate.
+  double tau_p_s = 1.0 / 50.0;
+  double p_max_bar = 1.4;
+  int filter_samples = 4;  // moving-average length on the measured pressure
+  // The controller's own valve model (nominal data sheet values, not the plant's truth).
+  double valve_conductance_m3_per_sPa = 3.0e-9;
+  double valve_critical_ratio = 0.35;
+  int valves_per_port = 2;
+  double volume_l = 0.45;
+  GasParameters gas{};
+};
+
+/// Norm-optimal ILC weights (spec section 5): M = m I, S = s I, W = w I.
+struct IlcParameters {
+  std::string law = "noilc-dense";  // which learning law runs between trials
+  double m = 1.0;
+  double s = 0.1;
+  double w = 2.0e-5;
+};
+
+/// Timing of the loop: the tick (pressure controllers, PWM) and the ILC sample (PID, ILC).
+struct TimingParameters {
+  double tick_s = 1.0 / 200.0;
+  int ticks_per_sample = 4;          // 200 Hz / 50 Hz
+  double settle_s = 1.0;             // hold at the trajectory's start before each trial
+  double sample_s() const { return tick_s * ticks_per_sample; }
+};
+
+}  // namespace bellows

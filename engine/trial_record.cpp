@@ -1,0 +1,44 @@
+#include "engine/trial_record.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace bellows {
+
+void TrialSamples::resize(Eigen::Index count) {
+  for (Eigen::VectorXd* v : {&time_s, &setpoint_rad, &angle_rad, &error_rad, &u_pid_bar, &u_ilc_bar, &u_total_bar,
+                             &pressure_a_bar, &pressure_b_bar, &setpoint_a_bar, &setpoint_b_bar}) {
+    v->setZero(count);
+  }
+}
+
+void TrialTicks::resize(Eigen::Index count) {
+  for (Eigen::VectorXd* v : {&time_s, &angle_rad, &pressure_a_bar, &pressure_b_bar, &supply_bar, &setpoint_a_bar,
+                             &setpoint_b_bar, &inlet_a, &outlet_a, &inlet_b, &outlet_b}) {
+    v->setZero(count);
+  }
+}
+
+void TrialRecord::prepare(int learning_samples_count, int ticks_per_sample) {
+  learning_samples = learning_samples_count;
+  samples.resize(learning_samples_count + 1);
+  ticks.resize(static_cast<Eigen::Index>(learning_samples_count) * ticks_per_sample);
+  complete = false;
+}
+
+Eigen::VectorXd TrialRecord::normalized_error() const {
+  return samples.error_rad.tail(learning_samples) / std::numbers::pi;
+}
+
+double TrialRecord::rms_error_deg() const {
+  if (learning_samples == 0) return 0.0;
+  const Eigen::VectorXd e = samples.error_rad.tail(learning_samples);
+  return std::sqrt(e.squaredNorm() / learning_samples) * 180.0 / std::numbers::pi;
+}
+
+double TrialRecord::max_abs_error_deg() const {
+  if (learning_samples == 0) return 0.0;
+  return samples.error_rad.tail(learning_samples).cwiseAbs().maxCoeff() * 180.0 / std::numbers::pi;
+}
+
+}  // namespace bellows
