@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/run_recording.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
@@ -28,33 +29,52 @@ std::string progress_line(const IterationSummary& s) {
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
-  const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
+  const SessionManifest* resumed = recording.resuming() ? &recording.resumed().manifest : nullptr;
+  const Configuration config = resumed != nullptr          ? resumed->configuration
+                               : options.config_path.empty() ? Configuration{}
+                                                             : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
-  const Trajectory trajectory = resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const Trajectory trajectory = resumed != nullptr ? recording.resumed().trajectory
+                                                   : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const std::uint64_t seed = recording.resuming() ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  SimulatedArm arm(config.plant, options.seed);
+  SimulatedArm arm(config.plant, seed);
   ControlCore core(config.controller, config.timing);
   LearningSession session(arm, core, *law, trajectory, config.timing, config.controller);
+  recording.restore(arm, core, session);
+  recording.start(config, trajectory, arm.name(), seed, options.iterations);
+  if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
 
   nlohmann::json iterations = nlohmann::json::array();
-  for (int i = 0; i <= options.iterations; ++i) {
-    const IterationSummary s = session.run_trial();
-    progress << progress_line(s) << std::endl;
-    iterations.push_back({{"iteration", s.iteration},
-                          {"rms_deg", s.rms_deg},
-                          {"max_abs_error_deg", s.max_abs_error_deg},
-                          {"max_abs_correction_bar", s.max_abs_correction_bar},
-                          {"saturated_samples", s.saturated_samples}});
-    if (i < options.iterations) session.learn();
+  const int trials = recording.trials(options.iterations);
+  try {
+    for (int i = 0; i < trials; ++i) {
+      const IterationSummary s = session.run_trial();
+      session.learn();  // also after the last trial: the saved session resumes with this correction
+      recording.save(session, s, arm, core);  // on disk before the line says it is done
+      progress << progress_line(s) << std::endl;
+      iterations.push_back({{"iteration", s.iteration},
+                            {"rms_deg", s.rms_deg},
+                            {"max_abs_error_deg", s.max_abs_error_deg},
+                            {"max_abs_correction_bar", s.max_abs_correction_bar},
+                            {"saturated_samples", s.saturated_samples}});
+    }
+  } catch (const std::exception& error) {
+    recording.fault(error.what());
+    throw;
   }
+  recording.finish(trials);
   if (options.json) {
     const nlohmann::json report = {{"device", arm.name()},
                                    {"trajectory", trajectory.name},
                                    {"law", law->name()},
-                                   {"seed", options.seed},
+                                   {"seed", seed},
                                    {"samples", trajectory.learning_samples()},
+                                   {"session", recording.directory().empty() ? nlohmann::json(nullptr)
+                                                                             : nlohmann::json(recording.directory().string())},
                                    {"iterations", iterations}};
     out << report.dump() << std::endl;
   }

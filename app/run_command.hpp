@@ -15,6 +15,11 @@ struct RunOptions {
   std::string config_path;
   std::uint64_t seed = 1;
   bool json = false;
+  // Sessions: saved as the run goes into data_dir/session_name unless no_save.
+  bool no_save = false;
+  std::string data_dir;      // empty: $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions
+  std::string session_name;  // empty: start time and trajectory
+  std::string resume_dir;    // continue this session (its configuration, trajectory and state)
 };
 
 /// Runs and reports. Progress lines go to `progress`; with --json one object goes to `out`.

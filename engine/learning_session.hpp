@@ -3,6 +3,7 @@
 // with the current correction, and hands the record to the learning law for the next correction.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "engine/control_core.hpp"
@@ -44,6 +45,8 @@ class LearningSession {
   void set_correction(const Eigen::VectorXd& correction_bar, int iteration);
   const TrialRecord& last_record() const { return record_; }
   const std::vector<IterationSummary>& history() const { return history_; }
+  /// Restores the summaries of earlier trials, e.g. when a saved session is resumed.
+  void set_history(std::vector<IterationSummary> history) { history_ = std::move(history); }
 
  private:
   Device& device_;
