@@ -32,13 +32,13 @@ JsonReader JsonReader::operator[](std::string_view key) const {
   expect_object();
   const auto found = value_->find(key);
   if (found == value_->end()) fail("missing \"" + std::string(key) + "\"");
-  return JsonReader(*found, *source_, path_ + "/" + std::string(key));
+  return JsonReader(*found, source_, path_ + "/" + std::string(key));
 }
 
 JsonReader JsonReader::operator[](std::size_t index) const {
   if (!value_->is_array()) fail("expected an array");
   if (index >= value_->size()) fail("expected at least " + std::to_string(index + 1) + " elements");
-  return JsonReader((*value_)[index], *source_, path_ + "/" + std::to_string(index));
+  return JsonReader((*value_)[index], source_, path_ + "/" + std::to_string(index));
 }
 
 std::size_t JsonReader::size() const {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -15,8 +16,9 @@ nlohmann::ordered_json parse_json(std::string_view text, const std::string& sour
 
 class JsonReader {
  public:
+  /// `value` must outlive the reader; `source` (e.g. "session S: manifest.json") is copied.
   JsonReader(const nlohmann::ordered_json& value, const std::string& source, std::string path = "")
-      : value_(&value), source_(&source), path_(std::move(path)) {}
+      : value_(&value), source_(std::make_shared<const std::string>(source)), path_(std::move(path)) {}
 
   /// A required member of an object.
   JsonReader operator[](std::string_view key) const;
@@ -37,8 +39,11 @@ class JsonReader {
   [[noreturn]] void fail(const std::string& message) const;
 
  private:
+  JsonReader(const nlohmann::ordered_json& value, std::shared_ptr<const std::string> source, std::string path)
+      : value_(&value), source_(std::move(source)), path_(std::move(path)) {}
+
   const nlohmann::ordered_json* value_;
-  const std::string* source_;
+  std::shared_ptr<const std::string> source_;
   std::string path_;
 };
 
