@@ -46,17 +46,18 @@ void append_csv(std::string& out, const std::vector<CsvColumn>& columns) {
     out += columns[c].name;
   }
   out += '\n';
-  // Up to 24 characters per number plus the separator; reserving once keeps appends cheap.
-  out.reserve(out.size() + static_cast<std::size_t>(rows) * columns.size() * 25);
-  char buffer[32];
+  // Written straight into the string: at most 24 characters per number and its separator.
+  constexpr std::size_t kWidest = 25;
+  const std::size_t start = out.size();
+  out.resize(start + static_cast<std::size_t>(rows) * columns.size() * kWidest);
+  char* cursor = out.data() + start;
   for (Eigen::Index r = 0; r < rows; ++r) {
     for (std::size_t c = 0; c < columns.size(); ++c) {
-      if (c > 0) out += ',';
-      const auto result = std::to_chars(buffer, buffer + sizeof buffer, (*columns[c].values)(r));
-      out.append(buffer, result.ptr);
+      cursor = std::to_chars(cursor, cursor + kWidest, (*columns[c].values)(r)).ptr;
+      *cursor++ = c + 1 < columns.size() ? ',' : '\n';
     }
-    out += '\n';
   }
+  out.resize(static_cast<std::size_t>(cursor - out.data()));
 }
 
 std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,

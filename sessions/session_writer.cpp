@@ -49,6 +49,12 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   loaded = load_session(directory);
   remove_temporary_files(directory);
   remove_temporary_files(directory / session_layout::kIterations);
+  // Files of an iteration whose manifest update a crash prevented: not part of the session.
+  for (int i = static_cast<int>(loaded.iterations.size());; ++i) {
+    const bool samples = fs::remove(directory / session_layout::samples_file(i), error);
+    const bool telemetry = fs::remove(directory / session_layout::telemetry_file(i), error);
+    if (!samples && !telemetry) break;
+  }
   return SessionWriter(directory, loaded.manifest, std::move(lock));
 }
 

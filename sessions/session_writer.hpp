@@ -21,7 +21,8 @@ class SessionWriter {
   static SessionWriter create(const std::filesystem::path& data_dir, const std::string& name, SessionManifest header,
                               const Trajectory& trajectory, const std::string& purpose);
   /// Reopens a session to continue it: takes its lock, loads and checks everything into `loaded`,
-  /// and removes leftovers of an interrupted write. Throws InputError (busy, bad session).
+  /// and removes leftovers of an interrupted write (temporary files, files of an
+  /// iteration the manifest does not list). Throws InputError (busy, bad session).
   static SessionWriter open(const std::filesystem::path& directory, const std::string& purpose, Session& loaded);
 
   const std::filesystem::path& directory() const { return directory_; }

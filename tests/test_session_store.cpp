@@ -234,6 +234,22 @@ TEST(SessionWriter, AutosavesEveryIterationAndEvent) {
                std::invalid_argument);
 }
 
+TEST(SessionWriter, ReopeningClearsWhatAnInterruptedWriteLeftBehind) {
+  TempDir dir;
+  save_session(testing::simulate_session(2), dir / "s");
+  const fs::path iterations = dir / "s" / session_layout::kIterations;
+  fs::copy_file(dir / "s" / session_layout::samples_file(1), dir / "s" / session_layout::samples_file(2));  // unlisted
+  testing::write_text(iterations / ".telemetry_0002.csv.tmp-4242", "time_s,ang");
+  testing::write_text(dir / "s" / ".manifest.json.tmp-4242", "{");
+  Session loaded;
+  SessionWriter writer = SessionWriter::open(dir / "s", "test", loaded);
+  EXPECT_EQ(loaded.iterations.size(), 2u);
+  EXPECT_FALSE(fs::exists(dir / "s" / session_layout::samples_file(2)));
+  EXPECT_FALSE(fs::exists(iterations / ".telemetry_0002.csv.tmp-4242"));
+  EXPECT_FALSE(fs::exists(dir / "s" / ".manifest.json.tmp-4242"));
+  EXPECT_TRUE(fs::exists(dir / "s" / session_layout::samples_file(1)));
+}
+
 TEST(SessionWriter, NamesSessionsByStartTimeAndTrajectory) {
   TempDir dir;
   const Session simulated = testing::simulate_session(0);
