@@ -20,16 +20,18 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "Learning iterations after the feedback-only trial")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1000000));
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
 
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& help) {
+    return app.exit(help);
   } catch (const CLI::ParseError& error) {
-    const int code = app.exit(error);
-    return code == 0 ? 0 : kExitBadInput;
+    std::cerr << "bellows: " << error.what() << " (see --help)" << std::endl;
+    return kExitBadInput;
   }
 
   try {
