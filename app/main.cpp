@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/config_file.hpp"
 #include "app/run_command.hpp"
 #include "engine/errors.hpp"
 
@@ -25,6 +26,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
 
+  std::string config_path;
+  CLI::App* config_cmd = app.add_subcommand("config", "Print the configuration (defaults, or --config on top of them) as TOML");
+  config_cmd->add_option("--config", config_path, "TOML configuration file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -36,6 +41,12 @@ int main(int argc, char** argv) {
 
   try {
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
+    if (config_cmd->parsed()) {
+      const bellows::Configuration config =
+          config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);
+      std::cout << bellows::config_to_toml(config);
+      return 0;
+    }
     std::cout << app.help();
     return 0;
   } catch (const bellows::InputError& error) {

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "app/config_file.hpp"
+
+#include <fstream>
+#include <sstream>
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -97,6 +100,27 @@ TEST(ConfigFile, RoundTripsThroughToml) {
   EXPECT_DOUBLE_EQ(back.plant.kappa_rad_per_bar, 6.5);
   EXPECT_EQ(back.controller.filter_samples, 6);
   EXPECT_EQ(back.ilc.law, "noilc-dense");
+}
+
+}  // namespace
+}  // namespace bellows
+
+namespace bellows {
+namespace {
+
+TEST(ConfigFile, EveryKeyIsDocumented) {
+  std::ifstream in(std::string(BELLOWS_SOURCE_DIR) + "/docs/configuration.md");
+  ASSERT_TRUE(in) << "docs/configuration.md missing";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  for (const ParameterBinding& b : parameter_bindings()) {
+    const auto section = doc.find("## [" + b.section + "]");
+    ASSERT_NE(section, std::string::npos) << "section [" << b.section << "] is not documented";
+    const auto next_section = doc.find("\n## ", section + 1);
+    const auto key = doc.find("| `" + b.key + "` |", section);
+    EXPECT_TRUE(key != std::string::npos && key < next_section) << "[" << b.section << "] " << b.key << " is not documented";
+  }
 }
 
 }  // namespace
