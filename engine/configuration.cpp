@@ -1,5 +1,6 @@
 #include "engine/configuration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -75,9 +76,10 @@ std::vector<ParameterBinding> make_bindings() {
       // [trajectory]
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
   };
-  ParameterBinding law{"ilc", "law", "", "learning law", Constraint::kAny, {}, {}, {}};
+  ParameterBinding law{"ilc", "law", "", "learning law (see docs/learning-laws.md)", Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
-  b.push_back(law);
+  const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
+  b.insert(first_ilc, law);
   return b;
 }
 
