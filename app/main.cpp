@@ -1,10 +1,12 @@
 // bellows: the lab console and its headless commands.
 #include <iostream>
+#include <map>
 
 #include <CLI/CLI.hpp>
 
 #include "app/config_file.hpp"
 #include "app/run_command.hpp"
+#include "app/signals.hpp"
 #include "engine/errors.hpp"
 
 namespace {
@@ -25,11 +27,25 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
+  run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sim", "wall"}));
+  run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
+  const std::map<std::string, bellows::RealtimeMode> rt_modes = {
+      {"enforce", bellows::RealtimeMode::kEnforce}, {"try", bellows::RealtimeMode::kTry}, {"off", bellows::RealtimeMode::kOff}};
+  run_cmd->add_option("--rt", run.rt, "Real-time scheduling: enforce (refuse without), try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
 
   std::string config_path;
   CLI::App* config_cmd = app.add_subcommand("config", "Print the configuration (defaults, or --config on top of them) as TOML");
   config_cmd->add_option("--config", config_path, "TOML configuration file");
+  bool config_markdown = false;
+  config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
 
+  bellows::install_stop_signal_handlers();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -44,7 +60,7 @@ int main(int argc, char** argv) {
     if (config_cmd->parsed()) {
       const bellows::Configuration config =
           config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);
-      std::cout << bellows::config_to_toml(config);
+      std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
       return 0;
     }
     std::cout << app.help();

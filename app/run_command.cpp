@@ -1,15 +1,17 @@
 #include "app/run_command.hpp"
 
 #include <cstdio>
+#include <memory>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
@@ -24,10 +26,28 @@ std::string progress_line(const IterationSummary& s) {
   return line;
 }
 
+nlohmann::json to_json(const IterationSummary& s) {
+  return {{"iteration", s.iteration},
+          {"rms_deg", s.rms_deg},
+          {"max_abs_error_deg", s.max_abs_error_deg},
+          {"max_abs_correction_bar", s.max_abs_correction_bar},
+          {"saturated_samples", s.saturated_samples}};
+}
+
 }  // namespace
+
+double parse_speed(const std::string& speed) {
+  if (speed == "max") return 0.0;
+  for (const char* allowed : {"1", "2", "5", "10"}) {
+    if (speed == allowed) return std::stod(speed);
+  }
+  throw InputError("--speed must be 1, 2, 5, 10 or max, not '" + speed + "'");
+}
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
+  if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+  const double speed = parse_speed(options.speed);
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
   const Trajectory trajectory = resolve_trajectory(options.trajectory, sample_s, config.trajectory);
@@ -35,30 +55,58 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
   SimulatedArm arm(config.plant, options.seed);
-  ControlCore core(config.controller, config.timing);
-  LearningSession session(arm, core, *law, trajectory, config.timing, config.controller);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  std::unique_ptr<EngineDriver> driver;
+  RealtimeLoop* loop = nullptr;
+  if (options.clock == "sim") {
+    driver = std::make_unique<SimulatedClock>(core, arm);
+  } else {
+    auto realtime = std::make_unique<RealtimeLoop>(core, arm, speed);
+    loop = realtime.get();
+    driver = std::move(realtime);
+    loop->start(options.rt);
+  }
+  LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
+  session.set_stop_flag(&stop_requested());
 
   nlohmann::json iterations = nlohmann::json::array();
-  for (int i = 0; i <= options.iterations; ++i) {
-    const IterationSummary s = session.run_trial();
-    progress << progress_line(s) << std::endl;
-    iterations.push_back({{"iteration", s.iteration},
-                          {"rms_deg", s.rms_deg},
-                          {"max_abs_error_deg", s.max_abs_error_deg},
-                          {"max_abs_correction_bar", s.max_abs_correction_bar},
-                          {"saturated_samples", s.saturated_samples}});
-    if (i < options.iterations) session.learn();
+  int status = 0;
+  std::string failure;
+  try {
+    for (int i = 0; i <= options.iterations; ++i) {
+      const IterationSummary s = session.run_trial();
+      progress << progress_line(s) << std::endl;
+      iterations.push_back(to_json(s));
+      if (i < options.iterations) session.learn();
+    }
+  } catch (const EngineFault& fault) {
+    failure = fault.what();
+    status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
+    progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
   }
+  if (loop != nullptr) loop->stop();  // vents
+  else arm.vent();
+
   if (options.json) {
-    const nlohmann::json report = {{"device", arm.name()},
-                                   {"trajectory", trajectory.name},
-                                   {"law", law->name()},
-                                   {"seed", options.seed},
-                                   {"samples", trajectory.learning_samples()},
-                                   {"iterations", iterations}};
+    nlohmann::json report = {{"device", arm.name()},
+                             {"trajectory", trajectory.name},
+                             {"law", law->name()},
+                             {"seed", options.seed},
+                             {"clock", options.clock},
+                             {"samples", trajectory.learning_samples()},
+                             {"iterations", iterations}};
+    if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
+    if (loop != nullptr) {
+      const LatencySummary l = loop->latency();
+      report["loop"] = {{"ticks", core.ticks()},
+                        {"missed", l.missed},
+                        {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
+                        {"rt", loop->rt_description()},
+                        {"speed", options.speed}};
+    }
     out << report.dump() << std::endl;
   }
-  return 0;
+  return status;
 }
 
 }  // namespace bellows

@@ -3,6 +3,7 @@
 
 #include "devices/simulated_arm.hpp"
 #include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
 #include "engine/learning_session.hpp"
 #include "engine/noilc_dense.hpp"
 
@@ -17,12 +18,18 @@ void BM_SimulatedArmClosedLoop(benchmark::State& state) {
   SimulatedArm arm(plant, 1);
   ControlCore core(controller, timing);
   const long ticks_per_second = std::lround(1.0 / timing.tick_s);
+  auto run_ticks = [&](long ticks) {
+    for (long i = 0; i < ticks; ++i) {
+      arm.write_valves(core.tick(arm.read_sensors()));
+      arm.advance(timing.tick_s);
+    }
+  };
   double simulated_s = 0.0;
   for (auto _ : state) {
     core.hold(0.3);
-    run_ticks_simulated(arm, core, ticks_per_second, timing.tick_s);
+    run_ticks(ticks_per_second);
     core.hold(-0.3);
-    run_ticks_simulated(arm, core, ticks_per_second, timing.tick_s);
+    run_ticks(ticks_per_second);
     simulated_s += 2.0;
   }
   state.counters["sim_s_per_wall_s"] = benchmark::Counter(simulated_s, benchmark::Counter::kIsRate);
@@ -60,9 +67,10 @@ void BM_PaperRun30Iterations(benchmark::State& state) {
   const Trajectory paper = library_trajectory("paper", timing.sample_s());
   for (auto _ : state) {
     SimulatedArm arm(plant, 1);
-    ControlCore core(controller, timing);
+    EngineCore core(arm, controller, timing, SafetyParameters{});
+    SimulatedClock clock(core, arm);
     NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{}, paper.learning_samples());
-    LearningSession session(arm, core, law, paper, timing, controller);
+    LearningSession session(clock, law, paper, timing, controller);
     for (int i = 0; i <= 30; ++i) {
       benchmark::DoNotOptimize(session.run_trial().rms_deg);
       if (i < 30) session.learn();

@@ -4,7 +4,7 @@
 #include <numbers>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
 #include "engine/learning_session.hpp"
 #include "engine/noilc_dense.hpp"
 #include "engine/valve_flow.hpp"
@@ -106,10 +106,11 @@ double largest_bounce_back_bar(const PlantParameters& plant) {
   ControllerParameters controller;
   TimingParameters timing;
   SimulatedArm arm(plant, 3);
-  ControlCore core(controller, timing);
+  EngineCore core(arm, controller, timing, SafetyParameters{});
+  SimulatedClock clock(core, arm);
   const Trajectory paper = library_trajectory("paper", timing.sample_s());
   NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{}, paper.learning_samples());
-  LearningSession session(arm, core, law, paper, timing, controller);
+  LearningSession session(clock, law, paper, timing, controller);
   session.run_trial();
   const TrialTicks& t = session.last_record().ticks;
   double largest = 0.0;
