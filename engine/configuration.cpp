@@ -47,6 +47,9 @@ std::vector<ParameterBinding> make_bindings() {
       number("plant", "hard_stop_damping", "1/s", "damping of the hard stops", kNonNeg, [](C& c) { return &c.plant.hard_stop_damping_per_s; }),
       number("plant", "integration_step_s", "s", "fixed internal integration step", kPos, [](C& c) { return &c.plant.integration_step_s; }),
       number("plant", "pwm_period_s", "s", "PWM period of the switching valves", kPos, [](C& c) { return &c.plant.pwm_period_s; }),
+      number("plant", "fault_at_s", "s", "device time of the injected fault", kNonNeg, [](C& c) { return &c.plant.fault_at_s; }),
+      number("plant", "spike_bar", "bar", "size of an injected pressure-sensor spike", kNonNeg, [](C& c) { return &c.plant.spike_bar; }),
+      number("plant", "spike_s", "s", "duration of an injected pressure-sensor spike", kPos, [](C& c) { return &c.plant.spike_s; }),
       number("plant", "temperature_K", "K", "air temperature", kPos, [](C& c) { return &c.plant.gas.temperature_K; }),
       // [model]: the nominal model the learning uses
       number("model", "kappa", "rad/bar", "nominal static gain", kPos, [](C& c) { return &c.model.kappa_rad_per_bar; }),
@@ -87,6 +90,10 @@ std::vector<ParameterBinding> make_bindings() {
       number("safety", "black_box_s", "s", "ticks kept before a fault", kPos, [](C& c) { return &c.safety.black_box_s; }),
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
   };
+  ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
+  fault.text = [](C& c) { return &c.plant.fault; };
+  const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
+  b.insert(after_plant, fault);
   ParameterBinding law{"ilc", "law", "", "learning law (see docs/learning-laws.md)", Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
