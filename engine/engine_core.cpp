@@ -112,14 +112,17 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       break;
     }
     case CommandKind::kStartTrial:
+      // The sender sizes the record (TrialRecord::prepare) so that the loop never allocates.
       if (command.trajectory == nullptr || command.correction == nullptr || command.record == nullptr ||
-          command.correction->size() != command.trajectory->learning_samples()) {
+          command.correction->size() != command.trajectory->learning_samples() ||
+          command.record->samples.time_s.size() != command.trajectory->learning_samples() + 1 ||
+          command.record->ticks.time_s.size() != command.trajectory->learning_samples() * timing_.ticks_per_sample) {
         EngineEvent event;
         event.kind = EventKind::kCommandRefused;
         event.time_s = now_s;
         event.from = event.to = from;
         event.command = command.kind;
-        event.refusal = "the trial's trajectory, correction or record is missing or of the wrong length";
+        event.refusal = "the trial's trajectory, correction or record is missing or not prepared to its length";
         emit(event);
         return;
       }

@@ -26,7 +26,8 @@ struct EngineCommand {
   CommandKind kind = CommandKind::kHeartbeat;
   const Trajectory* trajectory = nullptr;       // kSelectTrajectory, kStartTrial
   const Eigen::VectorXd* correction = nullptr;  // kStartTrial: u_ilc(0..N-1), bar
-  TrialRecord* record = nullptr;                // kStartTrial: where the trial is written
+  TrialRecord* record = nullptr;                // kStartTrial: where the trial is written, prepared
+                                                // (TrialRecord::prepare) to the trajectory's length
   int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains

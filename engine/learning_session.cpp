@@ -33,6 +33,7 @@ LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Traject
     throw InputError("learning law built for " + std::to_string(law.samples()) + " samples, trajectory has " +
                      std::to_string(trajectory_.learning_samples()));
   }
+  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample);
   EngineCommand select;
   select.kind = CommandKind::kSelectTrajectory;
   select.trajectory = &trajectory_;

@@ -37,6 +37,7 @@ TEST(EngineCore, RefusesATrialWhileSafeAndSaysWhy) {
   const Trajectory paper = library_trajectory("paper", 0.02);
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
   TrialRecord record;
+  record.prepare(paper.learning_samples(), 4);
   EngineCommand start;
   start.kind = CommandKind::kStartTrial;
   start.trajectory = &paper;
@@ -49,6 +50,27 @@ TEST(EngineCore, RefusesATrialWhileSafeAndSaysWhy) {
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].kind, EventKind::kCommandRefused);
   EXPECT_STREQ(events[0].refusal, "arm the valves first");
+}
+
+TEST(EngineCore, RefusesATrialWhoseRecordIsNotPrepared) {
+  EngineFixture f;
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
+  TrialRecord record;  // not prepared: the loop would have to allocate
+  f.send(CommandKind::kArm);
+  f.clock.step();
+  EngineCommand start;
+  start.kind = CommandKind::kStartTrial;
+  start.trajectory = &paper;
+  start.correction = &correction;
+  start.record = &record;
+  f.drain_events();
+  f.core.send(start);
+  f.clock.step();
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  const auto events = f.drain_events();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kCommandRefused);
 }
 
 TEST(EngineCore, FaultLatchesUntilResetAndResetNeedsAFreshArm) {
@@ -77,6 +99,7 @@ TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
   const Trajectory paper = library_trajectory("paper", 0.02);
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
   TrialRecord record;
+  record.prepare(paper.learning_samples(), 4);
   f.send(CommandKind::kArm);
   f.clock.step();
   EngineCommand start;
