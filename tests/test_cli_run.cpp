@@ -104,3 +104,67 @@ TEST(CliRun, BadInputGetsOneLineAndExitStatusTwo) {
 
 }  // namespace
 }  // namespace bellows
+
+#include <signal.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+extern char** environ;
+
+namespace bellows {
+namespace {
+
+// Starts `bellows args...` with stdout into a pipe; returns pid and the pipe's read end.
+std::pair<pid_t, int> spawn_bellows(std::vector<std::string> args) {
+  int pipe_fds[2];
+  EXPECT_EQ(pipe(pipe_fds), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  args.insert(args.begin(), BELLOWS_BINARY);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  EXPECT_EQ(posix_spawn(&pid, BELLOWS_BINARY, &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  return {pid, pipe_fds[0]};
+}
+
+std::string read_all(int fd) {
+  std::string text;
+  char buffer[4096];
+  ssize_t n;
+  while ((n = read(fd, buffer, sizeof buffer)) > 0) text.append(buffer, static_cast<std::size_t>(n));
+  close(fd);
+  return text;
+}
+
+TEST(CliRun, SigintVentsAndExitsCleanlyWithWhatFinished) {
+  for (int signal_number : {SIGINT, SIGTERM}) {
+    setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-xdg").c_str(), 1);  // never the real home
+    auto [pid, out] = spawn_bellows({"run", "--clock", "wall", "--speed", "5", "--iterations", "50", "--json"});
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // past the first trial (~1.8 s)
+    kill(pid, signal_number);
+    const std::string text = read_all(out);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal instead of exiting cleanly";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal_number);
+    const nlohmann::json report = nlohmann::json::parse(text);
+    EXPECT_EQ(report["fault"]["name"], "emergency-stop");
+    EXPECT_GE(report["iterations"].size(), 1u);
+    EXPECT_LT(report["iterations"].size(), 51u);
+  }
+}
+
+}  // namespace
+}  // namespace bellows
