@@ -1,5 +1,6 @@
 #include "app/arm_state_json.hpp"
 
+#include "engine/errors.hpp"
 #include "sessions/json_reader.hpp"
 
 namespace bellows {
@@ -35,6 +36,8 @@ nlohmann::ordered_json arm_state_to_json(const SimulatedArm& arm) {
           {"inlet_duty", pair_to_json(s.command.inlet_duty)},
           {"outlet_duty", pair_to_json(s.command.outlet_duty)},
           {"noise_state", noise},
+          {"fault", to_string(s.fault)},
+          {"fault_since_s", s.fault_since_s},
           {"supply_Pa", arm.supply_Pa()}};
 }
 
@@ -59,6 +62,12 @@ void restore_arm_state(SimulatedArm& arm, const nlohmann::ordered_json& json, co
   for (double pressure : s.chamber_Pa) {
     if (!(pressure > 0.0)) r["chamber_Pa"].fail("pressures must be positive");
   }
+  try {
+    s.fault = simulated_fault_from_string(r["fault"].text());
+  } catch (const InputError& error) {
+    r["fault"].fail(error.what());
+  }
+  s.fault_since_s = r["fault_since_s"].number();
   const double supply_Pa = r["supply_Pa"].number();
   if (!(supply_Pa > 0.0)) r["supply_Pa"].fail("must be positive");
   arm.set_state(s);

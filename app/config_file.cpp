@@ -85,4 +85,22 @@ std::string config_to_toml(const Configuration& config) {
   return out.str();
 }
 
+std::string config_to_markdown(const Configuration& config) {
+  Configuration copy = config;
+  std::ostringstream out;
+  std::string section;
+  for (const ParameterBinding& b : parameter_bindings()) {
+    if (b.section != section) {
+      section = b.section;
+      out << "\n## [" << section << "]\n\n| key | default | unit | meaning |\n|---|---|---|---|\n";
+    }
+    out << "| `" << b.key << "` | ";
+    if (b.text) out << '"' << *b.text(copy) << '"';
+    else if (b.integer) out << *b.integer(copy);
+    else out << *b.real(copy);
+    out << " | " << b.unit << " | " << b.description << " |\n";
+  }
+  return out.str();
+}
+
 }  // namespace bellows

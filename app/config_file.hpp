@@ -14,5 +14,7 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
 Configuration load_config_file(const std::string& path);
 /// The configuration as TOML, every key with its value: a starting point for a lab's own file.
 std::string config_to_toml(const Configuration& config);
+/// Every key as Markdown tables, one per section (the reference part of docs/configuration.md).
+std::string config_to_markdown(const Configuration& config);
 
 }  // namespace bellows

@@ -1,9 +1,12 @@
 // bellows: the lab console and its headless commands.
 #include <iostream>
+#include <map>
 
 #include <CLI/CLI.hpp>
 
+#include "app/config_file.hpp"
 #include "app/run_command.hpp"
+#include "app/signals.hpp"
 #include "app/sessions_command.hpp"
 #include "engine/errors.hpp"
 
@@ -21,10 +24,21 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "Learning iterations after the feedback-only trial")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1000000));
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
+  run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sim", "wall"}));
+  run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
+  const std::map<std::string, bellows::RealtimeMode> rt_modes = {
+      {"enforce", bellows::RealtimeMode::kEnforce}, {"try", bellows::RealtimeMode::kTry}, {"off", bellows::RealtimeMode::kOff}};
+  run_cmd->add_option("--rt", run.rt, "Real-time scheduling: enforce (refuse without), try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
   CLI::Option* no_save = run_cmd->add_flag("--no-save", run.no_save, "Do not save the session");
   run_cmd->add_option("--data-dir", run.data_dir,
                       "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions)")
@@ -56,15 +70,30 @@ int main(int argc, char** argv) {
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
 
+  std::string config_path;
+  CLI::App* config_cmd = app.add_subcommand("config", "Print the configuration (defaults, or --config on top of them) as TOML");
+  config_cmd->add_option("--config", config_path, "TOML configuration file");
+  bool config_markdown = false;
+  config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
+
+  bellows::install_stop_signal_handlers();
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& help) {
+    return app.exit(help);
   } catch (const CLI::ParseError& error) {
-    const int code = app.exit(error);
-    return code == 0 ? 0 : kExitBadInput;
+    std::cerr << "bellows: " << error.what() << " (see --help)" << std::endl;
+    return kExitBadInput;
   }
 
   try {
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
+    if (config_cmd->parsed()) {
+      const bellows::Configuration config =
+          config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);
+      std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
+      return 0;
+    }
     if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
     if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);
     if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);

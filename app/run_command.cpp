@@ -1,16 +1,18 @@
 #include "app/run_command.hpp"
 
 #include <cstdio>
+#include <memory>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
 #include "app/run_recording.hpp"
+#include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
@@ -25,60 +27,110 @@ std::string progress_line(const IterationSummary& s) {
   return line;
 }
 
+nlohmann::json to_json(const IterationSummary& s) {
+  return {{"iteration", s.iteration},
+          {"rms_deg", s.rms_deg},
+          {"max_abs_error_deg", s.max_abs_error_deg},
+          {"max_abs_correction_bar", s.max_abs_correction_bar},
+          {"saturated_samples", s.saturated_samples}};
+}
+
 }  // namespace
+
+double parse_speed(const std::string& speed) {
+  if (speed == "max") return 0.0;
+  for (const char* allowed : {"1", "2", "5", "10"}) {
+    if (speed == allowed) return std::stod(speed);
+  }
+  throw InputError("--speed must be 1, 2, 5, 10 or max, not '" + speed + "'");
+}
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
+  if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+  const double speed = parse_speed(options.speed);
   RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
-  const SessionManifest* resumed = recording.resuming() ? &recording.resumed().manifest : nullptr;
-  const Configuration config = resumed != nullptr          ? resumed->configuration
+  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
+  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
                                : options.config_path.empty() ? Configuration{}
                                                              : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
-  const Trajectory trajectory = resumed != nullptr ? recording.resumed().trajectory
-                                                   : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
-  const std::uint64_t seed = recording.resuming() ? recording.resumed_seed() : options.seed;
+  const Trajectory trajectory =
+      resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
   SimulatedArm arm(config.plant, seed);
-  ControlCore core(config.controller, config.timing);
-  LearningSession session(arm, core, *law, trajectory, config.timing, config.controller);
-  recording.restore(arm, core, session);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  std::unique_ptr<EngineDriver> driver;
+  SimulatedClock* clock = nullptr;
+  RealtimeLoop* loop = nullptr;
+  if (options.clock == "sim") {
+    auto simulated = std::make_unique<SimulatedClock>(core, arm);
+    clock = simulated.get();
+    driver = std::move(simulated);
+  } else {
+    auto realtime = std::make_unique<RealtimeLoop>(core, arm, speed);
+    loop = realtime.get();
+    driver = std::move(realtime);
+  }
+  LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
+  session.set_stop_flag(&stop_requested());
+  recording.restore(arm, core, clock, session);  // before the first tick
   recording.start(config, trajectory, arm.name(), seed, options.iterations);
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  if (loop != nullptr) loop->start(options.rt);
 
   nlohmann::json iterations = nlohmann::json::array();
+  int status = 0;
+  std::string failure;
   const int trials = recording.trials(options.iterations);
   try {
     for (int i = 0; i < trials; ++i) {
       const IterationSummary s = session.run_trial();
       session.learn();  // also after the last trial: the saved session resumes with this correction
-      recording.save(session, s, arm, core);  // on disk before the line says it is done
+      recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
-      iterations.push_back({{"iteration", s.iteration},
-                            {"rms_deg", s.rms_deg},
-                            {"max_abs_error_deg", s.max_abs_error_deg},
-                            {"max_abs_correction_bar", s.max_abs_correction_bar},
-                            {"saturated_samples", s.saturated_samples}});
+      iterations.push_back(to_json(s));
     }
+  } catch (const EngineFault& fault) {
+    failure = fault.what();
+    status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
+    progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
+    recording.fault(failure + " (" + fault_name(fault.code()) + ")");
   } catch (const std::exception& error) {
+    if (loop != nullptr) loop->stop();  // vents
+    else arm.vent();
     recording.fault(error.what());
     throw;
   }
-  recording.finish(trials);
+  if (loop != nullptr) loop->stop();  // vents
+  else arm.vent();
+  if (status == 0) recording.finish(trials);
+
   if (options.json) {
-    const nlohmann::json report = {{"device", arm.name()},
-                                   {"trajectory", trajectory.name},
-                                   {"law", law->name()},
-                                   {"seed", seed},
-                                   {"samples", trajectory.learning_samples()},
-                                   {"session", recording.directory().empty() ? nlohmann::json(nullptr)
-                                                                             : nlohmann::json(recording.directory().string())},
-                                   {"iterations", iterations}};
+    nlohmann::json report = {{"device", arm.name()},
+                             {"trajectory", trajectory.name},
+                             {"law", law->name()},
+                             {"seed", seed},
+                             {"clock", options.clock},
+                             {"samples", trajectory.learning_samples()},
+                             {"session", recording.directory().empty() ? nlohmann::json(nullptr)
+                                                                       : nlohmann::json(recording.directory().string())},
+                             {"iterations", iterations}};
+    if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
+    if (loop != nullptr) {
+      const LatencySummary l = loop->latency();
+      report["loop"] = {{"ticks", core.ticks()},
+                        {"missed", l.missed},
+                        {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
+                        {"rt", loop->rt_description()},
+                        {"speed", options.speed}};
+    }
     out << report.dump() << std::endl;
   }
-  return 0;
+  return status;
 }
 
 }  // namespace bellows

@@ -1,4 +1,4 @@
-// `bellows run`: trials on the simulated arm, learning between them, headless.
+// `bellows run`: trials headless, learning between them, on simulated or wall-clock time.
 #pragma once
 
 #include <cstdint>
@@ -6,6 +6,7 @@
 #include <string>
 
 #include "engine/configuration.hpp"
+#include "engine/realtime_loop.hpp"
 
 namespace bellows {
 
@@ -15,6 +16,9 @@ struct RunOptions {
   std::string config_path;
   std::uint64_t seed = 1;
   bool json = false;
+  std::string clock = "sim";   // sim: as fast as possible, deterministic; wall: the real-time loop
+  std::string speed = "1";     // wall clock with the simulated arm: 1, 2, 5, 10 or max
+  RealtimeMode rt = RealtimeMode::kTry;
   // Sessions: saved as the run goes into data_dir/session_name unless no_save.
   bool no_save = false;
   std::string data_dir;      // empty: $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions
@@ -22,8 +26,11 @@ struct RunOptions {
   std::string resume_dir;    // continue this session (its configuration, trajectory and state)
 };
 
+/// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.
+double parse_speed(const std::string& speed);
+
 /// Runs and reports. Progress lines go to `progress`; with --json one object goes to `out`.
-/// Throws InputError for bad input (before any trial runs).
+/// Throws InputError for bad input (before any trial runs). Returns the exit status.
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress);
 
 }  // namespace bellows

@@ -60,29 +60,34 @@ void RunRecording::start(const Configuration& config, const Trajectory& trajecto
                                         kPurpose));
 }
 
-void RunRecording::restore(SimulatedArm& arm, ControlCore& core, LearningSession& learning) {
+void RunRecording::restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
   if (!resuming_) return;
   const SessionManifest& m = resumed_.manifest;
-  if (m.resume && !resumed_.iterations.empty()) restore_completed(arm, core, learning);  // else: start afresh
+  if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
+    if (m.resume && m.resume->exact()) {
+      restore_arm_state(arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+      if (clock != nullptr) clock->set_ticks(m.resume->clock_ticks);
+      core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
+    }
+    learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));
+    std::vector<IterationSummary> history;
+    for (const IterationEntry& entry : m.iterations) history.push_back(entry.summary);
+    learning.set_history(std::move(history));
+  }
   writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
                                       " more iterations");
 }
 
-void RunRecording::restore_completed(SimulatedArm& arm, ControlCore& core, LearningSession& learning) const {
-  const SessionManifest& m = resumed_.manifest;
-  restore_arm_state(arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
-  core.set_state(m.resume->controller);
-  learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));
-  std::vector<IterationSummary> history;
-  for (const IterationEntry& entry : m.iterations) history.push_back(entry.summary);
-  learning.set_history(std::move(history));
-}
-
 void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm,
-                        const ControlCore& core) {
+                        EngineCore& core, const SimulatedClock* clock) {
   if (!writer_) return;
-  writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(),
-                          ResumeState{core.state(), arm_state_to_json(arm)});
+  ResumeState resume;
+  if (clock != nullptr) {  // same thread as the engine: its state is quiet between trials
+    resume.controller = core.control().state();
+    resume.device = arm_state_to_json(arm);
+    resume.clock_ticks = clock->ticks();
+  }
+  writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(), std::move(resume));
 }
 
 void RunRecording::fault(const std::string& what) noexcept {

@@ -10,7 +10,8 @@
 
 #include "app/run_command.hpp"
 #include "devices/simulated_arm.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
 #include "engine/learning_session.hpp"
 #include "sessions/session_writer.hpp"
 
@@ -33,12 +34,15 @@ class RunRecording {
   /// A fresh run: creates the session (nothing with --no-save).
   void start(const Configuration& config, const Trajectory& trajectory, const std::string& device, std::uint64_t seed,
              int iterations);
-  /// A resumed run: puts the arm, the controllers and the learning where the session stopped,
-  /// and records the resumption.
-  void restore(SimulatedArm& arm, ControlCore& core, LearningSession& learning);
-  /// After a trial and the learning from it.
-  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm,
-            const ControlCore& core);
+  /// A resumed run, before the engine's first tick: puts the arm, the engine (armed, with its
+  /// controllers' state), the clock and the learning where the session stopped, and records the
+  /// resumption. Nothing for a fresh run. `clock` is null on the wall clock.
+  void restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
+  /// After a trial and the learning from it. On the wall clock (`clock` null) the loop thread owns
+  /// the arm and the controllers, so their state is not captured: such a session resumes with the
+  /// correction and freshly armed controllers.
+  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm, EngineCore& core,
+            const SimulatedClock* clock);
   /// Records a fault; never throws (the fault itself is what the caller reports).
   void fault(const std::string& what) noexcept;
   void finish(int trials_run);
@@ -47,8 +51,6 @@ class RunRecording {
   std::filesystem::path directory() const;
 
  private:
-  void restore_completed(SimulatedArm& arm, ControlCore& core, LearningSession& learning) const;
-
   const RunOptions& options_;
   bool resuming_ = false;
   Session resumed_;

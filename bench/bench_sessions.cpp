@@ -9,7 +9,8 @@
 
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
 #include "sessions/iteration_files.hpp"
@@ -29,8 +30,9 @@ const Session& paper_session() {
     const DiscreteArmModel model = discretize_arm_model(config.model, config.timing.sample_s());
     const auto law = make_learning_law(config, model, trajectory.learning_samples());
     SimulatedArm arm(config.plant, 1);
-    ControlCore core(config.controller, config.timing);
-    LearningSession learning(arm, core, *law, trajectory, config.timing, config.controller);
+    EngineCore core(arm, config.controller, config.timing, config.safety);
+    SimulatedClock clock(core, arm);
+    LearningSession learning(clock, *law, trajectory, config.timing, config.controller);
     Session s;
     s.manifest.program_version = program_version();
     s.manifest.name = "paper";
@@ -46,7 +48,7 @@ const Session& paper_session() {
       learning.learn();
       s.iterations.push_back({learning.last_record(), learning.correction_bar()});
       s.manifest.iterations.push_back({summary, utc_now()});
-      s.manifest.resume = ResumeState{core.state(), {{"time_s", arm.state().time_s}}};
+      s.manifest.resume = ResumeState{core.control().state(), {{"time_s", arm.state().time_s}}, clock.ticks()};
     }
     return s;
   }();

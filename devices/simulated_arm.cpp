@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
+#include "engine/errors.hpp"
 #include "engine/valve_flow.hpp"
 
 namespace bellows {
@@ -12,11 +14,48 @@ constexpr double kPaPerBar = 1e5;
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }  // namespace
 
+const char* to_string(SimulatedFault fault) {
+  switch (fault) {
+    case SimulatedFault::kNone: return "none";
+    case SimulatedFault::kSensorDropout: return "sensor-dropout";
+    case SimulatedFault::kStuckInlet: return "stuck-inlet";
+    case SimulatedFault::kSupplyLoss: return "supply-loss";
+    case SimulatedFault::kNanAngle: return "nan-angle";
+    case SimulatedFault::kPressureSpike: return "pressure-spike";
+  }
+  return "?";
+}
+
+SimulatedFault simulated_fault_from_string(const std::string& name) {
+  for (auto fault : {SimulatedFault::kNone, SimulatedFault::kSensorDropout, SimulatedFault::kStuckInlet,
+                     SimulatedFault::kSupplyLoss, SimulatedFault::kNanAngle, SimulatedFault::kPressureSpike}) {
+    if (name == to_string(fault)) return fault;
+  }
+  throw InputError("unknown simulated fault '" + name +
+                   "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike)");
+}
+
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
     : params_(params), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
   state_.chamber_Pa = {params.gas.ambient_bar * kPaPerBar, params.gas.ambient_bar * kPaPerBar};
   state_.command = ValveCommand::vented();
   state_.noise = noise_.state();
+  const SimulatedFault configured = simulated_fault_from_string(params.fault);
+  if (configured != SimulatedFault::kNone) inject_fault(configured, params.fault_at_s);
+}
+
+void SimulatedArm::inject_fault(SimulatedFault fault, double at_s) {
+  scheduled_at_s_.store(at_s, std::memory_order_relaxed);
+  scheduled_fault_.store(static_cast<std::uint8_t>(fault), std::memory_order_release);
+}
+
+void SimulatedArm::activate_scheduled_fault() {
+  const auto scheduled = static_cast<SimulatedFault>(scheduled_fault_.load(std::memory_order_acquire));
+  if (scheduled == SimulatedFault::kNone || scheduled_at_s_.load(std::memory_order_relaxed) > state_.time_s) return;
+  scheduled_fault_.store(0, std::memory_order_relaxed);
+  state_.fault = scheduled;
+  state_.fault_since_s = state_.time_s;
+  if (scheduled == SimulatedFault::kSupplyLoss) supply_Pa_ = params_.gas.ambient_bar * kPaPerBar;
 }
 
 SimulatedArm::State SimulatedArm::state() const {
@@ -41,6 +80,8 @@ double SimulatedArm::air_mass_kg() const {
 }
 
 SensorReading SimulatedArm::read_sensors() {
+  activate_scheduled_fault();
+  if (state_.fault == SimulatedFault::kSensorDropout) return frozen_reading_;
   SensorReading r;
   r.time_s = state_.time_s;
   const double resolution_rad = params_.encoder_resolution_deg * kRadPerDeg;
@@ -51,6 +92,11 @@ SensorReading SimulatedArm::read_sensors() {
   }
   r.supply_bar = supply_Pa_ / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
   r.temperature_K = params_.gas.temperature_K;
+  if (state_.fault == SimulatedFault::kNanAngle) r.angle_rad = std::numeric_limits<double>::quiet_NaN();
+  if (state_.fault == SimulatedFault::kPressureSpike && state_.time_s - state_.fault_since_s < params_.spike_s) {
+    r.chamber_bar[0] += params_.spike_bar;
+  }
+  frozen_reading_ = r;
   return r;
 }
 
@@ -73,6 +119,7 @@ SimulatedArm::Openings SimulatedArm::openings_at(double phase_s) const {
     open.inlet[i] = phase_s < state_.command.inlet_duty[i] * period;
     open.outlet[i] = phase_s < state_.command.outlet_duty[i] * period;
   }
+  if (state_.fault == SimulatedFault::kStuckInlet) open.inlet[0] = true;
   return open;
 }
 
@@ -151,6 +198,7 @@ void SimulatedArm::advance(double dt_s) {
   // Tolerance so that float drift never produces sliver steps at period boundaries.
   constexpr double kEpsilon_s = 1e-12;
   const double period = params_.pwm_period_s;
+  activate_scheduled_fault();
   double remaining = dt_s;
   while (remaining > kEpsilon_s) {
     if (state_.pwm_phase_s >= period - kEpsilon_s) state_.pwm_phase_s = 0.0;  // PWM repeats

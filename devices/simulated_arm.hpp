@@ -5,6 +5,8 @@
 #pragma once
 
 #include <array>
+#include <atomic>
+#include <string>
 #include <cstdint>
 
 #include "devices/gaussian_noise.hpp"
@@ -12,6 +14,21 @@
 #include "engine/parameters.hpp"
 
 namespace bellows {
+
+/// Faults the simulated arm can suffer, so that every guard is tested against one it must catch.
+enum class SimulatedFault : std::uint8_t {
+  kNone,
+  kSensorDropout,   // the sensors stop updating: readings frozen, their time too
+  kStuckInlet,      // actuator A's inlet valve stays fully open whatever is commanded
+  kSupplyLoss,      // the supply pressure falls to ambient
+  kNanAngle,        // the encoder reads NaN
+  kPressureSpike,   // chamber A's sensor reads a spike of `spike_bar` for `spike_s`
+};
+
+/// "none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike".
+const char* to_string(SimulatedFault fault);
+/// Throws InputError for an unknown name.
+SimulatedFault simulated_fault_from_string(const std::string& name);
 
 class SimulatedArm final : public Device {
  public:
@@ -25,6 +42,8 @@ class SimulatedArm final : public Device {
     double pwm_phase_s = 0.0;                      // time since the current PWM period began
     ValveCommand command{};                        // duty cycles of the current period
     GaussianNoise::State noise{};
+    SimulatedFault fault = SimulatedFault::kNone;  // active fault
+    double fault_since_s = 0.0;
   };
 
   explicit SimulatedArm(const PlantParameters& params, std::uint64_t seed = 1);
@@ -47,6 +66,10 @@ class SimulatedArm final : public Device {
   double supply_Pa() const { return supply_Pa_; }
   void set_supply_bar(double supply_bar) { supply_Pa_ = supply_bar * 1e5; }
 
+  /// Schedule `fault` at device time `at_s` (now, if at_s is not in the future). Safe to call from
+  /// another thread than the one driving the device (a lock-free hand-over).
+  void inject_fault(SimulatedFault fault, double at_s = -1.0);
+
  private:
   struct Physical {  // the integrated part of the state
     double angle_rad, velocity_rad_per_s, creep_rad, pa_Pa, pb_Pa;
@@ -60,10 +83,15 @@ class SimulatedArm final : public Device {
   Openings openings_at(double phase_s) const;
   double time_to_next_switch(double phase_s) const;
 
+  void activate_scheduled_fault();
+
   PlantParameters params_;
   double supply_Pa_;
   State state_;
   GaussianNoise noise_;
+  SensorReading frozen_reading_{};  // what a dropped-out sensor keeps reporting
+  std::atomic<std::uint8_t> scheduled_fault_{0};
+  std::atomic<double> scheduled_at_s_{0.0};
 };
 
 }  // namespace bellows

@@ -1,5 +1,6 @@
 #include "engine/configuration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -46,6 +47,9 @@ std::vector<ParameterBinding> make_bindings() {
       number("plant", "hard_stop_damping", "1/s", "damping of the hard stops", kNonNeg, [](C& c) { return &c.plant.hard_stop_damping_per_s; }),
       number("plant", "integration_step_s", "s", "fixed internal integration step", kPos, [](C& c) { return &c.plant.integration_step_s; }),
       number("plant", "pwm_period_s", "s", "PWM period of the switching valves", kPos, [](C& c) { return &c.plant.pwm_period_s; }),
+      number("plant", "fault_at_s", "s", "device time of the injected fault", kNonNeg, [](C& c) { return &c.plant.fault_at_s; }),
+      number("plant", "spike_bar", "bar", "size of an injected pressure-sensor spike", kNonNeg, [](C& c) { return &c.plant.spike_bar; }),
+      number("plant", "spike_s", "s", "duration of an injected pressure-sensor spike", kPos, [](C& c) { return &c.plant.spike_s; }),
       number("plant", "temperature_K", "K", "air temperature", kPos, [](C& c) { return &c.plant.gas.temperature_K; }),
       // [model]: the nominal model the learning uses
       number("model", "kappa", "rad/bar", "nominal static gain", kPos, [](C& c) { return &c.model.kappa_rad_per_bar; }),
@@ -73,11 +77,27 @@ std::vector<ParameterBinding> make_bindings() {
       whole("timing", "ticks_per_sample", "loop ticks per ILC sample", [](C& c) { return &c.timing.ticks_per_sample; }),
       number("timing", "settle_s", "s", "hold at the start before each trial", kNonNeg, [](C& c) { return &c.timing.settle_s; }),
       // [trajectory]
+      // [safety]: the guards' limits
+      number("safety", "angle_limit_deg", "deg", "fault beyond this angle", kPos, [](C& c) { return &c.safety.angle_limit_deg; }),
+      number("safety", "pressure_margin_bar", "bar", "fault when a chamber exceeds p_max plus this", kNonNeg, [](C& c) { return &c.safety.pressure_margin_bar; }),
+      number("safety", "supply_min_bar", "bar", "fault below this absolute supply pressure", kPos, [](C& c) { return &c.safety.supply_min_bar; }),
+      number("safety", "sensor_min_bar", "bar", "lowest plausible pressure reading", kNonNeg, [](C& c) { return &c.safety.sensor_min_bar; }),
+      number("safety", "sensor_max_bar", "bar", "highest plausible pressure reading", kPos, [](C& c) { return &c.safety.sensor_max_bar; }),
+      number("safety", "sensor_max_angle_deg", "deg", "largest plausible encoder reading", kPos, [](C& c) { return &c.safety.sensor_max_angle_deg; }),
+      whole("safety", "stale_ticks", "ticks without a fresh reading before a stale-sensor fault", [](C& c) { return &c.safety.stale_ticks; }),
+      whole("safety", "missed_deadline_streak", "consecutive missed deadlines before a fault", [](C& c) { return &c.safety.missed_deadline_streak; }),
+      number("safety", "heartbeat_timeout_s", "s", "console silent this long: fault", kPos, [](C& c) { return &c.safety.heartbeat_timeout_s; }),
+      number("safety", "black_box_s", "s", "ticks kept before a fault", kPos, [](C& c) { return &c.safety.black_box_s; }),
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
   };
-  ParameterBinding law{"ilc", "law", "", "learning law", Constraint::kAny, {}, {}, {}};
+  ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
+  fault.text = [](C& c) { return &c.plant.fault; };
+  const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
+  b.insert(after_plant, fault);
+  ParameterBinding law{"ilc", "law", "", "learning law (see docs/learning-laws.md)", Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
-  b.push_back(law);
+  const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
+  b.insert(first_ilc, law);
   return b;
 }
 
@@ -129,6 +149,9 @@ void validate_configuration(const Configuration& config) {
   if (config.plant.volume_gain_per_rad * config.plant.hard_stop_deg * 3.14159265358979 / 180.0 >= 0.9) {
     throw InputError("[plant] volume_gain = " + format_number(config.plant.volume_gain_per_rad) +
                      ": the bellows volume would vanish before the hard stops");
+  }
+  if (config.trajectory.max_abs_angle_deg >= config.safety.angle_limit_deg) {
+    throw InputError("[trajectory] max_abs_angle_deg must be below [safety] angle_limit_deg");
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/parameters.hpp"
+#include "engine/safety.hpp"
 #include "engine/trajectory.hpp"
 
 namespace bellows {
@@ -19,6 +20,7 @@ struct Configuration {
   IlcParameters ilc;
   TimingParameters timing;
   TrajectoryLimits trajectory;
+  SafetyParameters safety;
 };
 
 /// What a parameter's value must satisfy.

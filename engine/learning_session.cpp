@@ -20,17 +20,9 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record, const
   return s;
 }
 
-void run_ticks_simulated(Device& device, ControlCore& core, long ticks, double tick_s) {
-  for (long i = 0; i < ticks; ++i) {
-    device.write_valves(core.tick(device.read_sensors()));
-    device.advance(tick_s);
-  }
-}
-
-LearningSession::LearningSession(Device& device, ControlCore& core, LearningLaw& law, Trajectory trajectory,
+LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Trajectory trajectory,
                                  const TimingParameters& timing, const ControllerParameters& controller)
-    : device_(device),
-      core_(core),
+    : driver_(driver),
       law_(law),
       trajectory_(std::move(trajectory)),
       timing_(timing),
@@ -41,6 +33,8 @@ LearningSession::LearningSession(Device& device, ControlCore& core, LearningLaw&
     throw InputError("learning law built for " + std::to_string(law.samples()) + " samples, trajectory has " +
                      std::to_string(trajectory_.learning_samples()));
   }
+  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample);
+  driver_.core().send(EngineCommand::select_trajectory(trajectory_));
 }
 
 void LearningSession::set_correction(const Eigen::VectorXd& correction_bar, int iteration) {
@@ -49,11 +43,49 @@ void LearningSession::set_correction(const Eigen::VectorXd& correction_bar, int 
   iteration_ = iteration;
 }
 
+EngineEvent LearningSession::next_event() {
+  EngineEvent event;
+  while (!driver_.core().poll_event(event)) {
+    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
+      driver_.core().send(EngineCommand::of(CommandKind::kEmergencyStop));
+      while (driver_.core().state() != EngineState::kFault) driver_.await();
+      throw EngineFault(FaultCode::kEmergencyStop, "interrupted: valves vented");
+    }
+    driver_.await();
+  }
+  return event;
+}
+
+void LearningSession::ensure_armed() {
+  EngineCore& core = driver_.core();
+  if (core.state() == EngineState::kArmed) return;
+  core.send(EngineCommand::of(CommandKind::kArm));
+  for (;;) {
+    const EngineEvent event = next_event();
+    if (event.kind == EventKind::kStateChanged && event.to == EngineState::kArmed) return;
+    if (event.kind == EventKind::kCommandRefused) {
+      throw EngineFault(core.fault(), std::string("the engine refused to arm: ") + event.refusal);
+    }
+    if (event.kind == EventKind::kFault) throw EngineFault(event.fault, fault_message(event.fault));
+  }
+}
+
 IterationSummary LearningSession::run_trial() {
-  core_.hold(trajectory_.angle_rad(0));
-  run_ticks_simulated(device_, core_, std::lround(timing_.settle_s / timing_.tick_s), timing_.tick_s);
-  core_.start_trial(trajectory_, correction_, record_);
-  while (!record_.complete) run_ticks_simulated(device_, core_, 1, timing_.tick_s);
+  ensure_armed();
+  const EngineCommand start = EngineCommand::start_trial(
+      trajectory_, correction_, record_, static_cast<int>(std::lround(timing_.settle_s / timing_.tick_s)), next_trial_id_++);
+  driver_.core().send(start);
+  for (;;) {
+    const EngineEvent event = next_event();
+    if (event.kind == EventKind::kTrialComplete && event.trial_id == start.trial_id) break;
+    if (event.kind == EventKind::kTrialAborted && event.trial_id == start.trial_id) {
+      const FaultCode code = driver_.core().fault();
+      throw EngineFault(code, std::string("trial aborted: ") + fault_message(code));
+    }
+    if (event.kind == EventKind::kCommandRefused) {
+      throw EngineFault(driver_.core().fault(), std::string("the engine refused the trial: ") + event.refusal);
+    }
+  }
   IterationSummary summary =
       summarize_trial(iteration_, record_, correction_, controller_.gas.ambient_bar, controller_.p_max_bar);
   history_.push_back(summary);

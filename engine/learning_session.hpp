@@ -1,13 +1,14 @@
-// Trials and learning between them, on simulated time: the headless counterpart of the real-time
-// engine. Each trial settles at the trajectory's start with the PID alone, runs the trajectory
-// with the current correction, and hands the record to the learning law for the next correction.
+// Trials and learning between them, driven through the engine like any operator would: arm, start
+// a trial (the engine settles at the trajectory's start, then runs it with the current correction),
+// wait for the record, hand it to the learning law for the next correction. The same code runs on
+// a simulated clock (headless, deterministic) and on the real-time loop (wall time).
 #pragma once
 
-#include <utility>
+#include <atomic>
+#include <stdexcept>
 #include <vector>
 
-#include "engine/control_core.hpp"
-#include "engine/device.hpp"
+#include "engine/engine_driver.hpp"
 #include "engine/learning_law.hpp"
 #include "engine/trajectory.hpp"
 #include "engine/trial_record.hpp"
@@ -26,15 +27,23 @@ struct IterationSummary {
 IterationSummary summarize_trial(int iteration, const TrialRecord& record, const Eigen::VectorXd& correction_bar,
                                  double ambient_bar, double p_max_bar);
 
-/// Runs `ticks` ticks of `core` on `device`, advancing device time by one tick after each.
-void run_ticks_simulated(Device& device, ControlCore& core, long ticks, double tick_s);
+/// The engine faulted (or refused) while the session was running a trial. Carries the fault code.
+class EngineFault : public std::runtime_error {
+ public:
+  EngineFault(FaultCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  FaultCode code() const { return code_; }
+
+ private:
+  FaultCode code_;
+};
 
 class LearningSession {
  public:
-  LearningSession(Device& device, ControlCore& core, LearningLaw& law, Trajectory trajectory,
-                  const TimingParameters& timing, const ControllerParameters& controller);
+  LearningSession(EngineDriver& driver, LearningLaw& law, Trajectory trajectory, const TimingParameters& timing,
+                  const ControllerParameters& controller);
 
-  /// Settles, runs one trial with the current correction and records it. Returns its summary.
+  /// Arms if needed, runs one trial with the current correction and records it. Throws EngineFault
+  /// if the engine faults or refuses; the trial is then not counted.
   IterationSummary run_trial();
   /// Replaces the correction by the law's update from the last trial.
   void learn();
@@ -45,12 +54,18 @@ class LearningSession {
   void set_correction(const Eigen::VectorXd& correction_bar, int iteration);
   const TrialRecord& last_record() const { return record_; }
   const std::vector<IterationSummary>& history() const { return history_; }
-  /// Restores the summaries of earlier trials, e.g. when a saved session is resumed.
   void set_history(std::vector<IterationSummary> history) { history_ = std::move(history); }
+  LearningLaw& law() { return law_; }
+  /// While waiting for the engine, a set flag (a signal arrived) stops the engine at once (vents)
+  /// and makes run_trial() throw EngineFault(kEmergencyStop).
+  void set_stop_flag(const std::atomic<bool>* stop) { stop_ = stop; }
 
  private:
-  Device& device_;
-  ControlCore& core_;
+  void ensure_armed();
+  /// Waits for the next event, letting engine time pass.
+  EngineEvent next_event();
+
+  EngineDriver& driver_;
   LearningLaw& law_;
   Trajectory trajectory_;
   TimingParameters timing_;
@@ -59,7 +74,9 @@ class LearningSession {
   Eigen::VectorXd next_correction_;
   TrialRecord record_;
   int iteration_ = 0;
+  std::uint32_t next_trial_id_ = 1;
   std::vector<IterationSummary> history_;
+  const std::atomic<bool>* stop_ = nullptr;
 };
 
 }  // namespace bellows

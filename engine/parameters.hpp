@@ -35,6 +35,11 @@ struct PlantParameters {
   double hard_stop_damping_per_s = 140.0;
   double integration_step_s = 1.0e-4;   // fixed internal step
   double pwm_period_s = 1.0 / 200.0;
+  // Fault injection for tests and drills: which fault, at what device time.
+  std::string fault = "none";
+  double fault_at_s = 0.0;
+  double spike_bar = 1.0;   // size of a pressure-sensor spike
+  double spike_s = 0.01;    // its duration
   GasParameters gas{};
 };
 

@@ -203,9 +203,13 @@ Json manifest_to_json(const SessionManifest& m) {
       {"events", events},
   };
   if (m.resume) {
-    out["resume"] = {{"next_iteration", static_cast<int>(m.iterations.size())},
-                     {"controller", controller_state_to_json(m.resume->controller)},
-                     {"device", m.resume->device}};
+    Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
+    if (m.resume->exact()) {
+      resume["clock_ticks"] = m.resume->clock_ticks;
+      resume["controller"] = controller_state_to_json(*m.resume->controller);
+      resume["device"] = m.resume->device;
+    }
+    out["resume"] = std::move(resume);
   }
   return out;
 }
@@ -251,9 +255,14 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
                                     std::to_string(next));
     }
     ResumeState state;
-    state.controller = controller_state_from_json(resume["controller"], m.configuration);
-    resume["device"].expect_object();
-    state.device = resume["device"].json();
+    if (resume["exact"].boolean()) {
+      const JsonReader ticks = resume["clock_ticks"];
+      if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
+      state.clock_ticks = ticks.json().get<long long>();
+      state.controller = controller_state_from_json(resume["controller"], m.configuration);
+      resume["device"].expect_object();
+      state.device = resume["device"].json();
+    }
     m.resume = std::move(state);
   } else if (!m.iterations.empty()) {
     r.fail("missing \"resume\": a session with completed iterations must hold the state to continue from");

@@ -40,11 +40,15 @@ struct IterationEntry {
   std::string completed_utc;
 };
 
-/// What continuing the run exactly needs beyond the correction: the controllers' state and the
-/// device's own state, which only the device's owner understands (kept here as JSON).
+/// What continuing the run exactly needs beyond the correction: the controllers' state, the
+/// device's own state (which only the device's owner understands, kept here as JSON) and the
+/// simulated clock. Only a run on a simulated clock can be captured exactly; after a wall-clock
+/// run `controller` is empty and a resume starts from freshly armed controllers.
 struct ResumeState {
-  ControlCore::State controller;
+  std::optional<ControlCore::State> controller;
   nlohmann::ordered_json device = nlohmann::ordered_json::object();
+  long long clock_ticks = 0;
+  bool exact() const { return controller.has_value(); }
 };
 
 struct SessionManifest {

@@ -17,7 +17,8 @@
 
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
-#include "engine/control_core.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
 #include "sessions/session.hpp"
@@ -152,8 +153,9 @@ inline Session simulate_session(int trials, const std::string& name = "simulated
   const DiscreteArmModel model = discretize_arm_model(config.model, config.timing.sample_s());
   const auto law = make_learning_law(config, model, trajectory.learning_samples());
   SimulatedArm arm(config.plant, 7);
-  ControlCore core(config.controller, config.timing);
-  LearningSession learning(arm, core, *law, trajectory, config.timing, config.controller);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  SimulatedClock clock(core, arm);
+  LearningSession learning(clock, *law, trajectory, config.timing, config.controller);
 
   Session session;
   SessionManifest& m = session.manifest;
@@ -173,7 +175,7 @@ inline Session simulate_session(int trials, const std::string& name = "simulated
     learning.learn();
     session.iterations.push_back({learning.last_record(), learning.correction_bar()});
     m.iterations.push_back({summary, utc_now()});
-    m.resume = ResumeState{core.state(), {{"time_s", arm.state().time_s}}};
+    m.resume = ResumeState{core.control().state(), {{"time_s", arm.state().time_s}}, clock.ticks()};
   }
   return session;
 }

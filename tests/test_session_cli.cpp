@@ -191,6 +191,47 @@ TEST(SessionLocking, ASecondProcessIsRefusedAndTheFirstNamed) {
   EXPECT_EQ(after.exit_code, 0) << after.err;
 }
 
+TEST(SessionSaving, AFaultIsRecordedAndEveryCompletedIterationKept) {
+  TempDir dir;
+  testing::write_short_run_files(dir.path());
+  const std::string data = (dir / "data").string();
+  const testing::Spawned run =
+      testing::spawn_bellows(short_run(dir, {"--iterations", "100000", "--data-dir", data, "--name", "f"}));
+  const std::string out = read_until(run.out, "iteration   2");
+  ASSERT_NE(out.find("iteration   2"), std::string::npos) << out;
+  ::kill(run.pid, SIGINT);  // the engine vents and the run stops with a fault: emergency stop
+  int status = 0;
+  ::waitpid(run.pid, &status, 0);
+  ::close(run.out);
+  ::close(run.err);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGINT) << status;
+  const Session session = load_session(dir / "data" / "f");
+  EXPECT_GE(session.iterations.size(), 3u);
+  ASSERT_FALSE(session.manifest.events.empty());
+  const SessionEvent& last = session.manifest.events.back();
+  EXPECT_EQ(last.kind, "fault");
+  EXPECT_EQ(last.iteration, static_cast<int>(session.iterations.size()));
+  EXPECT_NE(last.message.find("interrupted"), std::string::npos) << last.message;
+}
+
+TEST(SessionSaving, AWallClockRunSavesAndResumesWithItsCorrection) {
+  TempDir dir;
+  testing::write_short_run_files(dir.path());
+  const std::string data = (dir / "data").string();
+  const ProcessResult wall =
+      run_bellows(short_run(dir, {"--clock", "wall", "--speed", "max", "--iterations", "1", "--data-dir", data, "--name", "w"}));
+  ASSERT_EQ(wall.exit_code, 0) << wall.err;
+  const Session saved = load_session(dir / "data" / "w");
+  ASSERT_EQ(saved.iterations.size(), 2u);
+  ASSERT_TRUE(saved.manifest.resume.has_value());
+  EXPECT_FALSE(saved.manifest.resume->exact());  // the loop thread owned the state: not captured
+  const ProcessResult resumed = run_bellows({"run", "--resume", data + "/w", "--iterations", "1"});
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  const Session continued = load_session(dir / "data" / "w");
+  ASSERT_EQ(continued.iterations.size(), 3u);
+  EXPECT_EQ(continued.iterations[2].record.samples.u_ilc_bar.head(25), saved.iterations[1].next_correction_bar);
+}
+
 class SessionsCommand : public ::testing::Test {
  protected:
   void SetUp() override {

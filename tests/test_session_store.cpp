@@ -113,8 +113,10 @@ void expect_same_session(const Session& loaded, const Session& saved) {
   }
   ASSERT_EQ(a.resume.has_value(), b.resume.has_value());
   if (a.resume) {
-    expect_same_controller(a.resume->controller, b.resume->controller);
+    ASSERT_EQ(a.resume->exact(), b.resume->exact());
+    if (a.resume->exact()) expect_same_controller(*a.resume->controller, *b.resume->controller);
     EXPECT_EQ(a.resume->device, b.resume->device);
+    EXPECT_EQ(a.resume->clock_ticks, b.resume->clock_ticks);
   }
   EXPECT_EQ(loaded.trajectory.name, saved.trajectory.name);
   EXPECT_EQ(loaded.trajectory.sample_time_s, saved.trajectory.sample_time_s);

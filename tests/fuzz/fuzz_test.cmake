@@ -1,5 +1,9 @@
 # Registers the bounded fuzz run with ctest. It builds the fuzz target with clang in its own build
 # directory (<build>/fuzz) and runs it for BELLOWS_FUZZ_SECONDS; without clang it is skipped.
+# Registered in the plain build only: the sanitizer builds of CI would repeat the same fuzzing.
+if(BELLOWS_SANITIZE)
+  return()
+endif()
 set(BELLOWS_FUZZ_SECONDS 60 CACHE STRING "How long the fuzz test runs each fuzz target")
 find_program(BELLOWS_CLANGXX NAMES clang++ clang++-14)
 add_test(NAME fuzz_session_readers

@@ -1,0 +1,226 @@
+#include "engine/engine_core.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace bellows {
+namespace {
+constexpr std::size_t kCommandCapacity = 256;
+constexpr std::size_t kEventCapacity = 1024;
+constexpr int kMaxCommandsPerTick = 16;  // bounds the work of one tick
+}  // namespace
+
+EngineCore::EngineCore(Device& device, const ControllerParameters& controller, const TimingParameters& timing,
+                       const SafetyParameters& safety)
+    : device_(device),
+      controller_(controller),
+      timing_(timing),
+      safety_(safety),
+      control_(controller, timing),
+      black_box_(static_cast<std::size_t>(std::lround(safety.black_box_s / timing.tick_s))),
+      commands_(kCommandCapacity),
+      events_(kEventCapacity) {}
+
+TelemetryRing& EngineCore::add_telemetry_tap(std::size_t capacity) {
+  taps_.push_back(std::make_unique<TelemetryRing>(capacity));
+  return *taps_.back();
+}
+
+void EngineCore::emit(const EngineEvent& event) {
+  if (!events_.push(event)) dropped_events_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void EngineCore::change_state(EngineState next, double now_s, CommandKind cause) {
+  const EngineState from = state();
+  if (from == next) return;
+  state_.store(next, std::memory_order_release);
+  EngineEvent event;
+  event.kind = EventKind::kStateChanged;
+  event.time_s = now_s;
+  event.from = from;
+  event.to = next;
+  event.command = cause;
+  event.fault = fault();
+  emit(event);
+}
+
+void EngineCore::hand_back_trial(EventKind kind, double now_s) {
+  if (record_ == nullptr) return;
+  EngineEvent event;
+  event.kind = kind;
+  event.time_s = now_s;
+  event.record = record_;
+  event.trial_id = trial_id_;
+  event.from = event.to = state();
+  emit(event);
+  record_ = nullptr;
+  correction_ = nullptr;
+  if (control_.trial_running()) control_.abort_trial();
+}
+
+void EngineCore::enter_fault(FaultCode code, double now_s) {
+  fault_.store(code, std::memory_order_release);
+  device_.vent();
+  hand_back_trial(EventKind::kTrialAborted, now_s);
+  change_state(EngineState::kFault, now_s, CommandKind::kEmergencyStop);
+  EngineEvent event;
+  event.kind = EventKind::kFault;
+  event.time_s = now_s;
+  event.fault = code;
+  event.from = event.to = EngineState::kFault;
+  emit(event);
+}
+
+void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s) {
+  const EngineState from = state();
+  const Transition t = transition(from, command.kind);
+  auto refuse = [&](const char* why) {
+    EngineEvent event;
+    event.kind = EventKind::kCommandRefused;
+    event.time_s = now_s;
+    event.from = event.to = from;
+    event.command = command.kind;
+    event.refusal = why;
+    emit(event);
+  };
+  if (!t.allowed) {
+    refuse(t.refusal);
+    return;
+  }
+  switch (command.kind) {
+    case CommandKind::kHeartbeat:
+      last_heartbeat_s_ = wall_s;
+      return;
+    case CommandKind::kEmergencyStop:
+      enter_fault(FaultCode::kEmergencyStop, now_s);
+      return;
+    case CommandKind::kSelectTrajectory:
+      trajectory_ = command.trajectory;
+      if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->angle_rad(0));
+      return;
+    case CommandKind::kSetGains: {
+      ControllerParameters gains = controller_;
+      gains.k_ff = command.gains.k_ff;
+      gains.k_p = command.gains.k_p;
+      gains.k_i_per_s = command.gains.k_i_per_s;
+      gains.k_d_s = command.gains.k_d_s;
+      control_.set_controller_gains(gains);
+      return;
+    }
+    case CommandKind::kArm: {
+      // Fresh controllers, holding the trajectory's start (or where the arm is, without one).
+      control_.pid().reset();
+      const double hold = trajectory_ != nullptr ? trajectory_->angle_rad(0) : last_angle_rad_;
+      control_.hold(hold);
+      last_heartbeat_s_ = wall_s;
+      break;
+    }
+    case CommandKind::kStartTrial:
+      // The sender sizes the record (TrialRecord::prepare) so that the loop never allocates.
+      if (command.trajectory == nullptr || command.correction == nullptr || command.record == nullptr ||
+          command.correction->size() != command.trajectory->learning_samples() ||
+          command.record->samples.time_s.size() != command.trajectory->learning_samples() + 1 ||
+          command.record->ticks.time_s.size() != command.trajectory->learning_samples() * timing_.ticks_per_sample) {
+        refuse("the trial's trajectory, correction or record is missing or not prepared to its length");
+        return;
+      }
+      trajectory_ = command.trajectory;
+      correction_ = command.correction;
+      record_ = command.record;
+      record_->complete = false;  // the engine owns the record from now on
+      trial_id_ = command.trial_id;
+      settle_remaining_ = command.settle_ticks;
+      control_.hold(trajectory_->angle_rad(0));
+      if (settle_remaining_ <= 0) control_.start_trial(*trajectory_, *correction_, *record_);
+      break;
+    case CommandKind::kAbortTrial:
+    case CommandKind::kDisarm:
+      hand_back_trial(EventKind::kTrialAborted, now_s);
+      break;
+    case CommandKind::kReset:
+      fault_.store(FaultCode::kNone, std::memory_order_release);
+      black_box_.clear();
+      break;
+  }
+  change_state(t.next, now_s, command.kind);
+}
+
+void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
+  EngineCommand command;
+  for (int i = 0; i < kMaxCommandsPerTick && commands_.pop(command); ++i) apply(command, now_s, wall_s);
+
+  const SensorReading reading = device_.read_sensors();
+  stale_count_ = reading.time_s > last_reading_time_s_ ? 0 : stale_count_ + 1;
+  last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
+  if (std::isfinite(reading.angle_rad)) last_angle_rad_ = reading.angle_rad;
+  missed_streak_ = missed_deadlines > 0 ? missed_streak_ + missed_deadlines : 0;
+
+  if (valves_live(state())) {
+    GuardInputs inputs;
+    inputs.p_max_bar = controller_.p_max_bar;
+    inputs.stale_count = stale_count_;
+    inputs.missed_streak = missed_streak_;
+    inputs.heartbeat_age_s = monitor_heartbeat_.load(std::memory_order_relaxed) ? wall_s - last_heartbeat_s_ : 0.0;
+    const FaultCode code = check_guards(reading, inputs, safety_);
+    if (code != FaultCode::kNone) enter_fault(code, now_s);
+  }
+
+  ValveCommand valves = ValveCommand::vented();
+  if (valves_live(state())) {
+    if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
+      control_.start_trial(*trajectory_, *correction_, *record_);
+    }
+    valves = control_.tick(reading);
+    device_.write_valves(valves);
+    if (record_ != nullptr && record_->complete) {
+      EngineEvent event;
+      event.kind = EventKind::kTrialComplete;
+      event.time_s = now_s;
+      event.record = record_;
+      event.trial_id = trial_id_;
+      event.from = event.to = EngineState::kRunning;
+      emit(event);
+      record_ = nullptr;
+      correction_ = nullptr;
+      change_state(EngineState::kArmed, now_s, CommandKind::kStartTrial);
+    }
+  } else {
+    device_.vent();
+  }
+
+  TickRecord tick;
+  tick.tick = tick_count_.load(std::memory_order_relaxed);
+  tick.time_s = now_s;
+  tick.state = state();
+  tick.fault = fault();
+  tick.reading = reading;
+  tick.desired_angle_rad = control_.desired_angle_rad();
+  tick.u_total_bar = control_.last_u_total_bar();
+  tick.setpoints = control_.setpoints();
+  tick.valves = valves;
+  tick.sample = control_.sample_index();
+  tick.trial_id = trial_id_;
+  black_box_.record(tick);
+  if (state() == EngineState::kFault && !black_box_.frozen()) black_box_.freeze();
+  for (auto& tap : taps_) {
+    if (!tap->push(tick)) dropped_telemetry_.fetch_add(1, std::memory_order_relaxed);
+  }
+  snapshot_.write(tick);
+  tick_count_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void EngineCore::restore_armed(const ControlCore::State& state, double now_s) {
+  if (ticks() != 0 || this->state() != EngineState::kSafe) {
+    throw std::logic_error("EngineCore::restore_armed: only before the first tick, in SAFE");
+  }
+  control_.set_state(state);
+  last_angle_rad_ = state.hold_rad;
+  change_state(EngineState::kArmed, now_s, CommandKind::kArm);
+}
+
+void EngineCore::vent_now() {
+  device_.vent();
+  if (state() != EngineState::kFault) enter_fault(FaultCode::kEmergencyStop, 0.0);
+}
+
+}  // namespace bellows

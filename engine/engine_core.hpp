@@ -1,0 +1,107 @@
+// The engine: one tick of everything the loop does, whatever clock drives it.
+//
+// Per tick (tick()): take operator commands from the command queue, read the sensors, run the
+// guards, run the control scheme when the valves are live (else vent), write the valves, record the
+// tick in the black box, the telemetry taps and the latest-value snapshot, and emit events.
+// A clock driver calls tick(): SimulatedClock (as fast as possible, same thread, deterministic) or
+// RealtimeLoop (its own thread on absolute deadlines). tick() allocates nothing, takes no lock and
+// does no I/O; the other threads talk to it only through the lock-free queues and buffers below.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <boost/lockfree/spsc_queue.hpp>
+
+#include "engine/black_box.hpp"
+#include "engine/control_core.hpp"
+#include "engine/device.hpp"
+#include "engine/engine_messages.hpp"
+#include "engine/latest_value.hpp"
+#include "engine/parameters.hpp"
+#include "engine/safety.hpp"
+
+namespace bellows {
+
+using TelemetryRing = boost::lockfree::spsc_queue<TickRecord>;
+
+class EngineCore {
+ public:
+  EngineCore(Device& device, const ControllerParameters& controller, const TimingParameters& timing,
+             const SafetyParameters& safety);
+
+  // ---- operator side (one producer thread for commands, one consumer thread for events) ----
+  /// Queue a command for the next tick. False when the queue is full (nothing is lost silently).
+  bool send(const EngineCommand& command) { return commands_.push(command); }
+  bool poll_event(EngineEvent& event) { return events_.pop(event); }
+  /// The latest tick (single reader).
+  bool read_snapshot(TickRecord& out) { return snapshot_.read(out); }
+  /// A telemetry ring fed every tick, for one consumer. Add all taps before the loop starts.
+  TelemetryRing& add_telemetry_tap(std::size_t capacity);
+  const BlackBox& black_box() const { return black_box_; }
+  /// Fault heartbeat monitoring on: the console must send kHeartbeat while the valves are live.
+  void monitor_heartbeat(bool on) { monitor_heartbeat_.store(on, std::memory_order_relaxed); }
+
+  EngineState state() const { return state_.load(std::memory_order_acquire); }
+  FaultCode fault() const { return fault_.load(std::memory_order_acquire); }
+  std::uint64_t ticks() const { return tick_count_.load(std::memory_order_relaxed); }
+  std::uint64_t dropped_telemetry() const { return dropped_telemetry_.load(std::memory_order_relaxed); }
+  std::uint64_t dropped_events() const { return dropped_events_.load(std::memory_order_relaxed); }
+
+  // ---- loop side ----
+  /// One tick. `now_s`: engine (device) time; `wall_s`: monotonic wall time, for the heartbeat;
+  /// `missed_deadlines`: periods missed since the previous tick (wall clock only).
+  void tick(double now_s, double wall_s, int missed_deadlines);
+  /// Vent and go to FAULT from outside the loop thread's tick (signal handling, shutdown): only
+  /// call when the loop is not running.
+  void vent_now();
+
+  /// The control scheme (for restoring a saved state before the loop starts).
+  ControlCore& control() { return control_; }
+  /// Before the first tick: ARMED, the control scheme in `state` (from a saved session), as if the
+  /// engine had been armed and had run until then; a resumed run so continues exactly. Throws
+  /// std::logic_error once the engine has ticked or left SAFE.
+  void restore_armed(const ControlCore::State& state, double now_s);
+  const TimingParameters& timing() const { return timing_; }
+
+ private:
+  void apply(const EngineCommand& command, double now_s, double wall_s);
+  void change_state(EngineState next, double now_s, CommandKind cause);
+  void enter_fault(FaultCode code, double now_s);
+  void hand_back_trial(EventKind kind, double now_s);
+  void emit(const EngineEvent& event);
+
+  Device& device_;
+  ControllerParameters controller_;
+  TimingParameters timing_;
+  SafetyParameters safety_;
+  ControlCore control_;
+  BlackBox black_box_;
+  boost::lockfree::spsc_queue<EngineCommand> commands_;
+  boost::lockfree::spsc_queue<EngineEvent> events_;
+  std::vector<std::unique_ptr<TelemetryRing>> taps_;
+  LatestValue<TickRecord> snapshot_;
+
+  std::atomic<EngineState> state_{EngineState::kSafe};
+  std::atomic<FaultCode> fault_{FaultCode::kNone};
+  std::atomic<bool> monitor_heartbeat_{false};
+  std::atomic<std::uint64_t> tick_count_{0};
+  std::atomic<std::uint64_t> dropped_telemetry_{0};
+  std::atomic<std::uint64_t> dropped_events_{0};
+
+  // Loop-thread state.
+  const Trajectory* trajectory_ = nullptr;
+  const Eigen::VectorXd* correction_ = nullptr;
+  TrialRecord* record_ = nullptr;
+  std::uint32_t trial_id_ = 0;
+  int settle_remaining_ = 0;
+  double last_reading_time_s_ = -1.0;
+  double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
+  int stale_count_ = 0;
+  int missed_streak_ = 0;
+  double last_heartbeat_s_ = 0.0;
+};
+
+}  // namespace bellows

@@ -1,0 +1,93 @@
+// What crosses thread boundaries around the engine: operator commands in, events and tick records
+// out. All plain values (pointers to buffers the sender owns), so queues can copy them without
+// allocating.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Dense>
+
+#include "engine/device.hpp"
+#include "engine/engine_state.hpp"
+#include "engine/safety.hpp"
+#include "engine/setpoints.hpp"
+#include "engine/trajectory.hpp"
+#include "engine/trial_record.hpp"
+
+namespace bellows {
+
+struct PidGains {
+  double k_ff = 0.0, k_p = 0.0, k_i_per_s = 0.0, k_d_s = 0.0;
+};
+
+/// An operator command. Buffers named by pointer stay owned by the sender, who must keep them
+/// alive and unchanged until the engine hands them back (TrialComplete / TrialAborted event).
+struct EngineCommand {
+  CommandKind kind = CommandKind::kHeartbeat;
+  const Trajectory* trajectory = nullptr;       // kSelectTrajectory, kStartTrial
+  const Eigen::VectorXd* correction = nullptr;  // kStartTrial: u_ilc(0..N-1), bar
+  TrialRecord* record = nullptr;                // kStartTrial: where the trial is written, prepared
+                                                // (TrialRecord::prepare) to the trajectory's length
+  int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
+  std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
+  PidGains gains{};                             // kSetGains
+
+  /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
+  static EngineCommand of(CommandKind kind) {
+    EngineCommand c;
+    c.kind = kind;
+    return c;
+  }
+  static EngineCommand start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction, TrialRecord& record,
+                                   int settle_ticks, std::uint32_t trial_id) {
+    EngineCommand c = of(CommandKind::kStartTrial);
+    c.trajectory = &trajectory;
+    c.correction = &correction;
+    c.record = &record;
+    c.settle_ticks = settle_ticks;
+    c.trial_id = trial_id;
+    return c;
+  }
+  static EngineCommand select_trajectory(const Trajectory& trajectory) {
+    EngineCommand c = of(CommandKind::kSelectTrajectory);
+    c.trajectory = &trajectory;
+    return c;
+  }
+};
+
+enum class EventKind : std::uint8_t {
+  kStateChanged,
+  kCommandRefused,
+  kFault,
+  kTrialComplete,
+  kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
+};
+
+struct EngineEvent {
+  EventKind kind = EventKind::kStateChanged;
+  double time_s = 0.0;
+  EngineState from = EngineState::kSafe;
+  EngineState to = EngineState::kSafe;
+  CommandKind command = CommandKind::kHeartbeat;  // the command concerned, if any
+  const char* refusal = "";                       // kCommandRefused: why (static text)
+  FaultCode fault = FaultCode::kNone;
+  TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
+  std::uint32_t trial_id = 0;
+};
+
+/// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.
+struct TickRecord {
+  std::uint64_t tick = 0;
+  double time_s = 0.0;
+  EngineState state = EngineState::kSafe;
+  FaultCode fault = FaultCode::kNone;
+  SensorReading reading{};
+  double desired_angle_rad = 0.0;
+  double u_total_bar = 0.0;
+  ChamberSetpoints setpoints{};
+  ValveCommand valves{};
+  int sample = -1;  // ILC sample of the running trial, -1 otherwise
+  std::uint32_t trial_id = 0;
+};
+
+}  // namespace bellows

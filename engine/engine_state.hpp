@@ -1,0 +1,43 @@
+// The engine's safety state machine. Pure: a table of which operator command is allowed in which
+// state and where it leads, so every transition can be tested without a loop or a device.
+//
+//   SAFE     disarmed: inlets closed, outlets open
+//   ARMED    valves live, holding the trajectory's start
+//   RUNNING  a trial in progress (settle at the start, then the trajectory)
+//   FAULT    latched and vented; only Reset leaves it, and it leads to SAFE (re-arm explicitly)
+#pragma once
+
+#include <cstdint>
+
+namespace bellows {
+
+enum class EngineState : std::uint8_t { kSafe, kArmed, kRunning, kFault };
+
+enum class CommandKind : std::uint8_t {
+  kArm,             // SAFE -> ARMED
+  kDisarm,          // ARMED/RUNNING -> SAFE (a running trial is abandoned)
+  kStartTrial,      // ARMED -> RUNNING
+  kAbortTrial,      // RUNNING -> ARMED
+  kEmergencyStop,   // any -> FAULT, vents at once
+  kReset,           // FAULT -> SAFE
+  kSelectTrajectory,// SAFE/ARMED: the trajectory to hold and run next
+  kHeartbeat,       // the console is alive; no transition
+  kSetGains,        // SAFE/ARMED: PID gains between trials
+};
+
+struct Transition {
+  bool allowed = false;
+  EngineState next = EngineState::kSafe;
+  const char* refusal = "";  // why, when not allowed: for the operator
+};
+
+/// What `command` does in `state`.
+Transition transition(EngineState state, CommandKind command);
+
+const char* to_string(EngineState state);
+const char* to_string(CommandKind command);
+
+/// Whether valves may open in this state (only ARMED and RUNNING).
+inline bool valves_live(EngineState state) { return state == EngineState::kArmed || state == EngineState::kRunning; }
+
+}  // namespace bellows

@@ -1,0 +1,54 @@
+// Runs a shell command for end-to-end tests and captures its exit status, stdout and stderr.
+// XDG_DATA_HOME points into a fresh temporary directory so no test writes into a real home.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace bellows::testing {
+
+struct ProcessResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+inline std::filesystem::path make_temp_dir(const std::string& prefix) {
+  std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "-XXXXXX")).string();
+  if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+  return pattern;
+}
+
+inline ProcessResult run_process(const std::string& command) {
+  static const std::filesystem::path scratch = make_temp_dir("bellows-test");
+  const std::filesystem::path err_path = scratch / "stderr.txt";
+  const std::string full = "XDG_DATA_HOME='" + (scratch / "xdg").string() + "' " + command + " 2>'" + err_path.string() + "'";
+  ProcessResult result;
+  FILE* pipe = popen(full.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer{};
+  std::size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::ifstream err(err_path);
+  std::stringstream text;
+  text << err.rdbuf();
+  result.err = text.str();
+  return result;
+}
+
+inline std::filesystem::path write_file(const std::filesystem::path& dir, const std::string& name, const std::string& text) {
+  const std::filesystem::path path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace bellows::testing

@@ -1,0 +1,170 @@
+// End-to-end tests of `bellows run`: the paper's learning curve, model mismatch, bad input.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::run_process;
+using testing::write_file;
+
+nlohmann::json run_json(const std::string& args) {
+  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json --no-save " + args);
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  return nlohmann::json::parse(result.out);
+}
+
+std::vector<double> rms_sequence(const nlohmann::json& report) {
+  std::vector<double> rms;
+  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
+  return rms;
+}
+
+TEST(CliRun, ReproducesThePapersLearningCurve) {
+  const nlohmann::json report = run_json("--trajectory paper --iterations 60");
+  const std::vector<double> rms = rms_sequence(report);
+  ASSERT_EQ(rms.size(), 61u);
+  for (int i = 0; i <= 60; ++i) EXPECT_EQ(report["iterations"][i]["iteration"].get<int>(), i);
+  EXPECT_GE(rms[0], 10.0);
+  EXPECT_LE(rms[0], 16.0);
+  EXPECT_LT(rms[30], 2.0);
+  EXPECT_GE((rms[0] - rms[10]) / (rms[0] - rms[30]), 0.85);
+  for (int i = 30; i <= 60; ++i) EXPECT_LE(rms[i], 2.5) << "iteration " << i;
+  for (const auto& it : report["iterations"]) {
+    EXPECT_GE(it.at("max_abs_error_deg").get<double>(), it.at("rms_deg").get<double>());
+    EXPECT_GE(it.at("max_abs_correction_bar").get<double>(), 0.0);
+  }
+  EXPECT_EQ(report["iterations"][0]["max_abs_correction_bar"].get<double>(), 0.0);  // feedback only
+  EXPECT_GT(report["iterations"][30]["max_abs_correction_bar"].get<double>(), 0.1);
+}
+
+TEST(CliRun, ConvergesWithAModelTwentyPercentOff) {
+  const auto dir = testing::make_temp_dir("bellows-mismatch");
+  for (double factor : {1.2, 0.8}) {
+    const auto config = write_file(dir, "mismatch.toml",
+                                   "[plant]\nkappa = " + std::to_string(7.91 * factor) +
+                                       "\nomega0 = " + std::to_string(14.14 * factor) + "\n");
+    const std::vector<double> rms = rms_sequence(run_json("--iterations 30 --config " + config.string()));
+    ASSERT_EQ(rms.size(), 31u);
+    EXPECT_LE(rms[30], rms[0] / 3.0) << "plant factor " << factor;
+  }
+}
+
+TEST(CliRun, SameSeedSameRunOtherSeedOtherNoise) {
+  const auto a = rms_sequence(run_json("--iterations 2 --seed 11"));
+  const auto b = rms_sequence(run_json("--iterations 2 --seed 11"));
+  const auto c = rms_sequence(run_json("--iterations 2 --seed 12"));
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
+
+TEST(CliRun, RunsACsvTrajectory) {
+  const auto dir = testing::make_temp_dir("bellows-csv");
+  std::string text = "time_s,angle_deg\n";
+  for (int k = 0; k <= 150; ++k) text += std::to_string(k * 0.02) + "," + std::to_string(k < 50 ? 0.0 : 20.0) + "\n";
+  const auto path = write_file(dir, "step.csv", text);
+  const nlohmann::json report = run_json("--iterations 3 --trajectory " + path.string());
+  EXPECT_EQ(report["trajectory"], "step");
+  EXPECT_EQ(report["samples"], 150);
+  EXPECT_LT(report["iterations"][3]["rms_deg"].get<double>(), report["iterations"][0]["rms_deg"].get<double>());
+}
+
+void expect_bad_input(const std::string& args, const std::string& fragment) {
+  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json --no-save " + args);
+  EXPECT_EQ(result.exit_code, 2) << args;
+  EXPECT_TRUE(result.out.empty()) << "partial result printed for " << args << ": " << result.out;
+  EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
+  // One clear line: a single newline at the end.
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+TEST(CliRun, BadInputGetsOneLineAndExitStatusTwo) {
+  const auto dir = testing::make_temp_dir("bellows-bad");
+  const std::string good_rows = "0,0\n0.02,1\n0.04,2\n";
+  expect_bad_input("--trajectory " + write_file(dir, "header.csv", "t,deg\n" + good_rows).string(), "header");
+  expect_bad_input("--trajectory " + write_file(dir, "gap.csv", "time_s,angle_deg\n0,0\n0.02,1\n0.05,2\n").string(),
+                   "not uniform");
+  expect_bad_input("--trajectory " + write_file(dir, "nan.csv", "time_s,angle_deg\n0,0\n0.02,nan\n0.04,2\n").string(),
+                   "not a number");
+  expect_bad_input("--trajectory " + write_file(dir, "far.csv", "time_s,angle_deg\n0,0\n0.02,100\n0.04,2\n").string(),
+                   "joint range");
+  expect_bad_input("--trajectory " + (dir / "missing.csv").string(), "cannot be read");
+  expect_bad_input("--trajectory loops", "unknown trajectory");
+  expect_bad_input("--config " + write_file(dir, "key.toml", "[plant]\nkapa = 1.0\n").string(), "unknown key");
+  expect_bad_input("--config " + write_file(dir, "type.toml", "[ilc]\ns = \"big\"\n").string(), "expected a number");
+  expect_bad_input("--config " + write_file(dir, "tau.toml", "[plant]\ncreep_tau_s = 0\n").string(), "must be positive");
+  expect_bad_input("--config " + write_file(dir, "taup.toml", "[controller]\ntau_p_s = -1\n").string(), "must be positive");
+  expect_bad_input("--config " + (dir / "none.toml").string(), "cannot be read");
+  expect_bad_input("--iterations -3", "iterations");
+  expect_bad_input("--iterations many", "iterations");
+}
+
+}  // namespace
+}  // namespace bellows
+
+#include <signal.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+extern char** environ;
+
+namespace bellows {
+namespace {
+
+// Starts `bellows args...` with stdout into a pipe; returns pid and the pipe's read end.
+std::pair<pid_t, int> spawn_bellows(std::vector<std::string> args) {
+  int pipe_fds[2];
+  EXPECT_EQ(pipe(pipe_fds), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  args.insert(args.begin(), BELLOWS_BINARY);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  EXPECT_EQ(posix_spawn(&pid, BELLOWS_BINARY, &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  return {pid, pipe_fds[0]};
+}
+
+std::string read_all(int fd) {
+  std::string text;
+  char buffer[4096];
+  ssize_t n;
+  while ((n = read(fd, buffer, sizeof buffer)) > 0) text.append(buffer, static_cast<std::size_t>(n));
+  close(fd);
+  return text;
+}
+
+TEST(CliRun, SigintVentsAndExitsCleanlyWithWhatFinished) {
+  for (int signal_number : {SIGINT, SIGTERM}) {
+    setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-xdg").c_str(), 1);  // never the real home
+    auto [pid, out] = spawn_bellows({"run", "--clock", "wall", "--speed", "5", "--iterations", "50", "--json"});
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // past the first trial (~1.8 s)
+    kill(pid, signal_number);
+    const std::string text = read_all(out);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal instead of exiting cleanly";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal_number);
+    const nlohmann::json report = nlohmann::json::parse(text);
+    EXPECT_EQ(report["fault"]["name"], "emergency-stop");
+    EXPECT_GE(report["iterations"].size(), 1u);
+    EXPECT_LT(report["iterations"].size(), 51u);
+  }
+}
+
+}  // namespace
+}  // namespace bellows

@@ -1,0 +1,127 @@
+#include <gtest/gtest.h>
+
+#include "app/config_file.hpp"
+
+#include <fstream>
+#include <sstream>
+#include "engine/errors.hpp"
+
+namespace bellows {
+namespace {
+
+TEST(ConfigFile, DefaultsAreTheSpecsValues) {
+  const Configuration c;
+  EXPECT_DOUBLE_EQ(c.plant.kappa_rad_per_bar, 7.91);
+  EXPECT_DOUBLE_EQ(c.plant.omega0_rad_per_s, 14.14);
+  EXPECT_DOUBLE_EQ(c.plant.damping, 0.31);
+  EXPECT_DOUBLE_EQ(c.plant.volume_l, 0.45);
+  EXPECT_DOUBLE_EQ(c.plant.valve_conductance_m3_per_sPa, 3.0e-9);
+  EXPECT_DOUBLE_EQ(c.plant.creep_tau_s, 0.8);
+  EXPECT_DOUBLE_EQ(c.controller.k_ff, 0.4);
+  EXPECT_DOUBLE_EQ(c.controller.tau_p_s, 0.02);
+  EXPECT_DOUBLE_EQ(c.controller.p_max_bar, 1.4);
+  EXPECT_DOUBLE_EQ(c.ilc.s, 0.1);
+  EXPECT_DOUBLE_EQ(c.ilc.w, 2e-5);
+  EXPECT_NO_THROW(validate_configuration(c));
+}
+
+TEST(ConfigFile, InterfaceKeysAreAllKnown) {
+  Configuration c;
+  apply_config_toml(R"(
+[plant]
+kappa = 7.0
+omega0 = 12.0
+damping = 0.3
+volume_l = 0.5
+volume_gain = 0.3
+valve_conductance = 4e-9
+valve_critical_ratio = 0.38
+creep_gain = 0.2
+creep_tau_s = 1.0
+supply_bar = 3.5
+encoder_resolution_deg = 0.05
+pressure_noise_bar = 0.001
+[model]
+kappa = 7.5
+omega0 = 13.0
+damping = 0.32
+[controller]
+k_ff = 0.35
+k_p = 0.25
+k_i = 0.2
+k_d = 0.02
+tau_p_s = 0.03
+p_max_bar = 1.5
+[ilc]
+m = 2.0
+s = 0.2
+w = 1e-5
+)", "test.toml", c);
+  EXPECT_DOUBLE_EQ(c.plant.kappa_rad_per_bar, 7.0);
+  EXPECT_DOUBLE_EQ(c.plant.valve_critical_ratio, 0.38);
+  EXPECT_DOUBLE_EQ(c.model.kappa_rad_per_bar, 7.5);
+  EXPECT_DOUBLE_EQ(c.controller.k_i_per_s, 0.2);
+  EXPECT_DOUBLE_EQ(c.controller.p_max_bar, 1.5);
+  EXPECT_DOUBLE_EQ(c.ilc.w, 1e-5);
+  EXPECT_DOUBLE_EQ(c.plant.pressure_noise_bar, 0.001);
+}
+
+void expect_rejected(const std::string& toml, const std::string& fragment) {
+  Configuration c;
+  try {
+    apply_config_toml(toml, "lab.toml", c);
+    FAIL() << "accepted: " << toml;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lab.toml"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConfigFile, RejectsBadConfigurations) {
+  expect_rejected("[plant]\nkapa = 7.0\n", "unknown key");
+  expect_rejected("[plants]\nkappa = 7.0\n", "unknown section");
+  expect_rejected("[plant]\nkappa = \"seven\"\n", "expected a number");
+  expect_rejected("[controller]\nfilter_samples = 2.5\n", "expected a whole number");
+  expect_rejected("[controller]\ntau_p_s = 0.0\n", "must be positive");
+  expect_rejected("[plant]\ncreep_tau_s = -0.8\n", "must be positive");
+  expect_rejected("[controller]\np_max_bar = 1.0\n", "above ambient");
+  expect_rejected("[plant]\nkappa = nan\n", "finite");
+  expect_rejected("[plant\nkappa = 7\n", "lab.toml:");
+  expect_rejected("plant = 3\n", "must be a table");
+}
+
+TEST(ConfigFile, RoundTripsThroughToml) {
+  Configuration c;
+  c.plant.kappa_rad_per_bar = 6.5;
+  c.controller.filter_samples = 6;
+  c.ilc.law = "noilc-dense";
+  Configuration back;
+  apply_config_toml(config_to_toml(c), "roundtrip", back);
+  EXPECT_DOUBLE_EQ(back.plant.kappa_rad_per_bar, 6.5);
+  EXPECT_EQ(back.controller.filter_samples, 6);
+  EXPECT_EQ(back.ilc.law, "noilc-dense");
+}
+
+}  // namespace
+}  // namespace bellows
+
+namespace bellows {
+namespace {
+
+TEST(ConfigFile, EveryKeyIsDocumented) {
+  std::ifstream in(std::string(BELLOWS_SOURCE_DIR) + "/docs/configuration.md");
+  ASSERT_TRUE(in) << "docs/configuration.md missing";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  for (const ParameterBinding& b : parameter_bindings()) {
+    const auto section = doc.find("## [" + b.section + "]");
+    ASSERT_NE(section, std::string::npos) << "section [" << b.section << "] is not documented";
+    const auto next_section = doc.find("\n## ", section + 1);
+    const auto key = doc.find("| `" + b.key + "` |", section);
+    EXPECT_TRUE(key != std::string::npos && key < next_section) << "[" << b.section << "] " << b.key << " is not documented";
+  }
+}
+
+}  // namespace
+}  // namespace bellows

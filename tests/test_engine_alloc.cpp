@@ -1,0 +1,77 @@
+// Proves the loop allocates nothing once running: global operator new is counted while ticks run
+// (holding, a whole trial with telemetry taps, a fault and its black box, a reset).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "tests/engine_fixture.hpp"
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace bellows {
+namespace {
+
+class CountAllocations {
+ public:
+  CountAllocations() {
+    g_allocations.store(0);
+    g_counting.store(true);
+  }
+  ~CountAllocations() { g_counting.store(false); }
+  long count() const { return g_allocations.load(); }
+};
+
+TEST(EngineAllocations, CounterSeesAnAllocation) {  // the instrument works
+  CountAllocations counter;
+  auto* p = new int(3);
+  EXPECT_EQ(counter.count(), 1);
+  delete p;
+}
+
+TEST(EngineAllocations, TicksAllocateNothing) {
+  testing::EngineFixture f;
+  TelemetryRing& tap = f.core.add_telemetry_tap(8192);
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  Eigen::VectorXd correction = Eigen::VectorXd::Constant(paper.learning_samples(), 0.01);
+  TrialRecord record;
+  record.prepare(paper.learning_samples(), f.config.timing.ticks_per_sample);  // sized outside the loop
+  f.core.send(EngineCommand::select_trajectory(paper));
+  f.send(CommandKind::kArm);
+  f.clock.step(10);  // warm up outside the count
+
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 100, 1);
+  long allocations = 0;
+  {
+    CountAllocations counter;
+    f.core.send(start);
+    f.clock.step(100 + 4 * 400 + 10);  // settle, the whole trial, back to holding
+    f.send(CommandKind::kEmergencyStop);
+    f.clock.step(10);
+    f.send(CommandKind::kReset);
+    f.send(CommandKind::kArm);
+    f.clock.step(10);
+    allocations = counter.count();
+  }
+  EXPECT_TRUE(record.complete);
+  EXPECT_GT(tap.read_available(), 1000u);
+  EXPECT_EQ(allocations, 0);
+}
+
+}  // namespace
+}  // namespace bellows
