@@ -9,7 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <random>
-#include <regex>
+#include <cstdio>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -66,9 +67,15 @@ struct Printed {
 
 Printed parse_output(const std::string& out) {
   Printed printed;
-  static const std::regex line(R"(iteration +(\d+) +rms +([0-9.]+) deg)");
-  for (auto it = std::sregex_iterator(out.begin(), out.end(), line); it != std::sregex_iterator(); ++it) {
-    printed.iterations.emplace_back(std::stoi((*it)[1]), std::stod((*it)[2]));
+  std::istringstream lines(out);
+  std::string line;
+  while (std::getline(lines, line)) {
+    int iteration = 0;
+    double rms = 0.0;
+    // Only complete lines count: the last one may have been cut by the kill.
+    if (std::sscanf(line.c_str(), "iteration %d rms %lf deg", &iteration, &rms) == 2 && !lines.eof()) {
+      printed.iterations.emplace_back(iteration, rms);
+    }
   }
   printed.session_line = out.rfind("session ", 0) == 0;
   return printed;
