@@ -68,6 +68,16 @@ std::vector<ParameterBinding> make_bindings() {
       number("ilc", "m", "", "weight M = m I on the predicted error", kNonNeg, [](C& c) { return &c.ilc.m; }),
       number("ilc", "s", "", "weight S = s I on the change of correction", kNonNeg, [](C& c) { return &c.ilc.s; }),
       number("ilc", "w", "", "weight W = w I on the correction's rate", kNonNeg, [](C& c) { return &c.ilc.w; }),
+      number("ilc", "admm_rho", "", "noilc-constrained: ADMM penalty", kPos, [](C& c) { return &c.ilc.admm_rho; }),
+      whole("ilc", "admm_max_iterations", "noilc-constrained: ADMM iteration limit per update", [](C& c) { return &c.ilc.admm_max_iterations; }),
+      number("ilc", "admm_tolerance", "bar", "noilc-constrained: ADMM residual tolerance", kPos, [](C& c) { return &c.ilc.admm_tolerance; }),
+      number("ilc", "limit_margin_bar", "bar", "noilc-constrained: keep u_pid + u_ilc this far inside the pressure limits", kNonNeg, [](C& c) { return &c.ilc.limit_margin_bar; }),
+      number("ilc", "pd_kp", "", "pd: proportional learning gain", kAny, [](C& c) { return &c.ilc.pd_kp; }),
+      number("ilc", "pd_kd_s", "s", "pd: derivative learning gain", kAny, [](C& c) { return &c.ilc.pd_kd_s; }),
+      number("ilc", "pd_q_cutoff_hz", "Hz", "pd: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.pd_q_cutoff_hz; }),
+      number("ilc", "gradient_step", "", "gradient: step as a fraction of 1/||P||^2, in (0, 2)", kPos, [](C& c) { return &c.ilc.gradient_step; }),
+      number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", kPos, [](C& c) { return &c.ilc.inverse_gain; }),
+      number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
       // [timing]
       number("timing", "tick_s", "s", "loop period (pressure controllers, PWM)", kPos, [](C& c) { return &c.timing.tick_s; }),
       whole("timing", "ticks_per_sample", "loop ticks per ILC sample", [](C& c) { return &c.timing.ticks_per_sample; }),
@@ -75,7 +85,8 @@ std::vector<ParameterBinding> make_bindings() {
       // [trajectory]
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
   };
-  ParameterBinding law{"ilc", "law", "", "learning law", Constraint::kAny, {}, {}, {}};
+  ParameterBinding law{"ilc", "law", "", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
+                       Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
   b.push_back(law);
   return b;

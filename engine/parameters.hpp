@@ -65,12 +65,26 @@ struct ControllerParameters {
   GasParameters gas{};
 };
 
-/// Norm-optimal ILC weights (spec section 5): M = m I, S = s I, W = w I.
+/// The learning law and its parameters. Norm-optimal weights (spec section 5): M = m I, S = s I, W = w I.
 struct IlcParameters {
-  std::string law = "noilc-dense";  // which learning law runs between trials
+  std::string law = "noilc";  // which learning law runs between trials (engine/learning_law_factory)
   double m = 1.0;
   double s = 0.1;
   double w = 2.0e-5;
+  // noilc-constrained: ADMM on the pressure-limit bounds
+  double admm_rho = 1.0;            // penalty of the ADMM splitting (same units as s)
+  int admm_max_iterations = 2000;
+  double admm_tolerance = 1.0e-7;   // bar, on the primal and dual residuals
+  double limit_margin_bar = 0.0;    // keep u_pid + u_ilc this far inside the pressure limits
+  // pd: u_{j+1} = Q[u_j + k_p e + k_d de/dt]
+  double pd_kp = 0.5;
+  double pd_kd_s = 0.01;
+  double pd_q_cutoff_hz = 3.0;
+  // gradient: u_{j+1} = u_j + (step / ||P||^2) P' e
+  double gradient_step = 1.0;
+  // inverse: u_{j+1} = Q[u_j + gain P^-1 e]
+  double inverse_gain = 0.5;
+  double inverse_q_cutoff_hz = 5.0;
 };
 
 /// Timing of the loop: the tick (pressure controllers, PWM) and the ILC sample (PID, ILC).
