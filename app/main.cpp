@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/identify_command.hpp"
 #include "app/run_command.hpp"
 #include "engine/errors.hpp"
 
@@ -25,6 +26,15 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
 
+  bellows::IdentifyOptions identify;
+  CLI::App* identify_cmd =
+      app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
+  identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
+  identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
+  identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
+  identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -34,6 +44,9 @@ int main(int argc, char** argv) {
 
   try {
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
+    if (identify_cmd->parsed()) {
+      return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
+    }
     std::cout << app.help();
     return 0;
   } catch (const bellows::InputError& error) {

@@ -78,6 +78,15 @@ std::vector<ParameterBinding> make_bindings() {
       number("ilc", "gradient_step", "", "gradient: step as a fraction of 1/||P||^2, in (0, 2)", kPos, [](C& c) { return &c.ilc.gradient_step; }),
       number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", kPos, [](C& c) { return &c.ilc.inverse_gain; }),
       number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
+      number("ilc", "prediction_model_error", "", "convergence prediction: relative error of kappa and omega0 on the grid", Constraint::kFraction, [](C& c) { return &c.ilc.prediction_model_error; }),
+      whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", [](C& c) { return &c.ilc.prediction_grid_points; }),
+      // [identify]
+      number("identify", "amplitude_deg", "deg", "excitation amplitude of the reference angle", kPos, [](C& c) { return &c.identify.amplitude_deg; }),
+      number("identify", "max_abs_angle_deg", "deg", "abort the identification trial beyond this angle", kPos, [](C& c) { return &c.identify.max_abs_angle_deg; }),
+      number("identify", "duration_s", "s", "length of each identification trial", kPos, [](C& c) { return &c.identify.duration_s; }),
+      number("identify", "chirp_start_hz", "Hz", "chirp: start frequency", kPos, [](C& c) { return &c.identify.chirp_start_hz; }),
+      number("identify", "chirp_end_hz", "Hz", "chirp: end frequency", kPos, [](C& c) { return &c.identify.chirp_end_hz; }),
+      number("identify", "step_hold_s", "s", "steps: time between steps", kPos, [](C& c) { return &c.identify.step_hold_s; }),
       // [timing]
       number("timing", "tick_s", "s", "loop period (pressure controllers, PWM)", kPos, [](C& c) { return &c.timing.tick_s; }),
       whole("timing", "ticks_per_sample", "loop ticks per ILC sample", [](C& c) { return &c.timing.ticks_per_sample; }),
@@ -89,6 +98,10 @@ std::vector<ParameterBinding> make_bindings() {
                        Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
   b.push_back(law);
+  ParameterBinding signal{"identify", "signal", "", "excitation of the identification trial: chirp or steps",
+                          Constraint::kAny, {}, {}, {}};
+  signal.text = [](C& c) { return &c.identify.signal; };
+  b.push_back(signal);
   return b;
 }
 

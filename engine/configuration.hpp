@@ -17,6 +17,7 @@ struct Configuration {
   ModelParameters model;
   ControllerParameters controller;
   IlcParameters ilc;
+  IdentificationParameters identify;
   TimingParameters timing;
   TrajectoryLimits trajectory;
 };

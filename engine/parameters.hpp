@@ -85,6 +85,21 @@ struct IlcParameters {
   // inverse: u_{j+1} = Q[u_j + gain P^-1 e]
   double inverse_gain = 0.5;
   double inverse_q_cutoff_hz = 5.0;
+  // convergence prediction before a run: grid of kappa and omega0 errors
+  double prediction_model_error = 0.3;  // +-30 %
+  int prediction_grid_points = 5;       // per parameter
+};
+
+/// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's
+/// angle and chamber pressures are recorded; kappa, omega0 and delta are fitted to them.
+struct IdentificationParameters {
+  std::string signal = "chirp";   // "chirp" or "steps"; the other one is the held-out validation trial
+  double amplitude_deg = 20.0;    // excitation amplitude of the reference angle
+  double max_abs_angle_deg = 60.0;  // the trial is aborted (valves vented) beyond this angle
+  double duration_s = 20.0;
+  double chirp_start_hz = 0.1;
+  double chirp_end_hz = 3.0;
+  double step_hold_s = 1.0;       // time between steps of the step sequence
 };
 
 /// Timing of the loop: the tick (pressure controllers, PWM) and the ILC sample (PID, ILC).
