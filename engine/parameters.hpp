@@ -77,14 +77,16 @@ struct IlcParameters {
   double admm_tolerance = 1.0e-7;   // bar, on the primal and dual residuals
   double limit_margin_bar = 0.0;    // keep u_pid + u_ilc this far inside the pressure limits
   // pd: u_{j+1} = Q[u_j + k_p e + k_d de/dt]
-  double pd_kp = 0.5;
+  // (defaults: the best tuning on the paper scenario among those predicted to converge on the
+  // nominal model, see docs/learning-laws.md)
+  double pd_kp = 0.3;
   double pd_kd_s = 0.01;
-  double pd_q_cutoff_hz = 3.0;
+  double pd_q_cutoff_hz = 3.5;
   // gradient: u_{j+1} = u_j + (step / ||P||^2) P' e
   double gradient_step = 1.0;
   // inverse: u_{j+1} = Q[u_j + gain P^-1 e]
-  double inverse_gain = 0.5;
-  double inverse_q_cutoff_hz = 5.0;
+  double inverse_gain = 0.3;
+  double inverse_q_cutoff_hz = 8.0;
   // convergence prediction before a run: grid of kappa and omega0 errors
   double prediction_model_error = 0.3;  // +-30 %
   int prediction_grid_points = 5;       // per parameter
