@@ -59,10 +59,10 @@ void NormOptimalConstrained::update(const Eigen::Ref<const Eigen::VectorXd>& u_j
     u_next = x_;
     return;
   }
-  // ADMM on  min J(x) + I_box(z)  s.t.  x = z, warm-started at the projected free optimum and the
+  // ADMM on  min J(x) + I_box(z)  s.t.  x = z, warm-started at the last correction (projected) and the
   // last update's scaled dual (consecutive trials ask nearly the same question).
   const double rho = parameters_.admm_rho;
-  z_ = x_.cwiseMax(lower_).cwiseMin(upper_);
+  z_ = u_j.cwiseMax(lower_).cwiseMin(upper_);
   if (!dual_.allFinite()) dual_.setZero();
   for (int k = 1; k <= parameters_.admm_max_iterations; ++k) {
     target_ = z_ - dual_;
