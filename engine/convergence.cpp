@@ -80,11 +80,6 @@ constexpr double kDivergenceTolerance = 1e-3;
 
 }  // namespace
 
-double contraction_at(const LearningLaw& law, const Configuration& config, double kappa_scale, double omega0_scale,
-                      double theta_rad_per_sample) {
-  return estimate(law, config, kappa_scale, omega0_scale, theta_rad_per_sample, 1).contraction;
-}
-
 ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples) {
   ConvergencePrediction p;
   if (samples < 2 || !law.frequency_response(std::numbers::pi / 2.0)) return p;

@@ -37,11 +37,6 @@ struct ConvergencePrediction {
   std::string warning;        // empty when every grid point contracts
 };
 
-/// |lambda(theta)| for `law` against the closed loop of the configured PID and an arm with the given
-/// kappa and omega0 scales (damping nominal), at `theta_rad_per_sample` in (0, pi].
-double contraction_at(const LearningLaw& law, const Configuration& config, double kappa_scale, double omega0_scale,
-                      double theta_rad_per_sample);
-
 /// The prediction for `law` on trials of `samples` samples, with the grid of [ilc] prediction_*.
 ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples);
 

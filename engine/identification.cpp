@@ -21,9 +21,6 @@ constexpr double kPaPerBar = 1e5;
 constexpr double kRelativeCostTolerance = 1e-12;
 constexpr double kArxMinimumStep_s = 0.02;  // equation error is fitted no faster than this: less noise bias
 
-// Exact zero-order-hold discretization at step h: the input is the tick's mean pressure difference.
-DiscreteArmModel discretize(const ModelParameters& model, double h) { return discretize_arm_model(model, h); }
-
 Eigen::Vector3d to_log_parameters(const ModelParameters& m) {
   return {std::log(m.kappa_rad_per_bar), std::log(m.omega0_rad_per_s), std::log(m.damping)};
 }
@@ -119,7 +116,8 @@ Eigen::VectorXd simulate_arm_angle(const ModelParameters& model, const Identific
   const Eigen::Index n = data.angle_rad.size();
   Eigen::VectorXd angle(n);
   if (n == 0) return angle;
-  const DiscreteArmModel d = discretize(model, data.sample_time_s);
+  // Zero-order hold: the input of each step is the tick's mean pressure difference.
+  const DiscreteArmModel d = discretize_arm_model(model, data.sample_time_s);
   Eigen::Vector2d x(data.angle_rad(0) / std::numbers::pi, 0.0);
   angle(0) = data.angle_rad(0);
   for (Eigen::Index k = 0; k + 1 < n; ++k) {
