@@ -7,14 +7,17 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/learning_report.hpp"
 #include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
+#include "engine/convergence.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
+#include "engine/learning_monitor.hpp"
 #include "engine/learning_session.hpp"
 
 namespace bellows {
@@ -80,6 +83,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   recording.restore(arm, core, clock, session);  // before the first tick
   recording.start(config, trajectory, arm.name(), seed, options.iterations);
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
+  if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
+  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
+  if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
+    for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
+      monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
+    }
+  }
   if (loop != nullptr) loop->start(options.rt);
 
   nlohmann::json iterations = nlohmann::json::array();
@@ -92,7 +103,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
       session.learn();  // also after the last trial: the saved session resumes with this correction
       recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
-      iterations.push_back(to_json(s));
+      nlohmann::json iteration = to_json(s);
+      iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
+      iterations.push_back(iteration);
     }
   } catch (const EngineFault& fault) {
     failure = fault.what();
@@ -107,6 +120,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   }
   if (loop != nullptr) loop->stop();  // vents
   else arm.vent();
+  if (monitor.windup().detected) {
+    progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
+             << ": the correction keeps growing where the set points saturate (largest clamped excess "
+             << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
+  }
   if (status == 0) recording.finish(trials);
 
   if (options.json) {
@@ -116,6 +134,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"seed", seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
+                             {"prediction", prediction_json(prediction)},
+                             {"windup", windup_json(monitor.windup())},
                              {"session", recording.directory().empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};

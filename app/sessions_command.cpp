@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/errors.hpp"
+#include "sessions/manifest_json.hpp"
 #include "sessions/session_export.hpp"
 #include "sessions/session_store.hpp"
 
@@ -132,7 +133,7 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                           {{"name", m.trajectory_name},
                            {"learning_samples", m.trajectory_samples},
                            {"sample_time_s", c.timing.sample_s()}}},
-                         {"learning", {{"law", c.ilc.law}, {"m", c.ilc.m}, {"s", c.ilc.s}, {"w", c.ilc.w}}},
+                         {"learning", configuration_to_json(c).at("ilc")},
                          {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)},
                          {"iterations", iterations},
                          {"events", events}};

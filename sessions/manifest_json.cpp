@@ -169,6 +169,7 @@ Json manifest_to_json(const SessionManifest& m) {
   const Configuration& c = m.configuration;
   const double sample_s = c.timing.sample_s();
   const DiscreteArmModel model = discretize_arm_model(c.model, sample_s);
+  const Json configuration = configuration_to_json(c);
   Json iterations = Json::array();
   for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_to_json(entry));
   Json events = Json::array();
@@ -197,8 +198,8 @@ Json manifest_to_json(const SessionManifest& m) {
         {"A", {vector_to_json(model.A.row(0)), vector_to_json(model.A.row(1))}},
         {"B", vector_to_json(model.B)},
         {"C", vector_to_json(model.C)}}},
-      {"learning", {{"law", c.ilc.law}, {"m", c.ilc.m}, {"s", c.ilc.s}, {"w", c.ilc.w}}},
-      {"configuration", configuration_to_json(c)},
+      {"learning", configuration.at("ilc")},  // the law and its weights, as [ilc] has them
+      {"configuration", configuration},
       {"iterations", iterations},
       {"events", events},
   };

@@ -293,7 +293,7 @@ TEST_F(SessionsCommand, ShowGivesTheSummaryAndRmsPerIteration) {
   const ProcessResult shown = run_bellows({"sessions", "show", data_ + "/first"});
   ASSERT_EQ(shown.exit_code, 0) << shown.err;
   EXPECT_NE(shown.out.find("trajectory   short: 25 samples"), std::string::npos) << shown.out;
-  EXPECT_NE(shown.out.find("learning     noilc-dense"), std::string::npos);
+  EXPECT_NE(shown.out.find("learning     " + Configuration{}.ilc.law + ", m = 1, s = 0.1"), std::string::npos) << shown.out;
   for (const auto& iteration : first_["iterations"]) {
     char row[64];
     std::snprintf(row, sizeof row, "%9d  %9.3f", iteration["iteration"].get<int>(), iteration["rms_deg"].get<double>());
@@ -305,6 +305,8 @@ TEST_F(SessionsCommand, ShowGivesTheSummaryAndRmsPerIteration) {
   ASSERT_EQ(json["iterations"].size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(json["iterations"][i]["rms_deg"], first_["iterations"][i]["rms_deg"]);
   EXPECT_EQ(json["events"][0]["kind"], "start");
+  EXPECT_EQ(json["learning"]["law"], Configuration{}.ilc.law);
+  EXPECT_EQ(json["learning"]["w"], 2e-5);
 }
 
 TEST_F(SessionsCommand, ExportsCsvThatReadsBack) {
