@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/run_io.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
-#include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
@@ -54,14 +54,17 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  SimulatedArm arm(config.plant, options.seed);
-  EngineCore core(arm, config.controller, config.timing, config.safety);
+  RunIo io({options.device, options.lcm_url, options.lcm_log, options.clock, speed, options.seed, options.rt}, config);
+  Device& device = io.device();
+  EngineCore core(device, config.controller, config.timing, config.safety);
+  io.start_telemetry(core);
+  const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    driver = std::make_unique<SimulatedClock>(core, arm);
+    driver = io.simulated_clock(core);
   } else {
-    auto realtime = std::make_unique<RealtimeLoop>(core, arm, speed);
+    auto realtime = std::make_unique<RealtimeLoop>(core, device, speed);
     loop = realtime.get();
     driver = std::move(realtime);
     loop->start(options.rt);
@@ -72,30 +75,42 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   nlohmann::json iterations = nlohmann::json::array();
   int status = 0;
   std::string failure;
+  std::string failure_name;
   try {
-    for (int i = 0; i <= options.iterations; ++i) {
+    if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
+      failure = std::move(why);
+      failure_name = "rig-unavailable";
+      status = stop_signal() != 0 ? 128 + stop_signal() : 3;
+      progress << "bellows: " << failure << std::endl;
+    }
+    for (int i = 0; failure.empty() && i <= options.iterations; ++i) {
       const IterationSummary s = session.run_trial();
+      io.post_trial(s, session.correction_bar());
       progress << progress_line(s) << std::endl;
       iterations.push_back(to_json(s));
       if (i < options.iterations) session.learn();
     }
   } catch (const EngineFault& fault) {
     failure = fault.what();
+    failure_name = fault_name(core.fault());
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
   }
   if (loop != nullptr) loop->stop();  // vents
-  else arm.vent();
+  else device.vent();
+  io.stop();  // the rig's last vent command, the rest of the telemetry
+  if (const std::string warning = io.warning(); !warning.empty()) progress << "bellows: " << warning << std::endl;
 
   if (options.json) {
-    nlohmann::json report = {{"device", arm.name()},
+    nlohmann::json report = {{"device", device.name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
                              {"seed", options.seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
                              {"iterations", iterations}};
-    if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
+    if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
+    if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
       report["loop"] = {{"ticks", core.ticks()},

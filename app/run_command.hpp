@@ -19,6 +19,9 @@ struct RunOptions {
   std::string clock = "sim";   // sim: as fast as possible, deterministic; wall: the real-time loop
   std::string speed = "1";     // wall clock with the simulated arm: 1, 2, 5, 10 or max
   RealtimeMode rt = RealtimeMode::kTry;
+  std::string device = "sim";  // sim: the simulated arm in-process; lcm: a rig over LCM (wall clock only)
+  std::string lcm_url;         // --lcm URL: publish telemetry there (and find the rig there)
+  std::string lcm_log;         // --lcm-log FILE: an LCM event log of the telemetry
 };
 
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.
