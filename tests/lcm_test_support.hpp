@@ -58,6 +58,14 @@ class BusRecorder final : public LcmEndpoint {
     }
     return out;
   }
+  /// The latest message on `channel`, if any.
+  std::optional<Recorded> last(const std::string& channel) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = messages_.rbegin(); it != messages_.rend(); ++it) {
+      if (it->channel == channel) return *it;
+    }
+    return std::nullopt;
+  }
   std::size_t size() const {
     const std::lock_guard<std::mutex> lock(mutex_);
     return messages_.size();

@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <random>
+#include <regex>
 
 #include "devices/lcm_codec.hpp"
+#include "engine/safety.hpp"
 
 namespace bellows {
 namespace {
@@ -262,6 +265,24 @@ TEST(LcmCodec, StatesAnEngineMayRead) {
   s.angle_rad = std::numeric_limits<double>::quiet_NaN();
   EXPECT_TRUE(valid_state(s));
   EXPECT_TRUE(std::isnan(to_reading(s).angle_rad));
+}
+
+TEST(LcmCodec, TheProtocolDocListsEveryFaultCode) {
+  std::ifstream in(std::string(BELLOWS_SOURCE_DIR) + "/docs/lcm-protocol.md");
+  ASSERT_TRUE(in) << "docs/lcm-protocol.md missing";
+  const std::regex row(R"(^\| (\d+) \| `([a-z-]+)` \|$)");
+  int listed = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    const int code = std::stoi(m[1].str());
+    EXPECT_EQ(code, listed) << line;
+    EXPECT_EQ(m[2].str(), fault_name(static_cast<FaultCode>(code))) << line;
+    ++listed;
+  }
+  // Every code the engine has, and no more: the next one has no name yet.
+  EXPECT_GT(listed, 0);
+  EXPECT_STREQ(fault_name(static_cast<FaultCode>(listed)), "unknown") << "code " << listed << " is not in the doc";
 }
 
 }  // namespace
