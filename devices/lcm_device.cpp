@@ -52,10 +52,10 @@ void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(), false});
 
 // ---- I/O thread ----
 
-void LcmDevice::attach(lcm::LCM& bus) { bus.subscribe(kIoStateChannel, &LcmDevice::on_state, this); }
+void LcmDevice::attach(lcm::LCM& bus) { subscribe(bus, kIoStateChannel); }
 
-void LcmDevice::on_state(const lcm::ReceiveBuffer* buffer, const std::string&) {
-  const DecodeStatus status = decode_checked(buffer->data, buffer->data_size, received_);
+void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  // io_state_t only
+  const DecodeStatus status = decode_checked(data, size, received_);
   if (status != DecodeStatus::kOk) return counters_.count(status);
   const io_state_t& s = received_;
   if (!valid_state(s)) return counters_.invalid();

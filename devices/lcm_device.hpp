@@ -55,6 +55,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   // ---- LcmEndpoint: I/O thread only ----
   void attach(lcm::LCM& bus) override;
+  void on_message(const char* channel, const void* data, std::size_t size) override;
   double service(lcm::LCM* bus, double now_s) override;
   void finish(lcm::LCM* bus, double now_s) override;
 
@@ -70,7 +71,6 @@ class LcmDevice final : public Device, public LcmEndpoint {
     bool armed = false;
   };
 
-  void on_state(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
 
   const std::int64_t session_id_;

@@ -25,7 +25,16 @@ timespec to_timespec(double seconds) {
   return t;
 }
 
+void deliver(const lcm_recv_buf_t* buffer, const char* channel, void* endpoint) {
+  static_cast<LcmEndpoint*>(endpoint)->on_message(channel, buffer->data, buffer->data_size);
+}
+
 }  // namespace
+
+void LcmEndpoint::subscribe(lcm::LCM& bus, const std::string& channel, int queue_capacity) {
+  lcm_subscription_t* subscription = lcm_subscribe(bus.getUnderlyingLCM(), channel.c_str(), &deliver, this);
+  if (subscription != nullptr && queue_capacity > 0) lcm_subscription_set_queue_capacity(subscription, queue_capacity);
+}
 
 double monotonic_s() {
   timespec now{};

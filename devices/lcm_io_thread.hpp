@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <thread>
@@ -23,8 +24,14 @@ double monotonic_s();
 class LcmEndpoint {
  public:
   virtual ~LcmEndpoint() = default;
-  /// Subscribe to what it receives. Called once, before the first service().
+  /// Subscribe (with subscribe()) to what it receives. Called once, before the first service().
   virtual void attach(lcm::LCM& bus) { (void)bus; }
+  /// A message on a channel it subscribed to: raw bytes, trusted for nothing.
+  virtual void on_message(const char* channel, const void* data, std::size_t size) {
+    (void)channel;
+    (void)data;
+    (void)size;
+  }
   /// Periodic work: hand over what arrived, publish what is due. `bus` is null when the thread
   /// runs without a bus (a publisher that only writes a log). Returns the monotonic time by which
   /// it wants its next turn; it may get one earlier (after every message received).
@@ -34,6 +41,13 @@ class LcmEndpoint {
     (void)bus;
     (void)now_s;
   }
+
+ protected:
+  /// Delivers the messages on `channel` (an LCM channel regex) to on_message(). Through LCM's C
+  /// API: the C++ member-function subscribe of LCM 1.3.1 crashes when built with GCC 12's
+  /// -fsanitize=vptr (its pointer-to-member call goes wrong), so the sanitizer builds could not run
+  /// it. `queue_capacity` 0 keeps LCM's default (30 messages; a full queue drops the newest).
+  void subscribe(lcm::LCM& bus, const std::string& channel, int queue_capacity = 0);
 };
 
 class LcmIoThread {

@@ -21,10 +21,10 @@ RigServer::RigServer(SimulatedArm& arm, const RigServerParameters& params, std::
   buffer_.resize(static_cast<std::size_t>(state_.getEncodedSize()));
 }
 
-void RigServer::attach(lcm::LCM& bus) { bus.subscribe(kIoCommandChannel, &RigServer::on_command, this); }
+void RigServer::attach(lcm::LCM& bus) { subscribe(bus, kIoCommandChannel); }
 
-void RigServer::on_command(const lcm::ReceiveBuffer* buffer, const std::string&) {
-  const DecodeStatus status = decode_checked(buffer->data, buffer->data_size, received_);
+void RigServer::on_message(const char*, const void* data, std::size_t size) {  // io_command_t only
+  const DecodeStatus status = decode_checked(data, size, received_);
   if (status != DecodeStatus::kOk) return counters_.count(status);
   const io_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();

@@ -40,6 +40,7 @@ class RigServer final : public LcmEndpoint {
   RigServer(SimulatedArm& arm, const RigServerParameters& params, std::int64_t rig_id);
 
   void attach(lcm::LCM& bus) override;
+  void on_message(const char* channel, const void* data, std::size_t size) override;
   double service(lcm::LCM* bus, double now_s) override;
   void finish(lcm::LCM* bus, double now_s) override;
 
@@ -47,7 +48,6 @@ class RigServer final : public LcmEndpoint {
   RigServerStats stats() const;
 
  private:
-  void on_command(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void advance_to(double now_s);
   void publish_state(lcm::LCM& bus, double now_s);
 

@@ -42,9 +42,7 @@ struct Recorded {
 class BusRecorder final : public LcmEndpoint {
  public:
   explicit BusRecorder(std::string pattern = ".*") : pattern_(std::move(pattern)) {}
-  void attach(lcm::LCM& bus) override {
-    bus.subscribe(pattern_, &BusRecorder::on_message, this)->setQueueCapacity(100000);
-  }
+  void attach(lcm::LCM& bus) override { subscribe(bus, pattern_, 100000); }
   double service(lcm::LCM*, double now_s) override { return now_s + 0.05; }
 
   std::vector<Recorded> messages() const {
@@ -76,10 +74,10 @@ class BusRecorder final : public LcmEndpoint {
   }
 
  private:
-  void on_message(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
-    const auto* data = static_cast<const std::uint8_t*>(buffer->data);
+  void on_message(const char* channel, const void* data, std::size_t size) override {
+    const auto* bytes = static_cast<const std::uint8_t*>(data);
     const std::lock_guard<std::mutex> lock(mutex_);
-    messages_.push_back({channel, std::vector<std::uint8_t>(data, data + buffer->data_size), monotonic_s()});
+    messages_.push_back({channel, std::vector<std::uint8_t>(bytes, bytes + size), monotonic_s()});
   }
 
   std::string pattern_;

@@ -3,11 +3,12 @@
 // field claims.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <random>
-#include <regex>
+#include <sstream>
 
 #include "devices/lcm_codec.hpp"
 #include "engine/safety.hpp"
@@ -270,14 +271,18 @@ TEST(LcmCodec, StatesAnEngineMayRead) {
 TEST(LcmCodec, TheProtocolDocListsEveryFaultCode) {
   std::ifstream in(std::string(BELLOWS_SOURCE_DIR) + "/docs/lcm-protocol.md");
   ASSERT_TRUE(in) << "docs/lcm-protocol.md missing";
-  const std::regex row(R"(^\| (\d+) \| `([a-z-]+)` \|$)");
   int listed = 0;
   for (std::string line; std::getline(in, line);) {
-    std::smatch m;
-    if (!std::regex_match(line, m, row)) continue;
-    const int code = std::stoi(m[1].str());
+    // Rows of the fault table: "| 7 | `sensor-stale` |".
+    std::istringstream row(line);
+    std::string bar, number, name;
+    if (!(row >> bar >> number >> bar >> name) || number.empty() || !std::isdigit(static_cast<unsigned char>(number[0])) ||
+        name.size() < 3 || name.front() != '`') {
+      continue;
+    }
+    const int code = std::stoi(number);
     EXPECT_EQ(code, listed) << line;
-    EXPECT_EQ(m[2].str(), fault_name(static_cast<FaultCode>(code))) << line;
+    EXPECT_EQ(name.substr(1, name.size() - 2), fault_name(static_cast<FaultCode>(code))) << line;
     ++listed;
   }
   // Every code the engine has, and no more: the next one has no name yet.

@@ -55,7 +55,13 @@ nlohmann::json parse_report(const Child& child) {
 /// that asks.
 class Heckler final : public LcmEndpoint {
  public:
-  void attach(lcm::LCM& bus) override { bus.subscribe(kIoStateChannel, &Heckler::on_state, this); }
+  void attach(lcm::LCM& bus) override { subscribe(bus, kIoStateChannel); }
+  void on_message(const char*, const void* data, std::size_t size) override {
+    io_state_t state{};
+    if (decode_checked(data, size, state) == DecodeStatus::kOk && state.session_id != 0 && state.session_id != kSession) {
+      rig_taken_ = true;
+    }
+  }
   double service(lcm::LCM* bus, double now_s) override {
     if (!rig_taken_) return now_s + 0.01;
     if (bus == nullptr || now_s < next_s_) return next_s_;
@@ -83,13 +89,6 @@ class Heckler final : public LcmEndpoint {
   std::uint64_t rounds() const { return rounds_.load(); }
 
  private:
-  void on_state(const lcm::ReceiveBuffer* buffer, const std::string&) {
-    io_state_t state{};
-    if (decode_checked(buffer->data, buffer->data_size, state) == DecodeStatus::kOk && state.session_id != 0 &&
-        state.session_id != kSession) {
-      rig_taken_ = true;
-    }
-  }
   static constexpr std::int64_t kSession = 777;
   bool rig_taken_ = false;
   template <typename Message>
