@@ -1,0 +1,146 @@
+#include "app/run_io.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "devices/lcm_channels.hpp"
+#include "engine/errors.hpp"
+
+namespace bellows {
+namespace {
+
+// The device's I/O thread runs just below the engine loop (priority 80): it carries the loop's
+// sensor readings and valve commands.
+constexpr int kDeviceIoPriority = 70;
+// Telemetry taps hold this many ticks: the publisher drains every 20 ms, so a second of slack.
+constexpr double kTelemetryRing_s = 1.0;
+
+/// A simulated clock that lets the telemetry publisher keep up: before each tick it waits until
+/// the tap has room. Same ticks, same physics, same results; only slower when a log is written.
+}  // namespace
+
+nlohmann::json receive_counts_json(const ReceiveCounts& c) {
+  return {{"accepted", c.accepted},
+          {"ignored",
+           {{"truncated", c.truncated},
+            {"wrong_type", c.wrong_type},
+            {"too_large", c.too_large},
+            {"malformed", c.malformed},
+            {"invalid", c.invalid},
+            {"foreign", c.foreign},
+            {"out_of_order", c.out_of_order}}}};
+}
+
+RunIo::RunIo(const RunIoOptions& options, const Configuration& config) : options_(options), config_(config) {
+  if (options.device != "sim" && options.device != "lcm") throw InputError("--device must be sim or lcm, not '" + options.device + "'");
+  if (options.device == "lcm") {
+    if (options.clock != "wall") {
+      throw InputError("--device lcm needs --clock wall: a real rig's time passes on its own and cannot be simulated");
+    }
+    if (options.speed != 1.0) throw InputError("--device lcm runs in real time: --speed must be 1");
+  }
+  const bool needs_session = options.device == "lcm" || !options.lcm_url.empty() || !options.lcm_log.empty();
+  if (needs_session) session_id_ = LcmDevice::random_session_id();
+  if (options.device == "sim") {
+    arm_ = std::make_unique<SimulatedArm>(config.plant, options.seed);
+    return;
+  }
+  lcm_device_ = std::make_unique<LcmDevice>(session_id_);
+  const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
+  device_io_ = std::make_unique<LcmIoThread>(url, std::vector<LcmEndpoint*>{lcm_device_.get()});
+  device_io_->start(options.rt, kDeviceIoPriority);
+}
+
+RunIo::~RunIo() { stop(); }
+
+Device& RunIo::device() {
+  if (lcm_device_) return *lcm_device_;
+  return *arm_;
+}
+
+std::unique_ptr<SimulatedClock> RunIo::simulated_clock(EngineCore& core) {
+  auto clock = std::make_unique<SimulatedClock>(core, device());
+  clock->pace_by(tap_);
+  return clock;
+}
+
+SimulatedArm* RunIo::simulated_arm() { return arm_.get(); }
+
+void RunIo::start_telemetry(EngineCore& core) {
+  if (options_.lcm_url.empty() && options_.lcm_log.empty()) return;
+  const auto capacity = static_cast<std::size_t>(kTelemetryRing_s / config_.timing.tick_s) + 1;
+  tap_ = &core.add_telemetry_tap(capacity);
+  publisher_ = std::make_unique<TelemetryPublisher>(*tap_, session_id_, options_.lcm_log);
+  publisher_io_ = std::make_unique<LcmIoThread>(options_.lcm_url, std::vector<LcmEndpoint*>{publisher_.get()});
+  publisher_io_->start(RealtimeMode::kOff, 0);  // telemetry is not real-time
+}
+
+std::string RunIo::wait_for_rig(const std::atomic<bool>& stop) {
+  if (!lcm_device_) return "";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.lcm.connect_timeout_s);
+  while (!lcm_device_->connected()) {
+    if (stop.load(std::memory_order_relaxed)) return "interrupted while waiting for a rig";
+    if (std::chrono::steady_clock::now() > deadline) {
+      const LcmDeviceStats s = lcm_device_->stats();
+      char why[320];
+      if (s.states.foreign > 0 && s.last_foreign_session != 0) {
+        std::snprintf(why, sizeof why, "a rig answers on %s but serves another session (%lld)", device_io_->url().c_str(),
+                      static_cast<long long>(s.last_foreign_session));
+      } else {
+        std::snprintf(why, sizeof why, "no rig answered on %s within %g s (is `bellows io-sim` or a rig driver running?)",
+                      device_io_->url().c_str(), config_.lcm.connect_timeout_s);
+      }
+      return why;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return "";
+}
+
+void RunIo::post_trial(const IterationSummary& summary, const Eigen::VectorXd& correction_bar) {
+  if (publisher_) publisher_->post_trial(summary, correction_bar, config_.timing.sample_s());
+}
+
+void RunIo::stop() {
+  if (device_io_) device_io_->stop();
+  if (publisher_io_) publisher_io_->stop();
+}
+
+nlohmann::json RunIo::report() const {
+  if (session_id_ == 0) return nullptr;
+  nlohmann::json lcm = {{"session_id", session_id_}};
+  if (!options_.lcm_url.empty()) lcm["url"] = options_.lcm_url;
+  if (lcm_device_) {
+    const LcmDeviceStats s = lcm_device_->stats();
+    lcm["rig"] = {{"url", device_io_->url()},
+                  {"rig_id", s.rig_id},
+                  {"states", receive_counts_json(s.states)},
+                  {"rig_fault_states", s.rig_fault_states},
+                  {"last_fault_bits", s.last_fault_bits},
+                  {"commands_sent", s.commands_sent},
+                  {"vent_commands_sent", s.vent_commands_sent},
+                  {"publish_errors", s.publish_errors}};
+  }
+  if (publisher_) {
+    const TelemetryPublisherStats s = publisher_->stats();
+    lcm["telemetry"] = {{"ticks", s.ticks},
+                        {"dropped_ticks", s.dropped_ticks},
+                        {"events", s.events},
+                        {"trials", s.trials},
+                        {"log_events", s.log_events},
+                        {"errors", s.errors}};
+    if (!options_.lcm_log.empty()) lcm["telemetry"]["log"] = options_.lcm_log;
+  }
+  return lcm;
+}
+
+std::string RunIo::warning() const {
+  if (!publisher_) return "";
+  const TelemetryPublisherStats s = publisher_->stats();
+  if (s.dropped_ticks == 0 && s.errors == 0) return "";
+  return "telemetry: " + std::to_string(s.dropped_ticks) + " ticks dropped, " + std::to_string(s.errors) +
+         " publish or log errors";
+}
+
+}  // namespace bellows
