@@ -5,8 +5,10 @@
 #include <CLI/CLI.hpp>
 
 #include "app/config_file.hpp"
+#include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
 #include "app/run_command.hpp"
+#include "app/sessions_command.hpp"
 #include "app/signals.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/errors.hpp"
@@ -40,11 +42,44 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--rt", run.rt, "Real-time scheduling: enforce (refuse without), try, off")
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");
+  CLI::Option* no_save = run_cmd->add_flag("--no-save", run.no_save, "Do not save the session");
+  run_cmd->add_option("--data-dir", run.data_dir,
+                      "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions)")
+      ->excludes(no_save);
+  CLI::Option* name = run_cmd->add_option("--name", run.session_name, "Session name (default: start time and trajectory)")
+                          ->excludes(no_save);
+  run_cmd->add_option("--resume", run.resume_dir, "Continue a saved session (a directory, or a name in the data directory)")
+      ->excludes(no_save)
+      ->excludes(name)
+      ->excludes("--trajectory")
+      ->excludes("--config")
+      ->excludes("--seed");
+
+  bellows::SessionsOptions sessions;
+  CLI::App* sessions_cmd = app.add_subcommand("sessions", "List, show and export saved sessions");
+  sessions_cmd->require_subcommand(1);
+  const std::string data_dir_help = "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions)";
+  CLI::App* list_cmd = sessions_cmd->add_subcommand("list", "A table of the saved sessions");
+  CLI::App* show_cmd = sessions_cmd->add_subcommand("show", "One session: summary and RMS per iteration");
+  CLI::App* export_cmd = sessions_cmd->add_subcommand("export", "Export a session to CSV or MATLAB (v7.3)");
+  for (CLI::App* command : {list_cmd, show_cmd, export_cmd}) {
+    command->add_option("--data-dir", sessions.data_dir, data_dir_help);
+    command->add_flag("--json", sessions.json, "Print JSON on stdout");
+  }
+  for (CLI::App* command : {show_cmd, export_cmd}) {
+    command->add_option("session", sessions.session, "Session directory, or a session name in the data directory")
+        ->required();
+  }
+  export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
+  export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
   run_cmd->add_option("--device", run.device, "sim: the simulated arm in-process; lcm: a rig over LCM (--clock wall)")
       ->capture_default_str()
       ->check(CLI::IsMember({"sim", "lcm"}));
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find the rig there)");
-  run_cmd->add_option("--lcm-log", run.lcm_log, "Write the telemetry into this LCM event log (a new file)");
+  CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
+                                             "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
+                                             "FILE in the session directory")
+                             ->expected(0, 1);
 
   bellows::IoSimOptions io_sim;
   CLI::App* io_sim_cmd = app.add_subcommand("io-sim", "Serve the simulated arm over LCM in real time, as a rig would");
@@ -65,6 +100,16 @@ int main(int argc, char** argv) {
   config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
 
   bellows::install_stop_signal_handlers();
+
+  bellows::IdentifyOptions identify;
+  CLI::App* identify_cmd =
+      app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
+  identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
+  identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
+  identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
+  identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -75,6 +120,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    run.lcm_log = lcm_log->count() > 0;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (config_cmd->parsed()) {
@@ -83,6 +129,12 @@ int main(int argc, char** argv) {
       std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
       return 0;
     }
+    if (identify_cmd->parsed()) {
+      return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
+    }
+    if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
+    if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);
+    if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);
     std::cout << app.help();
     return 0;
   } catch (const bellows::InputError& error) {

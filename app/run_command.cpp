@@ -7,13 +7,17 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/learning_report.hpp"
 #include "app/run_io.hpp"
+#include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "engine/arm_model.hpp"
+#include "engine/convergence.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
+#include "engine/learning_monitor.hpp"
 #include "engine/learning_session.hpp"
 
 namespace bellows {
@@ -48,66 +52,109 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
   if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
   const double speed = parse_speed(options.speed);
-  const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
+  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
+  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+                               : options.config_path.empty() ? Configuration{}
+                                                             : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
-  const Trajectory trajectory = resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const Trajectory trajectory =
+      resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  RunIo io({options.device, options.lcm_url, options.lcm_log, options.clock, speed, options.seed, options.rt}, config);
+  RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
   Device& device = io.device();
+  SimulatedArm* arm = io.simulated_arm();
   EngineCore core(device, config.controller, config.timing, config.safety);
-  io.start_telemetry(core);
+  io.add_telemetry_tap(core);
   const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;
+  SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    driver = io.simulated_clock(core);
+    auto simulated = std::make_unique<SimulatedClock>(core, device);
+    clock = simulated.get();
+    driver = std::move(simulated);
   } else {
     auto realtime = std::make_unique<RealtimeLoop>(core, device, speed);
     loop = realtime.get();
     driver = std::move(realtime);
-    loop->start(options.rt);
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
+  recording.restore(arm, core, clock, session);  // before the first tick
+  recording.start(config, trajectory, device.name(), seed, options.iterations);
+  if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  io.start_telemetry(recording.directory());  // its LCM log goes into the session
+  const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
+  if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
+  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
+  if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
+    for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
+      monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
+    }
+  }
+  if (loop != nullptr) loop->start(options.rt);
 
   nlohmann::json iterations = nlohmann::json::array();
   int status = 0;
   std::string failure;
   std::string failure_name;
+  const int trials = recording.trials(options.iterations);
   try {
     if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
       failure = std::move(why);
       failure_name = "rig-unavailable";
       status = stop_signal() != 0 ? 128 + stop_signal() : 3;
       progress << "bellows: " << failure << std::endl;
+      recording.fault(failure);
     }
-    for (int i = 0; failure.empty() && i <= options.iterations; ++i) {
+    for (int i = 0; failure.empty() && i < trials; ++i) {
       const IterationSummary s = session.run_trial();
-      io.post_trial(s, session.correction_bar());
+      io.post_trial(s, session.correction_bar());  // the correction this trial applied
+      session.learn();  // also after the last trial: the saved session resumes with this correction
+      recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
-      iterations.push_back(to_json(s));
-      if (i < options.iterations) session.learn();
+      nlohmann::json iteration = to_json(s);
+      iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
+      iterations.push_back(iteration);
     }
   } catch (const EngineFault& fault) {
     failure = fault.what();
     failure_name = fault_name(core.fault());
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
+    recording.fault(failure + " (" + fault_name(fault.code()) + ")");
+  } catch (const std::exception& error) {
+    if (loop != nullptr) loop->stop();  // vents
+    else device.vent();
+    recording.fault(error.what());
+    throw;
   }
   if (loop != nullptr) loop->stop();  // vents
   else device.vent();
   io.stop();  // the rig's last vent command, the rest of the telemetry
   if (const std::string warning = io.warning(); !warning.empty()) progress << "bellows: " << warning << std::endl;
+  if (monitor.windup().detected) {
+    progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
+             << ": the correction keeps growing where the set points saturate (largest clamped excess "
+             << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
+  }
+  if (status == 0) recording.finish(trials);
 
   if (options.json) {
     nlohmann::json report = {{"device", device.name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
-                             {"seed", options.seed},
+                             {"seed", seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
+                             {"prediction", prediction_json(prediction)},
+                             {"windup", windup_json(monitor.windup())},
+                             {"session", recording.directory().empty() ? nlohmann::json(nullptr)
+                                                                       : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};
     if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;

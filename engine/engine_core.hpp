@@ -60,6 +60,10 @@ class EngineCore {
 
   /// The control scheme (for restoring a saved state before the loop starts).
   ControlCore& control() { return control_; }
+  /// Before the first tick: ARMED, the control scheme in `state` (from a saved session), as if the
+  /// engine had been armed and had run until then; a resumed run so continues exactly. Throws
+  /// std::logic_error once the engine has ticked or left SAFE.
+  void restore_armed(const ControlCore::State& state, double now_s);
   const TimingParameters& timing() const { return timing_; }
 
  private:
@@ -94,6 +98,7 @@ class EngineCore {
   std::uint32_t trial_id_ = 0;
   int settle_remaining_ = 0;
   double last_reading_time_s_ = -1.0;
+  double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;
   int missed_streak_ = 0;
   double last_heartbeat_s_ = 0.0;
