@@ -6,10 +6,10 @@
 
 #include "app/config_file.hpp"
 #include "app/identify_command.hpp"
-#include "app/run_command.hpp"
-#include "app/signals.hpp"
-#include "app/sessions_command.hpp"
 #include "app/io_sim_command.hpp"
+#include "app/run_command.hpp"
+#include "app/sessions_command.hpp"
+#include "app/signals.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/errors.hpp"
 
@@ -72,12 +72,14 @@ int main(int argc, char** argv) {
   }
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
-
   run_cmd->add_option("--device", run.device, "sim: the simulated arm in-process; lcm: a rig over LCM (--clock wall)")
       ->capture_default_str()
       ->check(CLI::IsMember({"sim", "lcm"}));
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find the rig there)");
-  run_cmd->add_option("--lcm-log", run.lcm_log, "Write the telemetry into this LCM event log (a new file)");
+  CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
+                                             "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
+                                             "FILE in the session directory")
+                             ->expected(0, 1);
 
   bellows::IoSimOptions io_sim;
   CLI::App* io_sim_cmd = app.add_subcommand("io-sim", "Serve the simulated arm over LCM in real time, as a rig would");
@@ -118,6 +120,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    run.lcm_log = lcm_log->count() > 0;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (config_cmd->parsed()) {

@@ -8,8 +8,8 @@
 
 #include "app/config_file.hpp"
 #include "app/learning_report.hpp"
-#include "app/run_recording.hpp"
 #include "app/run_io.hpp"
+#include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "engine/arm_model.hpp"
@@ -64,16 +64,17 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  RunIo io({options.device, options.lcm_url, options.lcm_log, options.clock, speed, seed, options.rt}, config);
+  RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
   Device& device = io.device();
+  SimulatedArm* arm = io.simulated_arm();
   EngineCore core(device, config.controller, config.timing, config.safety);
-  io.start_telemetry(core);
+  io.add_telemetry_tap(core);
   const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;
   SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    auto simulated = io.simulated_clock(core);
+    auto simulated = std::make_unique<SimulatedClock>(core, device);
     clock = simulated.get();
     driver = std::move(simulated);
   } else {
@@ -83,9 +84,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
-  recording.restore(io.simulated_arm(), core, clock, session);  // before the first tick
+  recording.restore(arm, core, clock, session);  // before the first tick
   recording.start(config, trajectory, device.name(), seed, options.iterations);
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  io.start_telemetry(recording.directory());  // its LCM log goes into the session
   const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
   if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
@@ -107,12 +109,13 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
       failure_name = "rig-unavailable";
       status = stop_signal() != 0 ? 128 + stop_signal() : 3;
       progress << "bellows: " << failure << std::endl;
+      recording.fault(failure);
     }
     for (int i = 0; failure.empty() && i < trials; ++i) {
       const IterationSummary s = session.run_trial();
-      io.post_trial(s, session.correction_bar());  // the correction this trial ran with
+      io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
-      recording.save(session, s, io.simulated_arm(), core, clock);  // on disk before the line says it is done
+      recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
       nlohmann::json iteration = to_json(s);
       iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));

@@ -26,7 +26,8 @@ struct RunOptions {
   std::string resume_dir;    // continue this session (its configuration, trajectory and state)
   std::string device = "sim";  // sim: the simulated arm in-process; lcm: a rig over LCM (wall clock only)
   std::string lcm_url;         // --lcm URL: publish telemetry there (and find the rig there)
-  std::string lcm_log;         // --lcm-log FILE: an LCM event log of the telemetry
+  bool lcm_log = false;        // --lcm-log [FILE]: an LCM event log of the telemetry,
+  std::string lcm_log_file;    //   in FILE, or (no FILE) in the session directory
 };
 
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.

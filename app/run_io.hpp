@@ -1,15 +1,17 @@
 // What `bellows run` drives and who watches it: the simulated arm in-process (`--device sim`) or a
-// rig over LCM (`--device lcm`), and, with `--lcm URL` or `--lcm-log FILE`, the telemetry
-// publisher. Owns the LCM I/O threads and stops them in the right order.
+// rig over LCM (`--device lcm`), and, with `--lcm URL` or `--lcm-log`, the telemetry publisher.
+// Owns the LCM I/O threads and stops them in the right order.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "app/run_command.hpp"
 #include "bridge/telemetry_publisher.hpp"
 #include "devices/lcm_device.hpp"
 #include "devices/simulated_arm.hpp"
@@ -19,16 +21,6 @@
 
 namespace bellows {
 
-struct RunIoOptions {
-  std::string device = "sim";  // sim | lcm
-  std::string lcm_url;         // --lcm: the bus (telemetry; the rig's bus with --device lcm)
-  std::string lcm_log;         // --lcm-log: an LCM event log of the telemetry
-  std::string clock = "sim";
-  double speed = 1.0;
-  std::uint64_t seed = 1;
-  RealtimeMode rt = RealtimeMode::kTry;
-};
-
 /// Received-message counters as a JSON object ({"accepted", "ignored": {by reason}}).
 nlohmann::json receive_counts_json(const ReceiveCounts& counts);
 
@@ -36,19 +28,23 @@ class RunIo {
  public:
   /// Checks the options against each other and opens the rig's bus (`--device lcm`). Throws
   /// InputError for a combination that makes no sense or a bus that cannot be opened.
-  RunIo(const RunIoOptions& options, const Configuration& config);
+  RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config);
   ~RunIo();
+  RunIo(const RunIo&) = delete;
+  RunIo& operator=(const RunIo&) = delete;
 
+  /// The device the engine drives.
   Device& device();
-  bool lcm_device() const { return lcm_device_ != nullptr; }
+  /// The simulated arm, or null for a rig over LCM.
+  SimulatedArm* simulated_arm() { return arm_.get(); }
 
-  /// The simulated clock for `--clock sim`. With telemetry it waits for the publisher whenever the
-  /// tap is full, so that a log holds every tick (simulated time has no deadline to miss).
-  std::unique_ptr<SimulatedClock> simulated_clock(EngineCore& core);
-  /// The in-process simulated arm, or null when the device is a rig over LCM.
-  SimulatedArm* simulated_arm();
-  /// Adds the telemetry tap and starts the publisher, if asked for. Before the engine loop starts.
-  void start_telemetry(EngineCore& core);
+  /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
+  /// tick. On the simulated clock the device then waits for the publisher whenever the tap is full,
+  /// so that the log holds every tick (simulated time has no deadline to miss).
+  void add_telemetry_tap(EngineCore& core);
+  /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
+  /// --lcm-log names no file. Before the first tick.
+  void start_telemetry(const std::filesystem::path& session_directory);
   /// With --device lcm: waits (the engine loop running) until a rig serves this session. Returns
   /// an empty string when it does, else why not; gives up early when `stop` is set.
   std::string wait_for_rig(const std::atomic<bool>& stop);
@@ -76,14 +72,19 @@ class RunIo {
   std::string warning() const;
 
  private:
-  RunIoOptions options_;
+  class TapPacedDevice;
+
+  const RunOptions& options_;
   Configuration config_;
+  bool telemetry_ = false;
   std::unique_ptr<SimulatedArm> arm_;
+  std::unique_ptr<TapPacedDevice> paced_;
   std::unique_ptr<LcmDevice> lcm_device_;
   std::unique_ptr<LcmIoThread> device_io_;
+  TelemetryRing* tap_ = nullptr;
+  std::string log_path_;
   std::unique_ptr<TelemetryPublisher> publisher_;
   std::unique_ptr<LcmIoThread> publisher_io_;
-  TelemetryRing* tap_ = nullptr;
   std::int64_t session_id_ = 0;
 };
 

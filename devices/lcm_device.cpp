@@ -21,7 +21,8 @@ void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_rela
 LcmDevice::LcmDevice(std::int64_t session_id) : session_id_(session_id) {
   command_.session_id = session_id_;
   buffer_.resize(static_cast<std::size_t>(command_.getEncodedSize()));
-  outbox_.write(Outgoing{ValveCommand::vented(), false});
+  // Nothing goes out before the engine's first tick: a rig serving nobody takes the first session
+  // that commands it, and would time out (and serve nobody again) if that session then fell silent.
 }
 
 std::int64_t LcmDevice::random_session_id() {
@@ -93,6 +94,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
     last_reading_time_s_ = pending_.time_s;
     inbox_.write(pending_);
     pending_fresh_ = false;
+    last_state_s_.store(now_s, std::memory_order_relaxed);
     connected_.store(true, std::memory_order_release);
   }
   Outgoing outgoing;

@@ -61,8 +61,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   // ---- any thread ----
   std::int64_t session_id() const { return session_id_; }
-  /// Whether a valid state of this session has arrived: a rig serves this engine.
+  /// Whether a valid state of this session has arrived: a rig has served this engine.
   bool connected() const { return connected_.load(std::memory_order_acquire); }
+  /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
+  double last_state_s() const { return last_state_s_.load(std::memory_order_relaxed); }
   LcmDeviceStats stats() const;
 
  private:
@@ -95,6 +97,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};
+  std::atomic<double> last_state_s_{-1.0};
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};
   std::atomic<std::int32_t> last_fault_bits_{0};

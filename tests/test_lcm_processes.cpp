@@ -24,6 +24,9 @@ using testing::Recorded;
 
 const std::string kBellows = BELLOWS_BINARY;
 
+/// Sessions of the runs started here go into a fresh directory, never into a real home.
+void isolate_sessions() { setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-lcm-xdg").c_str(), 1); }
+
 #define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                              \
   do {                                                                         \
     const std::string why_not = testing::enter_private_network_namespace();   \
@@ -104,6 +107,7 @@ class Heckler final : public LcmEndpoint {
 
 TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTrust) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  isolate_sessions();
   const auto dir = testing::make_temp_dir("bellows-lcm-rms");
   Heckler heckler;
   LcmIoThread bus(kDefaultLcmUrl, {&heckler});
@@ -116,7 +120,7 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   ASSERT_TRUE(run.started());
   const auto run_status = run.wait(300.0);
   ASSERT_TRUE(run_status.has_value()) << "bellows run did not finish in 5 minutes";
-  EXPECT_EQ(*run_status, 0) << run.err();
+  EXPECT_EQ(*run_status, 0) << run.err() << run.out();
   rig.signal(SIGTERM);
   ASSERT_TRUE(rig.wait(30.0).has_value()) << "io-sim did not stop on SIGTERM";
   bus.stop();
@@ -160,15 +164,15 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
 
 TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  isolate_sessions();
   const auto dir = testing::make_temp_dir("bellows-lcm-kill");
-  const std::string log = (dir / "run.lcmlog").string();
   BusRecorder recorder;
   LcmIoThread bus(kDefaultLcmUrl, {&recorder});
   bus.start(RealtimeMode::kOff, 0);
 
   Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
-  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
-             kDefaultLcmUrl, "--lcm-log", log},
+  Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
+             kDefaultLcmUrl, "--lcm-log", "--name", "killed"},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(rig.started() && run.started());
   // Mid-trial: half a second into the first trajectory.
@@ -189,6 +193,10 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   bus.stop();
   const nlohmann::json report = parse_report(run);
   EXPECT_EQ(report["fault"]["name"], "sensor-stale");
+  // The session holds the LCM log (--lcm-log without a FILE).
+  ASSERT_TRUE(report["session"].is_string()) << report.dump();
+  const std::string log = (std::filesystem::path(report["session"].get<std::string>()) / "telemetry.lcmlog").string();
+  EXPECT_EQ(report["lcm"]["telemetry"]["log"], log);
 
   // In the telemetry log: the first FAULT tick came stale_ticks ticks after the last fresh reading,
   // during the trial, and its valve command is the vented one.
@@ -254,7 +262,7 @@ TEST(LcmProcesses, LcmLogplayerReplaysASavedLogThatASubscriberDecodesEntirely) {
   for (int k = 0; k <= 50; ++k) csv += std::to_string(k * 0.02) + "," + std::to_string(k < 10 ? 0.0 : 15.0) + "\n";
   const auto trajectory = testing::write_file(dir, "step.csv", csv);
   const auto config = testing::write_file(dir, "short.toml", "[timing]\nsettle_s = 0.2\n");
-  const auto made = testing::run_process(kBellows + " run --clock wall --speed 2 --iterations 1 --json --trajectory " +
+  const auto made = testing::run_process(kBellows + " run --no-save --clock wall --speed 2 --iterations 1 --json --trajectory " +
                                          trajectory.string() + " --config " + config.string() + " --lcm-log " + log);
   ASSERT_EQ(made.exit_code, 0) << made.err;
   EXPECT_EQ(nlohmann::json::parse(made.out)["lcm"]["telemetry"]["dropped_ticks"], 0);
@@ -323,6 +331,7 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   expect_refused("io-sim --lcm nowhere://at-all", "cannot open the LCM bus");
   const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
   expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
+  expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
 
   // memq:// is private to a process: nobody answers there.
   const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");
