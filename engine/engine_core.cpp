@@ -73,14 +73,17 @@ void EngineCore::enter_fault(FaultCode code, double now_s) {
 void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s) {
   const EngineState from = state();
   const Transition t = transition(from, command.kind);
-  if (!t.allowed) {
+  auto refuse = [&](const char* why) {
     EngineEvent event;
     event.kind = EventKind::kCommandRefused;
     event.time_s = now_s;
     event.from = event.to = from;
     event.command = command.kind;
-    event.refusal = t.refusal;
+    event.refusal = why;
     emit(event);
+  };
+  if (!t.allowed) {
+    refuse(t.refusal);
     return;
   }
   switch (command.kind) {
@@ -106,7 +109,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
     case CommandKind::kArm: {
       // Fresh controllers, holding the trajectory's start (or where the arm is, without one).
       control_.pid().reset();
-      const double hold = trajectory_ != nullptr ? trajectory_->angle_rad(0) : device_.read_sensors().angle_rad;
+      const double hold = trajectory_ != nullptr ? trajectory_->angle_rad(0) : last_angle_rad_;
       control_.hold(hold);
       last_heartbeat_s_ = wall_s;
       break;
@@ -117,13 +120,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
           command.correction->size() != command.trajectory->learning_samples() ||
           command.record->samples.time_s.size() != command.trajectory->learning_samples() + 1 ||
           command.record->ticks.time_s.size() != command.trajectory->learning_samples() * timing_.ticks_per_sample) {
-        EngineEvent event;
-        event.kind = EventKind::kCommandRefused;
-        event.time_s = now_s;
-        event.from = event.to = from;
-        event.command = command.kind;
-        event.refusal = "the trial's trajectory, correction or record is missing or not prepared to its length";
-        emit(event);
+        refuse("the trial's trajectory, correction or record is missing or not prepared to its length");
         return;
       }
       trajectory_ = command.trajectory;
@@ -154,6 +151,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   const SensorReading reading = device_.read_sensors();
   stale_count_ = reading.time_s > last_reading_time_s_ ? 0 : stale_count_ + 1;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
+  if (std::isfinite(reading.angle_rad)) last_angle_rad_ = reading.angle_rad;
   missed_streak_ = missed_deadlines > 0 ? missed_streak_ + missed_deadlines : 0;
 
   if (valves_live(state())) {

@@ -94,6 +94,7 @@ class EngineCore {
   std::uint32_t trial_id_ = 0;
   int settle_remaining_ = 0;
   double last_reading_time_s_ = -1.0;
+  double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;
   int missed_streak_ = 0;
   double last_heartbeat_s_ = 0.0;

@@ -31,6 +31,28 @@ struct EngineCommand {
   int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains
+
+  /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
+  static EngineCommand of(CommandKind kind) {
+    EngineCommand c;
+    c.kind = kind;
+    return c;
+  }
+  static EngineCommand start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction, TrialRecord& record,
+                                   int settle_ticks, std::uint32_t trial_id) {
+    EngineCommand c = of(CommandKind::kStartTrial);
+    c.trajectory = &trajectory;
+    c.correction = &correction;
+    c.record = &record;
+    c.settle_ticks = settle_ticks;
+    c.trial_id = trial_id;
+    return c;
+  }
+  static EngineCommand select_trajectory(const Trajectory& trajectory) {
+    EngineCommand c = of(CommandKind::kSelectTrajectory);
+    c.trajectory = &trajectory;
+    return c;
+  }
 };
 
 enum class EventKind : std::uint8_t {

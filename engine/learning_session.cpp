@@ -34,10 +34,7 @@ LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Traject
                      std::to_string(trajectory_.learning_samples()));
   }
   record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample);
-  EngineCommand select;
-  select.kind = CommandKind::kSelectTrajectory;
-  select.trajectory = &trajectory_;
-  driver_.core().send(select);
+  driver_.core().send(EngineCommand::select_trajectory(trajectory_));
 }
 
 void LearningSession::set_correction(const Eigen::VectorXd& correction_bar, int iteration) {
@@ -50,9 +47,7 @@ EngineEvent LearningSession::next_event() {
   EngineEvent event;
   while (!driver_.core().poll_event(event)) {
     if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
-      EngineCommand stop;
-      stop.kind = CommandKind::kEmergencyStop;
-      driver_.core().send(stop);
+      driver_.core().send(EngineCommand::of(CommandKind::kEmergencyStop));
       while (driver_.core().state() != EngineState::kFault) driver_.await();
       throw EngineFault(FaultCode::kEmergencyStop, "interrupted: valves vented");
     }
@@ -64,9 +59,7 @@ EngineEvent LearningSession::next_event() {
 void LearningSession::ensure_armed() {
   EngineCore& core = driver_.core();
   if (core.state() == EngineState::kArmed) return;
-  EngineCommand arm;
-  arm.kind = CommandKind::kArm;
-  core.send(arm);
+  core.send(EngineCommand::of(CommandKind::kArm));
   for (;;) {
     const EngineEvent event = next_event();
     if (event.kind == EventKind::kStateChanged && event.to == EngineState::kArmed) return;
@@ -79,13 +72,8 @@ void LearningSession::ensure_armed() {
 
 IterationSummary LearningSession::run_trial() {
   ensure_armed();
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = &trajectory_;
-  start.correction = &correction_;
-  start.record = &record_;
-  start.settle_ticks = static_cast<int>(std::lround(timing_.settle_s / timing_.tick_s));
-  start.trial_id = next_trial_id_++;
+  const EngineCommand start = EngineCommand::start_trial(
+      trajectory_, correction_, record_, static_cast<int>(std::lround(timing_.settle_s / timing_.tick_s)), next_trial_id_++);
   driver_.core().send(start);
   for (;;) {
     const EngineEvent event = next_event();

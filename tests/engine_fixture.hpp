@@ -14,11 +14,7 @@ struct EngineFixture {
   explicit EngineFixture(const Configuration& c = Configuration{}, std::uint64_t seed = 1)
       : config(c), arm(c.plant, seed), core(arm, c.controller, c.timing, c.safety), clock(core, arm) {}
 
-  void send(CommandKind kind) {
-    EngineCommand command;
-    command.kind = kind;
-    core.send(command);
-  }
+  void send(CommandKind kind) { core.send(EngineCommand::of(kind)); }
   std::vector<EngineEvent> drain_events() {
     std::vector<EngineEvent> events;
     EngineEvent e;

@@ -51,19 +51,11 @@ TEST(EngineAllocations, TicksAllocateNothing) {
   Eigen::VectorXd correction = Eigen::VectorXd::Constant(paper.learning_samples(), 0.01);
   TrialRecord record;
   record.prepare(paper.learning_samples(), f.config.timing.ticks_per_sample);  // sized outside the loop
-  EngineCommand select;
-  select.kind = CommandKind::kSelectTrajectory;
-  select.trajectory = &paper;
-  f.core.send(select);
+  f.core.send(EngineCommand::select_trajectory(paper));
   f.send(CommandKind::kArm);
   f.clock.step(10);  // warm up outside the count
 
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = &paper;
-  start.correction = &correction;
-  start.record = &record;
-  start.settle_ticks = 100;
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 100, 1);
   long allocations = 0;
   {
     CountAllocations counter;

@@ -38,11 +38,7 @@ TEST(EngineCore, RefusesATrialWhileSafeAndSaysWhy) {
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
   TrialRecord record;
   record.prepare(paper.learning_samples(), 4);
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = &paper;
-  start.correction = &correction;
-  start.record = &record;
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 0, 1);
   f.core.send(start);
   f.clock.step(10);
   EXPECT_EQ(f.core.state(), EngineState::kSafe);
@@ -59,11 +55,7 @@ TEST(EngineCore, RefusesATrialWhoseRecordIsNotPrepared) {
   TrialRecord record;  // not prepared: the loop would have to allocate
   f.send(CommandKind::kArm);
   f.clock.step();
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = &paper;
-  start.correction = &correction;
-  start.record = &record;
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 0, 1);
   f.drain_events();
   f.core.send(start);
   f.clock.step();
@@ -102,12 +94,7 @@ TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
   record.prepare(paper.learning_samples(), 4);
   f.send(CommandKind::kArm);
   f.clock.step();
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = &paper;
-  start.correction = &correction;
-  start.record = &record;
-  start.trial_id = 42;
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 0, 42);
   f.core.send(start);
   f.clock.step(100);
   EXPECT_EQ(f.core.state(), EngineState::kRunning);

@@ -70,13 +70,11 @@ TEST(RealtimeLoop, HungConsoleTripsTheHeartbeatGuard) {
   core.monitor_heartbeat(true);
   RealtimeLoop loop(core, arm, 1.0);
   loop.start(RealtimeMode::kOff);
-  EngineCommand command;
-  command.kind = CommandKind::kArm;
-  core.send(command);
+  core.send(EngineCommand::of(CommandKind::kArm));
   const auto start = std::chrono::steady_clock::now();
-  command.kind = CommandKind::kHeartbeat;
+  const EngineCommand heartbeat = EngineCommand::of(CommandKind::kHeartbeat);
   while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(500)) {  // a live console
-    core.send(command);
+    core.send(heartbeat);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_EQ(core.state(), EngineState::kArmed);
