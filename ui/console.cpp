@@ -105,9 +105,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   // Vent: disarm through the engine (heartbeats continue meanwhile), then stop the loop.
   // (A quit from the keyboard has sent the disarm already; a signal has stopped the engine.)
   if (report.exited_after_time && valves_live(setup.core->state())) {
-    EngineCommand disarm;
-    disarm.kind = CommandKind::kDisarm;
-    setup.core->send(disarm);
+    setup.core->send(EngineCommand::of(CommandKind::kDisarm));
   }
   const double quit_s = monotonic_s();
   while (valves_live(setup.core->state()) && monotonic_s() - quit_s < kDisarmWaitS) {

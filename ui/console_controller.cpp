@@ -87,10 +87,13 @@ bool ConsoleController::send(const EngineCommand& command, const char* what) {
   return false;
 }
 
-void ConsoleController::send_simple(CommandKind kind, const char* what) {
-  EngineCommand command;
-  command.kind = kind;
-  send(command, what);
+void ConsoleController::send_simple(CommandKind kind, const char* what) { send(EngineCommand::of(kind), what); }
+
+void ConsoleController::send_gains() {
+  const ControllerParameters& c = state_.config.controller;
+  EngineCommand gains = EngineCommand::of(CommandKind::kSetGains);
+  gains.gains = {c.k_ff, c.k_p, c.k_i_per_s, c.k_d_s};
+  send(gains, "set gains");
 }
 
 void ConsoleController::start(double now_s) {
@@ -100,11 +103,7 @@ void ConsoleController::start(double now_s) {
   if (selected_trajectories_.empty() || selected_trajectories_.back() != state_.experiment.trajectory) {
     select_trajectory(state_.experiment.trajectory);
   }
-  EngineCommand gains;
-  gains.kind = CommandKind::kSetGains;
-  gains.gains = {state_.config.controller.k_ff, state_.config.controller.k_p, state_.config.controller.k_i_per_s,
-                 state_.config.controller.k_d_s};
-  send(gains, "set gains");
+  send_gains();
   rebuild_law();
   log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
                                    env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
@@ -113,10 +112,7 @@ void ConsoleController::start(double now_s) {
 
 void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> trajectory) {
   selected_trajectories_.push_back(trajectory);
-  EngineCommand select;
-  select.kind = CommandKind::kSelectTrajectory;
-  select.trajectory = selected_trajectories_.back().get();
-  send(select, "select trajectory");
+  send(EngineCommand::select_trajectory(*selected_trajectories_.back()), "select trajectory");
 }
 
 void ConsoleController::heartbeat(double now_s) {
@@ -134,9 +130,7 @@ void ConsoleController::heartbeat(double now_s) {
     }
   }
   if (last_heartbeat_s_ >= 0.0 && now_s - last_heartbeat_s_ < kHeartbeatPeriodS) return;
-  EngineCommand beat;
-  beat.kind = CommandKind::kHeartbeat;
-  if (env_.core->send(beat)) last_heartbeat_s_ = now_s;
+  if (env_.core->send(EngineCommand::of(CommandKind::kHeartbeat))) last_heartbeat_s_ = now_s;
 }
 
 void ConsoleController::update(double now_s) {
@@ -342,14 +336,9 @@ void ConsoleController::begin_trial() {
   trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample);
   trial->id = ++last_trial_id_;
   trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
-  EngineCommand start;
-  start.kind = CommandKind::kStartTrial;
-  start.trajectory = trial->trajectory.get();
-  start.correction = &trial->correction_bar;
-  start.record = &trial->record;
-  start.settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
-  start.trial_id = trial->id;
-  if (!send(start, "start trial")) {
+  const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
+  if (!send(EngineCommand::start_trial(*trial->trajectory, trial->correction_bar, trial->record, settle_ticks, trial->id),
+            "start trial")) {
     end_run("the trial was not started", true);
     return;
   }
@@ -440,8 +429,7 @@ void ConsoleController::end_run(const std::string& why, bool important) {
 }
 
 void ConsoleController::emergency_stop(const std::string& why) {
-  EngineCommand stop;
-  stop.kind = CommandKind::kEmergencyStop;
+  const EngineCommand stop = EngineCommand::of(CommandKind::kEmergencyStop);
   bool sent = false;
   for (int attempt = 0; attempt < 1000 && !(sent = env_.core->send(stop)); ++attempt) {
     // The queue is drained every tick; a full queue empties within a few ticks.

@@ -75,6 +75,7 @@ class ConsoleController {
   // Engine side (console_controller.cpp).
   bool send(const EngineCommand& command, const char* what);
   void send_simple(CommandKind kind, const char* what);
+  void send_gains();  // the current configuration's PID gains
   void poll_engine(double now_s);
   void on_event(const EngineEvent& event);
   void poll_snapshot_and_telemetry(double now_s);

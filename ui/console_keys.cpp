@@ -471,11 +471,7 @@ void ConsoleController::apply_tuning(int field, const std::string& text) {
   if (f.learning_weight) {
     rebuild_law();
   } else {
-    EngineCommand gains;
-    gains.kind = CommandKind::kSetGains;
-    gains.gains = {candidate.controller.k_ff, candidate.controller.k_p, candidate.controller.k_i_per_s,
-                   candidate.controller.k_d_s};
-    send(gains, "set gains");
+    send_gains();
   }
   set_status(format("%s = %g from the next trial on", f.label, value));
 }

@@ -121,10 +121,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
                                   adopted.best_rms_deg()));
   if (!at_start) {
     select_trajectory(adopted.trajectory);
-    EngineCommand gains;
-    gains.kind = CommandKind::kSetGains;
-    gains.gains = {config.controller.k_ff, config.controller.k_p, config.controller.k_i_per_s, config.controller.k_d_s};
-    send(gains, "set gains");
+    send_gains();
     rebuild_law();
     state_.screen = Screen::kMain;
     set_status("opened " + adopted.session_location);
