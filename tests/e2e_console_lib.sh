@@ -11,6 +11,7 @@ E2E_SOCKET="bellows-${E2E_NAME}-$$"
 E2E_DIR="$(mktemp -d "${TMPDIR:-/tmp}/${E2E_NAME}-XXXXXX")"
 E2E_WAIT_S="${E2E_WAIT_S:-90}"
 export LC_ALL=C.UTF-8  # tmux's own client (capture-pane) reads and writes UTF-8
+unset TMUX             # the tests may run inside a tmux session themselves
 
 e2e_tmux() { tmux -L "$E2E_SOCKET" "$@"; }
 
@@ -48,7 +49,7 @@ e2e_start() {
 
 e2e_keys() { e2e_tmux send-keys -t console "$@"; }
 e2e_screen() { e2e_tmux capture-pane -p -t console; }
-e2e_history() { e2e_tmux capture-pane -p -S - -t console; }  # the screen and what scrolled off it
+e2e_history() { e2e_tmux capture-pane -p -J -S - -t console; }  # the screen and what scrolled off it
 e2e_resize() { e2e_tmux resize-window -t console -x "$1" -y "$2"; }
 
 # e2e_wait_for REGEX [SECONDS]: until the screen matches (grep -E).

@@ -200,7 +200,7 @@ void ConsoleController::on_event(const EngineEvent& event) {
       state_.screen = Screen::kFault;
       return;
     case EventKind::kTrialComplete:
-      if (in_flight_ && event.trial_id == in_flight_->id) finish_trial();
+      if (in_flight_ && event.trial_id == in_flight_->id) finish_trial(event.time_s);
       return;
     case EventKind::kTrialAborted:
       if (in_flight_ && event.trial_id == in_flight_->id) {
@@ -349,7 +349,7 @@ void ConsoleController::begin_trial() {
   ++revision_;
 }
 
-void ConsoleController::finish_trial() {
+void ConsoleController::finish_trial(double time_s) {
   Experiment& e = state_.experiment;
   Trial trial;
   trial.correction_bar = std::move(in_flight_->correction_bar);
@@ -363,7 +363,8 @@ void ConsoleController::finish_trial() {
   const IterationSummary& s = e.trials.back().summary;
   if (follow || state_.inspector.trial < 0) state_.inspector.trial = static_cast<int>(e.trials.size()) - 1;
   log(LogSource::kEngine, format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar", s.iteration,
-                                 s.rms_deg, s.max_abs_error_deg, s.max_abs_correction_bar));
+                                 s.rms_deg, s.max_abs_error_deg, s.max_abs_correction_bar),
+      false, time_s);
   set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;

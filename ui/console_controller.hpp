@@ -82,7 +82,7 @@ class ConsoleController {
   void poll_tasks();
   void heartbeat(double now_s);
   void begin_trial();
-  void finish_trial();
+  void finish_trial(double time_s);
   void drop_trial(const std::string& why);
   void continue_run();
   void step();

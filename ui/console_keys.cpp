@@ -37,7 +37,7 @@ void ConsoleController::handle_key(int k, double now_s) {
   ++revision_;
   if (k == key::kResize) return;
   if (k == ' ') {  // from every screen and every dialog
-    emergency_stop("operator: EMERGENCY STOP (Space)");
+    emergency_stop("EMERGENCY STOP (Space)");
     return;
   }
   if (state_.dialog.kind != DialogKind::kNone) {
@@ -285,7 +285,7 @@ void ConsoleController::perform(Action action) {
       }
       return;
     case Action::kEmergencyStop:
-      emergency_stop("operator: EMERGENCY STOP (Space)");
+      emergency_stop("EMERGENCY STOP (Space)");
       return;
     case Action::kArm: {
       const Trajectory& t = *state_.experiment.trajectory;

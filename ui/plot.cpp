@@ -125,8 +125,8 @@ void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& 
 
   // Axes and labels.
   for (int y = 0; y < rows; ++y) canvas.put_glyph(left - 1, top + y, options.braille ? U'│' : U'|', Role::kDim);
-  canvas.put(area.x, top, fit(label(options.y_format.c_str(), r.y_max), kLabelWidth), Role::kDim);
-  canvas.put(area.x, top + rows - 1, fit(label(options.y_format.c_str(), r.y_min), kLabelWidth), Role::kDim);
+  canvas.put(area.x, top, fit(label(options.y_format, r.y_max), kLabelWidth), Role::kDim);
+  canvas.put(area.x, top + rows - 1, fit(label(options.y_format, r.y_min), kLabelWidth), Role::kDim);
   if (r.y_min < 0.0 && r.y_max > 0.0) {
     const int zero_row = static_cast<int>(std::lround((r.y_max / (r.y_max - r.y_min)) * (rows - 1)));
     if (zero_row > 0 && zero_row < rows - 1) {

@@ -21,8 +21,8 @@ struct PlotSeries {
 
 struct PlotOptions {
   bool braille = true;
-  std::string x_unit;                 // e.g. "s"
-  std::string y_format = "%.1f";      // printf format of the y labels
+  const char* x_unit = "";            // e.g. "s"
+  const char* y_format = "%.1f";      // printf format of the y labels
   std::optional<double> cursor_x;     // a vertical cursor line at this x
   std::optional<double> y_min, y_max; // fixed range; otherwise from the data (with a margin)
   bool integer_x = false;             // x labels as whole numbers (iterations)

@@ -3,6 +3,7 @@
 #include <langinfo.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -104,6 +105,9 @@ Terminal::Terminal(bool allow_colors) {
   if (isatty(STDIN_FILENO) == 0 || isatty(STDOUT_FILENO) == 0) {
     throw InputError("the console needs a terminal on stdin and stdout (for headless runs: bellows run)");
   }
+  // Suspending the console (Ctrl-Z) would stop the engine thread with it: ignored. Set before
+  // newterm, which then leaves SIGTSTP alone.
+  std::signal(SIGTSTP, SIG_IGN);
   const char* term = std::getenv("TERM");
   SCREEN* screen = newterm(term, stdout, stdin);
   if (screen == nullptr) {
