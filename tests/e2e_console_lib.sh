@@ -25,26 +25,32 @@ e2e_fail() {
   echo "FAIL ($E2E_NAME): $*" >&2
   echo "---- screen ----" >&2
   e2e_screen >&2 || true
+  echo "---- pane ----" >&2
+  local pid
+  pid="$(e2e_pid 2>/dev/null || true)"
+  [ -n "$pid" ] && grep -E '^(Name|State)' "/proc/$pid/status" >&2 || echo "no bellows process" >&2
   exit 1
 }
 
 # e2e_start WIDTH HEIGHT [ENV=VALUE...] -- ARGS...: starts `bellows ARGS` in a WIDTHxHEIGHT window.
+# A shell in the pane runs it in the foreground, reaps it and prints "EXIT STATUS n" after it (tmux
+# 3.3a does not always reap a pane's process, so its #{pane_dead_status} cannot be relied on).
 e2e_start() {
   local width="$1" height="$2"
   shift 2
   local env=("XDG_DATA_HOME=$E2E_DIR/data" "LC_ALL=C.UTF-8" "TERM=screen")
   while [ $# -gt 0 ] && [ "$1" != "--" ]; do env+=("$1"); shift; done
   [ "${1:-}" = "--" ] && shift
-  local command="exec env"
-  for e in "${env[@]}"; do command+=" $(printf '%q' "$e")"; done
-  command+=" $(printf '%q' "$BELLOWS")"
-  for a in "$@"; do command+=" $(printf '%q' "$a")"; done
+  local program="env"
+  for e in "${env[@]}"; do program+=" $(printf '%q' "$e")"; done
+  program+=" $(printf '%q' "$BELLOWS")"
+  for a in "$@"; do program+=" $(printf '%q' "$a")"; done
   if ! e2e_tmux has-session -t keep 2>/dev/null; then
     e2e_tmux new-session -d -s keep -x 80 -y 24 "sleep 100000"
-    e2e_tmux set-option -g remain-on-exit on
   fi
   e2e_tmux kill-session -t console 2>/dev/null || true
-  e2e_tmux new-session -d -s console -x "$width" -y "$height" "$command"
+  e2e_tmux new-session -d -s console -x "$width" -y "$height" \
+    "$program; echo \"EXIT STATUS \$?\"; exec sleep 100000"
 }
 
 e2e_keys() { e2e_tmux send-keys -t console "$@"; }
@@ -58,7 +64,7 @@ e2e_wait_for() {
   local deadline=$((SECONDS + limit))
   while [ $SECONDS -lt $deadline ]; do
     if e2e_screen | grep -qE -- "$pattern"; then return 0; fi
-    if [ "$(e2e_tmux display-message -p -t console '#{pane_dead}')" = "1" ]; then
+    if e2e_history | grep -qE '^EXIT STATUS [0-9]+'; then
       e2e_screen | grep -qE -- "$pattern" && return 0
       e2e_fail "the console exited while waiting for /$pattern/"
     fi
@@ -75,8 +81,10 @@ e2e_wait_exit() {
   local limit="${1:-$E2E_WAIT_S}"
   local deadline=$((SECONDS + limit))
   while [ $SECONDS -lt $deadline ]; do
-    if [ "$(e2e_tmux display-message -p -t console '#{pane_dead}')" = "1" ]; then
-      e2e_tmux display-message -p -t console '#{pane_dead_status}'
+    local line
+    line="$(e2e_history | grep -oE '^EXIT STATUS [0-9]+' | tail -1)"
+    if [ -n "$line" ]; then
+      echo "${line#EXIT STATUS }"
       return 0
     fi
     sleep 0.2
@@ -84,7 +92,12 @@ e2e_wait_exit() {
   e2e_fail "the console did not exit within ${limit} s"
 }
 
-e2e_pid() { e2e_tmux display-message -p -t console '#{pane_pid}'; }
+# The bellows process: the child of the pane's shell (env execs it).
+e2e_pid() {
+  local shell
+  shell="$(e2e_tmux display-message -p -t console '#{pane_pid}')"
+  awk '{print $1; exit}' "/proc/$shell/task/$shell/children"
+}
 
 # The RMS list of the main screen as "iteration rms" lines.
 e2e_rms_list() {

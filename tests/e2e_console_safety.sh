@@ -25,6 +25,7 @@ e2e_wait_for 'Arm the valves\?'
 e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 kill -TERM "$(e2e_pid)"
-[ "$(e2e_wait_exit)" = "143" ] || e2e_fail "exit status after SIGTERM"
+status="$(e2e_wait_exit)"
+[ "$status" = "143" ] || e2e_fail "exit status after SIGTERM: $status ($(e2e_tmux display-message -p -t console "signal #{pane_dead_signal}"))"
 e2e_output_has 'valves vented'
 echo ok
