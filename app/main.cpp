@@ -6,6 +6,7 @@
 
 #include "app/config_file.hpp"
 #include "app/console_command.hpp"
+#include "app/identify_command.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
 #include "engine/errors.hpp"
@@ -71,6 +72,16 @@ int main(int argc, char** argv) {
   config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
 
   bellows::install_stop_signal_handlers();
+
+  bellows::IdentifyOptions identify;
+  CLI::App* identify_cmd =
+      app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
+  identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
+  identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
+  identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
+  identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -87,6 +98,9 @@ int main(int argc, char** argv) {
           config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);
       std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
       return 0;
+    }
+    if (identify_cmd->parsed()) {
+      return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
     }
     // No subcommand (or `console`): the operator console.
     return bellows::console_command(console, std::cout);

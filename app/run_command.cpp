@@ -7,13 +7,16 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/learning_report.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
+#include "engine/convergence.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
+#include "engine/learning_monitor.hpp"
 #include "engine/learning_session.hpp"
 
 namespace bellows {
@@ -68,6 +71,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
+  const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
+  if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
+  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
 
   nlohmann::json iterations = nlohmann::json::array();
   int status = 0;
@@ -76,7 +82,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     for (int i = 0; i <= options.iterations; ++i) {
       const IterationSummary s = session.run_trial();
       progress << progress_line(s) << std::endl;
-      iterations.push_back(to_json(s));
+      nlohmann::json iteration = to_json(s);
+      iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
+      iterations.push_back(iteration);
       if (i < options.iterations) session.learn();
     }
   } catch (const EngineFault& fault) {
@@ -86,6 +94,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   }
   if (loop != nullptr) loop->stop();  // vents
   else arm.vent();
+  if (monitor.windup().detected) {
+    progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
+             << ": the correction keeps growing where the set points saturate (largest clamped excess "
+             << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
+  }
 
   if (options.json) {
     nlohmann::json report = {{"device", arm.name()},
@@ -94,6 +107,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"seed", options.seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
+                             {"prediction", prediction_json(prediction)},
+                             {"windup", windup_json(monitor.windup())},
                              {"iterations", iterations}};
     if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
     if (loop != nullptr) {

@@ -24,7 +24,7 @@ wait_for() {
   for _ in $(seq 1 300); do screen | grep -qE "$1" && return 0; sleep 0.2; done
   echo "timed out waiting for /$1/" >&2; screen >&2; exit 1
 }
-wait_for 'law noilc-dense  M'
+wait_for 'law [a-z-]+  M'
 tmux -L "$socket" send-keys -t console a
 wait_for 'Arm the valves'
 tmux -L "$socket" send-keys -t console y

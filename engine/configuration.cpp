@@ -72,6 +72,25 @@ std::vector<ParameterBinding> make_bindings() {
       number("ilc", "m", "", "weight M = m I on the predicted error", kNonNeg, [](C& c) { return &c.ilc.m; }),
       number("ilc", "s", "", "weight S = s I on the change of correction", kNonNeg, [](C& c) { return &c.ilc.s; }),
       number("ilc", "w", "", "weight W = w I on the correction's rate", kNonNeg, [](C& c) { return &c.ilc.w; }),
+      number("ilc", "admm_rho", "", "noilc-constrained: ADMM penalty", kPos, [](C& c) { return &c.ilc.admm_rho; }),
+      whole("ilc", "admm_max_iterations", "noilc-constrained: ADMM iteration limit per update", [](C& c) { return &c.ilc.admm_max_iterations; }),
+      number("ilc", "admm_tolerance", "bar", "noilc-constrained: ADMM residual tolerance", kPos, [](C& c) { return &c.ilc.admm_tolerance; }),
+      number("ilc", "limit_margin_bar", "bar", "noilc-constrained: keep u_pid + u_ilc this far inside the pressure limits", kNonNeg, [](C& c) { return &c.ilc.limit_margin_bar; }),
+      number("ilc", "pd_kp", "", "pd: proportional learning gain", kAny, [](C& c) { return &c.ilc.pd_kp; }),
+      number("ilc", "pd_kd_s", "s", "pd: derivative learning gain", kAny, [](C& c) { return &c.ilc.pd_kd_s; }),
+      number("ilc", "pd_q_cutoff_hz", "Hz", "pd: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.pd_q_cutoff_hz; }),
+      number("ilc", "gradient_step", "", "gradient: step as a fraction of 1/||P||^2, in (0, 2)", kPos, [](C& c) { return &c.ilc.gradient_step; }),
+      number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", kPos, [](C& c) { return &c.ilc.inverse_gain; }),
+      number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
+      number("ilc", "prediction_model_error", "", "convergence prediction: relative error of kappa and omega0 on the grid", Constraint::kFraction, [](C& c) { return &c.ilc.prediction_model_error; }),
+      whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", [](C& c) { return &c.ilc.prediction_grid_points; }),
+      // [identify]
+      number("identify", "amplitude_deg", "deg", "excitation amplitude of the reference angle", kPos, [](C& c) { return &c.identify.amplitude_deg; }),
+      number("identify", "max_abs_angle_deg", "deg", "abort the identification trial beyond this angle", kPos, [](C& c) { return &c.identify.max_abs_angle_deg; }),
+      number("identify", "duration_s", "s", "length of each identification trial", kPos, [](C& c) { return &c.identify.duration_s; }),
+      number("identify", "chirp_start_hz", "Hz", "chirp: start frequency", kPos, [](C& c) { return &c.identify.chirp_start_hz; }),
+      number("identify", "chirp_end_hz", "Hz", "chirp: end frequency", kPos, [](C& c) { return &c.identify.chirp_end_hz; }),
+      number("identify", "step_hold_s", "s", "steps: time between steps", kPos, [](C& c) { return &c.identify.step_hold_s; }),
       // [timing]
       number("timing", "tick_s", "s", "loop period (pressure controllers, PWM)", kPos, [](C& c) { return &c.timing.tick_s; }),
       whole("timing", "ticks_per_sample", "loop ticks per ILC sample", [](C& c) { return &c.timing.ticks_per_sample; }),
@@ -94,10 +113,16 @@ std::vector<ParameterBinding> make_bindings() {
   fault.text = [](C& c) { return &c.plant.fault; };
   const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
   b.insert(after_plant, fault);
-  ParameterBinding law{"ilc", "law", "", "learning law (see docs/learning-laws.md)", Constraint::kAny, {}, {}, {}};
+  ParameterBinding law{"ilc", "law", "", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
+                       Constraint::kAny, {}, {}, {}};
   law.text = [](C& c) { return &c.ilc.law; };
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
   b.insert(first_ilc, law);
+  ParameterBinding signal{"identify", "signal", "", "excitation of the identification trial: chirp or steps",
+                          Constraint::kAny, {}, {}, {}};
+  signal.text = [](C& c) { return &c.identify.signal; };
+  const auto first_identify = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "identify"; });
+  b.insert(first_identify, signal);
   return b;
 }
 

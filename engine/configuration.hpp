@@ -18,6 +18,7 @@ struct Configuration {
   ModelParameters model;
   ControllerParameters controller;
   IlcParameters ilc;
+  IdentificationParameters identify;
   TimingParameters timing;
   TrajectoryLimits trajectory;
   SafetyParameters safety;

@@ -3,11 +3,20 @@
 // weights and trial length (their expensive set-up happens there) and then updated per trial.
 #pragma once
 
-#include <Eigen/Dense>
-#include <memory>
+#include <complex>
+#include <optional>
 #include <string>
 
+#include <Eigen/Dense>
+
 namespace bellows {
+
+/// How a linear, time-invariant law acts on one frequency of an everlasting trial:
+/// U_{j+1} = from_correction * U_j + from_error * E_j (E_j the error at samples 1..N).
+struct LawFrequencyResponse {
+  std::complex<double> from_correction;
+  std::complex<double> from_error;
+};
 
 class LearningLaw {
  public:
@@ -18,6 +27,17 @@ class LearningLaw {
   /// The configuration name of the law, e.g. "noilc-dense".
   virtual std::string name() const = 0;
   virtual int samples() const = 0;
+
+  /// What the last trial's feedback contributed, u_pid(0..N-1) in bar, and the largest |u_pid + u_ilc|
+  /// the set-point clamp lets through (p_max - p0). Called before update(); laws that keep the
+  /// correction within the pressure limits use it, the others ignore it.
+  virtual void set_input_context(const Eigen::Ref<const Eigen::VectorXd>& /*feedback_bar*/, double /*input_limit_bar*/) {}
+
+  /// The law's frequency response at `theta_rad_per_sample` in (0, pi], for convergence prediction;
+  /// empty for laws that are not linear and time-invariant away from the trial's ends.
+  virtual std::optional<LawFrequencyResponse> frequency_response(double /*theta_rad_per_sample*/) const {
+    return std::nullopt;
+  }
 };
 
 }  // namespace bellows

@@ -93,6 +93,8 @@ IterationSummary LearningSession::run_trial() {
 }
 
 void LearningSession::learn() {
+  law_.set_input_context(record_.samples.u_pid_bar.head(record_.learning_samples),
+                         controller_.p_max_bar - controller_.gas.ambient_bar);
   law_.update(correction_, record_.normalized_error(), next_correction_);
   correction_.swap(next_correction_);
   ++iteration_;

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "engine/errors.hpp"
+#include "engine/noilc_riccati.hpp"
 
 namespace bellows {
 
@@ -17,7 +18,7 @@ Eigen::MatrixXd rate_difference_matrix(int samples, double sample_time_s) {
 }
 
 NormOptimalDense::NormOptimalDense(const DiscreteArmModel& model, const IlcParameters& weights, int samples)
-    : weights_(weights) {
+    : model_(model), weights_(weights) {
   if (samples < 2) throw InputError("norm-optimal ILC needs at least 2 samples, got " + std::to_string(samples));
   lifted_ = model.lifted(samples);
   rate_ = rate_difference_matrix(samples, model.sample_time_s);
@@ -36,6 +37,15 @@ void NormOptimalDense::update(const Eigen::Ref<const Eigen::VectorXd>& u_j, cons
   rhs_.noalias() = tracking_plus_change_ * u_j;
   rhs_.noalias() += weights_.m * lifted_.transpose() * e_j;
   u_next = factor_.solve(rhs_);
+}
+
+std::optional<LawFrequencyResponse> NormOptimalDense::frequency_response(double theta_rad_per_sample) const {
+  return norm_optimal_frequency_response(model_, weights_, theta_rad_per_sample);
+}
+
+std::size_t NormOptimalDense::memory_bytes() const {
+  const auto n = static_cast<std::size_t>(lifted_.rows());
+  return sizeof(double) * (4 * n * n + n);  // P, D, P'MP + S, the factor, and the right-hand side
 }
 
 Eigen::VectorXd NormOptimalDense::cost_gradient(const Eigen::VectorXd& u_j, const Eigen::VectorXd& e_j,

@@ -6,6 +6,8 @@
 // this dense one is the reference it is tested against.
 #pragma once
 
+#include <cstddef>
+
 #include "engine/arm_model.hpp"
 #include "engine/learning_law.hpp"
 #include "engine/parameters.hpp"
@@ -23,12 +25,17 @@ class NormOptimalDense final : public LearningLaw {
               Eigen::Ref<Eigen::VectorXd> u_next) override;
   std::string name() const override { return "noilc-dense"; }
   int samples() const override { return static_cast<int>(lifted_.rows()); }
+  std::optional<LawFrequencyResponse> frequency_response(double theta_rad_per_sample) const override;
+
+  /// Bytes held by the dense matrices and the factor (what grows with N).
+  std::size_t memory_bytes() const;
 
   /// Gradient of the cost J(u) at `u_next` for the given u_j, e_j: zero at the optimum.
   Eigen::VectorXd cost_gradient(const Eigen::VectorXd& u_j, const Eigen::VectorXd& e_j,
                                 const Eigen::VectorXd& u_next) const;
 
  private:
+  DiscreteArmModel model_;
   IlcParameters weights_;
   Eigen::MatrixXd lifted_;          // P
   Eigen::MatrixXd rate_;            // D

@@ -70,12 +70,43 @@ struct ControllerParameters {
   GasParameters gas{};
 };
 
-/// Norm-optimal ILC weights (spec section 5): M = m I, S = s I, W = w I.
+/// The learning law and its parameters. Norm-optimal weights (spec section 5): M = m I, S = s I, W = w I.
 struct IlcParameters {
-  std::string law = "noilc-dense";  // which learning law runs between trials
+  std::string law = "noilc";  // which learning law runs between trials (engine/learning_law_factory)
   double m = 1.0;
   double s = 0.1;
   double w = 2.0e-5;
+  // noilc-constrained: ADMM on the pressure-limit bounds
+  double admm_rho = 1.0;            // penalty of the ADMM splitting (same units as s)
+  int admm_max_iterations = 2000;
+  double admm_tolerance = 1.0e-7;   // bar, on the primal and dual residuals
+  double limit_margin_bar = 0.0;    // keep u_pid + u_ilc this far inside the pressure limits
+  // pd: u_{j+1} = Q[u_j + k_p e + k_d de/dt]
+  // (defaults: the best tuning on the paper scenario among those predicted to converge on the
+  // nominal model, see docs/learning-laws.md)
+  double pd_kp = 0.3;
+  double pd_kd_s = 0.01;
+  double pd_q_cutoff_hz = 3.5;
+  // gradient: u_{j+1} = u_j + (step / ||P||^2) P' e
+  double gradient_step = 1.0;
+  // inverse: u_{j+1} = Q[u_j + gain P^-1 e]
+  double inverse_gain = 0.3;
+  double inverse_q_cutoff_hz = 8.0;
+  // convergence prediction before a run: grid of kappa and omega0 errors
+  double prediction_model_error = 0.3;  // +-30 %
+  int prediction_grid_points = 5;       // per parameter
+};
+
+/// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's
+/// angle and chamber pressures are recorded; kappa, omega0 and delta are fitted to them.
+struct IdentificationParameters {
+  std::string signal = "chirp";   // "chirp" or "steps"; the other one is the held-out validation trial
+  double amplitude_deg = 20.0;    // excitation amplitude of the reference angle
+  double max_abs_angle_deg = 60.0;  // the trial is aborted (valves vented) beyond this angle
+  double duration_s = 20.0;
+  double chirp_start_hz = 0.1;
+  double chirp_end_hz = 3.0;
+  double step_hold_s = 1.0;       // time between steps of the step sequence
 };
 
 /// Timing of the loop: the tick (pressure controllers, PWM) and the ILC sample (PID, ILC).

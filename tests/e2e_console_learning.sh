@@ -6,7 +6,7 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 120 40 -- console --speed max --trajectory steps
 e2e_wait_for 'Bellows +SAFE '
-e2e_wait_for 'law noilc-dense  M'  # the learning law is ready
+e2e_wait_for 'law [a-z-]+  M'  # the learning law is ready
 
 # Arm: asks first.
 e2e_keys a
@@ -21,7 +21,7 @@ e2e_keys Up
 e2e_wait_for 'paper: 8.0 s, 400 samples'
 e2e_keys Enter
 e2e_wait_for 'trajectory paper \(8.0 s\)'
-e2e_wait_for 'law noilc-dense  M'  # rebuilt for 400 samples
+e2e_wait_for 'law [a-z-]+  M'  # rebuilt for 400 samples
 
 # Five iterations.
 e2e_keys N

@@ -39,7 +39,7 @@ ConsoleState sample_state(int trials, bool unicode) {
   s.loop.p99_us = 51;
   s.loop.max_us = 80;
   s.loop.rt = "fifo";
-  s.law_name = "noilc-dense";
+  s.law_name = "noilc";
   s.law_ready = true;
   auto trajectory = std::make_shared<const Trajectory>(library_trajectory("paper", 0.02));
   s.experiment = Experiment::start(trajectory);

@@ -411,7 +411,11 @@ void ConsoleController::step() {
   }
   const Trial& last = e.trials.back();
   state_.run.phase = RunProgress::Phase::kLearning;
-  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error()] {
+  const Eigen::Index n = last.correction_bar.size();
+  const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
+  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error(),
+                     feedback = Eigen::VectorXd(last.record.samples.u_pid_bar.head(n)), input_limit_bar] {
+    law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
     Eigen::VectorXd next(u.size());
     law->update(u, error, next);
     return next;

@@ -93,7 +93,13 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   int y = in.y;
   c.put(in.x + 1, y++, "PID gains, normalized units: sent to the engine", Role::kTitle, true);
   for (std::size_t i = 0; i < fields.size() && y < in.bottom(); ++i) {
-    if (i == 4) c.put(in.x + 1, y++, "Learning weights M, S, W (times I): the law " + s.law_name + " is rebuilt", Role::kTitle, true);
+    if (i == 4) {
+      const bool norm_optimal = s.law_name.rfind("noilc", 0) == 0;
+      c.put(in.x + 1, y++,
+            norm_optimal ? "Learning weights M, S, W (times I): the law " + s.law_name + " is rebuilt"
+                         : "Learning weights M, S, W: not used by the law " + s.law_name + " ([ilc] law chooses it)",
+            norm_optimal ? Role::kTitle : Role::kDim, true);
+    }
     const TuningField& f = fields[i];
     const bool selected = static_cast<int>(i) == s.tuning.selected;
     const std::string row = format("%s %-5s %12.6g %-4s  %-24s %s", selected ? ">" : " ", f.label,

@@ -1,0 +1,184 @@
+#include "app/identify_command.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/config_file.hpp"
+#include "devices/simulated_arm.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/errors.hpp"
+#include "engine/identification.hpp"
+#include "engine/identification_trial.hpp"
+
+namespace bellows {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t\r") - begin + 1);
+}
+
+std::string format_value(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+struct TrialFit {
+  std::string signal;
+  IdentificationData data;
+};
+
+TrialFit record_trial(const Configuration& config, const std::string& signal, std::uint64_t seed) {
+  SimulatedArm arm(config.plant, seed);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  SimulatedClock clock(core, arm);
+  const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
+  TrialRecord record;
+  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record);
+  arm.vent();
+  return {signal, identification_data(record, config.controller, config.timing.tick_s)};
+}
+
+nlohmann::json model_json(const ModelParameters& m) {
+  return {{"kappa", m.kappa_rad_per_bar}, {"omega0", m.omega0_rad_per_s}, {"damping", m.damping}};
+}
+
+void write_text_atomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::trunc);
+    if (!out) throw InputError("cannot write " + temporary);
+    out << text;
+    if (!out.flush()) throw InputError("cannot write " + temporary);
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw InputError("cannot replace " + path + ": " + error.message());
+}
+
+}  // namespace
+
+std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model) {
+  const std::vector<std::pair<std::string, double>> values = {
+      {"kappa", model.kappa_rad_per_bar}, {"omega0", model.omega0_rad_per_s}, {"damping", model.damping}};
+  std::vector<std::string> lines;
+  std::istringstream in(toml_text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+
+  std::vector<bool> written(values.size(), false);
+  bool in_model = false;
+  long header = -1, section_end = -1;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string t = trim(lines[i]);
+    if (!t.empty() && t.front() == '[') {
+      if (in_model) section_end = static_cast<long>(i);
+      in_model = t.rfind("[model]", 0) == 0 && (t.size() == 7 || trim(t.substr(7)).rfind('#', 0) == 0);
+      if (in_model) header = static_cast<long>(i);
+      continue;
+    }
+    if (!in_model) continue;
+    const auto equals = t.find('=');
+    if (equals == std::string::npos) continue;
+    const std::string key = trim(t.substr(0, equals));
+    for (std::size_t v = 0; v < values.size(); ++v) {
+      if (key == values[v].first) {
+        lines[i] = values[v].first + " = " + format_value(values[v].second) + "  # fitted by bellows identify";
+        written[v] = true;
+      }
+    }
+  }
+  if (in_model && section_end < 0) section_end = static_cast<long>(lines.size());
+  std::vector<std::string> missing;
+  for (std::size_t v = 0; v < values.size(); ++v) {
+    if (!written[v]) missing.push_back(values[v].first + " = " + format_value(values[v].second) + "  # fitted by bellows identify");
+  }
+  if (header < 0) {
+    if (!lines.empty() && !trim(lines.back()).empty()) lines.emplace_back();
+    lines.emplace_back("[model]");
+    lines.insert(lines.end(), missing.begin(), missing.end());
+  } else {
+    lines.insert(lines.begin() + header + 1, missing.begin(), missing.end());
+  }
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  Configuration check;
+  apply_config_toml(text, source_name, check);  // never write a file the loader would reject
+  if (check.model.kappa_rad_per_bar != std::stod(format_value(model.kappa_rad_per_bar))) {
+    throw InputError("config " + source_name + ": [model] could not be updated in place (dotted or inline keys?)");
+  }
+  return text;
+}
+
+int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress) {
+  Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  if (!options.signal.empty()) config.identify.signal = options.signal;
+  const std::string estimation_signal = config.identify.signal;
+  const std::string held_out_signal = validation_signal(estimation_signal);
+  std::string existing_text;
+  if (!options.write_model_path.empty() && std::filesystem::exists(options.write_model_path)) {
+    std::ifstream in(options.write_model_path);
+    if (!in) throw InputError("config " + options.write_model_path + ": cannot be read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    existing_text = text.str();
+    Configuration check;
+    apply_config_toml(existing_text, options.write_model_path, check);  // fail before any trial runs
+  }
+
+  progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
+           << config.identify.duration_s << " s)" << std::endl;
+  const TrialFit estimation = record_trial(config, estimation_signal, options.seed);
+  const ArmModelFit fit = fit_arm_model(estimation.data, config.model);
+  progress << "validation trial (" << held_out_signal << ")" << std::endl;
+  const TrialFit validation = record_trial(config, held_out_signal, options.seed + 1);
+  const double validation_fit =
+      normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
+  const double nominal_validation_fit =
+      normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
+
+  if (!options.write_model_path.empty()) {
+    write_text_atomically(options.write_model_path,
+                          with_model_section(existing_text, options.write_model_path, fit.model));
+    progress << "wrote [model] to " << options.write_model_path << std::endl;
+  }
+  if (options.json) {
+    const nlohmann::json report = {
+        {"device", "sim"},
+        {"signal", estimation_signal},
+        {"validation_signal", held_out_signal},
+        {"samples", estimation.data.angle_rad.size()},
+        {"sample_time_s", estimation.data.sample_time_s},
+        {"model", model_json(fit.model)},
+        {"initial_model", model_json(fit.initial)},
+        {"configured_model", model_json(config.model)},
+        {"fit_percent", fit.fit_percent},
+        {"validation_fit_percent", validation_fit},
+        {"configured_model_validation_fit_percent", nominal_validation_fit},
+        {"rms_residual_deg", fit.rms_residual_deg},
+        {"iterations", fit.iterations},
+        {"converged", fit.converged},
+        {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)}};
+    out << report.dump() << std::endl;
+  } else {
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "kappa %.4f rad/bar  omega0 %.4f 1/s  damping %.4f\n"
+                  "fit %.1f %% on %s, %.1f %% on held-out %s (configured model: %.1f %%), rms residual %.3f deg, "
+                  "%d iterations%s\n",
+                  fit.model.kappa_rad_per_bar, fit.model.omega0_rad_per_s, fit.model.damping, fit.fit_percent,
+                  estimation_signal.c_str(), validation_fit, held_out_signal.c_str(), nominal_validation_fit,
+                  fit.rms_residual_deg, fit.iterations, fit.converged ? "" : " (not converged)");
+    out << text;
+  }
+  return 0;
+}
+
+}  // namespace bellows

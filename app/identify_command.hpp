@@ -1,0 +1,29 @@
+// `bellows identify`: an identification trial on the device (the simulated arm), a least-squares
+// fit of kappa, omega0 and delta, a held-out validation trial with the other excitation, and
+// optionally the fitted values written into a config file's [model] section.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "engine/configuration.hpp"
+
+namespace bellows {
+
+struct IdentifyOptions {
+  std::string config_path;
+  std::string signal;  // overrides [identify] signal when set
+  std::uint64_t seed = 1;
+  bool json = false;
+  std::string write_model_path;  // config file whose [model] section receives the fit
+};
+
+int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress);
+
+/// `toml_text` with [model] kappa, omega0 and damping set to `model`: existing keys are replaced in
+/// place, missing ones added, everything else (comments, order, other sections) kept. The result is
+/// checked as a configuration; throws InputError naming `source_name` if it is not valid.
+std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model);
+
+}  // namespace bellows

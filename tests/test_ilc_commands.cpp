@@ -1,0 +1,125 @@
+// The binary's learning diagnostics and the identify subcommand, end to end.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class IlcCommands : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("bellows-ilc-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  Result bellows(const std::string& arguments) {
+    const auto out = dir_ / "stdout", err = dir_ / "stderr";
+    const std::string command = std::string(BELLOWS_BINARY) + " " + arguments + " >" + out.string() + " 2>" + err.string();
+    Result r;
+    const int raw = std::system(command.c_str());
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read_file(out);
+    r.err = read_file(err);
+    return r;
+  }
+  std::filesystem::path write(const std::string& name, const std::string& text) {
+    const auto path = dir_ / name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(IlcCommands, RunJsonCarriesPredictionAndPerIterationDiagnostics) {
+  const Result r = bellows("run --iterations 2 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["law"], "noilc");
+  ASSERT_TRUE(report["prediction"]["available"].get<bool>());
+  EXPECT_LT(report["prediction"]["nominal"]["contraction"].get<double>(), 1.0);
+  EXPECT_EQ(report["prediction"]["grid"].size(), 25u);
+  EXPECT_FALSE(report["windup"]["detected"].get<bool>());
+  const auto& iterations = report["iterations"];
+  ASSERT_EQ(iterations.size(), 3u);
+  EXPECT_TRUE(iterations[0]["contraction"].is_null());
+  for (int i = 1; i <= 2; ++i) {
+    const double contraction = iterations[i]["contraction"].get<double>();
+    EXPECT_GT(contraction, 0.3);
+    EXPECT_LT(contraction, 1.0);
+    EXPECT_GT(iterations[i]["correction_change_bar"].get<double>(), 0.0);
+  }
+  for (const auto& it : iterations) {
+    EXPECT_TRUE(it.contains("saturated_samples"));
+    EXPECT_TRUE(it.contains("clamped_excess_bar"));
+    EXPECT_TRUE(it.contains("windup_samples"));
+  }
+}
+
+TEST_F(IlcCommands, RunWarnsBeforeALawPredictedToDiverge) {
+  const auto config = write("pd.toml", "[ilc]\nlaw = \"pd\"\npd_kp = 0.5\npd_kd_s = 0.05\npd_q_cutoff_hz = 5.0\n");
+  const Result r = bellows("run --iterations 0 --json --config " + config.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: learning law 'pd' is predicted to diverge"), std::string::npos) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_GT(report["prediction"]["nominal"]["contraction"].get<double>(), 1.0);
+  EXPECT_TRUE(report["prediction"]["warning"].is_string());
+}
+
+TEST_F(IlcCommands, UnknownLawIsABadInput) {
+  const auto config = write("bad.toml", "[ilc]\nlaw = \"magic\"\n");
+  const Result r = bellows("run --iterations 0 --config " + config.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("unknown learning law"), std::string::npos) << r.err;
+}
+
+TEST_F(IlcCommands, IdentifyRecoversTheCreepFreeArmAndWritesTheModelSection) {
+  const auto plant = write("plant.toml", "[plant]\ncreep_gain = 0.0\n");
+  const Result r = bellows("identify --json --config " + plant.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(report["model"]["kappa"].get<double>(), 7.91, 0.05 * 7.91);
+  EXPECT_NEAR(report["model"]["omega0"].get<double>(), 14.14, 0.05 * 14.14);
+  EXPECT_NEAR(report["model"]["damping"].get<double>(), 0.31, 0.05 * 0.31);
+  EXPECT_GT(report["validation_fit_percent"].get<double>(), 95.0);
+
+  const auto lab = write("lab.toml", "# rig 2\n[model]\nkappa = 7.91  # paper\n");
+  const Result written = bellows("identify --write-model " + lab.string());
+  ASSERT_EQ(written.status, 0) << written.err;
+  const std::string text = read_file(lab);
+  EXPECT_NE(text.find("# rig 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("omega0 = "), std::string::npos) << text;
+  EXPECT_EQ(text.find("kappa = 7.91  # paper"), std::string::npos) << text;
+  const Result run = bellows("run --iterations 1 --config " + lab.string());
+  EXPECT_EQ(run.status, 0) << run.err;
+}
+
+TEST_F(IlcCommands, IdentifyLeavesAnInvalidConfigUntouched) {
+  const std::string original = "[model]\nkappa = \"seven\"\n";
+  const auto lab = write("lab.toml", original);
+  const Result r = bellows("identify --write-model " + lab.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(read_file(lab), original);
+  EXPECT_EQ(bellows("identify --signal noise").status, 2);
+}
+
+}  // namespace

@@ -1,0 +1,195 @@
+// Constraint-aware norm-optimal ILC: the update is the bounded optimum of the paper's cost (checked
+// by the KKT conditions against the dense gradient), equals the unconstrained law when no bound is
+// active, always returns a feasible correction, and on the paper scenario does not wind up.
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "devices/simulated_arm.hpp"
+#include "engine/errors.hpp"
+#include "engine/learning_law_factory.hpp"
+#include "engine/learning_monitor.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/learning_session.hpp"
+#include "engine/noilc_constrained.hpp"
+#include "engine/noilc_dense.hpp"
+
+namespace bellows {
+namespace {
+
+DiscreteArmModel paper_model() { return discretize_arm_model(ModelParameters{}, 0.02); }
+
+struct RandomProblem {
+  Eigen::VectorXd u_j, e_j;
+};
+
+RandomProblem random_problem(int samples, std::mt19937& random) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  RandomProblem p{Eigen::VectorXd(samples), Eigen::VectorXd(samples)};
+  // Smooth-ish error with large excursions, so that the free optimum leaves any moderate box.
+  double drift = 0.0;
+  for (int t = 0; t < samples; ++t) {
+    drift = 0.9 * drift + 0.1 * normal(random);
+    p.e_j(t) = drift;
+    p.u_j(t) = 0.05 * normal(random);
+  }
+  return p;
+}
+
+// KKT for min J(u) s.t. lower <= u <= upper: g = grad J(u) is ~0 where u is strictly inside,
+// g >= 0 on the lower bound and g <= 0 on the upper bound.
+void expect_kkt(const NormOptimalDense& dense, const RandomProblem& p, const Eigen::VectorXd& lower,
+                const Eigen::VectorXd& upper, const Eigen::VectorXd& u, double tolerance) {
+  const Eigen::VectorXd g = dense.cost_gradient(p.u_j, p.e_j, u);
+  int active = 0;
+  for (Eigen::Index t = 0; t < u.size(); ++t) {
+    ASSERT_GE(u(t), lower(t));
+    ASSERT_LE(u(t), upper(t));
+    const bool at_lower = u(t) <= lower(t) + 1e-9, at_upper = u(t) >= upper(t) - 1e-9;
+    if (at_lower || at_upper) ++active;
+    if (at_lower) EXPECT_GE(g(t), -tolerance) << "sample " << t;
+    else if (at_upper) EXPECT_LE(g(t), tolerance) << "sample " << t;
+    else EXPECT_NEAR(g(t), 0.0, tolerance) << "sample " << t;
+  }
+  EXPECT_GT(active, 0) << "the test problem should have active bounds";
+}
+
+TEST(NoilcConstrained, UpdateIsTheBoundedOptimum) {
+  std::mt19937 random(5);
+  IlcParameters parameters;
+  parameters.admm_tolerance = 1e-10;
+  parameters.admm_max_iterations = 20000;
+  for (int samples : {20, 120, 400}) {
+    const RandomProblem p = random_problem(samples, random);
+    NormOptimalDense dense(paper_model(), parameters, samples);
+    NormOptimalConstrained constrained(paper_model(), parameters, samples);
+    Eigen::VectorXd free(samples);
+    dense.update(p.u_j, p.e_j, free);
+    const double reach = 0.5 * free.cwiseAbs().maxCoeff();
+    const Eigen::VectorXd lower = Eigen::VectorXd::Constant(samples, -reach);
+    const Eigen::VectorXd upper = Eigen::VectorXd::Constant(samples, reach).array() - 0.1 * reach * (Eigen::ArrayXd::LinSpaced(samples, 0.0, 1.0));
+    constrained.set_bounds(lower, upper);
+    Eigen::VectorXd u(samples);
+    constrained.update(p.u_j, p.e_j, u);
+    EXPECT_TRUE(constrained.last_report().converged);
+    EXPECT_GT(constrained.last_report().admm_iterations, 0);
+    expect_kkt(dense, p, lower, upper, u, 1e-7 * (1.0 + dense.cost_gradient(p.u_j, p.e_j, p.u_j).norm()));
+  }
+}
+
+TEST(NoilcConstrained, EqualsUnconstrainedWhenNoBoundIsActive) {
+  std::mt19937 random(9);
+  const int samples = 300;
+  const RandomProblem p = random_problem(samples, random);
+  NormOptimalDense dense(paper_model(), IlcParameters{}, samples);
+  NormOptimalConstrained constrained(paper_model(), IlcParameters{}, samples);
+  Eigen::VectorXd expected(samples), actual(samples);
+  dense.update(p.u_j, p.e_j, expected);
+  // From the pressure-limit context: zero feedback and a limit far beyond the correction.
+  constrained.set_input_context(Eigen::VectorXd::Zero(samples), 10.0 * expected.cwiseAbs().maxCoeff());
+  constrained.update(p.u_j, p.e_j, actual);
+  EXPECT_EQ(constrained.last_report().admm_iterations, 0);
+  EXPECT_LT((actual - expected).norm(), 1e-10 * expected.norm());
+}
+
+TEST(NoilcConstrained, BoundsComeFromTheFeedbackAndThePressureLimit) {
+  const int samples = 50;
+  IlcParameters parameters;
+  parameters.limit_margin_bar = 0.01;
+  NormOptimalConstrained constrained(paper_model(), parameters, samples);
+  const Eigen::VectorXd feedback = Eigen::VectorXd::LinSpaced(samples, -0.2, 0.3);
+  constrained.set_input_context(feedback, 0.387);
+  // u_pid + u_ilc must stay within +-(limit - margin).
+  EXPECT_TRUE(((feedback + constrained.upper_bound()).array() - 0.377).abs().maxCoeff() < 1e-15);
+  EXPECT_TRUE(((feedback + constrained.lower_bound()).array() + 0.377).abs().maxCoeff() < 1e-15);
+  // A large error would drive the free update far beyond; the constrained one stays feasible
+  // even when ADMM is stopped after one iteration.
+  parameters.admm_max_iterations = 1;
+  NormOptimalConstrained hurried(paper_model(), parameters, samples);
+  hurried.set_input_context(feedback, 0.387);
+  Eigen::VectorXd u(samples);
+  hurried.update(Eigen::VectorXd::Zero(samples), Eigen::VectorXd::Constant(samples, 1.0), u);
+  EXPECT_FALSE(hurried.last_report().converged);
+  EXPECT_LE((feedback + u).cwiseAbs().maxCoeff(), 0.377 + 1e-15);
+}
+
+TEST(NoilcConstrained, RejectsBadParametersAndBounds) {
+  IlcParameters parameters;
+  parameters.admm_rho = 0.0;
+  EXPECT_THROW(NormOptimalConstrained(paper_model(), parameters, 10), InputError);
+  NormOptimalConstrained constrained(paper_model(), IlcParameters{}, 10);
+  EXPECT_THROW(constrained.set_input_context(Eigen::VectorXd::Zero(9), 0.3), InputError);
+  EXPECT_THROW(constrained.set_bounds(Eigen::VectorXd::Ones(10), Eigen::VectorXd::Zero(10)), InputError);
+  IlcParameters wide_margin;
+  wide_margin.limit_margin_bar = 0.5;
+  NormOptimalConstrained no_room(paper_model(), wide_margin, 10);
+  EXPECT_THROW(no_room.set_input_context(Eigen::VectorXd::Zero(10), 0.387), InputError);
+}
+
+// ---- The paper scenario, 200 iterations on the simulated arm ----------------------------------
+
+struct PaperRun {
+  std::vector<double> rms_deg, max_correction_bar;
+  double worst_planned_total_bar = 0.0;  // max over j, k of |u_pid,j(k) + u_ilc,j+1(k)|
+  WindupSummary windup;
+  double largest_clamp_bar = 0.0;
+};
+
+PaperRun run_paper_scenario(const std::string& law_name, int iterations) {
+  Configuration config;
+  config.ilc.law = law_name;
+  const Trajectory trajectory = library_trajectory("paper", config.timing.sample_s());
+  const int n = trajectory.learning_samples();
+  const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()), n);
+  SimulatedArm arm(config.plant, 1);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  SimulatedClock clock(core, arm);
+  LearningSession session(clock, *law, trajectory, config.timing, config.controller);
+  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, n);
+  PaperRun run;
+  for (int j = 0; j <= iterations; ++j) {
+    const IterationSummary s = session.run_trial();
+    const IterationDiagnostics& d = monitor.observe(j, session.last_record());
+    run.rms_deg.push_back(s.rms_deg);
+    run.max_correction_bar.push_back(s.max_abs_correction_bar);
+    run.largest_clamp_bar = std::max(run.largest_clamp_bar, d.clamped_excess_bar);
+    if (j == iterations) break;
+    const Eigen::VectorXd feedback = session.last_record().samples.u_pid_bar.head(n);
+    session.learn();
+    run.worst_planned_total_bar =
+        std::max(run.worst_planned_total_bar, (feedback + session.correction_bar()).cwiseAbs().maxCoeff());
+  }
+  run.windup = monitor.windup();
+  return run;
+}
+
+TEST(NoilcConstrainedOnThePaperScenario, NoWindupWhereTheUnconstrainedLawWindsUp) {
+  constexpr int kIterations = 200;
+  const double limit = ControllerParameters{}.p_max_bar - GasParameters{}.ambient_bar;
+  const PaperRun constrained = run_paper_scenario("noilc-constrained", kIterations);
+  const PaperRun free = run_paper_scenario("noilc", kIterations);
+
+  // Every correction keeps the set points inside [p0, p_max] with the feedback it was planned for.
+  EXPECT_LE(constrained.worst_planned_total_bar, limit + 1e-9);
+  // In the trials themselves the feedback moves a little; the clamp then cuts less than 5 mbar.
+  EXPECT_LT(constrained.largest_clamp_bar, 0.005);
+  EXPECT_FALSE(constrained.windup.detected);
+  EXPECT_LT(constrained.max_correction_bar.back(), limit + 0.1);
+  // The correction has settled: no growth over the last 50 trials.
+  EXPECT_LT(std::abs(constrained.max_correction_bar.back() - constrained.max_correction_bar[150]), 0.005);
+
+  // The paper's unconstrained update winds up, and the run says so.
+  EXPECT_TRUE(free.windup.detected);
+  EXPECT_GT(free.max_correction_bar.back(), 2.5 * limit);
+  EXPECT_GT(free.max_correction_bar.back(), free.max_correction_bar[150] + 0.03);
+  EXPECT_GT(free.largest_clamp_bar, 0.5);
+
+  // Tracking: the bounded optimum ends within 5 % of the wound-up law at 200 trials (it is about
+  // 3.5 % above it there; see docs/learning-laws.md), with an RMS that no longer drifts upwards.
+  EXPECT_LT(constrained.rms_deg.back(), 1.05 * free.rms_deg.back());
+  EXPECT_LT(constrained.rms_deg.back(), 1.2);
+  EXPECT_GT(free.rms_deg.back(), free.rms_deg[60]);  // the wound-up law has been getting worse
+}
+
+}  // namespace
+}  // namespace bellows
