@@ -303,7 +303,7 @@ TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
   for (int i = 0; i < 3; ++i) f.key(key::kBackspace);
   f.type("0.45");
   f.key(key::kEnter);
-  EXPECT_DOUBLE_EQ(f.state().config.controller.k_p, 0.45);
+  EXPECT_DOUBLE_EQ(f.state().config.controller.k_p, 0.45) << f.state().status;
   EXPECT_TRUE(f.logged("k_p changed 0.3 -> 0.45 ([controller] k_p)"));
   EXPECT_TRUE(f.state().experiment.settings_changed);
   // A refused value changes nothing.
