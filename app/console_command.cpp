@@ -5,6 +5,7 @@
 #include <ostream>
 
 #include "app/config_file.hpp"
+#include "app/console_sessions.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
@@ -28,14 +29,18 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
     return resolve_trajectory(name_or_path, sample_s, limits);
   };
 
-  ui::UnavailableSessionGateway sessions("the session store is not part of this build yet");
+  StoreSessionGateway sessions(options.device);
   ui::ConsoleSetup setup;
-  setup.trajectory = load_trajectory(options.trajectory);
+  std::uint64_t seed = options.seed;
   if (!options.session_dir.empty()) {
-    throw InputError("--session " + options.session_dir + ": " + sessions.unavailable_reason());
+    setup.session = sessions.open(options.session_dir);  // InputError: missing, busy or damaged
+    setup.trajectory = *setup.session->experiment.trajectory;
+    seed = setup.session->seed;  // the same simulated arm it was recorded with
+  } else {
+    setup.trajectory = load_trajectory(options.trajectory);
   }
 
-  SimulatedArm arm(config.plant, options.seed);
+  SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   RealtimeLoop loop(core, arm, speed);
   setup.core = &core;
@@ -46,7 +51,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.load_trajectory = load_trajectory;
   setup.environment.sessions = &sessions;
   setup.environment.device_name = arm.name();
-  setup.environment.seed = options.seed;
+  setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
   setup.stop_flag = &stop_requested();
   setup.exit_after_s = options.exit_after_s;

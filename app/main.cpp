@@ -9,6 +9,7 @@
 #include "app/identify_command.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
+#include "app/sessions_command.hpp"
 #include "engine/errors.hpp"
 
 namespace {
@@ -40,6 +41,36 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--rt", run.rt, "Real-time scheduling: enforce (refuse without), try, off")
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");
+  CLI::Option* no_save = run_cmd->add_flag("--no-save", run.no_save, "Do not save the session");
+  run_cmd->add_option("--data-dir", run.data_dir,
+                      "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions)")
+      ->excludes(no_save);
+  CLI::Option* name = run_cmd->add_option("--name", run.session_name, "Session name (default: start time and trajectory)")
+                          ->excludes(no_save);
+  run_cmd->add_option("--resume", run.resume_dir, "Continue a saved session (a directory, or a name in the data directory)")
+      ->excludes(no_save)
+      ->excludes(name)
+      ->excludes("--trajectory")
+      ->excludes("--config")
+      ->excludes("--seed");
+
+  bellows::SessionsOptions sessions;
+  CLI::App* sessions_cmd = app.add_subcommand("sessions", "List, show and export saved sessions");
+  sessions_cmd->require_subcommand(1);
+  const std::string data_dir_help = "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions)";
+  CLI::App* list_cmd = sessions_cmd->add_subcommand("list", "A table of the saved sessions");
+  CLI::App* show_cmd = sessions_cmd->add_subcommand("show", "One session: summary and RMS per iteration");
+  CLI::App* export_cmd = sessions_cmd->add_subcommand("export", "Export a session to CSV or MATLAB (v7.3)");
+  for (CLI::App* command : {list_cmd, show_cmd, export_cmd}) {
+    command->add_option("--data-dir", sessions.data_dir, data_dir_help);
+    command->add_flag("--json", sessions.json, "Print JSON on stdout");
+  }
+  for (CLI::App* command : {show_cmd, export_cmd}) {
+    command->add_option("session", sessions.session, "Session directory, or a session name in the data directory")
+        ->required();
+  }
+  export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
+  export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
@@ -102,6 +133,9 @@ int main(int argc, char** argv) {
     if (identify_cmd->parsed()) {
       return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
     }
+    if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
+    if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);
+    if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);
     // No subcommand (or `console`): the operator console.
     return bellows::console_command(console, std::cout);
   } catch (const bellows::InputError& error) {

@@ -8,6 +8,7 @@
 
 #include "app/config_file.hpp"
 #include "app/learning_report.hpp"
+#include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
@@ -51,46 +52,71 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
   if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
   const double speed = parse_speed(options.speed);
-  const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
+  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
+  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+                               : options.config_path.empty() ? Configuration{}
+                                                             : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
-  const Trajectory trajectory = resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const Trajectory trajectory =
+      resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
+  const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  SimulatedArm arm(config.plant, options.seed);
+  SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   std::unique_ptr<EngineDriver> driver;
+  SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    driver = std::make_unique<SimulatedClock>(core, arm);
+    auto simulated = std::make_unique<SimulatedClock>(core, arm);
+    clock = simulated.get();
+    driver = std::move(simulated);
   } else {
     auto realtime = std::make_unique<RealtimeLoop>(core, arm, speed);
     loop = realtime.get();
     driver = std::move(realtime);
-    loop->start(options.rt);
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
+  recording.restore(arm, core, clock, session);  // before the first tick
+  recording.start(config, trajectory, arm.name(), seed, options.iterations);
+  if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
   const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
   if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
+  if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
+    for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
+      monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
+    }
+  }
+  if (loop != nullptr) loop->start(options.rt);
 
   nlohmann::json iterations = nlohmann::json::array();
   int status = 0;
   std::string failure;
+  const int trials = recording.trials(options.iterations);
   try {
-    for (int i = 0; i <= options.iterations; ++i) {
+    for (int i = 0; i < trials; ++i) {
       const IterationSummary s = session.run_trial();
+      session.learn();  // also after the last trial: the saved session resumes with this correction
+      recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
       nlohmann::json iteration = to_json(s);
       iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
       iterations.push_back(iteration);
-      if (i < options.iterations) session.learn();
     }
   } catch (const EngineFault& fault) {
     failure = fault.what();
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
+    recording.fault(failure + " (" + fault_name(fault.code()) + ")");
+  } catch (const std::exception& error) {
+    if (loop != nullptr) loop->stop();  // vents
+    else arm.vent();
+    recording.fault(error.what());
+    throw;
   }
   if (loop != nullptr) loop->stop();  // vents
   else arm.vent();
@@ -99,16 +125,19 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
              << ": the correction keeps growing where the set points saturate (largest clamped excess "
              << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
   }
+  if (status == 0) recording.finish(trials);
 
   if (options.json) {
     nlohmann::json report = {{"device", arm.name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
-                             {"seed", options.seed},
+                             {"seed", seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
                              {"prediction", prediction_json(prediction)},
                              {"windup", windup_json(monitor.windup())},
+                             {"session", recording.directory().empty() ? nlohmann::json(nullptr)
+                                                                       : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};
     if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
     if (loop != nullptr) {

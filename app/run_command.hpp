@@ -19,6 +19,11 @@ struct RunOptions {
   std::string clock = "sim";   // sim: as fast as possible, deterministic; wall: the real-time loop
   std::string speed = "1";     // wall clock with the simulated arm: 1, 2, 5, 10 or max
   RealtimeMode rt = RealtimeMode::kTry;
+  // Sessions: saved as the run goes into data_dir/session_name unless no_save.
+  bool no_save = false;
+  std::string data_dir;      // empty: $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions
+  std::string session_name;  // empty: start time and trajectory
+  std::string resume_dir;    // continue this session (its configuration, trajectory and state)
 };
 
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.

@@ -41,6 +41,23 @@ void ControlCore::set_controller_gains(const ControllerParameters& params) {
   pid_.set_gains(controller_);
 }
 
+ControlCore::State ControlCore::state() const {
+  return {pid_.state(), pressure_a_.state(), pressure_b_.state(), setpoints_, hold_rad_, desired_rad_, u_total_bar_,
+          tick_in_sample_};
+}
+
+void ControlCore::set_state(const State& state) {
+  trajectory_ = nullptr;
+  pid_.set_state(state.pid);
+  pressure_a_.set_state(state.pressure_a);
+  pressure_b_.set_state(state.pressure_b);
+  setpoints_ = state.setpoints;
+  hold_rad_ = state.hold_rad;
+  desired_rad_ = state.desired_rad;
+  u_total_bar_ = state.u_total_bar;
+  tick_in_sample_ = state.tick_in_sample;
+}
+
 void ControlCore::run_sample(const SensorReading& reading) {
   const double measured = reading.angle_rad / std::numbers::pi;
   double u_ilc = 0.0;

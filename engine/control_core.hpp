@@ -21,6 +21,17 @@ namespace bellows {
 
 class ControlCore {
  public:
+  /// Everything that evolves between ticks while holding: enough to continue a run exactly.
+  struct State {
+    PidController::State pid;
+    PressureController::State pressure_a, pressure_b;
+    ChamberSetpoints setpoints;
+    double hold_rad = 0.0;
+    double desired_rad = 0.0;
+    double u_total_bar = 0.0;
+    int tick_in_sample = 0;
+  };
+
   ControlCore(const ControllerParameters& controller, const TimingParameters& timing);
 
   /// Hold `angle_rad` with the PID only (no correction) until a trial starts.
@@ -41,6 +52,9 @@ class ControlCore {
   double desired_angle_rad() const { return desired_rad_; }
   PidController& pid() { return pid_; }
   void set_controller_gains(const ControllerParameters& params);
+  /// The state between trials. set_state() abandons a trial in progress and holds `hold_rad`.
+  State state() const;
+  void set_state(const State& state);
 
  private:
   void run_sample(const SensorReading& reading);

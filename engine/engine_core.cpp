@@ -1,6 +1,7 @@
 #include "engine/engine_core.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace bellows {
 namespace {
@@ -206,6 +207,15 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   }
   snapshot_.write(tick);
   tick_count_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void EngineCore::restore_armed(const ControlCore::State& state, double now_s) {
+  if (ticks() != 0 || this->state() != EngineState::kSafe) {
+    throw std::logic_error("EngineCore::restore_armed: only before the first tick, in SAFE");
+  }
+  control_.set_state(state);
+  last_angle_rad_ = state.hold_rad;
+  change_state(EngineState::kArmed, now_s, CommandKind::kArm);
 }
 
 void EngineCore::vent_now() {

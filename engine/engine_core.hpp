@@ -60,6 +60,10 @@ class EngineCore {
 
   /// The control scheme (for restoring a saved state before the loop starts).
   ControlCore& control() { return control_; }
+  /// Before the first tick: ARMED, the control scheme in `state` (from a saved session), as if the
+  /// engine had been armed and had run until then; a resumed run so continues exactly. Throws
+  /// std::logic_error once the engine has ticked or left SAFE.
+  void restore_armed(const ControlCore::State& state, double now_s);
   const TimingParameters& timing() const { return timing_; }
 
  private:

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The operator's day in the real binary: arm, choose `paper`, run 5 iterations and read the falling
 # RMS off the screen, inspect the correction and move the cursor, emergency stop and see FAULT,
-# reset, re-arm, run again, quit (asked, because of unsaved work) with the valves vented.
+# reset, re-arm, run again, save, quit with the valves vented; relaunch with --session and see the
+# same RMS history, find it in the browser, and continue learning into the same session.
 source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 120 40 -- console --speed max --trajectory steps
@@ -71,12 +72,40 @@ e2e_keys n
 e2e_wait_for 'iteration 5: RMS' 120
 e2e_wait_for 'iteration 6  RMS'
 
-# Quit: unsaved work is announced; the valves are vented before the exit.
+# Quit asks while work is unsaved; cancel, save, then quit: the valves are vented before the exit.
 e2e_keys q
 e2e_wait_for 'Quit\?'
 e2e_wait_for '6 iterations are not saved'
+e2e_keys Escape
+e2e_keys s
+e2e_wait_for 'saved: /'
+session="$(e2e_screen | grep -oE 'saved: /[^ ]+' | head -1 | cut -c8-)"
+[ -f "$session/manifest.json" ] || e2e_fail "no session at '$session'"
+history="$(e2e_rms_list)"
 e2e_keys q
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has 'bellows console: .* 6 iterations, best RMS .*valves vented'
+
+# Relaunch on the saved session: the same RMS history, and learning goes on from it.
+e2e_start 120 40 -- console --speed max --session "$session"
+e2e_wait_for 'iteration 6  RMS'
+e2e_wait_for 'law [a-z-]+  M'
+[ "$(e2e_rms_list)" = "$history" ] || e2e_fail "RMS history after relaunch: $(e2e_rms_list | tr '\n' ' ') vs $(echo "$history" | tr '\n' ' ')"
+# The browser lists it: date, trajectory, iterations, best RMS.
+best="$(echo "$history" | awk 'NR == 1 || $2 < b { b = $2 } END { print b }')"
+e2e_keys o
+e2e_wait_for "> [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2} +paper +6 +$best +$(basename "$session")"
+e2e_keys Escape
+e2e_keys a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys n
+e2e_wait_for 'iteration 7  RMS' 120
+e2e_keys s
+e2e_wait_for 'saved: /'
+"$BELLOWS" sessions show "$session" | grep -qE '^iterations +7,' || e2e_fail "the session did not grow to 7 iterations"
+e2e_keys q
+[ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after the relaunch"
 echo "ok: $(echo "$rms" | tr '\n' ' ')"

@@ -12,7 +12,7 @@ using testing::run_process;
 using testing::write_file;
 
 nlohmann::json run_json(const std::string& args) {
-  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json " + args);
+  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json --no-save " + args);
   EXPECT_EQ(result.exit_code, 0) << result.err;
   return nlohmann::json::parse(result.out);
 }
@@ -73,7 +73,7 @@ TEST(CliRun, RunsACsvTrajectory) {
 }
 
 void expect_bad_input(const std::string& args, const std::string& fragment) {
-  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json " + args);
+  const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json --no-save " + args);
   EXPECT_EQ(result.exit_code, 2) << args;
   EXPECT_TRUE(result.out.empty()) << "partial result printed for " << args << ": " << result.out;
   EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;

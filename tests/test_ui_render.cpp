@@ -71,9 +71,9 @@ ConsoleState sample_state(int trials, bool unicode) {
   s.live.reading.supply_bar = 3.0;
   s.live.valves.inlet_duty = {0.5, 0.0};
   s.live.valves.outlet_duty = {0.0, 0.25};
-  s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false});
-  s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false});
-  s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true});
+  s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false, "", 0});
+  s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false, "", 0});
+  s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true, "", 0});
   s.status = "hello operator";
   return s;
 }
@@ -294,7 +294,7 @@ TEST(UiRender, TuningLogAndSessionScreens) {
   ConsoleState s = sample_state(1, false);
   s.screen = Screen::kTuning;
   s.tuning.selected = 1;
-  s.log.add({"12:01:00", 2.0, LogSource::kOperator, "k_p changed 0.3 -> 0.4 ([controller] k_p)", false, false});
+  s.log.add({"12:01:00", 2.0, LogSource::kOperator, "k_p changed 0.3 -> 0.4 ([controller] k_p)", false, false, "", 0});
   std::string text = all(render_lines(s));
   EXPECT_NE(text.find("> k_p            0.3"), std::string::npos) << text;
   EXPECT_NE(text.find("  W            2e-05"), std::string::npos) << text;

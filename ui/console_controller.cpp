@@ -70,7 +70,8 @@ bool ConsoleController::active() const {
 
 void ConsoleController::log(LogSource source, std::string text, bool important, double engine_time_s, bool routine) {
   if (engine_time_s < -1.0) engine_time_s = state_.live_valid ? state_.live.time_s : -1.0;
-  state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine});
+  state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine, utc_timestamp(),
+                  state_.experiment.next_iteration()});
   ++revision_;
 }
 

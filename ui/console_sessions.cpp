@@ -19,9 +19,11 @@ void ConsoleController::start_save() {
   snapshot.config = state_.config;
   snapshot.experiment = state_.experiment;
   snapshot.events.assign(state_.log.entries().begin(), state_.log.entries().end());
+  snapshot.events_total = state_.log.total();
   snapshot.device_name = env_.device_name;
   snapshot.seed = env_.seed;
   saving_trials_ = static_cast<int>(state_.experiment.trials.size());
+  saving_events_ = state_.log.total();
   saving_settings_changed_ = state_.experiment.settings_changed;
   state_.learner_busy = true;
   state_.learner_task = "saving";
@@ -52,6 +54,7 @@ void ConsoleController::poll_session_tasks() {
       Experiment& e = state_.experiment;
       e.session_location = location;
       e.saved_trials = saving_trials_;
+      e.saved_events = saving_events_;
       // Settings changed while saving stay unsaved.
       if (saving_settings_changed_ == e.settings_changed) e.settings_changed = false;
       log(LogSource::kSession, format("saved %d iterations to %s", saving_trials_, location.c_str()));
@@ -113,6 +116,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.experiment = std::move(snapshot.experiment);
   state_.experiment.saved_trials = static_cast<int>(state_.experiment.trials.size());
   state_.experiment.settings_changed = false;
+  state_.experiment.saved_events = state_.log.total();  // what came with the session is saved
   state_.inspector = InspectorView{};
   state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
   const Experiment& adopted = state_.experiment;

@@ -2,7 +2,10 @@
 // saved session keeps. Bounded, oldest entries dropped first.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
+#include <cstdio>
+#include <ctime>
 #include <deque>
 #include <string>
 
@@ -19,7 +22,12 @@ struct LogEntry {
   std::string text;
   bool important = false;  // faults, refusals: highlighted
   bool routine = false;    // a trial's own state changes: only on the log screen
+  std::string time_utc;    // ISO 8601 ("2024-05-01T12:00:00.123Z"), for saved sessions
+  int iteration = 0;       // the iteration next to run when it happened
 };
+
+/// The current time as ISO 8601 UTC with milliseconds.
+std::string utc_timestamp();
 
 class EventLog {
  public:
@@ -37,6 +45,19 @@ class EventLog {
   std::deque<LogEntry> entries_;
   std::size_t total_ = 0;
 };
+
+inline std::string utc_timestamp() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+  const auto millis = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &utc);
+  char out[40];
+  std::snprintf(out, sizeof out, "%s.%03dZ", stamp, static_cast<int>(millis));
+  return out;
+}
 
 inline const char* to_string(LogSource source) {
   switch (source) {

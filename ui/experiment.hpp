@@ -33,6 +33,7 @@ struct Experiment {
   int saved_trials = 0;                 // trials already in the saved session
   bool settings_changed = false;        // gains or weights changed since the last save
   std::string session_location;         // where it was saved or opened from; empty if never
+  std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
 
   /// A fresh experiment on `trajectory`: zero correction, no trials.
   static Experiment start(std::shared_ptr<const Trajectory> trajectory);

@@ -20,7 +20,8 @@ namespace bellows::ui {
 struct SessionSnapshot {
   Configuration config;
   Experiment experiment;          // trajectory, trials, next correction, where it is saved
-  std::vector<LogEntry> events;   // the operator's and the engine's log
+  std::vector<LogEntry> events;   // the operator's and the engine's log (the newest entries)
+  std::size_t events_total = 0;   // entries ever logged (EventLog::total()), to tell new ones apart
   std::string device_name;        // e.g. "sim"
   std::uint64_t seed = 1;
 };
@@ -42,8 +43,9 @@ class SessionGateway {
   virtual bool available() const = 0;
   /// Why save and open are not available (shown to the operator).
   virtual std::string unavailable_reason() const { return "saving sessions is not available in this build"; }
-  /// Saves `snapshot` (a new session, or the trials added since `experiment.saved_trials` to the
-  /// session at `experiment.session_location`). Returns the session's location. Throws on failure.
+  /// Saves `snapshot`: a new session, or, when `experiment.session_location` is the session this
+  /// gateway opened or saved last, the trials and log entries added since (`experiment.saved_trials`,
+  /// `experiment.saved_events`). Returns the session's location. Throws on failure.
   virtual std::string save(const SessionSnapshot& snapshot) = 0;
   /// Saved sessions, oldest first.
   virtual std::vector<SessionListing> list() = 0;

@@ -1,0 +1,108 @@
+#include "app/run_recording.hpp"
+
+#include "app/arm_state_json.hpp"
+#include "engine/errors.hpp"
+#include "sessions/session_layout.hpp"
+#include "sessions/session_store.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr const char* kPurpose = "bellows run";
+
+std::filesystem::path data_dir_of(const RunOptions& options) {
+  return options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
+}
+
+}  // namespace
+
+RunRecording::RunRecording(const RunOptions& options) : options_(options), resuming_(!options.resume_dir.empty()) {
+  if (!resuming_) return;
+  std::filesystem::path data_dir;
+  try {
+    data_dir = data_dir_of(options);
+  } catch (const InputError&) {
+    // Without a data directory, --resume needs a path; resolve_session_dir() says so.
+  }
+  const std::filesystem::path directory = resolve_session_dir(options.resume_dir, data_dir);
+  writer_.emplace(SessionWriter::open(directory, kPurpose, resumed_));
+  if (resumed_.manifest.device != "sim") {
+    throw InputError("session " + directory.string() + " was recorded on the device '" + resumed_.manifest.device +
+                     "'; bellows run drives the simulated arm only");
+  }
+}
+
+std::uint64_t RunRecording::resumed_seed() const {
+  const nlohmann::ordered_json& info = resumed_.manifest.device_info;
+  const auto seed = info.find("seed");
+  if (seed == info.end() || !seed->is_number_unsigned()) {
+    throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
+                     ": /device_info/seed: expected a whole number, the simulated arm's seed");
+  }
+  return seed->get<std::uint64_t>();
+}
+
+int RunRecording::trials(int iterations) const {
+  return resuming_ && !resumed_.manifest.iterations.empty() ? iterations : iterations + 1;
+}
+
+void RunRecording::start(const Configuration& config, const Trajectory& trajectory, const std::string& device,
+                         std::uint64_t seed, int iterations) {
+  if (options_.no_save || resuming_) return;
+  SessionManifest header;
+  header.device = device;
+  header.device_info = {{"seed", seed}};
+  header.configuration = config;
+  header.events.push_back({utc_now(), 0, "start",
+                           std::string(kPurpose) + ": trajectory " + trajectory.name + ", " + std::to_string(iterations) +
+                               " iterations, seed " + std::to_string(seed)});
+  writer_.emplace(SessionWriter::create(data_dir_of(options_), options_.session_name, std::move(header), trajectory,
+                                        kPurpose));
+}
+
+void RunRecording::restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
+  if (!resuming_) return;
+  const SessionManifest& m = resumed_.manifest;
+  if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
+    if (m.resume && m.resume->exact()) {
+      restore_arm_state(arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+      if (clock != nullptr) clock->set_ticks(m.resume->clock_ticks);
+      core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
+    }
+    learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));
+    std::vector<IterationSummary> history;
+    for (const IterationEntry& entry : m.iterations) history.push_back(entry.summary);
+    learning.set_history(std::move(history));
+  }
+  writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
+                                      " more iterations");
+}
+
+void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm,
+                        EngineCore& core, const SimulatedClock* clock) {
+  if (!writer_) return;
+  ResumeState resume;
+  if (clock != nullptr) {  // same thread as the engine: its state is quiet between trials
+    resume.controller = core.control().state();
+    resume.device = arm_state_to_json(arm);
+    resume.clock_ticks = clock->ticks();
+  }
+  writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(), std::move(resume));
+}
+
+void RunRecording::fault(const std::string& what) noexcept {
+  if (!writer_) return;
+  try {
+    writer_->record_event("fault", what);
+  } catch (...) {
+    // The session keeps every completed iteration either way; the caller reports the fault.
+  }
+}
+
+void RunRecording::finish(int trials_run) {
+  if (writer_) writer_->record_event("finish", std::string(kPurpose) + ": " + std::to_string(trials_run) + " trials done");
+}
+
+std::filesystem::path RunRecording::directory() const { return writer_ ? writer_->directory() : std::filesystem::path(); }
+
+}  // namespace bellows

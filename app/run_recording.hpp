@@ -1,0 +1,60 @@
+// The session side of `bellows run`: a new session saved as the run goes (unless --no-save), or a
+// saved session continued with --resume. Each completed iteration is on disk before its progress
+// line is printed; faults are recorded as events before the run gives up.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "app/run_command.hpp"
+#include "devices/simulated_arm.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
+#include "engine/learning_session.hpp"
+#include "sessions/session_writer.hpp"
+
+namespace bellows {
+
+class RunRecording {
+ public:
+  /// With --resume: takes the session's lock and loads it (InputError if busy or bad).
+  explicit RunRecording(const RunOptions& options);
+
+  bool resuming() const { return resuming_; }
+  /// The session being continued (valid when resuming()).
+  const Session& resumed() const { return resumed_; }
+  /// The simulated arm's seed the resumed session was started with.
+  std::uint64_t resumed_seed() const;
+  /// Trials to run for `--iterations K`: K + 1 from scratch (trial 0 is feedback only), K when
+  /// continuing after completed iterations.
+  int trials(int iterations) const;
+
+  /// A fresh run: creates the session (nothing with --no-save).
+  void start(const Configuration& config, const Trajectory& trajectory, const std::string& device, std::uint64_t seed,
+             int iterations);
+  /// A resumed run, before the engine's first tick: puts the arm, the engine (armed, with its
+  /// controllers' state), the clock and the learning where the session stopped, and records the
+  /// resumption. Nothing for a fresh run. `clock` is null on the wall clock.
+  void restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
+  /// After a trial and the learning from it. On the wall clock (`clock` null) the loop thread owns
+  /// the arm and the controllers, so their state is not captured: such a session resumes with the
+  /// correction and freshly armed controllers.
+  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm, EngineCore& core,
+            const SimulatedClock* clock);
+  /// Records a fault; never throws (the fault itself is what the caller reports).
+  void fault(const std::string& what) noexcept;
+  void finish(int trials_run);
+
+  /// The session directory; empty with --no-save.
+  std::filesystem::path directory() const;
+
+ private:
+  const RunOptions& options_;
+  bool resuming_ = false;
+  Session resumed_;
+  std::optional<SessionWriter> writer_;
+};
+
+}  // namespace bellows

@@ -1,0 +1,193 @@
+#include "app/sessions_command.hpp"
+
+#include <cstdio>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/errors.hpp"
+#include "sessions/manifest_json.hpp"
+#include "sessions/session_export.hpp"
+#include "sessions/session_store.hpp"
+
+namespace bellows {
+namespace fs = std::filesystem;
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+fs::path data_dir_of(const SessionsOptions& options) {
+  return options.data_dir.empty() ? default_data_dir() : fs::path(options.data_dir);
+}
+
+fs::path session_dir_of(const SessionsOptions& options) {
+  fs::path data_dir;
+  try {
+    data_dir = data_dir_of(options);
+  } catch (const InputError&) {
+    // Then only a path can name the session; resolve_session_dir() says so if it is not one.
+  }
+  return resolve_session_dir(options.session, data_dir);
+}
+
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+/// "2024-05-01T12:03:07.123Z" -> "2024-05-01 12:03:07"
+std::string short_time(const std::string& utc) {
+  std::string out = utc.substr(0, 19);
+  if (out.size() > 10 && out[10] == 'T') out[10] = ' ';
+  return out;
+}
+
+Json summary_json(const IterationEntry& entry) {
+  const IterationSummary& s = entry.summary;
+  return {{"iteration", s.iteration},
+          {"rms_deg", s.rms_deg},
+          {"max_abs_error_deg", s.max_abs_error_deg},
+          {"max_abs_correction_bar", s.max_abs_correction_bar},
+          {"saturated_samples", s.saturated_samples},
+          {"completed_utc", entry.completed_utc}};
+}
+
+Json listing_json(const fs::path& directory, const SessionManifest& m) {
+  const double best = best_rms_deg(m);
+  return {{"name", m.name},
+          {"directory", directory.string()},
+          {"started_utc", m.started_utc},
+          {"device", m.device},
+          {"trajectory", m.trajectory_name},
+          {"iterations", m.iterations.size()},
+          {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)}};
+}
+
+}  // namespace
+
+int sessions_list_command(const SessionsOptions& options, std::ostream& out, std::ostream& err) {
+  const fs::path data_dir = data_dir_of(options);
+  const std::vector<SessionListing> listings = list_sessions(data_dir);
+  for (const SessionListing& listing : listings) {
+    if (!listing.error.empty()) err << "bellows: warning: " << listing.error << std::endl;
+  }
+  if (options.json) {
+    Json all = Json::array();
+    for (const SessionListing& listing : listings) {
+      all.push_back(listing.error.empty()
+                        ? listing_json(listing.directory, listing.manifest)
+                        : Json{{"name", listing.directory.filename().string()},
+                               {"directory", listing.directory.string()},
+                               {"error", listing.error}});
+    }
+    out << all.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    return 0;
+  }
+  if (listings.empty()) {
+    out << "no sessions in " << data_dir.string() << std::endl;
+    return 0;
+  }
+  char line[512];
+  std::snprintf(line, sizeof line, "%-40s  %-19s  %-6s  %-16s  %10s  %12s", "NAME", "STARTED (UTC)", "DEVICE",
+                "TRAJECTORY", "ITERATIONS", "BEST RMS");
+  out << line << "\n";
+  for (const SessionListing& listing : listings) {
+    const std::string name = listing.directory.filename().string();
+    if (!listing.error.empty()) {
+      std::snprintf(line, sizeof line, "%-40s  (unreadable: see the warning above)", name.c_str());
+    } else {
+      const SessionManifest& m = listing.manifest;
+      const double best = best_rms_deg(m);
+      std::snprintf(line, sizeof line, "%-40s  %-19s  %-6s  %-16s  %10zu  %12s", name.c_str(),
+                    short_time(m.started_utc).c_str(), m.device.c_str(), m.trajectory_name.c_str(), m.iterations.size(),
+                    best < 0.0 ? "-" : format("%.3f deg", best).c_str());
+    }
+    out << line << "\n";
+  }
+  out << std::flush;
+  return 0;
+}
+
+int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
+  const Session session = load_session(session_dir_of(options));  // checks every file
+  const SessionManifest& m = session.manifest;
+  const Configuration& c = m.configuration;
+  const double best = best_rms_deg(m);
+  if (options.json) {
+    Json iterations = Json::array();
+    for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_json(entry));
+    Json events = Json::array();
+    for (const SessionEvent& e : m.events) {
+      events.push_back({{"time_utc", e.time_utc}, {"iteration", e.iteration}, {"kind", e.kind}, {"message", e.message}});
+    }
+    const Json report = {{"name", m.name},
+                         {"directory", session.directory.string()},
+                         {"schema_version", m.schema_version},
+                         {"program_version", m.program_version},
+                         {"device", m.device},
+                         {"device_info", m.device_info},
+                         {"started_utc", m.started_utc},
+                         {"updated_utc", m.updated_utc},
+                         {"trajectory",
+                          {{"name", m.trajectory_name},
+                           {"learning_samples", m.trajectory_samples},
+                           {"sample_time_s", c.timing.sample_s()}}},
+                         {"learning", configuration_to_json(c).at("ilc")},
+                         {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)},
+                         {"iterations", iterations},
+                         {"events", events}};
+    out << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    return 0;
+  }
+  out << "session      " << session.directory.string() << "\n"
+      << "name         " << m.name << "\n"
+      << "written by   bellows " << m.program_version << " (session schema " << m.schema_version << ")\n"
+      << "device       " << m.device << " " << m.device_info.dump() << "\n"
+      << "started      " << m.started_utc << "\n"
+      << "updated      " << m.updated_utc << "\n"
+      << "trajectory   " << m.trajectory_name << ": " << m.trajectory_samples << " samples every " << c.timing.sample_s()
+      << " s (" << m.trajectory_samples * c.timing.sample_s() << " s)\n"
+      << "learning     " << c.ilc.law << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
+      << "iterations   " << m.iterations.size();
+  if (best >= 0.0) out << ", best RMS " << format("%.3f", best) << " deg";
+  out << "\n\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%9s  %9s  %15s  %20s  %9s  %s", "ITERATION", "RMS [deg]", "MAX ERROR [deg]",
+                "MAX CORRECTION [bar]", "SATURATED", "COMPLETED (UTC)");
+  out << line << "\n";
+  for (const IterationEntry& entry : m.iterations) {
+    const IterationSummary& s = entry.summary;
+    std::snprintf(line, sizeof line, "%9d  %9.3f  %15.3f  %20.4f  %9d  %s", s.iteration, s.rms_deg, s.max_abs_error_deg,
+                  s.max_abs_correction_bar, s.saturated_samples, short_time(entry.completed_utc).c_str());
+    out << line << "\n";
+  }
+  if (!m.events.empty()) out << "\nevents\n";
+  for (const SessionEvent& e : m.events) {
+    out << "  " << short_time(e.time_utc) << "  iteration " << e.iteration << "  " << e.kind << ": " << e.message << "\n";
+  }
+  out << std::flush;
+  return 0;
+}
+
+int sessions_export_command(const SessionsOptions& options, std::ostream& out) {
+  if (options.format != "csv" && options.format != "mat") {
+    throw InputError("--format must be csv or mat, not '" + options.format + "'");
+  }
+  const Session session = load_session(session_dir_of(options));
+  const fs::path output =
+      options.output.empty() ? fs::path(session.directory.filename().string() + "." + options.format) : fs::path(options.output);
+  const std::vector<fs::path> files = options.format == "csv" ? export_session_csv(session, output)
+                                                              : std::vector<fs::path>{export_session_mat(session, output)};
+  if (options.json) {
+    Json paths = Json::array();
+    for (const fs::path& file : files) paths.push_back(file.string());
+    out << Json{{"format", options.format}, {"iterations", session.iterations.size()}, {"files", paths}}.dump() << std::endl;
+    return 0;
+  }
+  for (const fs::path& file : files) out << "wrote " << file.string() << "\n";
+  out << std::flush;
+  return 0;
+}
+
+}  // namespace bellows

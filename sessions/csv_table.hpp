@@ -1,0 +1,28 @@
+// Numeric CSV as sessions store it: one header line of column names, then one line per row of
+// comma-separated numbers in the shortest form that reads back to the same double. Plain enough for
+// spreadsheets, pandas, MATLAB readtable and PlotJuggler; strict on reading: the exact header, the
+// same field count on every line, finite numbers only, a final end of line (else: truncated).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace bellows {
+
+struct CsvColumn {
+  std::string_view name;
+  const Eigen::VectorXd* values;
+};
+
+/// Appends header and rows to `out`. Throws std::invalid_argument if the columns differ in length.
+void append_csv(std::string& out, const std::vector<CsvColumn>& columns);
+
+/// Parses `text` whose header must be exactly `header`; one vector per column. Throws InputError
+/// that starts with `source` and names the line (and column) at fault.
+std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,
+                                       const std::string& source);
+
+}  // namespace bellows

@@ -1,0 +1,274 @@
+#include "sessions/manifest_json.hpp"
+
+#include <set>
+
+#include "engine/arm_model.hpp"
+#include "engine/errors.hpp"
+#include "sessions/session_layout.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr const char* kFormat = "bellows-session";
+constexpr int kMostIterations = 1000000;
+constexpr int kMostSamples = 100000000;
+
+using Json = nlohmann::ordered_json;
+
+template <typename Derived>
+Json vector_to_json(const Eigen::DenseBase<Derived>& values) {
+  Json out = Json::array();
+  for (Eigen::Index i = 0; i < values.size(); ++i) out.push_back(values(i));
+  return out;
+}
+
+Json pressure_state_to_json(const PressureController::State& s) {
+  Json history = Json::array();
+  for (double value : s.history_bar) history.push_back(value);
+  return {{"history_bar", history}, {"count", s.count}, {"next", s.next}, {"sum_bar", s.sum_bar}};
+}
+
+PressureController::State pressure_state_from_json(const JsonReader& r, int filter_samples) {
+  PressureController::State s;
+  const JsonReader history = r["history_bar"];
+  if (history.size() != s.history_bar.size()) {
+    history.fail("expected " + std::to_string(s.history_bar.size()) + " numbers, found " + std::to_string(history.size()));
+  }
+  for (std::size_t i = 0; i < s.history_bar.size(); ++i) s.history_bar[i] = history[i].number();
+  s.count = r["count"].integer(0, filter_samples);
+  s.next = r["next"].integer(0, filter_samples - 1);
+  s.sum_bar = r["sum_bar"].number();
+  return s;
+}
+
+Json summary_to_json(const IterationEntry& entry) {
+  const IterationSummary& s = entry.summary;
+  return {{"iteration", s.iteration},
+          {"completed_utc", entry.completed_utc},
+          {"rms_deg", s.rms_deg},
+          {"max_abs_error_deg", s.max_abs_error_deg},
+          {"max_abs_correction_bar", s.max_abs_correction_bar},
+          {"saturated_samples", s.saturated_samples},
+          {"samples_file", session_layout::samples_file(s.iteration)},
+          {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
+}
+
+double non_negative(const JsonReader& r) {
+  const double value = r.number();
+  if (value < 0.0) r.fail("must not be negative");
+  return value;
+}
+
+IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
+  IterationEntry entry;
+  IterationSummary& s = entry.summary;
+  s.iteration = r["iteration"].integer(0, kMostIterations);
+  if (s.iteration != index) {
+    r["iteration"].fail("iterations must be numbered 0, 1, 2, ...: expected " + std::to_string(index) + ", found " +
+                        std::to_string(s.iteration));
+  }
+  entry.completed_utc = r["completed_utc"].text();
+  s.rms_deg = non_negative(r["rms_deg"]);
+  s.max_abs_error_deg = non_negative(r["max_abs_error_deg"]);
+  s.max_abs_correction_bar = non_negative(r["max_abs_correction_bar"]);
+  s.saturated_samples = r["saturated_samples"].integer(0, samples);
+  for (const auto& [key, expected] : {std::pair{"samples_file", session_layout::samples_file(index)},
+                                      std::pair{"telemetry_file", session_layout::telemetry_file(index)}}) {
+    if (r[key].text() != expected) r[key].fail("expected \"" + expected + "\"");
+  }
+  return entry;
+}
+
+Json event_to_json(const SessionEvent& e) {
+  return {{"time_utc", e.time_utc}, {"iteration", e.iteration}, {"kind", e.kind}, {"message", e.message}};
+}
+
+SessionEvent event_from_json(const JsonReader& r) {
+  return {r["time_utc"].text(), r["iteration"].integer(0, kMostIterations), r["kind"].text(), r["message"].text()};
+}
+
+}  // namespace
+
+Json configuration_to_json(const Configuration& config) {
+  Configuration copy = config;  // the bindings hand out pointers into a mutable configuration
+  Json out = Json::object();
+  for (const ParameterBinding& b : parameter_bindings()) {
+    Json& section = out[b.section];
+    if (b.text) section[b.key] = *b.text(copy);
+    else if (b.integer) section[b.key] = *b.integer(copy);
+    else section[b.key] = *b.real(copy);
+  }
+  return out;
+}
+
+Configuration configuration_from_json(const JsonReader& reader) {
+  reader.expect_object();
+  const auto& bindings = parameter_bindings();
+  std::set<std::string> sections;
+  for (const ParameterBinding& b : bindings) sections.insert(b.section);
+  Configuration config;
+  for (const auto& [section, values] : reader.json().items()) {
+    if (!sections.count(section)) reader.fail("unknown section \"" + section + "\" (written by a newer bellows?)");
+    const JsonReader section_reader = reader[section];
+    section_reader.expect_object();
+    for (const auto& item : values.items()) {
+      const std::string& key = item.key();
+      const ParameterBinding* binding = nullptr;
+      for (const ParameterBinding& b : bindings) {
+        if (b.section == section && b.key == key) binding = &b;
+      }
+      if (binding == nullptr) section_reader.fail("unknown key \"" + key + "\" (written by a newer bellows?)");
+      const JsonReader value = section_reader[key];
+      if (binding->text) *binding->text(config) = value.text();
+      else if (binding->integer) *binding->integer(config) = value.integer(-1000000000, 1000000000);
+      else *binding->real(config) = value.number();
+    }
+  }
+  try {
+    validate_configuration(config);
+  } catch (const InputError& error) {
+    reader.fail(error.what());
+  }
+  config.controller.gas = config.plant.gas;  // as the TOML loader does: one ambient for both
+  return config;
+}
+
+Json controller_state_to_json(const ControlCore::State& s) {
+  return {{"pid", {{"integral_s", s.pid.integral_s}, {"previous_output", s.pid.previous_output},
+                   {"has_previous", s.pid.has_previous}}},
+          {"pressure_a", pressure_state_to_json(s.pressure_a)},
+          {"pressure_b", pressure_state_to_json(s.pressure_b)},
+          {"setpoints", {{"a_bar", s.setpoints.a_bar}, {"b_bar", s.setpoints.b_bar},
+                         {"saturation_sign", s.setpoints.saturation_sign}}},
+          {"hold_rad", s.hold_rad},
+          {"desired_rad", s.desired_rad},
+          {"u_total_bar", s.u_total_bar},
+          {"tick_in_sample", s.tick_in_sample}};
+}
+
+ControlCore::State controller_state_from_json(const JsonReader& r, const Configuration& config) {
+  ControlCore::State s;
+  const JsonReader pid = r["pid"];
+  s.pid.integral_s = pid["integral_s"].number();
+  s.pid.previous_output = pid["previous_output"].number();
+  s.pid.has_previous = pid["has_previous"].boolean();
+  s.pressure_a = pressure_state_from_json(r["pressure_a"], config.controller.filter_samples);
+  s.pressure_b = pressure_state_from_json(r["pressure_b"], config.controller.filter_samples);
+  const JsonReader setpoints = r["setpoints"];
+  s.setpoints.a_bar = setpoints["a_bar"].number();
+  s.setpoints.b_bar = setpoints["b_bar"].number();
+  s.setpoints.saturation_sign = setpoints["saturation_sign"].integer(-1, 1);
+  s.hold_rad = r["hold_rad"].number();
+  s.desired_rad = r["desired_rad"].number();
+  s.u_total_bar = r["u_total_bar"].number();
+  s.tick_in_sample = r["tick_in_sample"].integer(0, config.timing.ticks_per_sample - 1);
+  return s;
+}
+
+Json manifest_to_json(const SessionManifest& m) {
+  const Configuration& c = m.configuration;
+  const double sample_s = c.timing.sample_s();
+  const DiscreteArmModel model = discretize_arm_model(c.model, sample_s);
+  const Json configuration = configuration_to_json(c);
+  Json iterations = Json::array();
+  for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_to_json(entry));
+  Json events = Json::array();
+  for (const SessionEvent& event : m.events) events.push_back(event_to_json(event));
+  Json out = {
+      {"format", kFormat},
+      {"schema_version", m.schema_version},
+      {"program_version", m.program_version},
+      {"name", m.name},
+      {"device", m.device},
+      {"device_info", m.device_info},
+      {"started_utc", m.started_utc},
+      {"updated_utc", m.updated_utc},
+      {"trajectory",
+       {{"name", m.trajectory_name},
+        {"file", session_layout::kTrajectory},
+        {"learning_samples", m.trajectory_samples},
+        {"sample_time_s", sample_s},
+        {"duration_s", m.trajectory_samples * sample_s}}},
+      // Derived from the configuration, written for readers; ignored when loading.
+      {"model",
+       {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
+        {"omega0_rad_per_s", c.model.omega0_rad_per_s},
+        {"damping", c.model.damping},
+        {"sample_time_s", sample_s},
+        {"A", {vector_to_json(model.A.row(0)), vector_to_json(model.A.row(1))}},
+        {"B", vector_to_json(model.B)},
+        {"C", vector_to_json(model.C)}}},
+      {"learning", configuration.at("ilc")},  // the law and its weights, as [ilc] has them
+      {"configuration", configuration},
+      {"iterations", iterations},
+      {"events", events},
+  };
+  if (m.resume) {
+    Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
+    if (m.resume->exact()) {
+      resume["clock_ticks"] = m.resume->clock_ticks;
+      resume["controller"] = controller_state_to_json(*m.resume->controller);
+      resume["device"] = m.resume->device;
+    }
+    out["resume"] = std::move(resume);
+  }
+  return out;
+}
+
+std::string format_manifest(const SessionManifest& manifest) {
+  return manifest_to_json(manifest).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+SessionManifest parse_manifest(std::string_view text, const std::string& source) {
+  const Json json = parse_json(text, source);
+  const JsonReader r(json, source);
+  if (!json.is_object() || !json.contains("format") || json["format"] != kFormat) {
+    r.fail("not a bellows session manifest (expected \"format\": \"" + std::string(kFormat) + "\")");
+  }
+  SessionManifest m;
+  m.schema_version = r["schema_version"].integer(0, 1000000);
+  if (m.schema_version != kSessionSchemaVersion) {
+    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) +
+                             " is not supported (this bellows reads version " + std::to_string(kSessionSchemaVersion) + ")");
+  }
+  m.program_version = r["program_version"].text();
+  m.name = r["name"].text();
+  m.device = r["device"].text();
+  r["device_info"].expect_object();
+  m.device_info = r["device_info"].json();
+  m.started_utc = r["started_utc"].text();
+  m.updated_utc = r["updated_utc"].text();
+  m.configuration = configuration_from_json(r["configuration"]);
+  const JsonReader trajectory = r["trajectory"];
+  m.trajectory_name = trajectory["name"].text();
+  m.trajectory_samples = trajectory["learning_samples"].integer(m.configuration.trajectory.min_learning_samples, kMostSamples);
+  const JsonReader iterations = r["iterations"];
+  for (std::size_t i = 0; i < iterations.size(); ++i) {
+    m.iterations.push_back(summary_from_json(iterations[i], static_cast<int>(i), m.trajectory_samples));
+  }
+  const JsonReader events = r["events"];
+  for (std::size_t i = 0; i < events.size(); ++i) m.events.push_back(event_from_json(events[i]));
+  if (r.has("resume")) {
+    const JsonReader resume = r["resume"];
+    const int next = resume["next_iteration"].integer(0, kMostIterations);
+    if (next != static_cast<int>(m.iterations.size())) {
+      resume["next_iteration"].fail("expected " + std::to_string(m.iterations.size()) + " (the iterations listed), found " +
+                                    std::to_string(next));
+    }
+    ResumeState state;
+    if (resume["exact"].boolean()) {
+      const JsonReader ticks = resume["clock_ticks"];
+      if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
+      state.clock_ticks = ticks.json().get<long long>();
+      state.controller = controller_state_from_json(resume["controller"], m.configuration);
+      resume["device"].expect_object();
+      state.device = resume["device"].json();
+    }
+    m.resume = std::move(state);
+  } else if (!m.iterations.empty()) {
+    r.fail("missing \"resume\": a session with completed iterations must hold the state to continue from");
+  }
+  return m;
+}
+
+}  // namespace bellows

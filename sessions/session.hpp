@@ -1,0 +1,86 @@
+// A session in memory: what a run saves and what loading gives back. On disk it is a directory
+// (docs/session-format.md): manifest.json, trajectory.csv and, per iteration, the ILC-rate samples
+// and the tick-rate telemetry as CSV.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "engine/configuration.hpp"
+#include "engine/control_core.hpp"
+#include "engine/learning_session.hpp"
+#include "engine/trajectory.hpp"
+#include "engine/trial_record.hpp"
+
+namespace bellows {
+
+/// The manifest layout this program writes and reads. Older or newer versions are refused.
+inline constexpr int kSessionSchemaVersion = 1;
+
+/// The program's version, written into every manifest.
+std::string program_version();
+
+/// Something that happened: the run starting or resuming, a fault, an operator's action.
+struct SessionEvent {
+  std::string time_utc;  // ISO 8601, e.g. 2024-05-01T12:00:00.123Z
+  int iteration = 0;     // the iteration running or next to run when it happened
+  std::string kind;      // "start", "resume", "finish", "fault", "configuration", "note", ...
+  std::string message;
+};
+
+/// One completed iteration as the manifest lists it.
+struct IterationEntry {
+  IterationSummary summary;
+  std::string completed_utc;
+};
+
+/// What continuing the run exactly needs beyond the correction: the controllers' state, the
+/// device's own state (which only the device's owner understands, kept here as JSON) and the
+/// simulated clock. Only a run on a simulated clock can be captured exactly; after a wall-clock
+/// run `controller` is empty and a resume starts from freshly armed controllers.
+struct ResumeState {
+  std::optional<ControlCore::State> controller;
+  nlohmann::ordered_json device = nlohmann::ordered_json::object();
+  long long clock_ticks = 0;
+  bool exact() const { return controller.has_value(); }
+};
+
+struct SessionManifest {
+  int schema_version = kSessionSchemaVersion;
+  std::string program_version;
+  std::string name;
+  std::string device;                                      // Device::name(), e.g. "sim"
+  nlohmann::ordered_json device_info = nlohmann::ordered_json::object();  // e.g. {"seed": 1}
+  std::string started_utc;
+  std::string updated_utc;
+  Configuration configuration;
+  std::string trajectory_name;
+  int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
+  std::vector<IterationEntry> iterations;
+  std::vector<SessionEvent> events;
+  std::optional<ResumeState> resume;  // present once an iteration has completed
+};
+
+/// One iteration's signals: the trial record and the correction learned from it for the next trial.
+struct IterationData {
+  TrialRecord record;
+  Eigen::VectorXd next_correction_bar;  // N values
+};
+
+struct Session {
+  std::filesystem::path directory;
+  SessionManifest manifest;
+  Trajectory trajectory;
+  std::vector<IterationData> iterations;  // in the order of manifest.iterations
+};
+
+/// Current UTC time in the manifest's format.
+std::string utc_now();
+
+}  // namespace bellows

@@ -1,0 +1,24 @@
+// File names inside a session directory (docs/session-format.md). Derived from the iteration
+// number, never taken from the manifest, so a damaged manifest cannot point outside the session.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace bellows::session_layout {
+
+inline constexpr const char* kManifest = "manifest.json";
+inline constexpr const char* kTrajectory = "trajectory.csv";
+inline constexpr const char* kIterations = "iterations";
+
+inline std::string numbered(const char* stem, int iteration) {
+  char name[48];
+  std::snprintf(name, sizeof name, "%s/%s_%04d.csv", kIterations, stem, iteration);
+  return name;
+}
+/// ILC-rate samples of one iteration, relative to the session directory.
+inline std::string samples_file(int iteration) { return numbered("iteration", iteration); }
+/// Tick-rate telemetry of one iteration, relative to the session directory.
+inline std::string telemetry_file(int iteration) { return numbered("telemetry", iteration); }
+
+}  // namespace bellows::session_layout

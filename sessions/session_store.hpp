@@ -1,0 +1,48 @@
+// Sessions on disk: where they live, how they are named, loading them (checked completely) and
+// writing a whole session at once. Incremental writing during a run is SessionWriter's job.
+#pragma once
+
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sessions/session.hpp"
+
+namespace bellows {
+
+/// $XDG_DATA_HOME/bellows/sessions, else ~/.local/share/bellows/sessions. InputError if neither
+/// variable gives an absolute path.
+std::filesystem::path default_data_dir();
+
+/// "2024-05-01_14-03-07_paper": the local start time, then the trajectory's name (made safe).
+std::string default_session_name(std::time_t start, const std::string& trajectory_name);
+/// Throws InputError unless `name` is a plain directory name (no '/', not hidden, printable).
+void validate_session_name(const std::string& name);
+
+/// A session given as a directory path, or as the name of one inside `data_dir`.
+std::filesystem::path resolve_session_dir(const std::string& path_or_name, const std::filesystem::path& data_dir);
+
+/// The manifest alone (fast, for listings). Throws InputError for anything missing or malformed.
+SessionManifest load_manifest(const std::filesystem::path& directory);
+/// Everything: manifest, trajectory, every listed iteration's samples and telemetry, each checked
+/// (lengths, sampling, finite values, RMS against the manifest). Throws InputError.
+Session load_session(const std::filesystem::path& directory);
+
+/// Writes `session` as a new directory `directory` (which must not exist yet), atomically: the
+/// directory appears complete or not at all.
+void save_session(const Session& session, const std::filesystem::path& directory);
+
+struct SessionListing {
+  std::filesystem::path directory;
+  SessionManifest manifest;  // valid when `error` is empty
+  std::string error;
+};
+/// Every session directory in `data_dir` (hidden entries skipped), oldest first. A missing data
+/// directory has no sessions.
+std::vector<SessionListing> list_sessions(const std::filesystem::path& data_dir);
+
+/// The lowest RMS of the listed iterations, or a negative value if there are none.
+double best_rms_deg(const SessionManifest& manifest);
+
+}  // namespace bellows

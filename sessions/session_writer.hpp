@@ -1,0 +1,49 @@
+// Saving a session as it happens: a run (or the console) creates or reopens a session, then saves
+// after every completed iteration and records events (faults, operator actions) as they occur.
+// Every save writes the iteration's files first and then the manifest that lists them, each
+// atomically, so a crash at any moment leaves a session that loads with every iteration whose
+// save returned. The writer holds the session's lock for its lifetime: one writer per session.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "sessions/session.hpp"
+#include "sessions/session_lock.hpp"
+
+namespace bellows {
+
+class SessionWriter {
+ public:
+  /// Creates a session in `data_dir` named `name` (empty: from the start time and the trajectory)
+  /// from `header` (device, configuration, trajectory name, first events; no iterations).
+  /// Throws InputError when the name is taken or the directory cannot be written.
+  static SessionWriter create(const std::filesystem::path& data_dir, const std::string& name, SessionManifest header,
+                              const Trajectory& trajectory, const std::string& purpose);
+  /// Reopens a session to continue it: takes its lock, loads and checks everything into `loaded`,
+  /// and removes leftovers of an interrupted write (temporary files, files of an
+  /// iteration the manifest does not list). Throws InputError (busy, bad session).
+  static SessionWriter open(const std::filesystem::path& directory, const std::string& purpose, Session& loaded);
+
+  const std::filesystem::path& directory() const { return directory_; }
+  const SessionManifest& manifest() const { return manifest_; }
+
+  /// Autosave after iteration `summary.iteration` (which must be the next one) completed, with
+  /// the correction learned from it and the state to continue from.
+  void save_iteration(const TrialRecord& record, const IterationSummary& summary,
+                      const Eigen::VectorXd& next_correction_bar, ResumeState resume);
+  /// Appends an event and saves the manifest at once.
+  void record_event(const std::string& kind, const std::string& message);
+  /// Replaces the configuration (e.g. the operator changed gains); saved at once.
+  void set_configuration(const Configuration& config);
+
+ private:
+  SessionWriter(std::filesystem::path directory, SessionManifest manifest, SessionLock lock);
+  int next_iteration() const { return static_cast<int>(manifest_.iterations.size()); }
+
+  std::filesystem::path directory_;
+  SessionManifest manifest_;
+  SessionLock lock_;
+};
+
+}  // namespace bellows

@@ -1,0 +1,30 @@
+# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DCLANGXX=... -DTARGET=... -DSECONDS=... -P run_fuzz.cmake
+# Configures and builds the clang + libFuzzer + ASan/UBSan build, then fuzzes TARGET for SECONDS,
+# starting from the seeds in tests/fuzz/seeds and the corpus grown by earlier runs.
+if(NOT CLANGXX OR NOT EXISTS "${CLANGXX}")
+  message("SKIPPED: clang++ not found; scripts/setup.sh installs it")
+  return()
+endif()
+execute_process(
+  COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BUILD_DIR} -DCMAKE_CXX_COMPILER=${CLANGXX}
+          -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBELLOWS_FUZZ=ON -DBELLOWS_BUILD_TESTS=OFF -DBELLOWS_BUILD_BENCH=OFF
+          -DBELLOWS_SANITIZE=address,undefined
+  RESULT_VARIABLE configured OUTPUT_QUIET)
+if(configured)
+  message(FATAL_ERROR "configuring the fuzz build in ${BUILD_DIR} failed")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${BUILD_DIR} --target ${TARGET} -j 2 RESULT_VARIABLE built)
+if(built)
+  message(FATAL_ERROR "building ${TARGET} failed")
+endif()
+file(MAKE_DIRECTORY ${BUILD_DIR}/corpus/${TARGET})
+set(binary ${BUILD_DIR}/tests/fuzz/${TARGET})
+execute_process(
+  COMMAND ${binary} ${BUILD_DIR}/corpus/${TARGET} ${SOURCE_DIR}/tests/fuzz/seeds
+          -dict=${SOURCE_DIR}/tests/fuzz/session.dict -max_total_time=${SECONDS} -max_len=16384 -timeout=10
+          -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=${BUILD_DIR}/
+  RESULT_VARIABLE fuzzed)
+if(fuzzed)
+  message(FATAL_ERROR "${TARGET} found a failing input (exit ${fuzzed}); it is saved in ${BUILD_DIR} "
+                      "as crash-* / timeout-* / oom-*; reproduce with: ${binary} <file>")
+endif()
