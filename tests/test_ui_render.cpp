@@ -197,6 +197,14 @@ TEST(UiRender, BelowTheMinimumSizeAClearMessage) {
       EXPECT_NE(text.find("80x24"), std::string::npos);
     }
   }
+  ConsoleState small = sample_state(2, true);
+  small.width = 70;
+  small.height = 20;
+  small.dialog = {DialogKind::kConfirmQuit, "Quit?", {"2 iterations are not saved."}, "", "q quit without saving   Esc cancel"};
+  const std::string small_text = all(render_lines(small));
+  EXPECT_NE(small_text.find("Quit?"), std::string::npos) << small_text;
+  EXPECT_NE(small_text.find("q quit without saving   Esc cancel"), std::string::npos);
+
   ConsoleState s = sample_state(2, true);
   s.width = 80;
   s.height = 24;

@@ -147,13 +147,17 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
 }
 
 void render_too_small(const ConsoleState& s, Canvas& c) {
-  const std::vector<std::string> lines = {
+  std::vector<std::string> lines = {
       "Terminal too small",
       format("%dx%d: Bellows needs at least %dx%d.", s.width, s.height, kMinWidth, kMinHeight),
       "Enlarge the window to see the console.",
       format("Engine: %s", to_string(s.engine_state)),
       "Space: emergency stop    q: quit",
   };
+  if (s.dialog.kind != DialogKind::kNone) {  // a question waits for an answer: say which
+    lines.push_back(s.dialog.title);
+    lines.push_back(s.dialog.hint);
+  }
   const int top = std::max(0, (c.height() - static_cast<int>(lines.size())) / 2);
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const int y = top + static_cast<int>(i);
