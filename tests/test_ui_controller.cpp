@@ -48,6 +48,8 @@ TEST(UiController, FiveIterationsLowerTheRms) {
   EXPECT_EQ(f.state().experiment.trials[3].origin, "learned from 2");
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
   EXPECT_TRUE(f.logged("batch of 5 done"));
+  // The law's convergence prediction is shown (for the paper's defaults it warns about model errors).
+  EXPECT_NE(f.state().convergence.find("contraction"), std::string::npos) << f.state().convergence;
   EXPECT_TRUE(f.state().experiment.unsaved());
 }
 

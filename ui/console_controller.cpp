@@ -6,6 +6,7 @@
 
 #include <time.h>
 
+#include "engine/convergence.hpp"
 #include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
@@ -280,7 +281,19 @@ void ConsoleController::rebuild_law() {
   law_samples_ = state_.experiment.samples();
   state_.law_name = state_.config.ilc.law;
   law_build_.start([config = state_.config, model = model_, samples = law_samples_] {
-    return make_learning_law(config, model, samples);
+    BuiltLaw built;
+    built.law = make_learning_law(config, model, samples);
+    const ConvergencePrediction p = predict_convergence(*built.law, config, samples);
+    if (p.available) {
+      built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
+                                 "off by up to %.0f %%",
+                                 p.nominal.contraction, p.worst.contraction, 100.0 * p.model_error);
+      built.warning = !p.warning.empty();
+      if (built.warning) built.convergence = p.warning;
+    } else {
+      built.convergence = "no convergence prediction for this law";
+    }
+    return built;
   });
   ++revision_;
 }
@@ -288,12 +301,16 @@ void ConsoleController::rebuild_law() {
 void ConsoleController::poll_tasks() {
   if (law_build_.ready()) {
     try {
-      law_ = law_build_.take();
+      BuiltLaw built = law_build_.take();
+      law_ = std::move(built.law);
       if (law_->samples() != state_.experiment.samples()) rebuild_pending_ = true;
       state_.law_ready = !rebuild_pending_;
       if (state_.law_ready) {
+        state_.convergence = built.convergence;
+        state_.convergence_warning = built.warning;
         log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
                                         law_->samples(), state_.config.ilc.m, state_.config.ilc.s, state_.config.ilc.w));
+        if (built.warning) log(LogSource::kLearner, built.convergence, true);
       }
     } catch (const std::exception& error) {
       law_.reset();
@@ -363,8 +380,11 @@ void ConsoleController::finish_trial(double time_s) {
   e.add_trial(std::move(trial));
   const IterationSummary& s = e.trials.back().summary;
   if (follow || state_.inspector.trial < 0) state_.inspector.trial = static_cast<int>(e.trials.size()) - 1;
-  log(LogSource::kEngine, format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar", s.iteration,
-                                 s.rms_deg, s.max_abs_error_deg, s.max_abs_correction_bar),
+  // Saturated samples: the set-point clamp cut the input there (where wind-up starts).
+  log(LogSource::kEngine,
+      format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s", s.iteration, s.rms_deg,
+             s.max_abs_error_deg, s.max_abs_correction_bar,
+             s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
       false, time_s);
   set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
   state_.run.phase = RunProgress::Phase::kNone;

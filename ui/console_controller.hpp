@@ -143,7 +143,12 @@ class ConsoleController {
   std::uint64_t strip_revision_ = 0, strip_exported_ = 0;
 
   // Declared last: destroyed (joined) first, before the law and the state they use.
-  BackgroundTask<std::unique_ptr<LearningLaw>> law_build_;
+  struct BuiltLaw {
+    std::unique_ptr<LearningLaw> law;
+    std::string convergence;
+    bool warning = false;
+  };
+  BackgroundTask<BuiltLaw> law_build_;
   BackgroundTask<Eigen::VectorXd> law_update_;
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;

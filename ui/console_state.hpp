@@ -134,6 +134,8 @@ struct ConsoleState {
   Experiment experiment;
   std::string law_name;
   bool law_ready = false;
+  std::string convergence;        // the law's predicted contraction per trial, in words
+  bool convergence_warning = false;  // it may diverge for a plausible model error
   bool learner_busy = false;
   std::string learner_task;    // "building the learning law", "learning", "saving", ...
   RunProgress run;

@@ -163,7 +163,7 @@ void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body) {
   const int trial_height = right.height / 2;
   render_trial_plot(s, c, {right.x, right.y, right.width, trial_height}, g);
   const Rect bottom{right.x, right.y + trial_height, right.width, right.height - trial_height};
-  const int rms_width = std::clamp(bottom.width * 2 / 5, 22, 44);
+  const int rms_width = std::clamp(bottom.width / 2, 22, 50);
   render_rms(s, c, {bottom.x, bottom.y, rms_width, bottom.height}, g);
   render_correction(s, c, {bottom.x + rms_width, bottom.y, bottom.width - rms_width, bottom.height}, g);
 }

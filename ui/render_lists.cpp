@@ -85,7 +85,7 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
 
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  const int form_height = std::min(body.height, 12);
+  const int form_height = std::min(body.height, 13);
   const Rect form{body.x, body.y, body.width, form_height};
   c.frame(form, g, "Gains and learning weights (changed between trials)");
   const Rect in = inner(form);
@@ -105,6 +105,10 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
     const std::string row = format("%s %-5s %12.6g %-4s  %-24s %s", selected ? ">" : " ", f.label,
                                    tuning_value(s.config, static_cast<int>(i)), f.unit, f.config_key, f.description);
     c.put(in.x + 1, y++, fit(row, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
+  }
+  if (y < in.bottom() && !s.convergence.empty()) {
+    c.put(in.x + 1, y++, s.convergence, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning,
+          in.right());
   }
   const Rect changes{body.x, form.bottom(), body.width, body.height - form_height};
   if (changes.height < 3) return;
