@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/config_file.hpp"
+#include "app/console_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
 #include "app/run_command.hpp"
@@ -93,6 +94,30 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
 
+  bellows::ConsoleOptions console;
+  CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
+  console_cmd->add_option("--device", console.device, "The rig: sim (the simulated arm)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sim"}));
+  console_cmd->add_option("--speed", console.speed, "The simulated arm's time warp: 1, 2, 5, 10 or max")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
+  console_cmd->add_option("--config", console.config_path, "TOML configuration file");
+  console_cmd->add_option("--trajectory", console.trajectory, "Library name (paper, steps, sine) or a CSV file")
+      ->capture_default_str();
+  console_cmd->add_option("--session", console.session_dir, "Open this saved session at start");
+  console_cmd->add_option("--rt", console.rt, "Real-time scheduling of the engine loop: enforce, try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
+  console_cmd->add_option("--seed", console.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  console_cmd->add_option("--stop-after-rises", console.stop_after_rises,
+                          "A run of K iterations stops when the RMS rose this many times in a row")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  console_cmd->add_option("--exit-after", console.exit_after_s, "Close by itself after this many seconds (benchmarks)")
+      ->check(CLI::NonNegativeNumber);
+  console_cmd->add_flag("--no-color", console.no_color, "Attributes only, no colours (also: NO_COLOR set)");
+
   std::string config_path;
   CLI::App* config_cmd = app.add_subcommand("config", "Print the configuration (defaults, or --config on top of them) as TOML");
   config_cmd->add_option("--config", config_path, "TOML configuration file");
@@ -135,8 +160,8 @@ int main(int argc, char** argv) {
     if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
     if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);
     if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);
-    std::cout << app.help();
-    return 0;
+    // No subcommand (or `console`): the operator console.
+    return bellows::console_command(console, std::cout);
   } catch (const bellows::InputError& error) {
     std::cerr << "bellows: " << error.what() << std::endl;
     return kExitBadInput;

@@ -1,0 +1,194 @@
+#include "app/console_sessions.hpp"
+
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+
+#include "engine/errors.hpp"
+#include "sessions/session_store.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr const char* kPurpose = "bellows console";
+// Log entries saved after a session's creation travel as one event per save (one manifest write),
+// a line per entry: "HH:MM:SS source: text".
+constexpr const char* kConsoleLogKind = "console-log";
+
+/// What of the console's log belongs in a session: not a trial's routine state changes, nor the
+/// learner's lines (the iterations themselves are saved with their results).
+bool worth_saving(const ui::LogEntry& e) { return !e.routine && e.source != ui::LogSource::kLearner; }
+
+std::string kind_of(const ui::LogEntry& e) {
+  if (e.important && e.text.rfind("FAULT", 0) == 0) return "fault";
+  return ui::to_string(e.source);
+}
+
+ui::LogSource source_of(const std::string& name) {
+  if (name == "operator") return ui::LogSource::kOperator;
+  if (name == "engine" || name == "fault") return ui::LogSource::kEngine;
+  if (name == "learner") return ui::LogSource::kLearner;
+  return ui::LogSource::kSession;
+}
+
+std::string local_clock_of(const std::string& utc) {
+  const std::string date = local_date_of(utc);  // "YYYY-MM-DD HH:MM"
+  if (date.size() != 16 || utc.size() < 19) return utc;
+  return date.substr(11) + utc.substr(16, 3);  // seconds do not depend on the time zone
+}
+
+/// The saved events as log entries; a console-log event gives back its lines.
+std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
+  std::vector<ui::LogEntry> out;
+  for (const SessionEvent& e : m.events) {
+    if (e.kind == kConsoleLogKind) {
+      std::istringstream lines(e.message);
+      std::string line;
+      while (std::getline(lines, line)) {
+        const auto colon = line.find(": ", 9);
+        if (line.size() < 10 || colon == std::string::npos) continue;
+        const std::string source = line.substr(9, colon - 9);
+        out.push_back({line.substr(0, 8), -1.0, source_of(source), line.substr(colon + 2), source == "fault", false,
+                       e.time_utc, e.iteration});
+      }
+      continue;
+    }
+    const bool known = e.kind == "operator" || e.kind == "engine" || e.kind == "session" || e.kind == "fault";
+    out.push_back({local_clock_of(e.time_utc), -1.0, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
+                   e.kind == "fault", false, e.time_utc, e.iteration});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string local_date_of(const std::string& utc) {
+  std::tm t{};
+  if (std::sscanf(utc.c_str(), "%d-%d-%dT%d:%d:%d", &t.tm_year, &t.tm_mon, &t.tm_mday, &t.tm_hour, &t.tm_min,
+                  &t.tm_sec) != 6) {
+    return utc;
+  }
+  t.tm_year -= 1900;
+  t.tm_mon -= 1;
+  const std::time_t seconds = timegm(&t);
+  std::tm local{};
+  localtime_r(&seconds, &local);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M", &local);
+  return text;
+}
+
+StoreSessionGateway::StoreSessionGateway(std::string device_name) : device_name_(std::move(device_name)) {
+  try {
+    data_dir_ = default_data_dir();
+  } catch (const InputError& error) {
+    reason_ = error.what();
+  }
+}
+
+std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  const ui::Experiment& e = snapshot.experiment;
+  if (!e.trajectory) throw InputError("nothing to save: no trajectory");
+  const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
+
+  // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
+  const std::size_t held = snapshot.events.size();
+  const std::size_t first_held = snapshot.events_total - held;
+  const std::size_t first_new = continuing ? std::max(e.saved_events, first_held) - first_held : 0;
+
+  std::size_t first_trial = 0;
+  if (continuing) {
+    first_trial = writer_->manifest().iterations.size();
+    if (first_trial > e.trials.size()) throw InputError("the session on disk has more iterations than the console");
+    if (e.settings_changed) writer_->set_configuration(snapshot.config);
+    std::string lines;
+    for (std::size_t i = first_new; i < held; ++i) {
+      const ui::LogEntry& entry = snapshot.events[i];
+      if (worth_saving(entry)) lines += entry.clock + " " + kind_of(entry) + ": " + entry.text + "\n";
+    }
+    if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
+  } else {
+    SessionManifest header;
+    header.device = snapshot.device_name;
+    header.device_info = {{"seed", snapshot.seed}};
+    header.configuration = snapshot.config;
+    for (const ui::LogEntry& entry : snapshot.events) {
+      if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
+    }
+    writer_.reset();  // the previous session's lock goes first
+    writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
+  }
+  for (std::size_t i = first_trial; i < e.trials.size(); ++i) {
+    const ui::Trial& trial = e.trials[i];
+    const Eigen::VectorXd& next = i + 1 < e.trials.size() ? e.trials[i + 1].correction_bar : e.next_correction_bar;
+    // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
+    writer_->save_iteration(trial.record, trial.summary, next, ResumeState{});
+  }
+  return writer_->directory().string();
+}
+
+std::vector<ui::SessionListing> StoreSessionGateway::list() {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  std::vector<ui::SessionListing> out;
+  for (const SessionListing& s : list_sessions(data_dir_)) {
+    ui::SessionListing l;
+    l.location = s.directory.string();
+    l.name = s.directory.filename().string();
+    l.error = s.error;
+    if (s.error.empty()) {
+      l.date = local_date_of(s.manifest.started_utc);
+      l.trajectory = s.manifest.trajectory_name;
+      l.iterations = static_cast<int>(s.manifest.iterations.size());
+      l.best_rms_deg = best_rms_deg(s.manifest);
+    }
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  const std::filesystem::path directory = resolve_session_dir(location, data_dir_);
+  if (writer_ && writer_->directory() == directory) writer_.reset();  // reopening our own session
+  Session loaded;
+  SessionWriter writer = SessionWriter::open(directory, kPurpose, loaded);
+  const SessionManifest& m = loaded.manifest;
+  if (m.device != device_name_) {
+    throw InputError("session " + directory.string() + " was recorded on the device '" + m.device +
+                     "'; this console drives '" + device_name_ + "'");
+  }
+  ui::SessionSnapshot snapshot;
+  snapshot.config = m.configuration;
+  snapshot.device_name = m.device;
+  const auto seed = m.device_info.find("seed");
+  if (seed != m.device_info.end() && seed->is_number_unsigned()) snapshot.seed = seed->get<std::uint64_t>();
+  ui::Experiment& e = snapshot.experiment;
+  e = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
+  const int n = loaded.trajectory.learning_samples();
+  for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
+    ui::Trial trial;
+    trial.iteration = static_cast<int>(i);
+    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
+    trial.record = std::move(loaded.iterations[i].record);
+    trial.summary = m.iterations[i].summary;
+    trial.origin = "saved";
+    e.trials.push_back(std::move(trial));
+  }
+  if (!loaded.iterations.empty()) {
+    e.next_correction_bar = loaded.iterations.back().next_correction_bar;
+    e.next_origin = "saved with the session";
+    // The correction the last trial ran with again: the next step learns first.
+    e.next_tried = e.next_correction_bar.isApprox(e.trials.back().correction_bar) ||
+                   (e.next_correction_bar.isZero() && e.trials.back().correction_bar.isZero());
+  }
+  e.session_location = directory.string();
+  e.saved_trials = static_cast<int>(e.trials.size());
+  snapshot.events = log_of(m);
+  snapshot.events_total = snapshot.events.size();
+  writer_.reset();
+  writer_.emplace(std::move(writer));
+  return snapshot;
+}
+
+}  // namespace bellows

@@ -1,0 +1,45 @@
+// The console's save and open on the session store (sessions/). The first save creates a session
+// in the data directory; later saves append the new iterations and log entries to it. Each saved
+// iteration's "next correction" is what the following trial ran with; for the last one saved, the
+// correction the console had chosen for the next trial at the time of saving (learning after the
+// save shows in the next trial's own samples, u_ilc). Opening a
+// session takes its lock, like `bellows run --resume`, so that the console continues it; the lock
+// is held until another session is opened or created, or the console exits. Every call may come
+// from a console background task: one at a time (a mutex).
+#pragma once
+
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "sessions/session_writer.hpp"
+#include "ui/session_gateway.hpp"
+
+namespace bellows {
+
+class StoreSessionGateway final : public ui::SessionGateway {
+ public:
+  /// `device_name`: the console's device; a session recorded on another one is not opened.
+  explicit StoreSessionGateway(std::string device_name);
+
+  bool available() const override { return !data_dir_.empty(); }
+  std::string unavailable_reason() const override { return reason_; }
+  std::string save(const ui::SessionSnapshot& snapshot) override;
+  std::vector<ui::SessionListing> list() override;
+  ui::SessionSnapshot open(const std::string& location) override;
+
+  const std::filesystem::path& data_dir() const { return data_dir_; }
+
+ private:
+  std::mutex mutex_;
+  std::string device_name_;
+  std::filesystem::path data_dir_;  // empty: not available (reason_ says why)
+  std::string reason_;
+  std::optional<SessionWriter> writer_;  // the session the console saves into
+};
+
+/// "2024-05-01T14:03:07.123Z" as local time "2024-05-01 14:03" (the text itself if it does not parse).
+std::string local_date_of(const std::string& utc);
+
+}  // namespace bellows

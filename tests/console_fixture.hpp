@@ -1,0 +1,125 @@
+// A console controller over a real engine and simulated arm on a simulated clock, driven by keys,
+// for the console's tests; and sessions kept in memory.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "app/trajectory_file.hpp"
+#include "devices/simulated_arm.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
+#include "ui/console_controller.hpp"
+#include "ui/keys.hpp"
+
+namespace bellows::testing {
+
+/// Sessions kept in memory: what the console would save and open.
+class MemorySessions final : public ui::SessionGateway {
+ public:
+  bool available() const override { return true; }
+  std::string save(const ui::SessionSnapshot& snapshot) override {
+    const std::string location =
+        snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size()) : snapshot.experiment.session_location;
+    saved[location] = snapshot;
+    ++saves;
+    return location;
+  }
+  std::vector<ui::SessionListing> list() override {
+    std::vector<ui::SessionListing> out;
+    for (const auto& [location, s] : saved) {
+      out.push_back({location, location, "2024-05-01 12:00", s.experiment.trajectory->name,
+                     static_cast<int>(s.experiment.trials.size()), s.experiment.best_rms_deg(), ""});
+    }
+    return out;
+  }
+  ui::SessionSnapshot open(const std::string& location) override {
+    ui::SessionSnapshot s = saved.at(location);
+    s.experiment.session_location = location;
+    return s;
+  }
+  std::map<std::string, ui::SessionSnapshot> saved;
+  int saves = 0;
+};
+
+struct ConsoleFixture {
+  /// `gateway`: where sessions go (default: `sessions`, in memory).
+  explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
+                          ui::SessionGateway* gateway = nullptr)
+      : config(c), arm(c.plant, 1), core(arm, c.controller, c.timing, c.safety), clock(core, arm) {
+    ui::ConsoleEnvironment env;
+    env.core = &core;
+    env.telemetry = &core.add_telemetry_tap(4096);
+    env.config = config;
+    env.load_trajectory = [c](const std::string& name) { return resolve_trajectory(name, c.timing.sample_s(), c.trajectory); };
+    env.sessions = gateway != nullptr ? gateway : &sessions;
+    env.stop_after_rises = stop_after_rises;
+    env.clock_text = [] { return std::string("12:00:00"); };
+    console = std::make_unique<ui::ConsoleController>(env, library_trajectory("paper", c.timing.sample_s()), false);
+    console->resize(120, 40);
+    console->start(clock.now_s());
+  }
+
+  const ui::ConsoleState& state() const { return console->state(); }
+  void key(int k) {
+    console->handle_key(k, clock.now_s());
+    console->update(clock.now_s());
+  }
+  void type(const std::string& keys) {
+    for (char k : keys) key(k);
+  }
+  /// Lets engine time pass, the console keeping up every 25 ms of it, until `done` or the limits.
+  bool pump_until(const std::function<bool()>& done, double max_engine_s = 400.0) {
+    const auto wall_start = std::chrono::steady_clock::now();
+    const double start = clock.now_s();
+    while (!done()) {
+      if (clock.now_s() - start > max_engine_s) return false;
+      if (std::chrono::steady_clock::now() - wall_start > std::chrono::seconds(120)) return false;
+      // Engine time stands still while the learner works, so that runs are deterministic.
+      const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning || console->state().learner_busy ||
+                           !console->state().law_ready;
+      if (waiting) std::this_thread::sleep_for(std::chrono::microseconds(200));
+      else clock.step(5);
+      console->update(clock.now_s());
+    }
+    return true;
+  }
+  void pump_for(double engine_s) {
+    const double until = clock.now_s() + engine_s;
+    pump_until([&] { return clock.now_s() >= until; });
+  }
+  bool idle() const { return state().run.mode == ui::RunProgress::Mode::kIdle && state().engine_state != EngineState::kRunning; }
+  void arm_valves() {
+    ASSERT_TRUE(pump_until([&] { return state().law_ready; }));
+    key('a');
+    key('y');
+    ASSERT_TRUE(pump_until([&] { return state().engine_state == EngineState::kArmed; }));
+  }
+  void run_batch(int k) {
+    key('N');
+    key(ui::key::kBackspace);
+    key(ui::key::kBackspace);
+    type(std::to_string(k));
+    key(ui::key::kEnter);
+    ASSERT_TRUE(pump_until([&] { return idle(); }));
+  }
+  bool logged(const std::string& fragment) const {
+    for (const ui::LogEntry& e : state().log.entries()) {
+      if (e.text.find(fragment) != std::string::npos) return true;
+    }
+    return false;
+  }
+
+  Configuration config;
+  SimulatedArm arm;
+  EngineCore core;
+  SimulatedClock clock;
+  MemorySessions sessions;
+  std::unique_ptr<ui::ConsoleController> console;
+};
+
+}  // namespace bellows::testing

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Without a UTF-8 locale the console draws ASCII only (plots with marks instead of braille); with
+# --no-color (or NO_COLOR) it uses attributes alone. A trial runs and its RMS shows as before.
+source "$(dirname "$0")/e2e_console_lib.sh"
+
+e2e_start 100 30 LC_ALL=C LANG=C -- console --speed max --no-color
+e2e_wait_for 'law [a-z-]+  M'
+e2e_keys a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys r
+e2e_wait_for 'iteration 0: RMS [0-9]+\.[0-9]{3} deg' 120
+e2e_wait_for 'Iteration 0: angle and set point'
+e2e_screen | grep -qF '+- Live ---' || e2e_fail "no ASCII frame"
+e2e_screen | grep -qE '\|[^|]*\*\*' || e2e_fail "no ASCII plot marks"
+non_ascii="$(e2e_screen | LC_ALL=C tr -d '\000-\177' | wc -c)"
+[ "$non_ascii" -eq 0 ] || e2e_fail "$non_ascii non-ASCII bytes on an ASCII screen"
+# No colour escape (foreground 30-37, background 40-47), but attributes (reverse video) remain.
+escaped="$(e2e_tmux capture-pane -p -e -t console)"
+echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours with --no-color"
+echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video for the keys and states"
+
+# The same screen in a UTF-8 locale with colours: braille and colour escapes.
+e2e_keys q
+e2e_wait_for 'Quit\?'
+e2e_keys q
+[ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
+e2e_start 100 30 -- console --speed max
+e2e_wait_for 'law [a-z-]+  M'
+e2e_keys a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys r
+e2e_wait_for 'Iteration 0: angle and set point' 120
+e2e_screen | LC_ALL=C grep -q $'\xe2[\xa0-\xa3]' || e2e_fail "no braille in a UTF-8 locale"  # U+2800..U+28FF
+e2e_tmux capture-pane -p -e -t console | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' || e2e_fail "no colours"
+e2e_keys q
+e2e_wait_for 'Quit\?'
+e2e_keys q
+[ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
+echo ok

@@ -1,0 +1,367 @@
+// The console's logic driven by keys against a real engine on a simulated clock: what happens to
+// the engine, the trials and the screens, without a terminal.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "devices/simulated_arm.hpp"
+#include "tests/console_fixture.hpp"
+#include "tests/process_runner.hpp"
+#include "ui/canvas.hpp"
+
+namespace bellows::ui {
+namespace {
+
+using testing::ConsoleFixture;
+using testing::MemorySessions;
+
+
+TEST(UiController, ArmingAsksForConfirmation) {
+  ConsoleFixture f;
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('a');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kConfirmArm);
+  f.pump_for(0.5);
+  EXPECT_EQ(f.core.state(), EngineState::kSafe);
+  f.key('n');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  f.pump_for(0.5);
+  EXPECT_EQ(f.core.state(), EngineState::kSafe);
+  f.key('a');
+  f.key('y');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kArmed; }));
+  EXPECT_TRUE(f.logged("SAFE -> ARMED (arm)"));
+  // The heartbeat keeps the armed engine alive.
+  f.pump_for(3.0);
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+}
+
+TEST(UiController, FiveIterationsLowerTheRms) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(5);
+  const auto rms = f.state().experiment.rms_history_deg();
+  ASSERT_EQ(rms.size(), 5u);
+  for (std::size_t i = 1; i < rms.size(); ++i) EXPECT_LT(rms[i], rms[i - 1]) << "iteration " << i;
+  EXPECT_NEAR(rms[0], 15.06, 0.2);  // the feedback-only trial, as `bellows run` gives it
+  EXPECT_EQ(f.state().experiment.trials[0].origin, "feedback only");
+  EXPECT_EQ(f.state().experiment.trials[3].origin, "learned from 2");
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  EXPECT_TRUE(f.logged("batch of 5 done"));
+  // The law's convergence prediction is shown (for the paper's defaults it warns about model errors).
+  EXPECT_NE(f.state().convergence.find("contraction"), std::string::npos) << f.state().convergence;
+  EXPECT_TRUE(f.state().experiment.unsaved());
+}
+
+TEST(UiController, RunRepeatsAndNextLearnsFirst) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  const auto& trials = f.state().experiment.trials;
+  ASSERT_EQ(trials.size(), 2u);
+  EXPECT_EQ(trials[1].origin, "same as 0");
+  EXPECT_TRUE(trials[1].correction_bar.isZero());
+  f.key('n');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  ASSERT_EQ(trials.size(), 3u);
+  EXPECT_EQ(trials[2].origin, "learned from 1");
+  EXPECT_GT(trials[2].correction_bar.cwiseAbs().maxCoeff(), 0.01);
+  EXPECT_LT(trials[2].summary.rms_deg, trials[1].summary.rms_deg);
+}
+
+TEST(UiController, BatchIsInterruptible) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('N');
+  f.key(key::kBackspace);
+  f.key(key::kBackspace);
+  f.type("50");
+  f.key(key::kEnter);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().experiment.trials.size() == 2 && f.core.state() == EngineState::kRunning; }));
+  f.key('x');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 2u);  // the running trial was aborted, not counted
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  EXPECT_TRUE(f.logged("stopped"));
+}
+
+TEST(UiController, BatchStopsByItselfWhenTheRmsKeepsRising) {
+  Configuration c;
+  c.model.kappa_rad_per_bar = 0.8;  // a model ten times too weak: the learning overshoots and diverges
+  c.ilc.s = 0.0;
+  c.ilc.w = 0.0;
+  ConsoleFixture f(c, 3);
+  f.arm_valves();
+  f.run_batch(10);
+  const auto rms = f.state().experiment.rms_history_deg();
+  const auto rose_three_times_until = [&](std::size_t last) {
+    return last >= 3 && rms[last] > rms[last - 1] && rms[last - 1] > rms[last - 2] && rms[last - 2] > rms[last - 3];
+  };
+  ASSERT_GE(rms.size(), 4u);
+  ASSERT_LT(rms.size(), 10u) << "the batch should have stopped by itself";
+  EXPECT_TRUE(rose_three_times_until(rms.size() - 1));
+  for (std::size_t last = 3; last + 1 < rms.size(); ++last) EXPECT_FALSE(rose_three_times_until(last)) << last;
+  EXPECT_TRUE(f.logged("the RMS rose 3 times in a row"));
+  EXPECT_TRUE(f.state().status_important);
+}
+
+TEST(UiController, EmergencyStopFromAnyScreenAndDialogThenResetAndRearm) {
+  ConsoleFixture f;
+  // From a dialog: the dialog closes and the engine vents.
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('a');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmArm);
+  f.key(' ');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }));
+  f.key('R');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  // From the log screen while a trial runs: the trial is handed back and not counted.
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.core.state() == EngineState::kRunning; }));
+  f.key('l');
+  ASSERT_EQ(f.state().screen, Screen::kLog);
+  f.key(' ');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.black_box.empty() && f.idle(); }));
+  EXPECT_EQ(f.state().engine_state, EngineState::kFault);
+  EXPECT_EQ(f.state().fault, FaultCode::kEmergencyStop);
+  EXPECT_EQ(f.state().screen, Screen::kFault);
+  EXPECT_TRUE(f.state().experiment.trials.empty());
+  EXPECT_EQ(f.state().fault_view.black_box.back().state, EngineState::kFault);
+  const auto& box = f.state().fault_view.black_box;
+  EXPECT_TRUE(std::any_of(box.begin(), box.end(), [](const TickRecord& t) { return t.state == EngineState::kRunning; }));
+  // Arming is refused until the fault is reset.
+  f.key('a');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  EXPECT_NE(f.state().status.find("reset it first"), std::string::npos) << f.state().status;
+  f.key('R');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  EXPECT_EQ(f.state().screen, Screen::kMain);
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 1u);
+}
+
+TEST(UiController, HeartbeatDrillMakesTheEngineVent) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('H');
+  EXPECT_TRUE(f.state().heartbeat_drill);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }, 5.0));
+  EXPECT_EQ(f.core.fault(), FaultCode::kHeartbeatLost);
+  f.pump_for(0.1);
+  EXPECT_FALSE(f.state().heartbeat_drill);
+  EXPECT_TRUE(f.logged("heartbeat drill: the engine vented"));
+}
+
+TEST(UiController, InspectorCursorAndGoingBackToAnEarlierCorrection) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(3);
+  f.key('c');
+  EXPECT_EQ(f.state().screen, Screen::kInspector);
+  EXPECT_EQ(f.state().inspector.trial, 2);
+  for (int i = 0; i < 3; ++i) f.key(key::kRight);
+  f.key(key::kPageDown);
+  EXPECT_EQ(f.state().inspector.sample, 43);
+  f.key(key::kEnd);
+  EXPECT_EQ(f.state().inspector.sample, 400);
+  f.key(key::kRight);
+  EXPECT_EQ(f.state().inspector.sample, 400);
+  f.key(key::kUp);
+  f.key('m');
+  EXPECT_EQ(f.state().inspector.chosen, 1);
+  f.key('u');
+  EXPECT_EQ(f.state().experiment.next_origin, "correction of 1");
+  EXPECT_FALSE(f.state().experiment.next_tried);
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  const auto& trials = f.state().experiment.trials;
+  ASSERT_EQ(trials.size(), 4u);
+  EXPECT_EQ(trials[3].origin, "correction of 1");
+  EXPECT_TRUE(trials[3].correction_bar.isApprox(trials[1].correction_bar));
+  EXPECT_TRUE(f.logged("go back to the correction of iteration 1"));
+}
+
+TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('w');
+  f.key(key::kDown);  // k_p
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kEditValue);
+  EXPECT_EQ(f.state().dialog.input, "0.3");
+  for (int i = 0; i < 3; ++i) f.key(key::kBackspace);
+  f.type("0.45");
+  f.key(key::kEnter);
+  EXPECT_DOUBLE_EQ(f.state().config.controller.k_p, 0.45) << f.state().status;
+  EXPECT_TRUE(f.logged("k_p changed 0.3 -> 0.45 ([controller] k_p)"));
+  EXPECT_TRUE(f.state().experiment.settings_changed);
+  // A refused value changes nothing.
+  f.key(key::kEnter);
+  for (int i = 0; i < 4; ++i) f.key(key::kBackspace);
+  f.type("-1");
+  f.key(key::kEnter);
+  EXPECT_DOUBLE_EQ(f.state().config.controller.k_p, 0.45);
+  EXPECT_TRUE(f.state().status_important);
+  EXPECT_NE(f.state().status.find("k_p"), std::string::npos) << f.state().status;
+  // A weight rebuilds the law.
+  for (int i = 0; i < 3; ++i) f.key(key::kDown);  // k_i, k_d, M
+  f.key(key::kDown);                               // S
+  f.key(key::kEnter);
+  for (int i = 0; i < 3; ++i) f.key(key::kBackspace);
+  f.type("0.2");
+  f.key(key::kEnter);
+  EXPECT_DOUBLE_EQ(f.state().config.ilc.s, 0.2);
+  EXPECT_FALSE(f.state().law_ready);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  EXPECT_TRUE(f.logged("S 0.2"));
+  // The gains reach the engine: the next trial differs from one with the old gains.
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  ASSERT_EQ(f.state().experiment.trials.size(), 1u);
+  EXPECT_GT(std::abs(f.state().experiment.trials[0].summary.rms_deg - 15.06), 0.3);
+}
+
+TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  f.key('t');
+  EXPECT_EQ(f.state().screen, Screen::kTrajectory);
+  EXPECT_EQ(f.state().chooser.preview->name, "paper");
+  f.key(key::kDown);
+  ASSERT_TRUE(f.state().chooser.preview);
+  EXPECT_EQ(f.state().chooser.preview->name, "steps");
+  f.key(key::kEnter);  // one unsaved trial: asks first
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmDiscard);
+  f.key('y');
+  EXPECT_EQ(f.state().experiment.trajectory->name, "steps");
+  EXPECT_TRUE(f.state().experiment.trials.empty());
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  ASSERT_EQ(f.state().experiment.trials.size(), 1u);
+  EXPECT_EQ(f.state().experiment.trials[0].record.learning_samples, 500);
+
+  // A file: a bad one shows why, a good one previews.
+  const auto dir = testing::make_temp_dir("bellows-ui");
+  const auto bad = testing::write_file(dir, "bad.csv", "time_s,angle_deg\n0,0\n0.02,abc\n");
+  std::string good_text = "time_s,angle_deg\n";
+  for (int k = 0; k <= 100; ++k) good_text += format("%.2f,%.3f\n", k * 0.02, 10.0 * std::sin(k * 0.05));
+  const auto good = testing::write_file(dir, "good.csv", good_text);
+  f.key('t');
+  for (int i = 0; i < 5; ++i) f.key(key::kDown);
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
+  f.type(bad.string());
+  f.key(key::kEnter);
+  EXPECT_NE(f.state().chooser.preview_error.find("bad.csv"), std::string::npos) << f.state().chooser.preview_error;
+  f.key(key::kEnter);
+  for (std::size_t i = 0; i < bad.string().size(); ++i) f.key(key::kBackspace);
+  f.type(good.string());
+  f.key(key::kEnter);
+  ASSERT_TRUE(f.state().chooser.preview) << f.state().chooser.preview_error;
+  EXPECT_EQ(f.state().chooser.preview->learning_samples(), 100);
+  f.key(key::kEnter);
+  f.key('y');
+  EXPECT_EQ(f.state().experiment.samples(), 100);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('n');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 1u);
+}
+
+TEST(UiController, RefusalsAreExplainedAndSendNothing) {
+  ConsoleFixture f;
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('r');
+  EXPECT_NE(f.state().status.find("arm the valves first"), std::string::npos) << f.state().status;
+  f.key('c');
+  EXPECT_NE(f.state().status.find("no trial has run yet"), std::string::npos);
+  f.pump_for(0.2);
+  EXPECT_EQ(f.core.state(), EngineState::kSafe);
+  EXPECT_TRUE(f.state().experiment.trials.empty());
+}
+
+TEST(UiController, SaveAndOpenThroughTheGateway) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(3);
+  f.key('s');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy; }));
+  ASSERT_EQ(f.sessions.saves, 1);
+  const SessionSnapshot& saved = f.sessions.saved.begin()->second;
+  EXPECT_EQ(saved.experiment.trials.size(), 3u);
+  EXPECT_FALSE(saved.events.empty());
+  EXPECT_FALSE(f.state().experiment.unsaved());
+  EXPECT_EQ(f.state().experiment.session_location, "mem://0");
+  const auto rms = f.state().experiment.rms_history_deg();
+
+  // Another trial, then open the saved session: asks (unsaved), and needs the valves vented.
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  f.key('o');
+  EXPECT_NE(f.state().status.find("disarm first"), std::string::npos) << f.state().status;
+  f.key('d');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  f.key('o');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
+  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  EXPECT_EQ(f.state().browser.sessions[0].iterations, 3);
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmDiscard);
+  f.key('y');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy && f.state().law_ready; }));
+  EXPECT_EQ(f.state().experiment.rms_history_deg(), rms);
+  EXPECT_FALSE(f.state().experiment.unsaved());
+  // Learning continues from the opened session.
+  f.arm_valves();
+  f.key('n');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 4u);
+  EXPECT_EQ(f.state().experiment.trials[3].origin, "learned from 2");
+  EXPECT_LT(f.state().experiment.trials[3].summary.rms_deg, rms[2]);
+}
+
+TEST(UiController, QuitAsksWhenWorkIsUnsavedAndDisarms) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  f.key('q');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
+  f.key(key::kEscape);
+  EXPECT_FALSE(f.console->quit_requested());
+  f.key('q');
+  f.key('s');  // save, then quit
+  ASSERT_TRUE(f.pump_until([&] { return f.console->quit_requested(); }));
+  EXPECT_EQ(f.sessions.saves, 1);
+  ASSERT_TRUE(f.pump_until([&] { return f.core.state() == EngineState::kSafe; }));
+}
+
+TEST(UiController, WithoutASessionStoreSaveSaysSo) {
+  Configuration c;
+  SimulatedArm arm(c.plant, 1);
+  EngineCore core(arm, c.controller, c.timing, c.safety);
+  UnavailableSessionGateway none("the session store is not part of this build yet");
+  ConsoleEnvironment env;
+  env.core = &core;
+  env.config = c;
+  env.sessions = &none;
+  ConsoleController console(env, library_trajectory("paper", 0.02), false);
+  console.start(0.0);
+  console.handle_key('s', 0.0);
+  EXPECT_NE(console.state().status.find("not part of this build"), std::string::npos) << console.state().status;
+  console.handle_key('o', 0.0);
+  EXPECT_EQ(console.state().screen, Screen::kMain);
+}
+
+}  // namespace
+}  // namespace bellows::ui

@@ -1,0 +1,213 @@
+// The console's save and open on the real session store: what the console saves reopens the same,
+// later saves append, a session is one console's at a time, and bad sessions say why.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include "app/console_sessions.hpp"
+#include "engine/errors.hpp"
+#include "sessions/session_store.hpp"
+#include "tests/console_fixture.hpp"
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::ConsoleFixture;
+
+/// Points the data directory ($XDG_DATA_HOME) at a fresh temporary directory for one test.
+class UiSessions : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    data_home_ = testing::make_temp_dir("bellows-ui-sessions");
+    const char* previous = std::getenv("XDG_DATA_HOME");
+    if (previous != nullptr) previous_ = previous;
+    had_previous_ = previous != nullptr;
+    setenv("XDG_DATA_HOME", data_home_.c_str(), 1);
+  }
+  void TearDown() override {
+    if (had_previous_) setenv("XDG_DATA_HOME", previous_.c_str(), 1);
+    else unsetenv("XDG_DATA_HOME");
+    std::filesystem::remove_all(data_home_);
+  }
+  std::filesystem::path sessions_dir() const { return data_home_ / "bellows" / "sessions"; }
+
+  std::filesystem::path data_home_;
+  std::string previous_;
+  bool had_previous_ = false;
+};
+
+void save_and_wait(ConsoleFixture& f) {
+  f.key('s');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy; }));
+  ASSERT_FALSE(f.state().status_important) << f.state().status;
+}
+
+TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
+  StoreSessionGateway gateway("sim");
+  ASSERT_TRUE(gateway.available()) << gateway.unavailable_reason();
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(3);
+  save_and_wait(f);
+  const ui::Experiment& saved = f.state().experiment;
+  ASSERT_FALSE(saved.session_location.empty());
+  EXPECT_EQ(std::filesystem::path(saved.session_location).parent_path(), sessions_dir());
+  EXPECT_EQ(saved.saved_trials, 3);
+
+  // The session is the console's while it holds it.
+  StoreSessionGateway other("sim");
+  EXPECT_THROW(other.open(saved.session_location), InputError);
+
+  const std::string location = saved.session_location;
+  f.console.reset();
+  const ui::SessionSnapshot copy = gateway.open(location);  // the gateway that holds it may reopen it
+  const ui::Experiment& e = copy.experiment;
+  ASSERT_EQ(e.trials.size(), 3u);
+  EXPECT_EQ(e.trajectory->name, "paper");
+  for (int i = 0; i < 3; ++i) {
+    const ui::Trial& t = e.trials[static_cast<std::size_t>(i)];
+    EXPECT_EQ(t.iteration, i);
+    EXPECT_GT(t.summary.rms_deg, 0.0);
+    EXPECT_EQ(t.record.learning_samples, 400);
+  }
+  EXPECT_LT(e.trials[2].summary.rms_deg, e.trials[0].summary.rms_deg);
+  EXPECT_TRUE(e.trials[0].correction_bar.isZero());
+  EXPECT_GT(e.trials[2].correction_bar.cwiseAbs().maxCoeff(), 0.01);
+  // The last trial ran with the correction saved as "next": a step learns first.
+  EXPECT_TRUE(e.next_tried);
+  EXPECT_EQ(e.saved_trials, 3);
+  bool armed_logged = false;
+  for (const ui::LogEntry& entry : copy.events) armed_logged = armed_logged || entry.text == "SAFE -> ARMED (arm)";
+  EXPECT_TRUE(armed_logged);
+  EXPECT_EQ(copy.seed, 1u);
+}
+
+TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(2);
+  save_and_wait(f);
+  const std::string location = f.state().experiment.session_location;
+  f.key('w');
+  f.key(ui::key::kDown);
+  f.key(ui::key::kEnter);
+  for (int i = 0; i < 3; ++i) f.key(ui::key::kBackspace);
+  f.type("0.35");
+  f.key(ui::key::kEnter);
+  f.key('n');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  EXPECT_EQ(f.state().experiment.session_location, location);  // the same session, grown
+  f.console.reset();
+
+  const Session loaded = load_session(location);
+  ASSERT_EQ(loaded.manifest.iterations.size(), 3u);
+  EXPECT_DOUBLE_EQ(loaded.manifest.configuration.controller.k_p, 0.35);
+  bool change_logged = false;
+  for (const SessionEvent& e : loaded.manifest.events) {
+    change_logged = change_logged || e.message.find("k_p changed 0.3 -> 0.35") != std::string::npos;
+  }
+  EXPECT_TRUE(change_logged);
+  // Iteration 0's next correction is what iteration 1 ran with. Iteration 1 was saved before the
+  // console learned from it: its next correction is the one chosen then (its own); what iteration 2
+  // ran with is in iteration 2's samples.
+  const auto applied = [&](std::size_t i) { return Eigen::VectorXd(loaded.iterations[i].record.samples.u_ilc_bar.head(400)); };
+  EXPECT_TRUE(loaded.iterations[0].next_correction_bar.isApprox(applied(1)));
+  EXPECT_TRUE(loaded.iterations[1].next_correction_bar.isApprox(applied(1)));
+  EXPECT_FALSE(applied(2).isApprox(applied(1)));
+}
+
+TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
+  std::string location;
+  {
+    StoreSessionGateway gateway("sim");
+    ConsoleFixture f(Configuration{}, 3, &gateway);
+    f.arm_valves();
+    f.run_batch(2);
+    save_and_wait(f);
+    location = f.state().experiment.session_location;
+  }
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('o');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
+  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  const ui::SessionListing& l = f.state().browser.sessions[0];
+  EXPECT_EQ(l.location, location);
+  EXPECT_EQ(l.trajectory, "paper");
+  EXPECT_EQ(l.iterations, 2);
+  EXPECT_NEAR(l.best_rms_deg, 9.38, 0.3);
+  EXPECT_EQ(l.date.size(), 16u) << l.date;
+  f.key(ui::key::kEnter);
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy && f.state().law_ready; }));
+  ASSERT_EQ(f.state().experiment.trials.size(), 2u);
+  f.arm_valves();
+  f.key('n');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  EXPECT_EQ(f.state().experiment.session_location, location);
+  f.console.reset();
+  EXPECT_EQ(load_manifest(location).iterations.size(), 3u);
+}
+
+TEST_F(UiSessions, BadSessionsAreListedWithTheReasonAndNotOpened) {
+  std::filesystem::create_directories(sessions_dir() / "broken");
+  std::ofstream(sessions_dir() / "broken" / "manifest.json") << "{ not json";
+  StoreSessionGateway gateway("sim");
+  const auto listing = gateway.list();
+  ASSERT_EQ(listing.size(), 1u);
+  EXPECT_EQ(listing[0].name, "broken");
+  EXPECT_FALSE(listing[0].error.empty());
+  EXPECT_THROW(gateway.open((sessions_dir() / "broken").string()), InputError);
+  EXPECT_THROW(gateway.open("no-such-session"), InputError);
+}
+
+TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
+  std::string location;
+  {
+    StoreSessionGateway gateway("sim");
+    ConsoleFixture f(Configuration{}, 3, &gateway);
+    f.arm_valves();
+    f.key('r');
+    ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+    save_and_wait(f);
+    location = f.state().experiment.session_location;
+  }
+  StoreSessionGateway lcm("lcm");
+  try {
+    lcm.open(location);
+    FAIL() << "opened a sim session on an lcm console";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("recorded on the device 'sim'"), std::string::npos) << error.what();
+  }
+}
+
+TEST(UiSessionDates, LocalDateOfUtc) {
+  setenv("TZ", "UTC", 1);
+  tzset();
+  EXPECT_EQ(local_date_of("2024-05-01T14:03:07.123Z"), "2024-05-01 14:03");
+  EXPECT_EQ(local_date_of("not a date"), "not a date");
+  unsetenv("TZ");
+  tzset();
+}
+
+TEST(UiSessionGateway, WithoutADataDirectoryItSaysWhy) {
+  const char* xdg = std::getenv("XDG_DATA_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string saved_xdg = xdg != nullptr ? xdg : "", saved_home = home != nullptr ? home : "";
+  unsetenv("XDG_DATA_HOME");
+  setenv("HOME", "relative/home", 1);
+  StoreSessionGateway gateway("sim");
+  EXPECT_FALSE(gateway.available());
+  EXPECT_FALSE(gateway.unavailable_reason().empty());
+  if (xdg != nullptr) setenv("XDG_DATA_HOME", saved_xdg.c_str(), 1);
+  if (home != nullptr) setenv("HOME", saved_home.c_str(), 1);
+  else unsetenv("HOME");
+}
+
+}  // namespace
+}  // namespace bellows

@@ -1,0 +1,126 @@
+#include "ui/console.hpp"
+
+#include <clocale>
+#include <ctime>
+
+#include "ui/keys.hpp"
+#include "ui/render.hpp"
+#include "ui/terminal.hpp"
+
+namespace bellows::ui {
+namespace {
+
+constexpr double kFramePeriodS = 1.0 / 30.0;  // redraw at most 30 times a second
+constexpr double kIdleFramePeriodS = 0.1;     // live values only: 10 times a second
+constexpr int kKeyTimeoutMs = 33;
+constexpr double kDisarmWaitS = 1.0;          // on quit: how long the engine may take to disarm
+constexpr std::size_t kTelemetryCapacity = 4096;  // ~20 s of ticks at 200 Hz between two frames
+
+double seconds_of(clockid_t clock) {
+  timespec t{};
+  clock_gettime(clock, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+double monotonic_s() { return seconds_of(CLOCK_MONOTONIC); }
+
+/// Stops the engine loop (which vents) however the console ends.
+struct LoopStopper {
+  RealtimeLoop* loop;
+  ~LoopStopper() { loop->stop(); }
+};
+
+}  // namespace
+
+ConsoleReport run_console(ConsoleSetup setup) {
+  std::setlocale(LC_ALL, "");
+  const bool unicode = locale_is_utf8();
+
+  ConsoleEnvironment env = std::move(setup.environment);
+  env.core = setup.core;
+  env.telemetry = &setup.core->add_telemetry_tap(kTelemetryCapacity);  // before the loop starts
+  RealtimeLoop* loop = setup.loop;
+  env.latency = [loop] { return loop->latency(); };
+
+  // Declared before the loop stopper: the controller owns the buffers of a running trial, so it
+  // must outlive the engine loop however this function ends.
+  std::optional<ConsoleController> controller;
+  std::optional<Terminal> terminal;
+  terminal.emplace(setup.allow_colors);  // throws InputError without a terminal, before the loop runs
+  try {
+    loop->start(setup.rt_mode);
+  } catch (...) {
+    terminal.reset();  // the error must reach a normal screen
+    throw;
+  }
+  LoopStopper stopper{loop};
+  env.rt_description = loop->rt_description();
+  controller.emplace(std::move(env), std::move(setup.trajectory), unicode);
+  if (setup.session) controller->adopt_session(std::move(*setup.session));
+
+  ConsoleReport report;
+  report.unicode = unicode;
+  report.colors = terminal->colors();
+  const double start_s = monotonic_s();
+  const double cpu_start_s = seconds_of(CLOCK_THREAD_CPUTIME_ID);
+  controller->resize(terminal->width(), terminal->height());
+  controller->start(start_s);
+  Canvas canvas(terminal->width(), terminal->height());
+  double last_draw_s = -1.0;
+  std::uint64_t drawn_revision = ~0ull;
+
+  while (!controller->quit_requested()) {
+    int key = terminal->read_key(kKeyTimeoutMs);
+    for (int extra = 0; key != key::kNone && extra < 64; ++extra) {  // every key typed ahead, then draw
+      if (key == key::kResize) {
+        controller->resize(terminal->width(), terminal->height());
+        canvas = Canvas(terminal->width(), terminal->height());
+      }
+      controller->handle_key(key, monotonic_s());
+      if (controller->quit_requested()) break;
+      key = terminal->read_key(0);
+    }
+    const double now = monotonic_s();
+    controller->update(now);
+    if (setup.stop_flag != nullptr && setup.stop_flag->load(std::memory_order_relaxed)) {
+      controller->emergency_stop("signal: emergency stop and exit");
+      report.stopped_by_signal = true;
+      break;
+    }
+    if (setup.exit_after_s > 0.0 && now - start_s >= setup.exit_after_s) {
+      report.exited_after_time = true;
+      break;
+    }
+    const double since_draw = now - last_draw_s;
+    const bool changed = controller->revision() != drawn_revision;
+    const double period = controller->active() ? kFramePeriodS : kIdleFramePeriodS;
+    if (last_draw_s < 0.0 || (since_draw >= kFramePeriodS && (changed || since_draw >= period))) {
+      drawn_revision = controller->revision();
+      render(controller->state(), canvas);
+      terminal->draw(canvas);
+      last_draw_s = now;
+      ++report.frames;
+    }
+  }
+
+  // Vent: disarm through the engine (heartbeats continue meanwhile), then stop the loop.
+  // (A quit from the keyboard has sent the disarm already; a signal has stopped the engine.)
+  if (report.exited_after_time && valves_live(setup.core->state())) {
+    setup.core->send(EngineCommand::of(CommandKind::kDisarm));
+  }
+  const double quit_s = monotonic_s();
+  while (valves_live(setup.core->state()) && monotonic_s() - quit_s < kDisarmWaitS) {
+    terminal->read_key(10);
+    controller->update(monotonic_s());
+  }
+  report.seconds = monotonic_s() - start_s;
+  report.ui_cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID) - cpu_start_s;
+  loop->stop();
+  terminal.reset();
+  report.loop = loop->latency();
+  report.ticks = setup.core->ticks();
+  report.iterations = static_cast<int>(controller->state().experiment.trials.size());
+  report.best_rms_deg = controller->state().experiment.best_rms_deg();
+  return report;
+}
+
+}  // namespace bellows::ui

@@ -1,0 +1,477 @@
+#include "ui/console_controller.hpp"
+
+#include <cmath>
+#include <ctime>
+#include <numbers>
+
+#include <time.h>
+
+#include "engine/convergence.hpp"
+#include "engine/errors.hpp"
+#include "engine/learning_law_factory.hpp"
+#include "engine/learning_session.hpp"
+#include "ui/canvas.hpp"
+
+namespace bellows::ui {
+namespace {
+
+constexpr double kHeartbeatPeriodS = 0.05;    // well inside the engine's timeout (1 s by default)
+constexpr double kLoopStatsPeriodS = 0.25;    // the latency summary walks a histogram: not every frame
+constexpr double kStaleSnapshotS = 0.5;       // no fresh tick for this long: the device shows no data
+constexpr double kStripSeconds = 5.0;         // the live plot's window
+
+std::string system_clock_text() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char text[16];
+  std::strftime(text, sizeof text, "%H:%M:%S", &local);
+  return text;
+}
+
+}  // namespace
+
+struct ConsoleController::InFlight {
+  std::shared_ptr<const Trajectory> trajectory;
+  Eigen::VectorXd correction_bar;
+  TrialRecord record;
+  std::uint32_t id = 0;
+  std::string origin;
+  bool accepted = false;  // the engine took it (went RUNNING)
+};
+
+ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajectory, bool unicode)
+    : env_(std::move(env)), model_(discretize_arm_model(env_.config.model, env_.config.timing.sample_s())) {
+  if (!env_.clock_text) env_.clock_text = system_clock_text;
+  state_.unicode = unicode;
+  state_.config = env_.config;
+  state_.device.name = env_.device_name;
+  state_.loop.rt = env_.rt_description;
+  state_.loop.speed = env_.speed;
+  state_.loop.tick_hz = 1.0 / env_.config.timing.tick_s;
+  state_.loop.realtime = static_cast<bool>(env_.latency);
+  state_.law_name = env_.config.ilc.law;
+  state_.stop_after_rises = env_.stop_after_rises;
+  state_.sessions_available = env_.sessions != nullptr && env_.sessions->available();
+  state_.sessions_unavailable_reason =
+      env_.sessions != nullptr ? env_.sessions->unavailable_reason() : "no session store in this build";
+  auto shared = std::make_shared<const Trajectory>(std::move(trajectory));
+  state_.experiment = Experiment::start(shared);
+  const auto strip_size = static_cast<std::size_t>(std::lround(kStripSeconds / env_.config.timing.sample_s()));
+  strip_time_.assign(strip_size, 0.0);
+  strip_angle_.assign(strip_size, 0.0);
+  strip_setpoint_.assign(strip_size, 0.0);
+}
+
+ConsoleController::~ConsoleController() = default;
+
+bool ConsoleController::active() const {
+  return state_.run.mode != RunProgress::Mode::kIdle || state_.engine_state == EngineState::kRunning;
+}
+
+void ConsoleController::log(LogSource source, std::string text, bool important, double engine_time_s, bool routine) {
+  if (engine_time_s < -1.0) engine_time_s = state_.live_valid ? state_.live.time_s : -1.0;
+  state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine, utc_timestamp(),
+                  state_.experiment.next_iteration()});
+  ++revision_;
+}
+
+void ConsoleController::set_status(std::string text, bool important) {
+  state_.status = std::move(text);
+  state_.status_important = important;
+  ++revision_;
+}
+
+bool ConsoleController::send(const EngineCommand& command, const char* what) {
+  if (env_.core->send(command)) return true;
+  log(LogSource::kOperator, std::string("command queue full: ") + what + " not sent", true);
+  set_status(std::string("the engine's command queue is full: ") + what + " not sent", true);
+  return false;
+}
+
+void ConsoleController::send_simple(CommandKind kind, const char* what) { send(EngineCommand::of(kind), what); }
+
+void ConsoleController::send_gains() {
+  const ControllerParameters& c = state_.config.controller;
+  EngineCommand gains = EngineCommand::of(CommandKind::kSetGains);
+  gains.gains = {c.k_ff, c.k_p, c.k_i_per_s, c.k_d_s};
+  send(gains, "set gains");
+}
+
+void ConsoleController::start(double now_s) {
+  now_s_ = now_s;
+  env_.core->monitor_heartbeat(true);
+  heartbeat(now_s);
+  if (selected_trajectories_.empty() || selected_trajectories_.back() != state_.experiment.trajectory) {
+    select_trajectory(state_.experiment.trajectory);
+  }
+  send_gains();
+  rebuild_law();
+  log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
+                                   env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
+  set_status("a arms the valves, t chooses a trajectory, ? lists every key");
+}
+
+void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> trajectory) {
+  selected_trajectories_.push_back(trajectory);
+  send(EngineCommand::select_trajectory(*selected_trajectories_.back()), "select trajectory");
+}
+
+void ConsoleController::heartbeat(double now_s) {
+  if (state_.heartbeat_drill) {
+    const double waited = now_s - drill_started_s_;
+    if (state_.engine_state == EngineState::kFault) {
+      state_.heartbeat_drill = false;
+      log(LogSource::kOperator, format("heartbeat drill: the engine vented after %.1f s without heartbeat (%s)", waited,
+                                       fault_name(state_.fault)));
+    } else if (waited > env_.config.safety.heartbeat_timeout_s + 3.0) {
+      state_.heartbeat_drill = false;
+      log(LogSource::kOperator, format("heartbeat drill FAILED: the engine did not vent within %.1f s", waited), true);
+    } else {
+      return;
+    }
+  }
+  if (last_heartbeat_s_ >= 0.0 && now_s - last_heartbeat_s_ < kHeartbeatPeriodS) return;
+  if (env_.core->send(EngineCommand::of(CommandKind::kHeartbeat))) last_heartbeat_s_ = now_s;
+}
+
+void ConsoleController::update(double now_s) {
+  now_s_ = now_s;
+  heartbeat(now_s);
+  poll_engine(now_s);
+  poll_snapshot_and_telemetry(now_s);
+  poll_tasks();
+  if (black_box_pending_ && env_.core->black_box().frozen()) {
+    state_.fault_view.black_box = env_.core->black_box().copy_frozen();
+    black_box_pending_ = false;
+    ++revision_;
+  }
+  if (env_.latency && (last_loop_stats_s_ < 0.0 || now_s - last_loop_stats_s_ >= kLoopStatsPeriodS)) {
+    last_loop_stats_s_ = now_s;
+    const LatencySummary l = env_.latency();
+    state_.loop.missed = l.missed;
+    state_.loop.p50_us = l.p50_us;
+    state_.loop.p99_us = l.p99_us;
+    state_.loop.max_us = l.max_us;
+  }
+  state_.loop.ticks = env_.core->ticks();
+  state_.loop.dropped_telemetry = env_.core->dropped_telemetry();
+}
+
+void ConsoleController::poll_engine(double /*now_s*/) {
+  EngineEvent event;
+  while (env_.core->poll_event(event)) on_event(event);
+  const EngineState engine = env_.core->state();
+  if (engine != state_.engine_state) {
+    state_.engine_state = engine;
+    ++revision_;
+  }
+  state_.fault = env_.core->fault();
+}
+
+void ConsoleController::on_event(const EngineEvent& event) {
+  switch (event.kind) {
+    case EventKind::kStateChanged:
+      state_.engine_state = event.to;
+    {
+      // A trial's own ARMED <-> RUNNING changes are routine: the trial's lines say it better.
+      const bool routine = event.command == CommandKind::kStartTrial &&
+                           (event.to == EngineState::kRunning || event.to == EngineState::kArmed);
+      log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), to_string(event.command)),
+          event.to == EngineState::kFault, event.time_s, routine);
+    }
+      if (event.to == EngineState::kRunning && in_flight_) {
+        in_flight_->accepted = true;
+        state_.run.phase = RunProgress::Phase::kSettling;
+      }
+      return;
+    case EventKind::kCommandRefused:
+      log(LogSource::kEngine, format("refused %s: %s", to_string(event.command), event.refusal), true, event.time_s);
+      set_status(format("the engine refused %s: %s", to_string(event.command), event.refusal), true);
+      if (event.command == CommandKind::kStartTrial && in_flight_ && !in_flight_->accepted) {
+        drop_trial("the engine refused the trial");
+      }
+      return;
+    case EventKind::kFault:
+      state_.fault = event.fault;
+      state_.fault_view = FaultView{event.fault, event.time_s, {}};
+      black_box_pending_ = true;
+      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), fault_message(event.fault)), true, event.time_s);
+      set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);
+      state_.dialog = {};
+      state_.screen = Screen::kFault;
+      return;
+    case EventKind::kTrialComplete:
+      if (in_flight_ && event.trial_id == in_flight_->id) finish_trial(event.time_s);
+      return;
+    case EventKind::kTrialAborted:
+      if (in_flight_ && event.trial_id == in_flight_->id) {
+        log(LogSource::kEngine, format("iteration %d aborted", state_.experiment.next_iteration()), false, event.time_s);
+        drop_trial("trial aborted");
+      }
+      return;
+  }
+}
+
+void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
+  TickRecord tick;
+  if (env_.core->read_snapshot(tick)) {
+    state_.live = tick;
+    state_.live_valid = true;
+    last_fresh_snapshot_s_ = now_s;
+  }
+  // Device health from what the sensors say.
+  DeviceHealth health{env_.device_name, false, "no data"};
+  if (state_.live_valid && now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS) {
+    const SensorReading& r = state_.live.reading;
+    if (!std::isfinite(r.angle_rad) || !std::isfinite(r.chamber_bar[0]) || !std::isfinite(r.chamber_bar[1]) ||
+        !std::isfinite(r.supply_bar)) {
+      health.status = "sensor not a number";
+    } else if (r.supply_bar < env_.config.safety.supply_min_bar) {
+      health.status = format("supply low (%.2f bar)", r.supply_bar);
+    } else {
+      health = {env_.device_name, true, "ok"};
+    }
+  }
+  if (health.ok != state_.device.ok || health.status != state_.device.status) {
+    state_.device = health;
+    ++revision_;
+  }
+  if (in_flight_ && in_flight_->accepted && state_.live.trial_id == in_flight_->id && state_.live.sample >= 0) {
+    state_.run.phase = RunProgress::Phase::kRunning;
+    state_.run.sample = state_.live.sample;
+  }
+  // The live strip, decimated to the ILC rate.
+  if (env_.telemetry != nullptr) {
+    const int per_sample = env_.config.timing.ticks_per_sample;
+    env_.telemetry->consume_all([&](const TickRecord& t) {
+      if (per_sample > 0 && t.tick % static_cast<std::uint64_t>(per_sample) != 0) return;
+      strip_time_[strip_next_] = t.time_s;
+      strip_angle_[strip_next_] = t.reading.angle_rad * 180.0 / std::numbers::pi;
+      strip_setpoint_[strip_next_] = t.desired_angle_rad * 180.0 / std::numbers::pi;
+      strip_next_ = (strip_next_ + 1) % strip_time_.size();
+      strip_count_ = std::min(strip_count_ + 1, strip_time_.size());
+      ++strip_revision_;
+    });
+    if (strip_revision_ != strip_exported_) {
+      strip_exported_ = strip_revision_;
+      LiveStrip& s = state_.strip;
+      s.time_s.resize(strip_count_);
+      s.angle_deg.resize(strip_count_);
+      s.setpoint_deg.resize(strip_count_);
+      const std::size_t first = (strip_next_ + strip_time_.size() - strip_count_) % strip_time_.size();
+      const double newest_s = strip_time_[(strip_next_ + strip_time_.size() - 1) % strip_time_.size()];
+      for (std::size_t i = 0; i < strip_count_; ++i) {
+        const std::size_t j = (first + i) % strip_time_.size();
+        s.time_s[i] = strip_time_[j] - newest_s;  // seconds before now
+        s.angle_deg[i] = strip_angle_[j];
+        s.setpoint_deg[i] = strip_setpoint_[j];
+      }
+    }
+  }
+}
+
+void ConsoleController::rebuild_law() {
+  if (law_build_.busy() || law_update_.busy()) {
+    rebuild_pending_ = true;
+    return;
+  }
+  rebuild_pending_ = false;
+  state_.law_ready = false;
+  law_samples_ = state_.experiment.samples();
+  state_.law_name = state_.config.ilc.law;
+  law_build_.start([config = state_.config, model = model_, samples = law_samples_] {
+    BuiltLaw built;
+    built.law = make_learning_law(config, model, samples);
+    const ConvergencePrediction p = predict_convergence(*built.law, config, samples);
+    if (p.available) {
+      built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
+                                 "off by up to %.0f %%",
+                                 p.nominal.contraction, p.worst.contraction, 100.0 * p.model_error);
+      built.warning = !p.warning.empty();
+      if (built.warning) built.convergence = p.warning;
+    } else {
+      built.convergence = "no convergence prediction for this law";
+    }
+    return built;
+  });
+  ++revision_;
+}
+
+void ConsoleController::poll_tasks() {
+  if (law_build_.ready()) {
+    try {
+      BuiltLaw built = law_build_.take();
+      law_ = std::move(built.law);
+      if (law_->samples() != state_.experiment.samples()) rebuild_pending_ = true;
+      state_.law_ready = !rebuild_pending_;
+      if (state_.law_ready) {
+        state_.convergence = built.convergence;
+        state_.convergence_warning = built.warning;
+        log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
+                                        law_->samples(), state_.config.ilc.m, state_.config.ilc.s, state_.config.ilc.w));
+        if (built.warning) log(LogSource::kLearner, built.convergence, true);
+      }
+    } catch (const std::exception& error) {
+      law_.reset();
+      state_.law_ready = false;
+      log(LogSource::kLearner, std::string("cannot build the learning law: ") + error.what(), true);
+      set_status(std::string("cannot build the learning law: ") + error.what(), true);
+    }
+    ++revision_;
+  }
+  if (law_update_.ready()) {
+    try {
+      Eigen::VectorXd next = law_update_.take();
+      const int from = state_.experiment.trials.back().iteration;
+      state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from));
+      log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
+                                      state_.experiment.next_correction_bar.cwiseAbs().maxCoeff()));
+      state_.run.phase = RunProgress::Phase::kNone;
+      if (state_.run.stop_requested || state_.engine_state != EngineState::kArmed) {
+        end_run(state_.run.stop_requested ? "stopped by the operator" : "stopped: the valves are not armed", false);
+      } else {
+        begin_trial();
+      }
+    } catch (const std::exception& error) {
+      end_run(std::string("learning failed: ") + error.what(), true);
+    }
+    ++revision_;
+  }
+  if (rebuild_pending_ && !law_build_.busy() && !law_update_.busy()) rebuild_law();
+  poll_session_tasks();
+}
+
+void ConsoleController::begin_trial() {
+  Experiment& e = state_.experiment;
+  if (state_.engine_state != EngineState::kArmed) {
+    end_run("arm the valves first (a)", true);
+    return;
+  }
+  auto trial = std::make_unique<InFlight>();
+  trial->trajectory = e.trajectory;
+  trial->correction_bar = e.next_correction_bar;
+  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample);
+  trial->id = ++last_trial_id_;
+  trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
+  const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
+  if (!send(EngineCommand::start_trial(*trial->trajectory, trial->correction_bar, trial->record, settle_ticks, trial->id),
+            "start trial")) {
+    end_run("the trial was not started", true);
+    return;
+  }
+  log(LogSource::kOperator, format("run iteration %d (%s)", e.next_iteration(), trial->origin.c_str()));
+  in_flight_ = std::move(trial);
+  state_.run.phase = RunProgress::Phase::kSettling;
+  state_.run.sample = -1;
+  ++revision_;
+}
+
+void ConsoleController::finish_trial(double time_s) {
+  Experiment& e = state_.experiment;
+  Trial trial;
+  trial.correction_bar = std::move(in_flight_->correction_bar);
+  trial.record = std::move(in_flight_->record);
+  trial.origin = in_flight_->origin;
+  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
+                                  env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
+  in_flight_.reset();
+  const bool follow = state_.inspector.trial == static_cast<int>(e.trials.size()) - 1;
+  e.add_trial(std::move(trial));
+  const IterationSummary& s = e.trials.back().summary;
+  if (follow || state_.inspector.trial < 0) state_.inspector.trial = static_cast<int>(e.trials.size()) - 1;
+  // Saturated samples: the set-point clamp cut the input there (where wind-up starts).
+  log(LogSource::kEngine,
+      format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s", s.iteration, s.rms_deg,
+             s.max_abs_error_deg, s.max_abs_correction_bar,
+             s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
+      false, time_s);
+  set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  state_.run.phase = RunProgress::Phase::kNone;
+  state_.run.sample = -1;
+  continue_run();
+}
+
+void ConsoleController::drop_trial(const std::string& why) {
+  in_flight_.reset();
+  state_.run.phase = RunProgress::Phase::kNone;
+  if (state_.run.stop_requested) {
+    end_run("trials stopped by the operator; the unfinished trial is not counted", false);
+  } else {
+    end_run(why + "; it is not counted", state_.engine_state == EngineState::kFault);
+  }
+}
+
+void ConsoleController::continue_run() {
+  RunProgress& r = state_.run;
+  if (r.mode != RunProgress::Mode::kBatch) {
+    end_run("", false);
+    return;
+  }
+  ++r.batch_done;
+  if (r.stop_requested) {
+    end_run(format("batch stopped by the operator after %d of %d", r.batch_done, r.batch_total), false);
+  } else if (state_.experiment.rms_rising(state_.stop_after_rises)) {
+    end_run(format("batch stopped by itself: the RMS rose %d times in a row", state_.stop_after_rises), true);
+  } else if (r.batch_done >= r.batch_total) {
+    end_run(format("batch of %d done: RMS %.3f deg", r.batch_total, state_.experiment.trials.back().summary.rms_deg), false);
+  } else {
+    step();
+  }
+}
+
+void ConsoleController::step() {
+  Experiment& e = state_.experiment;
+  if (!e.next_tried || e.trials.empty()) {
+    begin_trial();
+    return;
+  }
+  if (!state_.law_ready || !law_ || law_build_.busy()) {
+    end_run("the learning law is not ready", true);
+    return;
+  }
+  const Trial& last = e.trials.back();
+  state_.run.phase = RunProgress::Phase::kLearning;
+  const Eigen::Index n = last.correction_bar.size();
+  const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
+  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error(),
+                     feedback = Eigen::VectorXd(last.record.samples.u_pid_bar.head(n)), input_limit_bar] {
+    law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
+    Eigen::VectorXd next(u.size());
+    law->update(u, error, next);
+    return next;
+  });
+  ++revision_;
+}
+
+void ConsoleController::end_run(const std::string& why, bool important) {
+  const bool was_running = state_.run.mode != RunProgress::Mode::kIdle;
+  state_.run = RunProgress{};
+  if (!why.empty() && was_running) {
+    log(LogSource::kOperator, why, important);
+    set_status(why, important);
+  }
+  ++revision_;
+}
+
+void ConsoleController::emergency_stop(const std::string& why) {
+  const EngineCommand stop = EngineCommand::of(CommandKind::kEmergencyStop);
+  bool sent = false;
+  for (int attempt = 0; attempt < 1000 && !(sent = env_.core->send(stop)); ++attempt) {
+    // The queue is drained every tick; a full queue empties within a few ticks.
+    struct timespec pause{0, 1'000'000};
+    nanosleep(&pause, nullptr);
+  }
+  if (state_.run.mode != RunProgress::Mode::kIdle) state_.run.stop_requested = true;
+  state_.dialog = {};
+  log(LogSource::kOperator, why + (sent ? "" : " (NOT SENT: the command queue stayed full)"), true);
+  set_status("EMERGENCY STOP: valves vented", true);
+}
+
+void ConsoleController::resize(int width, int height) {
+  state_.width = width;
+  state_.height = height;
+  ++revision_;
+}
+
+}  // namespace bellows::ui

@@ -1,0 +1,161 @@
+// The console's logic, on the UI thread and without ncurses: it turns the operator's keys into
+// engine commands, the engine's events, snapshot and telemetry into the ConsoleState the screens
+// show, and runs trials and learning without ever blocking:
+//   - trials go through the engine's commands (kStartTrial with a record and a correction this
+//     controller owns until the engine hands them back), never through a blocking API;
+//   - learning updates, building the law, saving and opening run as background tasks;
+//   - it sends the heartbeat every update (at least every 50 ms) unless a drill withholds it.
+// The UI thread is the single producer of engine commands and the single consumer of its events,
+// its snapshot and one telemetry tap. Tests drive it with a simulated clock.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/arm_model.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/learning_law.hpp"
+#include "engine/realtime_loop.hpp"
+#include "ui/background_task.hpp"
+#include "ui/console_state.hpp"
+#include "ui/key_map.hpp"
+#include "ui/session_gateway.hpp"
+
+namespace bellows::ui {
+
+/// What the console needs from the program around it.
+struct ConsoleEnvironment {
+  EngineCore* core = nullptr;
+  TelemetryRing* telemetry = nullptr;            // a tap added before the loop started (optional)
+  std::function<LatencySummary()> latency;       // the loop's statistics; empty on a simulated clock
+  std::string rt_description = "other";
+  std::string speed = "1";
+  Configuration config;
+  /// A library name or a CSV path to a trajectory; throws InputError with the reason.
+  std::function<Trajectory(const std::string&)> load_trajectory;
+  SessionGateway* sessions = nullptr;
+  std::string device_name = "sim";
+  std::uint64_t seed = 1;
+  int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
+  std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
+};
+
+class ConsoleController {
+ public:
+  ConsoleController(ConsoleEnvironment env, Trajectory trajectory, bool unicode);
+  ~ConsoleController();
+  ConsoleController(const ConsoleController&) = delete;
+  ConsoleController& operator=(const ConsoleController&) = delete;
+
+  /// Starts from a saved session instead of a fresh experiment (call before start()).
+  void adopt_session(SessionSnapshot snapshot);
+  /// Heartbeat monitoring on, the trajectory selected, the learning law being built.
+  void start(double now_s);
+  /// One key from the operator (ui/keys.hpp codes).
+  void handle_key(int key, double now_s);
+  /// Heartbeat, engine events, snapshot, telemetry, background tasks, loop statistics.
+  void update(double now_s);
+  void resize(int width, int height);
+  /// Vents at once (Space, a signal); stops any trials.
+  void emergency_stop(const std::string& why);
+
+  const ConsoleState& state() const { return state_; }
+  bool quit_requested() const { return quit_requested_; }
+  /// Bumped by every discrete change (keys, events, results): the screen needs a redraw.
+  std::uint64_t revision() const { return revision_; }
+  /// Trials or learning in progress: the screen changes continuously.
+  bool active() const;
+
+ private:
+  struct InFlight;  // a trial the engine owns until it hands it back
+
+  // Engine side (console_controller.cpp).
+  bool send(const EngineCommand& command, const char* what);
+  void send_simple(CommandKind kind, const char* what);
+  void send_gains();  // the current configuration's PID gains
+  void poll_engine(double now_s);
+  void on_event(const EngineEvent& event);
+  void poll_snapshot_and_telemetry(double now_s);
+  void poll_tasks();
+  void heartbeat(double now_s);
+  void begin_trial();
+  void finish_trial(double time_s);
+  void drop_trial(const std::string& why);
+  void continue_run();
+  void step();
+  void end_run(const std::string& why, bool important);
+  void rebuild_law();
+  void select_trajectory(std::shared_ptr<const Trajectory> trajectory);
+  void log(LogSource source, std::string text, bool important = false, double engine_time_s = -2.0,
+           bool routine = false);
+  void set_status(std::string text, bool important = false);
+
+  // Operator side (console_keys.cpp).
+  bool handle_dialog_key(int key);
+  bool handle_screen_key(int key);
+  void perform(Action action);
+  void open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
+                   std::string input = {});
+  void accept_input();
+  void open_trajectory_chooser();
+  void preview_selected_trajectory();
+  void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
+  void apply_tuning(int field, const std::string& text);
+  void confirm_discard(std::string what, std::function<void()> action);
+  void quit_now();
+
+  // Sessions (console_sessions.cpp).
+  void start_save();
+  void start_listing();
+  void start_open(const std::string& location);
+  void poll_session_tasks();
+  void adopt(SessionSnapshot snapshot, bool at_start);
+
+  ConsoleEnvironment env_;
+  DiscreteArmModel model_;
+  ConsoleState state_;
+  std::uint64_t revision_ = 0;
+  bool quit_requested_ = false;
+  bool quit_after_save_ = false;
+
+  // Trajectories ever given to the engine stay alive: it may hold a pointer to any of them.
+  std::vector<std::shared_ptr<const Trajectory>> selected_trajectories_;
+  std::unique_ptr<InFlight> in_flight_;
+  std::uint32_t last_trial_id_ = 0;
+
+  // The law; never touched while a background update uses it.
+  std::unique_ptr<LearningLaw> law_;
+  bool rebuild_pending_ = false;
+  int law_samples_ = 0;
+  std::function<void()> pending_discard_action_;
+
+  double last_heartbeat_s_ = -1.0;
+  double drill_started_s_ = 0.0;
+  double last_loop_stats_s_ = -1.0;
+  double last_fresh_snapshot_s_ = -1.0;
+  double now_s_ = 0.0;
+  bool black_box_pending_ = false;
+  std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate
+  std::size_t strip_next_ = 0, strip_count_ = 0;
+  std::uint64_t strip_revision_ = 0, strip_exported_ = 0;
+
+  // Declared last: destroyed (joined) first, before the law and the state they use.
+  struct BuiltLaw {
+    std::unique_ptr<LearningLaw> law;
+    std::string convergence;
+    bool warning = false;
+  };
+  BackgroundTask<BuiltLaw> law_build_;
+  BackgroundTask<Eigen::VectorXd> law_update_;
+  BackgroundTask<std::string> save_task_;
+  BackgroundTask<std::vector<SessionListing>> list_task_;
+  BackgroundTask<SessionSnapshot> open_task_;
+  int saving_trials_ = 0;
+  std::size_t saving_events_ = 0;
+  bool saving_settings_changed_ = false;
+};
+
+}  // namespace bellows::ui

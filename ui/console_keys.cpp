@@ -1,0 +1,251 @@
+// The operator's side of the controller: keys, dialogs and the global commands.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+
+#include "engine/errors.hpp"
+#include "ui/console_controller.hpp"
+#include "ui/keys.hpp"
+#include "ui/render.hpp"
+#include "ui/text_input.hpp"
+#include "ui/tuning.hpp"
+
+namespace bellows::ui {
+namespace {
+
+constexpr int kMaxBatch = 1000;
+
+}  // namespace
+
+void ConsoleController::handle_key(int k, double now_s) {
+  now_s_ = now_s;
+  ++revision_;
+  if (k == key::kResize) return;
+  if (k == ' ') {  // from every screen and every dialog
+    emergency_stop("EMERGENCY STOP (Space)");
+    return;
+  }
+  if (state_.dialog.kind != DialogKind::kNone) {
+    handle_dialog_key(k);
+    return;
+  }
+  if (state_.width < kMinWidth || state_.height < kMinHeight) {
+    if (k == 'q') perform(Action::kQuit);  // the too-small screen offers Space and q only
+    return;
+  }
+  if (handle_screen_key(k)) return;
+  if (const auto action = action_for_key(k)) perform(*action);
+}
+
+void ConsoleController::open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
+                                    std::string input) {
+  state_.dialog = Dialog{kind, std::move(title), std::move(text), std::move(input), std::move(hint)};
+}
+
+bool ConsoleController::handle_dialog_key(int k) {
+  Dialog& d = state_.dialog;
+  const bool prompt = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
+                      d.kind == DialogKind::kEditValue;
+  if (k == key::kEscape) {
+    state_.dialog = {};
+    pending_discard_action_ = nullptr;
+    set_status("cancelled");
+    return true;
+  }
+  if (prompt) {
+    if (k == key::kEnter) {
+      accept_input();
+    } else if (k == key::kBackspace) {
+      pop_last_code_point(d.input);
+    } else if (k >= 0x20 && k < key::kSpecial && d.input.size() < 512) {
+      append_utf8(d.input, static_cast<char32_t>(k));
+    }
+    return true;
+  }
+  switch (d.kind) {
+    case DialogKind::kConfirmArm:
+      if (k == 'y' || k == 'Y') {
+        state_.dialog = {};
+        send_simple(CommandKind::kArm, "arm");
+        log(LogSource::kOperator, "arm");
+      } else if (k == 'n' || k == 'N') {
+        state_.dialog = {};
+        set_status("not armed");
+      }
+      return true;
+    case DialogKind::kConfirmDiscard:
+      if (k == 'y' || k == 'Y') {
+        state_.dialog = {};
+        auto action = std::move(pending_discard_action_);
+        pending_discard_action_ = nullptr;
+        if (action) action();
+      } else if (k == 'n' || k == 'N') {
+        state_.dialog = {};
+        pending_discard_action_ = nullptr;
+        set_status("cancelled");
+      }
+      return true;
+    case DialogKind::kConfirmQuit:
+      if (k == 's' && state_.sessions_available) {
+        state_.dialog = {};
+        quit_after_save_ = true;
+        start_save();
+      } else if (k == 'q' || k == 'y') {
+        state_.dialog = {};
+        quit_now();
+      } else if (k == 'n' || k == 'c') {
+        state_.dialog = {};
+      }
+      return true;
+    default:
+      return true;
+  }
+}
+
+void ConsoleController::accept_input() {
+  Dialog d = state_.dialog;
+  state_.dialog = {};
+  switch (d.kind) {
+    case DialogKind::kAskIterations: {
+      double k = 0;
+      if (!parse_number(d.input, k) || k < 1 || k > kMaxBatch || std::floor(k) != k) {
+        set_status(format("K must be a whole number from 1 to %d, not '%s'", kMaxBatch, d.input.c_str()), true);
+        return;
+      }
+      if (!availability(Action::kRunIterations, state_).available) {
+        set_status("cannot run iterations now: " + availability(Action::kRunIterations, state_).reason, true);
+        return;
+      }
+      state_.run = RunProgress{};
+      state_.run.mode = RunProgress::Mode::kBatch;
+      state_.run.batch_total = static_cast<int>(k);
+      log(LogSource::kOperator, format("run %d iterations (stops by itself after %d rises of the RMS in a row)",
+                                       state_.run.batch_total, state_.stop_after_rises));
+      step();
+      return;
+    }
+    case DialogKind::kTrajectoryPath: {
+      state_.chooser.file_path = d.input;
+      preview_selected_trajectory();
+      return;
+    }
+    case DialogKind::kEditValue:
+      apply_tuning(state_.tuning.selected, d.input);
+      return;
+    default:
+      return;
+  }
+}
+
+void ConsoleController::perform(Action action) {
+  const Availability a = availability(action, state_);
+  if (!a.available) {
+    set_status(std::string(binding(action).bar_label) + ": " + a.reason, true);
+    return;
+  }
+  switch (action) {
+    case Action::kHelp:
+      if (state_.screen == Screen::kHelp) {
+        state_.screen = state_.previous_screen;
+      } else {
+        state_.previous_screen = state_.screen;
+        state_.screen = Screen::kHelp;
+      }
+      return;
+    case Action::kEmergencyStop:
+      emergency_stop("EMERGENCY STOP (Space)");
+      return;
+    case Action::kArm: {
+      const Trajectory& t = *state_.experiment.trajectory;
+      open_dialog(DialogKind::kConfirmArm, "Arm the valves?",
+                  {"The valves go live: the arm moves to the start of " + t.name,
+                   format("(%.1f deg) and holds it with the PID.", t.angle_rad(0) * 180.0 / std::numbers::pi)},
+                  "y arm   n or Esc cancel");
+      return;
+    }
+    case Action::kDisarm:
+      if (state_.run.mode != RunProgress::Mode::kIdle) state_.run.stop_requested = true;
+      send_simple(CommandKind::kDisarm, "disarm");
+      log(LogSource::kOperator, "disarm");
+      return;
+    case Action::kReset:
+      send_simple(CommandKind::kReset, "reset");
+      log(LogSource::kOperator, format("reset the fault (%s)", fault_name(state_.fault)));
+      set_status("fault reset: the valves stay vented (SAFE) until you arm (a)");
+      if (state_.screen == Screen::kFault) state_.screen = Screen::kMain;
+      return;
+    case Action::kTrajectory:
+      open_trajectory_chooser();
+      return;
+    case Action::kRunTrial:
+      state_.run = RunProgress{};
+      state_.run.mode = RunProgress::Mode::kTrial;
+      begin_trial();
+      return;
+    case Action::kNextIteration:
+      state_.run = RunProgress{};
+      state_.run.mode = RunProgress::Mode::kStep;
+      step();
+      return;
+    case Action::kRunIterations:
+      open_dialog(DialogKind::kAskIterations, "Run K iterations",
+                  {"Each iteration learns from the last trial, then runs.",
+                   format("x interrupts; it stops by itself when the RMS rises %d times in a row.", state_.stop_after_rises)},
+                  "Enter run   Esc cancel", "10");
+      return;
+    case Action::kStopRun:
+      state_.run.stop_requested = true;
+      if (state_.engine_state == EngineState::kRunning) send_simple(CommandKind::kAbortTrial, "abort trial");
+      log(LogSource::kOperator, "stop the trials");
+      set_status("stopping the trials");
+      return;
+    case Action::kInspector: {
+      InspectorView& v = state_.inspector;
+      const int trials = static_cast<int>(state_.experiment.trials.size());
+      if (v.trial < 0 || v.trial >= trials) v.trial = trials - 1;
+      state_.screen = Screen::kInspector;
+      return;
+    }
+    case Action::kTuning: state_.screen = Screen::kTuning; return;
+    case Action::kLog:
+      state_.log_scroll = 0;
+      state_.screen = Screen::kLog;
+      return;
+    case Action::kFaultView: state_.screen = Screen::kFault; return;
+    case Action::kSave: start_save(); return;
+    case Action::kOpen:
+      state_.screen = Screen::kSessions;
+      start_listing();
+      return;
+    case Action::kQuit:
+      if (state_.experiment.unsaved() && !state_.experiment.trials.empty()) {
+        const int unsaved = static_cast<int>(state_.experiment.trials.size()) - state_.experiment.saved_trials;
+        std::vector<std::string> text = {format("%d iteration%s not saved%s.", unsaved, unsaved == 1 ? " is" : "s are",
+                                                state_.experiment.settings_changed ? " and settings changed" : "")};
+        if (!state_.sessions_available) text.push_back("Saving is not available: " + state_.sessions_unavailable_reason);
+        text.push_back("The valves are vented before the console exits.");
+        open_dialog(DialogKind::kConfirmQuit, "Quit?", text,
+                    state_.sessions_available ? "s save and quit   q quit without saving   Esc cancel"
+                                              : "q quit without saving   Esc cancel");
+      } else {
+        quit_now();
+      }
+      return;
+    case Action::kHeartbeatDrill:
+      state_.heartbeat_drill = true;
+      drill_started_s_ = now_s_;
+      log(LogSource::kOperator, format("heartbeat drill: heartbeats withheld; the engine must vent within %.1f s",
+                                       env_.config.safety.heartbeat_timeout_s));
+      return;
+    case Action::kMain: state_.screen = Screen::kMain; return;
+  }
+}
+
+void ConsoleController::quit_now() {
+  log(LogSource::kOperator, "quit: vent and exit");
+  if (valves_live(state_.engine_state)) send_simple(CommandKind::kDisarm, "disarm");
+  quit_requested_ = true;
+}
+
+}  // namespace bellows::ui

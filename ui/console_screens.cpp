@@ -1,0 +1,235 @@
+// The screens' own keys (inspector, trajectory chooser, tuning, sessions, log) and what they do.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "engine/errors.hpp"
+#include "ui/canvas.hpp"
+#include "ui/console_controller.hpp"
+#include "ui/keys.hpp"
+#include "ui/text_input.hpp"
+#include "ui/tuning.hpp"
+
+namespace bellows::ui {
+
+bool ConsoleController::handle_screen_key(int k) {
+  switch (state_.screen) {
+    case Screen::kInspector: {
+      InspectorView& v = state_.inspector;
+      const int trials = static_cast<int>(state_.experiment.trials.size());
+      if (trials == 0) return false;
+      v.trial = std::clamp(v.trial, 0, trials - 1);
+      const int n = state_.experiment.trials[static_cast<std::size_t>(v.trial)].record.learning_samples;
+      const int page = std::max(1, n / 10);
+      switch (k) {
+        case key::kLeft: v.sample = std::max(0, v.sample - 1); return true;
+        case key::kRight: v.sample = std::min(n, v.sample + 1); return true;
+        case key::kPageUp: v.sample = std::max(0, v.sample - page); return true;
+        case key::kPageDown: v.sample = std::min(n, v.sample + page); return true;
+        case key::kHome: v.sample = 0; return true;
+        case key::kEnd: v.sample = n; return true;
+        case key::kUp: v.trial = std::max(0, v.trial - 1); return true;
+        case key::kDown: v.trial = std::min(trials - 1, v.trial + 1); return true;
+        case 'm':
+          v.chosen = v.chosen == v.trial ? -1 : v.trial;
+          return true;
+        case 'u': {
+          const Trial& t = state_.experiment.trials[static_cast<std::size_t>(v.trial)];
+          if (state_.run.mode != RunProgress::Mode::kIdle) {
+            set_status("not while trials run", true);
+            return true;
+          }
+          state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration));
+          log(LogSource::kOperator, format("go back to the correction of iteration %d for the next trial", t.iteration));
+          set_status(format("the next trial applies the correction of iteration %d", t.iteration));
+          return true;
+        }
+        default: return false;
+      }
+    }
+    case Screen::kTrajectory: {
+      TrajectoryChooser& ch = state_.chooser;
+      const int count = static_cast<int>(ch.names.size());
+      if (k == key::kUp || k == key::kDown) {
+        ch.selected = std::clamp(ch.selected + (k == key::kUp ? -1 : 1), 0, count - 1);
+        preview_selected_trajectory();
+        return true;
+      }
+      if (k == key::kEnter) {
+        const bool file_entry = ch.selected == count - 1;
+        if (file_entry && (!ch.preview || !ch.preview_error.empty() || ch.file_path.empty())) {
+          open_dialog(DialogKind::kTrajectoryPath, "Trajectory file", {"A CSV file with the header time_s,angle_deg,",
+                      "sampled every " + format("%.3f s", env_.config.timing.sample_s()) + " from t = 0."},
+                      "Enter load and preview   Esc cancel", ch.file_path);
+          return true;
+        }
+        if (ch.preview && ch.preview_error.empty()) use_trajectory(ch.preview);
+        return true;
+      }
+      return false;
+    }
+    case Screen::kTuning:
+      if (k == key::kUp || k == key::kDown) {
+        state_.tuning.selected = std::clamp(state_.tuning.selected + (k == key::kUp ? -1 : 1), 0, TuningForm::kFields - 1);
+        return true;
+      }
+      if (k == key::kEnter) {
+        if (state_.run.mode != RunProgress::Mode::kIdle || state_.engine_state == EngineState::kRunning) {
+          set_status("gains and weights change between trials: stop the trials first (x)", true);
+        } else if (state_.engine_state == EngineState::kFault) {
+          set_status("a fault is latched: reset it (R) before changing gains", true);
+        } else {
+          const TuningField& f = tuning_fields()[static_cast<std::size_t>(state_.tuning.selected)];
+          open_dialog(DialogKind::kEditValue, std::string("Change ") + f.label,
+                      {std::string(f.description) + " (" + f.config_key + ")"}, "Enter apply   Esc cancel",
+                      format("%g", tuning_value(state_.config, state_.tuning.selected)));
+        }
+        return true;
+      }
+      return false;
+    case Screen::kSessions: {
+      SessionBrowser& b = state_.browser;
+      const int count = static_cast<int>(b.sessions.size());
+      if ((k == key::kUp || k == key::kDown) && count > 0) {
+        b.selected = std::clamp(b.selected + (k == key::kUp ? -1 : 1), 0, count - 1);
+        return true;
+      }
+      if (k == key::kEnter && count > 0) {
+        const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];
+        if (!l.error.empty()) {
+          set_status(l.name + " cannot be opened: " + l.error, true);
+        } else if (!availability(Action::kOpen, state_).available) {
+          set_status("cannot open now: " + availability(Action::kOpen, state_).reason, true);
+        } else {
+          const std::string location = l.location;
+          confirm_discard("opening " + l.name, [this, location] { start_open(location); });
+        }
+        return true;
+      }
+      return false;
+    }
+    case Screen::kLog: {
+      const int count = static_cast<int>(state_.log.entries().size());
+      const int page = std::max(1, state_.height - 8);
+      int& scroll = state_.log_scroll;
+      if (k == key::kUp) scroll = std::min(count - 1, scroll + 1);
+      else if (k == key::kDown) scroll = std::max(0, scroll - 1);
+      else if (k == key::kPageUp) scroll = std::min(std::max(count - 1, 0), scroll + page);
+      else if (k == key::kPageDown) scroll = std::max(0, scroll - page);
+      else if (k == key::kEnd) scroll = 0;
+      else return false;
+      scroll = std::max(0, scroll);
+      return true;
+    }
+    case Screen::kMain:
+    case Screen::kHelp:
+    case Screen::kFault:
+      return false;
+  }
+  return false;
+}
+
+void ConsoleController::open_trajectory_chooser() {
+  TrajectoryChooser& ch = state_.chooser;
+  ch.names.clear();
+  ch.descriptions.clear();
+  const std::string current = state_.experiment.trajectory->name;
+  ch.selected = -1;
+  for (const std::string& name : trajectory_library_names()) {
+    if (name == current) ch.selected = static_cast<int>(ch.names.size());
+    ch.names.push_back(name);
+    ch.descriptions.push_back(trajectory_library_description(name));
+  }
+  ch.names.push_back("from a file...");
+  ch.descriptions.push_back("CSV: time_s,angle_deg");
+  if (ch.selected < 0) ch.selected = static_cast<int>(ch.names.size()) - 1;
+  state_.screen = Screen::kTrajectory;
+  preview_selected_trajectory();
+}
+
+void ConsoleController::preview_selected_trajectory() {
+  TrajectoryChooser& ch = state_.chooser;
+  ch.preview.reset();
+  ch.preview_error.clear();
+  const bool file_entry = ch.selected == static_cast<int>(ch.names.size()) - 1;
+  const std::string what = file_entry ? ch.file_path : ch.names[static_cast<std::size_t>(ch.selected)];
+  if (what.empty()) return;
+  if (!file_entry && what == state_.experiment.trajectory->name) {
+    ch.preview = state_.experiment.trajectory;
+    return;
+  }
+  try {
+    ch.preview = std::make_shared<const Trajectory>(env_.load_trajectory(what));
+  } catch (const std::exception& error) {
+    ch.preview_error = error.what();
+  }
+}
+
+void ConsoleController::confirm_discard(std::string what, std::function<void()> action) {
+  const Experiment& e = state_.experiment;
+  if (!e.unsaved() || e.trials.empty()) {
+    action();
+    return;
+  }
+  pending_discard_action_ = std::move(action);
+  const int unsaved = static_cast<int>(e.trials.size()) - e.saved_trials;
+  open_dialog(DialogKind::kConfirmDiscard, "Discard unsaved work?",
+              {format("%d iteration%s not saved; %s starts afresh.", unsaved, unsaved == 1 ? " is" : "s are", what.c_str())},
+              "y discard   n or Esc cancel");
+}
+
+void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> trajectory) {
+  if (state_.engine_state == EngineState::kFault) {
+    set_status("a fault is latched: reset it (R) before choosing a trajectory", true);
+    return;
+  }
+  if (state_.run.mode != RunProgress::Mode::kIdle || state_.engine_state == EngineState::kRunning) {
+    set_status("not while trials run", true);
+    return;
+  }
+  if (trajectory == state_.experiment.trajectory) {
+    state_.screen = Screen::kMain;
+    return;
+  }
+  confirm_discard("the trajectory " + trajectory->name, [this, trajectory] {
+    const int old_samples = state_.experiment.samples();
+    select_trajectory(trajectory);
+    state_.experiment = Experiment::start(trajectory);
+    state_.inspector = InspectorView{};
+    if (trajectory->learning_samples() != old_samples || !law_) rebuild_law();
+    log(LogSource::kOperator, format("trajectory %s (%.1f s, N = %d)", trajectory->name.c_str(), trajectory->duration_s(),
+                                     trajectory->learning_samples()));
+    set_status("trajectory " + trajectory->name + ": iteration 0 runs with feedback only");
+    state_.screen = Screen::kMain;
+  });
+}
+
+void ConsoleController::apply_tuning(int field, const std::string& text) {
+  const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
+  double value = 0;
+  if (!parse_number(text, value)) {
+    set_status(std::string(f.label) + ": '" + text + "' is not a number", true);
+    return;
+  }
+  Configuration candidate = state_.config;
+  const double old = *f.value(candidate);
+  *f.value(candidate) = value;
+  try {
+    validate_configuration(candidate);
+  } catch (const InputError& error) {
+    set_status(error.what(), true);
+    return;
+  }
+  if (old == value) return;
+  state_.config = candidate;
+  state_.experiment.settings_changed = true;
+  log(LogSource::kOperator, format("%s changed %g -> %g (%s)", f.label, old, value, f.config_key));
+  if (f.learning_weight) {
+    rebuild_law();
+  } else {
+    send_gains();
+  }
+  set_status(format("%s = %g from the next trial on", f.label, value));
+}
+
+}  // namespace bellows::ui

@@ -1,0 +1,135 @@
+// Saving and opening sessions through the SessionGateway, on background tasks.
+#include "engine/errors.hpp"
+#include "ui/canvas.hpp"
+#include "ui/console_controller.hpp"
+
+namespace bellows::ui {
+
+void ConsoleController::start_save() {
+  if (!state_.sessions_available) {
+    set_status("saving is not available: " + state_.sessions_unavailable_reason, true);
+    quit_after_save_ = false;
+    return;
+  }
+  if (save_task_.busy()) {
+    set_status("already saving");
+    return;
+  }
+  SessionSnapshot snapshot;
+  snapshot.config = state_.config;
+  snapshot.experiment = state_.experiment;
+  snapshot.events.assign(state_.log.entries().begin(), state_.log.entries().end());
+  snapshot.events_total = state_.log.total();
+  snapshot.device_name = env_.device_name;
+  snapshot.seed = env_.seed;
+  saving_trials_ = static_cast<int>(state_.experiment.trials.size());
+  saving_events_ = state_.log.total();
+  saving_settings_changed_ = state_.experiment.settings_changed;
+  state_.learner_busy = true;
+  state_.learner_task = "saving";
+  log(LogSource::kSession, format("saving %d iterations", saving_trials_));
+  save_task_.start([gateway = env_.sessions, snapshot = std::move(snapshot)] { return gateway->save(snapshot); });
+}
+
+void ConsoleController::start_listing() {
+  if (list_task_.busy()) return;
+  state_.browser.loading = true;
+  state_.browser.error.clear();
+  list_task_.start([gateway = env_.sessions] { return gateway->list(); });
+}
+
+void ConsoleController::start_open(const std::string& location) {
+  if (open_task_.busy()) return;
+  state_.learner_busy = true;
+  state_.learner_task = "opening";
+  log(LogSource::kSession, "opening " + location);
+  open_task_.start([gateway = env_.sessions, location] { return gateway->open(location); });
+}
+
+void ConsoleController::poll_session_tasks() {
+  if (save_task_.ready()) {
+    state_.learner_busy = false;
+    try {
+      const std::string location = save_task_.take();
+      Experiment& e = state_.experiment;
+      e.session_location = location;
+      e.saved_trials = saving_trials_;
+      e.saved_events = saving_events_;
+      // Settings changed while saving stay unsaved.
+      if (saving_settings_changed_ == e.settings_changed) e.settings_changed = false;
+      log(LogSource::kSession, format("saved %d iterations to %s", saving_trials_, location.c_str()));
+      set_status("saved: " + location);
+      if (quit_after_save_) quit_now();
+    } catch (const std::exception& error) {
+      log(LogSource::kSession, std::string("save failed: ") + error.what(), true);
+      set_status(std::string("save failed: ") + error.what(), true);
+    }
+    quit_after_save_ = false;
+    ++revision_;
+  }
+  if (list_task_.ready()) {
+    state_.browser.loading = false;
+    try {
+      state_.browser.sessions = list_task_.take();
+      // Newest first is what an operator looks for.
+      std::reverse(state_.browser.sessions.begin(), state_.browser.sessions.end());
+      state_.browser.selected = 0;
+    } catch (const std::exception& error) {
+      state_.browser.sessions.clear();
+      state_.browser.error = std::string("cannot list the sessions: ") + error.what();
+    }
+    ++revision_;
+  }
+  if (open_task_.ready()) {
+    state_.learner_busy = false;
+    try {
+      adopt(open_task_.take(), false);
+    } catch (const std::exception& error) {
+      log(LogSource::kSession, std::string("open failed: ") + error.what(), true);
+      set_status(std::string("open failed: ") + error.what(), true);
+    }
+    ++revision_;
+  }
+}
+
+void ConsoleController::adopt_session(SessionSnapshot snapshot) { adopt(std::move(snapshot), true); }
+
+void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
+  const Experiment& e = snapshot.experiment;
+  if (!e.trajectory) throw InputError("the session has no trajectory");
+  if (std::abs(e.trajectory->sample_time_s - env_.config.timing.sample_s()) > 1e-9) {
+    throw InputError(format("the session was recorded with a sample time of %g s, this console runs %g s",
+                            e.trajectory->sample_time_s, env_.config.timing.sample_s()));
+  }
+  if (!at_start && (valves_live(state_.engine_state) || state_.run.mode != RunProgress::Mode::kIdle)) {
+    throw InputError("disarm before opening a session");
+  }
+  // The session's gains and weights replace the current ones; the rig's own settings stay.
+  Configuration config = state_.config;
+  config.controller.k_ff = snapshot.config.controller.k_ff;
+  config.controller.k_p = snapshot.config.controller.k_p;
+  config.controller.k_i_per_s = snapshot.config.controller.k_i_per_s;
+  config.controller.k_d_s = snapshot.config.controller.k_d_s;
+  config.ilc = snapshot.config.ilc;
+  state_.config = config;
+  for (const LogEntry& entry : snapshot.events) state_.log.add(entry);
+  state_.experiment = std::move(snapshot.experiment);
+  state_.experiment.saved_trials = static_cast<int>(state_.experiment.trials.size());
+  state_.experiment.settings_changed = false;
+  state_.experiment.saved_events = state_.log.total();  // what came with the session is saved
+  state_.inspector = InspectorView{};
+  state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
+  const Experiment& adopted = state_.experiment;
+  log(LogSource::kSession, format("opened %s: %s, %d iterations, best RMS %.3f deg", adopted.session_location.c_str(),
+                                  adopted.trajectory->name.c_str(), static_cast<int>(adopted.trials.size()),
+                                  adopted.best_rms_deg()));
+  if (!at_start) {
+    select_trajectory(adopted.trajectory);
+    send_gains();
+    rebuild_law();
+    state_.screen = Screen::kMain;
+    set_status("opened " + adopted.session_location);
+  }
+}
+
+}  // namespace bellows::ui

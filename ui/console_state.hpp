@@ -1,0 +1,156 @@
+// Everything a console screen shows, as plain values: the controller keeps it up to date from the
+// engine and the operator's keys; render() turns it into text. Tests build one by hand.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/configuration.hpp"
+#include "engine/engine_messages.hpp"
+#include "engine/engine_state.hpp"
+#include "engine/safety.hpp"
+#include "ui/event_log.hpp"
+#include "ui/experiment.hpp"
+#include "ui/session_gateway.hpp"
+
+namespace bellows::ui {
+
+enum class Screen { kMain, kHelp, kTrajectory, kInspector, kTuning, kLog, kSessions, kFault };
+
+enum class DialogKind {
+  kNone,
+  kConfirmArm,       // y/n
+  kAskIterations,    // a number K
+  kTrajectoryPath,   // a file path
+  kEditValue,        // a number for the tuning field
+  kConfirmQuit,      // s / q / Esc
+  kConfirmDiscard,   // y/n: unsaved trials would be lost
+};
+
+struct Dialog {
+  DialogKind kind = DialogKind::kNone;
+  std::string title;
+  std::vector<std::string> text;
+  std::string input;   // what the operator typed (prompts)
+  std::string hint;    // the keys, e.g. "y arm   n cancel"
+};
+
+struct DeviceHealth {
+  std::string name = "sim";
+  bool ok = false;
+  std::string status = "no data";
+};
+
+struct LoopHealth {
+  std::uint64_t ticks = 0;
+  std::uint64_t missed = 0;
+  double p50_us = 0, p99_us = 0, max_us = 0;
+  std::string rt = "other";
+  std::string speed = "1";       // "1", "2", "5", "10", "max"
+  double tick_hz = 200.0;
+  std::uint64_t dropped_telemetry = 0;
+  bool realtime = true;          // false on a simulated clock (no latency to show)
+};
+
+/// The last seconds of the live signals at the ILC rate, oldest first, for the live plot; time in
+/// seconds before the newest sample (so it ends at 0).
+struct LiveStrip {
+  std::vector<double> time_s, angle_deg, setpoint_deg;
+};
+
+/// What the console is doing about trials.
+struct RunProgress {
+  enum class Mode { kIdle, kTrial, kStep, kBatch };
+  Mode mode = Mode::kIdle;
+  enum class Phase { kNone, kLearning, kSettling, kRunning };
+  Phase phase = Phase::kNone;
+  int batch_total = 0;   // K of a batch
+  int batch_done = 0;    // steps finished in the batch
+  int sample = -1;       // sample of the running trial
+  bool stop_requested = false;
+};
+
+struct InspectorView {
+  int trial = -1;     // index into experiment.trials
+  int sample = 0;     // cursor, 0..N
+  int chosen = -1;    // an iteration overlaid for comparison (-1: none)
+};
+
+struct TrajectoryChooser {
+  std::vector<std::string> names;         // library names, then the file entry
+  std::vector<std::string> descriptions;
+  int selected = 0;
+  std::shared_ptr<const Trajectory> preview;
+  std::string preview_error;
+  std::string file_path;                  // the file entry's path, once given
+};
+
+/// The tuning screen's fields, in order: k_ff, k_p, k_i, k_d, M, S, W.
+struct TuningForm {
+  static constexpr int kFields = 7;
+  int selected = 0;
+};
+
+struct SessionBrowser {
+  std::vector<SessionListing> sessions;
+  int selected = 0;
+  bool loading = false;
+  std::string error;
+};
+
+struct FaultView {
+  FaultCode code = FaultCode::kNone;
+  double time_s = 0.0;
+  std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
+};
+
+struct ConsoleState {
+  // The terminal.
+  int width = 120, height = 40;
+  bool unicode = true;  // braille plots and box drawing (UTF-8 locale)
+
+  // What is on screen.
+  Screen screen = Screen::kMain;
+  Screen previous_screen = Screen::kMain;  // where help was opened from
+  Dialog dialog;
+  std::string status;          // the latest message for the operator
+  bool status_important = false;
+  int log_scroll = 0;          // log screen: entries scrolled back from the newest
+
+  // The engine and the rig.
+  EngineState engine_state = EngineState::kSafe;
+  FaultCode fault = FaultCode::kNone;
+  DeviceHealth device;
+  LoopHealth loop;
+  bool live_valid = false;
+  TickRecord live;             // the latest tick
+  LiveStrip strip;
+  bool heartbeat_drill = false;  // heartbeats withheld on purpose
+
+  // The learning.
+  Configuration config;        // current gains and weights included
+  Experiment experiment;
+  std::string law_name;
+  bool law_ready = false;
+  std::string convergence;        // the law's predicted contraction per trial, in words
+  bool convergence_warning = false;  // it may diverge for a plausible model error
+  bool learner_busy = false;
+  std::string learner_task;    // "building the learning law", "learning", "saving", ...
+  RunProgress run;
+  int stop_after_rises = 3;
+
+  // Screens' own state.
+  InspectorView inspector;
+  TrajectoryChooser chooser;
+  TuningForm tuning;
+  SessionBrowser browser;
+  FaultView fault_view;
+  EventLog log;
+
+  bool sessions_available = false;
+  std::string sessions_unavailable_reason;
+};
+
+}  // namespace bellows::ui

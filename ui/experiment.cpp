@@ -1,0 +1,52 @@
+#include "ui/experiment.hpp"
+
+#include <algorithm>
+
+namespace bellows::ui {
+
+Experiment Experiment::start(std::shared_ptr<const Trajectory> trajectory) {
+  Experiment e;
+  e.trajectory = std::move(trajectory);
+  e.next_correction_bar = Eigen::VectorXd::Zero(e.samples());
+  return e;
+}
+
+void Experiment::add_trial(Trial trial) {
+  trial.iteration = next_iteration();
+  trials.push_back(std::move(trial));
+  next_tried = true;
+}
+
+void Experiment::set_next(Eigen::VectorXd correction_bar, std::string origin) {
+  next_correction_bar = std::move(correction_bar);
+  next_origin = std::move(origin);
+  next_tried = false;
+}
+
+std::vector<double> Experiment::rms_history_deg() const {
+  std::vector<double> rms;
+  rms.reserve(trials.size());
+  for (const Trial& t : trials) rms.push_back(t.summary.rms_deg);
+  return rms;
+}
+
+double Experiment::best_rms_deg() const {
+  double best = -1.0;
+  for (const Trial& t : trials) {
+    if (best < 0.0 || t.summary.rms_deg < best) best = t.summary.rms_deg;
+  }
+  return best;
+}
+
+bool Experiment::rms_rising(int count) const {
+  const int n = static_cast<int>(trials.size());
+  if (count <= 0 || n < count + 1) return false;
+  for (int i = n - count; i < n; ++i) {
+    if (!(trials[static_cast<std::size_t>(i)].summary.rms_deg > trials[static_cast<std::size_t>(i - 1)].summary.rms_deg)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace bellows::ui

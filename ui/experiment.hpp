@@ -1,0 +1,56 @@
+// What the operator has done with one trajectory: every trial in order (its correction, record and
+// summary) and the correction the next trial will apply. Iterations are numbered in the order the
+// trials ran; going back to an earlier correction or repeating a trial adds a new iteration whose
+// origin says where its correction came from, so the history is never rewritten.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "engine/learning_session.hpp"
+#include "engine/trajectory.hpp"
+#include "engine/trial_record.hpp"
+
+namespace bellows::ui {
+
+struct Trial {
+  int iteration = 0;
+  Eigen::VectorXd correction_bar;  // u_ilc(0..N-1) the trial applied
+  TrialRecord record;
+  IterationSummary summary;
+  std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
+};
+
+struct Experiment {
+  std::shared_ptr<const Trajectory> trajectory;
+  std::vector<Trial> trials;
+  Eigen::VectorXd next_correction_bar;  // what the next trial applies
+  std::string next_origin = "feedback only";
+  bool next_tried = false;              // a trial already ran with it: a step learns first
+  int saved_trials = 0;                 // trials already in the saved session
+  bool settings_changed = false;        // gains or weights changed since the last save
+  std::string session_location;         // where it was saved or opened from; empty if never
+  std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
+
+  /// A fresh experiment on `trajectory`: zero correction, no trials.
+  static Experiment start(std::shared_ptr<const Trajectory> trajectory);
+
+  int samples() const { return trajectory ? trajectory->learning_samples() : 0; }
+  int next_iteration() const { return static_cast<int>(trials.size()); }
+  bool unsaved() const { return static_cast<int>(trials.size()) > saved_trials || settings_changed; }
+  /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
+  void add_trial(Trial trial);
+  /// The correction the next trial applies, from `origin`.
+  void set_next(Eigen::VectorXd correction_bar, std::string origin);
+  /// RMS per trial, in order.
+  std::vector<double> rms_history_deg() const;
+  /// Lowest RMS so far; negative without trials.
+  double best_rms_deg() const;
+  /// True when each of the last `count` trials had a higher RMS than the one before it.
+  bool rms_rising(int count) const;
+};
+
+}  // namespace bellows::ui

@@ -1,0 +1,173 @@
+#include "ui/key_map.hpp"
+
+#include "ui/keys.hpp"
+
+namespace bellows::ui {
+namespace {
+
+bool run_idle(const ConsoleState& s) { return s.run.mode == RunProgress::Mode::kIdle; }
+
+Availability no(std::string why) { return {false, std::move(why)}; }
+
+Availability needs_armed_idle(const ConsoleState& s) {
+  switch (s.engine_state) {
+    case EngineState::kSafe: return no("arm the valves first (a)");
+    case EngineState::kFault: return no("a fault is latched: reset it (R), then arm");
+    case EngineState::kRunning: return no("a trial is running");
+    case EngineState::kArmed: break;
+  }
+  if (!run_idle(s)) return no("trials are running (x stops them)");
+  return {};
+}
+
+}  // namespace
+
+const std::vector<KeyBinding>& key_bindings() {
+  static const std::vector<KeyBinding> bindings = {
+      {Action::kHelp, '?', key::kF1, "?/F1", "Help", "help: every key, greyed when not available now"},
+      {Action::kEmergencyStop, ' ', key::kNone, "Space", "E-STOP", "emergency stop: vent at once (every screen)"},
+      {Action::kArm, 'a', key::kNone, "a", "Arm", "arm the valves (asks for confirmation)"},
+      {Action::kDisarm, 'd', key::kNone, "d", "Disarm", "disarm: vent, abandoning a running trial"},
+      {Action::kReset, 'R', key::kNone, "R", "Reset", "reset a latched fault (then arm again)"},
+      {Action::kTrajectory, 't', key::kNone, "t", "Traj", "choose the trajectory (library or file), with a preview"},
+      {Action::kRunTrial, 'r', key::kNone, "r", "Run", "run a trial with the current correction, no learning"},
+      {Action::kNextIteration, 'n', key::kNone, "n", "Next", "next ILC iteration: learn from the last trial, then run"},
+      {Action::kRunIterations, 'N', key::kNone, "N", "Run K", "run K iterations (asks for K; x interrupts)"},
+      {Action::kStopRun, 'x', key::kNone, "x", "Stop", "stop the trials: abort the running one, keep the valves armed"},
+      {Action::kInspector, 'c', key::kNone, "c", "Inspect", "correction inspector: cursor along time and iterations"},
+      {Action::kTuning, 'w', key::kNone, "w", "Tune", "learning weights M, S, W and PID gains (between trials)"},
+      {Action::kLog, 'l', key::kNone, "l", "Log", "event log: everything the operator and the engine did"},
+      {Action::kFaultView, 'f', key::kNone, "f", "Fault", "the last fault: which guard fired and the black box"},
+      {Action::kSave, 's', key::kNone, "s", "Save", "save the session"},
+      {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
+      {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
+      {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
+      {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
+  };
+  return bindings;
+}
+
+const KeyBinding& binding(Action action) {
+  for (const KeyBinding& b : key_bindings()) {
+    if (b.action == action) return b;
+  }
+  return key_bindings().front();
+}
+
+std::optional<Action> action_for_key(int k) {
+  for (const KeyBinding& b : key_bindings()) {
+    if (b.key == k || (b.alt_key != key::kNone && b.alt_key == k)) return b.action;
+  }
+  return std::nullopt;
+}
+
+Availability availability(Action action, const ConsoleState& s) {
+  switch (action) {
+    case Action::kHelp:
+    case Action::kEmergencyStop:
+    case Action::kLog:
+    case Action::kTuning:
+    case Action::kQuit:
+    case Action::kMain:
+      return {};
+    case Action::kArm:
+      if (s.engine_state == EngineState::kFault) return no("a fault is latched: reset it first (R)");
+      if (s.engine_state != EngineState::kSafe) return no("already armed");
+      return {};
+    case Action::kDisarm:
+      if (s.engine_state == EngineState::kArmed || s.engine_state == EngineState::kRunning) return {};
+      return no("the valves are not armed");
+    case Action::kReset:
+      if (s.engine_state == EngineState::kFault) return {};
+      return no("no fault is latched");
+    case Action::kTrajectory:
+      if (!run_idle(s) || s.engine_state == EngineState::kRunning) return no("not while trials run");
+      return {};
+    case Action::kRunTrial:
+      return needs_armed_idle(s);
+    case Action::kNextIteration: {
+      Availability a = needs_armed_idle(s);
+      if (a.available && s.experiment.next_tried && !s.law_ready) return no("the learning law is not ready yet");
+      return a;
+    }
+    case Action::kRunIterations: {
+      Availability a = needs_armed_idle(s);
+      if (a.available && !s.law_ready) return no("the learning law is not ready yet");
+      return a;
+    }
+    case Action::kStopRun:
+      if (run_idle(s)) return no("no trials are running");
+      return {};
+    case Action::kInspector:
+      if (s.experiment.trials.empty()) return no("no trial has run yet");
+      return {};
+    case Action::kFaultView:
+      if (s.fault_view.code == FaultCode::kNone) return no("no fault so far");
+      return {};
+    case Action::kSave:
+      if (!s.sessions_available) return no(s.sessions_unavailable_reason);
+      if (!s.experiment.unsaved()) return no("nothing new to save");
+      if (s.learner_busy && s.learner_task == "saving") return no("already saving");
+      return {};
+    case Action::kOpen:
+      if (!s.sessions_available) return no(s.sessions_unavailable_reason);
+      if (!run_idle(s) || valves_live(s.engine_state)) return no("disarm first (d): opening replaces the session");
+      return {};
+    case Action::kHeartbeatDrill: {
+      Availability a = needs_armed_idle(s);
+      if (a.available && s.heartbeat_drill) return no("the drill is running");
+      return a;
+    }
+  }
+  return {};
+}
+
+std::vector<Action> function_bar_actions(const ConsoleState& s) {
+  std::vector<Action> candidates;
+  if (s.engine_state == EngineState::kFault) {
+    candidates = {Action::kReset, Action::kFaultView, Action::kLog, Action::kTrajectory, Action::kHelp, Action::kQuit};
+  } else if (!run_idle(s) || s.engine_state == EngineState::kRunning) {
+    candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kInspector, Action::kLog,
+                  Action::kHelp};
+  } else if (s.engine_state == EngineState::kArmed) {
+    candidates = {Action::kEmergencyStop, Action::kRunTrial, Action::kNextIteration, Action::kRunIterations,
+                  Action::kDisarm, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
+                  Action::kHelp, Action::kQuit};
+  } else {
+    candidates = {Action::kArm, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave, Action::kOpen,
+                  Action::kLog, Action::kHelp, Action::kQuit};
+  }
+  std::vector<Action> shown;
+  for (Action a : candidates) {
+    if (availability(a, s).available) shown.push_back(a);
+  }
+  return shown;
+}
+
+std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
+  switch (screen) {
+    case Screen::kInspector:
+      return {{"Left/Right", "cursor along time, one sample"},
+              {"PgUp/PgDn", "cursor along time, a tenth of the trial"},
+              {"Home/End", "start / end of the trial"},
+              {"Up/Down", "earlier / later iteration"},
+              {"m", "overlay this iteration for comparison (m again: remove)"},
+              {"u", "use this iteration's correction for the next trial"}};
+    case Screen::kTrajectory:
+      return {{"Up/Down", "choose; the preview follows"}, {"Enter", "use it (the file entry asks for a path)"}};
+    case Screen::kTuning:
+      return {{"Up/Down", "choose a value"}, {"Enter", "change it (between trials; recorded in the log)"}};
+    case Screen::kSessions:
+      return {{"Up/Down", "choose a session"}, {"Enter", "open it"}};
+    case Screen::kLog:
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"End", "newest"}};
+    case Screen::kFault:
+      return {{"R", "reset the fault"}};
+    case Screen::kMain:
+    case Screen::kHelp:
+      break;
+  }
+  return {};
+}
+
+}  // namespace bellows::ui

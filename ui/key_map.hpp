@@ -1,0 +1,61 @@
+// The console's commands and their keys: one table that the key handling, the help screen and the
+// function bar all read, and the rule of when each command is available.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ui/console_state.hpp"
+
+namespace bellows::ui {
+
+enum class Action {
+  kHelp,
+  kEmergencyStop,
+  kArm,
+  kDisarm,
+  kReset,
+  kTrajectory,
+  kRunTrial,
+  kNextIteration,
+  kRunIterations,
+  kStopRun,
+  kInspector,
+  kTuning,
+  kLog,
+  kFaultView,
+  kSave,
+  kOpen,
+  kQuit,
+  kHeartbeatDrill,
+  kMain,
+};
+
+struct KeyBinding {
+  Action action;
+  int key;
+  int alt_key;              // key::kNone if none
+  const char* key_label;    // as the help screen shows it, e.g. "?/F1"
+  const char* bar_label;    // short, for the function bar
+  const char* description;
+};
+
+/// Every global command, in the help screen's order.
+const std::vector<KeyBinding>& key_bindings();
+const KeyBinding& binding(Action action);
+std::optional<Action> action_for_key(int key);
+
+struct Availability {
+  bool available = true;
+  std::string reason;  // why not, for the operator
+};
+Availability availability(Action action, const ConsoleState& state);
+
+/// The commands that matter in the current state, most important first (the function bar).
+std::vector<Action> function_bar_actions(const ConsoleState& state);
+
+/// Keys of the current screen beyond the global ones: (key, what it does).
+std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen);
+
+}  // namespace bellows::ui

@@ -1,0 +1,59 @@
+#include "ui/plot_data.hpp"
+
+#include <numbers>
+
+namespace bellows::ui {
+namespace {
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+std::vector<double> to_vector(const Eigen::VectorXd& v, double scale, Eigen::Index count) {
+  std::vector<double> out(static_cast<std::size_t>(count));
+  for (Eigen::Index i = 0; i < count; ++i) out[static_cast<std::size_t>(i)] = v(i) * scale;
+  return out;
+}
+}  // namespace
+
+TrialSeries trial_series(const TrialRecord& record) {
+  const Eigen::Index n = record.samples.time_s.size();
+  return {to_vector(record.samples.time_s, 1.0, n), to_vector(record.samples.angle_rad, kDegPerRad, n),
+          to_vector(record.samples.setpoint_rad, kDegPerRad, n)};
+}
+
+RmsSeries rms_series(const Experiment& experiment) {
+  RmsSeries out;
+  for (const Trial& t : experiment.trials) {
+    out.iteration.push_back(t.iteration);
+    out.rms_deg.push_back(t.summary.rms_deg);
+  }
+  return out;
+}
+
+CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chosen) {
+  CorrectionOverlay out;
+  const int n = e.samples();
+  if (n <= 0 || !e.trajectory) return out;
+  const int trials = static_cast<int>(e.trials.size());
+  out.time_s.resize(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) out.time_s[static_cast<std::size_t>(k)] = k * e.trajectory->sample_time_s;
+  const auto correction_of = [&](int i) -> const Eigen::VectorXd& {
+    return i < 0 ? e.next_correction_bar : e.trials[static_cast<std::size_t>(i)].correction_bar;
+  };
+  const auto label_of = [&](int i) { return i < 0 ? std::string("next") : "it " + std::to_string(i); };
+  const int previous = primary < 0 ? trials - 1 : primary - 1;
+  if (previous >= 0) out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
+  if (chosen >= 0 && chosen < trials && chosen != primary && chosen != previous) {
+    out.series.push_back({label_of(chosen), Role::kSeries3, 'o', to_vector(correction_of(chosen), 1.0, n)});
+  }
+  if (primary < trials) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
+  return out;
+}
+
+CorrectionOverlay correction_overlay(const ConsoleState& s) {
+  const Experiment& e = s.experiment;
+  const bool untouched = e.trials.empty() && (e.next_correction_bar.size() == 0 || e.next_correction_bar.isZero());
+  if (untouched) return {};
+  const int primary = e.next_tried && !e.trials.empty() ? static_cast<int>(e.trials.size()) - 1 : -1;
+  return correction_overlay(e, primary, s.inspector.chosen);
+}
+
+}  // namespace bellows::ui

@@ -1,0 +1,201 @@
+#include "ui/render.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+#include "ui/key_map.hpp"
+#include "ui/render_parts.hpp"
+
+namespace bellows::ui {
+namespace detail {
+
+Role state_role(EngineState state) {
+  switch (state) {
+    case EngineState::kSafe: return Role::kSafe;
+    case EngineState::kArmed: return Role::kArmed;
+    case EngineState::kRunning: return Role::kRunning;
+    case EngineState::kFault: return Role::kFault;
+  }
+  return Role::kNormal;
+}
+
+const char* state_words(EngineState state) {
+  switch (state) {
+    case EngineState::kSafe: return "vented";
+    case EngineState::kArmed: return "valves live";
+    case EngineState::kRunning: return "trial running";
+    case EngineState::kFault: return "vented, latched";
+  }
+  return "";
+}
+
+double to_deg(double rad) { return rad * 180.0 / std::numbers::pi; }
+
+Rect inner(const Rect& a) { return {a.x + 1, a.y + 1, a.width - 2, a.height - 2}; }
+
+void render_log_lines(const ConsoleState& s, Canvas& c, const Rect& area) {
+  std::vector<const LogEntry*> shown;
+  const auto& entries = s.log.entries();
+  for (auto it = entries.rbegin(); it != entries.rend() && static_cast<int>(shown.size()) < area.height; ++it) {
+    if (!it->routine) shown.push_back(&*it);
+  }
+  int y = area.y;
+  for (auto it = shown.rbegin(); it != shown.rend(); ++it, ++y) {
+    const LogEntry& e = **it;
+    int x = c.put(area.x, y, e.clock + " ", Role::kDim, false, area.right());
+    const Role role = e.important ? Role::kWarning : (e.source == LogSource::kOperator ? Role::kNormal : Role::kTitle);
+    c.put(x, y, e.text, role, e.important, area.right());
+  }
+}
+
+}  // namespace detail
+
+namespace {
+
+using namespace detail;
+
+void render_header(const ConsoleState& s, Canvas& c) {
+  int x = c.put(0, 0, " Bellows ", Role::kTitle, true);
+  std::string state = format(" %s ", to_string(s.engine_state));
+  if (s.engine_state == EngineState::kFault) state = format(" FAULT: %s ", fault_name(s.fault));
+  x = c.put(x + 1, 0, state, state_role(s.engine_state), true);
+  x = c.put(x, 0, format(" %s ", state_words(s.engine_state)), Role::kDim);
+  x = c.put(x + 1, 0, "device ", Role::kDim);
+  x = c.put(x, 0, s.device.name + ": " + s.device.status, s.device.ok ? Role::kGood : Role::kWarning);
+  const Experiment& e = s.experiment;
+  if (e.trajectory) {
+    x = c.put(x + 2, 0, "trajectory ", Role::kDim);
+    x = c.put(x, 0, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()), Role::kNormal, true);
+  }
+  x = c.put(x + 2, 0, "iteration ", Role::kDim);
+  x = c.put(x, 0, format("%d", e.next_iteration()), Role::kNormal, true);
+  if (!e.trials.empty()) {
+    x = c.put(x + 2, 0, "RMS ", Role::kDim);
+    x = c.put(x, 0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true);
+    c.put(x, 0, format(" (best %.3f)", e.best_rms_deg()), Role::kDim);
+  }
+
+  const LoopHealth& l = s.loop;
+  x = c.put(1, 1, "loop ", Role::kDim);
+  x = c.put(x, 1, format("%.0f Hz x%s %s", l.tick_hz, l.speed.c_str(), l.rt.c_str()));
+  x = c.put(x + 2, 1, "missed ", Role::kDim);
+  x = c.put(x, 1, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood);
+  if (l.realtime && l.speed != "max") {
+    x = c.put(x + 2, 1, "latency ", Role::kDim);
+    x = c.put(x, 1, format("p50 %.0f p99 %.0f max %.0f us", l.p50_us, l.p99_us, l.max_us));
+  } else if (l.realtime) {
+    x = c.put(x + 2, 1, "unpaced", Role::kDim);
+  }
+  x = c.put(x + 2, 1, "law ", Role::kDim);
+  x = c.put(x, 1, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning);
+  x = c.put(x + 2, 1, format("M %g S %g W %g", s.config.ilc.m, s.config.ilc.s, s.config.ilc.w), Role::kDim);
+  if (s.experiment.unsaved() && !s.experiment.trials.empty()) c.put(x + 2, 1, "unsaved", Role::kWarning);
+}
+
+void render_status(const ConsoleState& s, Canvas& c) {
+  const int y = c.height() - 2;
+  std::string text = s.status;
+  if (s.learner_busy && !s.learner_task.empty()) text = s.learner_task + "...  " + text;
+  if (s.heartbeat_drill) text = "HEARTBEAT DRILL: heartbeats withheld, the engine must vent  " + text;
+  c.put(1, y, text, s.status_important || s.heartbeat_drill ? Role::kWarning : Role::kNormal, s.status_important);
+}
+
+void render_function_bar(const ConsoleState& s, Canvas& c) {
+  const int y = c.height() - 1;
+  int x = 0;
+  for (Action a : function_bar_actions(s)) {
+    const KeyBinding& b = binding(a);
+    const std::string key = a == Action::kEmergencyStop ? "Space" : b.key_label;
+    const int need = text_width(key) + text_width(b.bar_label) + 3;
+    if (x + need > c.width()) break;
+    x = c.put(x, y, key, Role::kKey, true);
+    x = c.put(x, y, " ");
+    x = c.put(x, y, b.bar_label, a == Action::kEmergencyStop ? Role::kFault : Role::kTitle, true);
+    x = c.put(x, y, "  ");
+  }
+}
+
+void render_dialog(const ConsoleState& s, Canvas& c) {
+  const Dialog& d = s.dialog;
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  int content_width = text_width(d.title) + 4;
+  for (const std::string& line : d.text) content_width = std::max(content_width, text_width(line));
+  content_width = std::max({content_width, text_width(d.hint), 40});
+  const int width = std::min(content_width + 4, c.width() - 4);
+  const bool has_input = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
+                         d.kind == DialogKind::kEditValue;
+  const int height = static_cast<int>(d.text.size()) + (has_input ? 2 : 0) + 4;
+  const Rect box{(c.width() - width) / 2, std::max(2, (c.height() - height) / 2), width, height};
+  c.fill(box, U' ');
+  c.frame(box, g, d.title, Role::kWarning);
+  int y = box.y + 1;
+  for (const std::string& line : d.text) c.put(box.x + 2, y++, line, Role::kNormal, false, box.right() - 2);
+  if (has_input) {
+    ++y;
+    const int field = box.width - 6;
+    const std::u32string typed = decode_utf8(d.input);
+    std::string visible = d.input;
+    if (static_cast<int>(typed.size()) >= field) {  // show the end of a long input
+      visible.clear();
+      for (std::size_t i = typed.size() - static_cast<std::size_t>(field - 1); i < typed.size(); ++i) append_utf8(visible, typed[i]);
+    }
+    c.put(box.x + 2, y, "> ", Role::kKey, true);
+    c.put(box.x + 4, y, fit(visible + "_", field), Role::kSelected);
+    ++y;
+  }
+  c.put(box.x + 2, box.bottom() - 2, d.hint, Role::kDim, false, box.right() - 2);
+}
+
+void render_too_small(const ConsoleState& s, Canvas& c) {
+  std::vector<std::string> lines = {
+      "Terminal too small",
+      format("%dx%d: Bellows needs at least %dx%d.", s.width, s.height, kMinWidth, kMinHeight),
+      "Enlarge the window to see the console.",
+      format("Engine: %s", to_string(s.engine_state)),
+      "Space: emergency stop    q: quit",
+  };
+  if (s.dialog.kind != DialogKind::kNone) {  // a question waits for an answer: say which
+    lines.push_back(s.dialog.title);
+    lines.push_back(s.dialog.hint);
+  }
+  const int top = std::max(0, (c.height() - static_cast<int>(lines.size())) / 2);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const int y = top + static_cast<int>(i);
+    const int x = std::max(0, (c.width() - text_width(lines[i])) / 2);
+    const Role role = i == 0 ? Role::kWarning : (i == 3 ? state_role(s.engine_state) : Role::kNormal);
+    c.put(x, y, lines[i], role, i == 0);
+  }
+}
+
+}  // namespace
+
+void render(const ConsoleState& s, Canvas& c) {
+  c.clear();
+  if (c.width() < kMinWidth || c.height() < kMinHeight) {
+    render_too_small(s, c);
+    return;
+  }
+  render_header(s, c);
+  const Rect body{0, 2, c.width(), c.height() - 4};
+  switch (s.screen) {
+    case Screen::kMain: render_dashboard(s, c, body); break;
+    case Screen::kInspector: render_inspector(s, c, body); break;
+    case Screen::kFault: render_fault(s, c, body); break;
+    case Screen::kHelp: render_help(s, c, body); break;
+    case Screen::kTrajectory: render_trajectory(s, c, body); break;
+    case Screen::kTuning: render_tuning(s, c, body); break;
+    case Screen::kLog: render_log(s, c, body); break;
+    case Screen::kSessions: render_sessions(s, c, body); break;
+  }
+  render_status(s, c);
+  render_function_bar(s, c);
+  if (s.dialog.kind != DialogKind::kNone) render_dialog(s, c);
+}
+
+std::vector<std::string> render_lines(const ConsoleState& state) {
+  Canvas canvas(state.width, state.height);
+  render(state, canvas);
+  return canvas.lines();
+}
+
+}  // namespace bellows::ui

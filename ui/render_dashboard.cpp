@@ -1,0 +1,171 @@
+// The main screen: live values and valve duty cycles, the last trial against its set point, RMS
+// per iteration, the correction (with the previous and a chosen iteration), the newest log lines.
+#include <algorithm>
+
+#include "ui/plot.hpp"
+#include "ui/plot_data.hpp"
+#include "ui/render_parts.hpp"
+
+namespace bellows::ui::detail {
+namespace {
+
+void value_row(Canvas& c, const Rect& area, int row, const std::string& label, const std::string& value,
+               Role role = Role::kNormal) {
+  if (row >= area.height) return;
+  c.put(area.x + 1, area.y + row, label, Role::kDim, false, area.right());
+  c.put(area.x + 12, area.y + row, value, role, true, area.right());
+}
+
+void duty_row(Canvas& c, const Rect& area, int row, const std::string& label, double duty, const Glyphs& g) {
+  if (row >= area.height) return;
+  const int bar_width = std::max(4, area.width - 13);
+  c.put(area.x + 1, area.y + row, label, Role::kDim, false, area.right());
+  c.put(area.x + 7, area.y + row, bar(duty, bar_width, g), Role::kSeries1, false, area.right());
+  c.put(area.x + 8 + bar_width, area.y + row, format("%3.0f%%", 100.0 * duty), Role::kNormal, false, area.right());
+}
+
+std::string run_phase_text(const ConsoleState& s) {
+  const RunProgress& r = s.run;
+  switch (r.phase) {
+    case RunProgress::Phase::kLearning: return "learning";
+    case RunProgress::Phase::kSettling: return "settling at the start";
+    case RunProgress::Phase::kRunning:
+      if (s.experiment.trajectory) {
+        return format("running %.1f / %.1f s", std::max(r.sample, 0) * s.experiment.trajectory->sample_time_s,
+                      s.experiment.trajectory->duration_s());
+      }
+      return "running";
+    case RunProgress::Phase::kNone: break;
+  }
+  return "idle";
+}
+
+void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
+  c.frame(area, g, "Live");
+  const Rect in = inner(area);
+  if (!s.live_valid) {
+    c.put(in.x + 1, in.y, "waiting for the engine", Role::kDim);
+    return;
+  }
+  const TickRecord& t = s.live;
+  int row = 0;
+  value_row(c, in, row++, "angle", format("%7.2f deg", to_deg(t.reading.angle_rad)));
+  value_row(c, in, row++, "set point", format("%7.2f deg", to_deg(t.desired_angle_rad)));
+  value_row(c, in, row++, "error", format("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
+  value_row(c, in, row++, "p A", format("%7.3f bar", t.reading.chamber_bar[0]));
+  value_row(c, in, row++, "p B", format("%7.3f bar", t.reading.chamber_bar[1]));
+  value_row(c, in, row++, "supply", format("%7.3f bar", t.reading.supply_bar),
+            t.reading.supply_bar < s.config.safety.supply_min_bar ? Role::kWarning : Role::kNormal);
+  duty_row(c, in, row++, "in A", t.valves.inlet_duty[0], g);
+  duty_row(c, in, row++, "out A", t.valves.outlet_duty[0], g);
+  duty_row(c, in, row++, "in B", t.valves.inlet_duty[1], g);
+  duty_row(c, in, row++, "out B", t.valves.outlet_duty[1], g);
+  value_row(c, in, row++, "trial", run_phase_text(s), s.run.phase == RunProgress::Phase::kNone ? Role::kDim : Role::kRunning);
+  if (s.run.mode == RunProgress::Mode::kBatch) {
+    value_row(c, in, row++, "batch", format("%d of %d done%s", s.run.batch_done, s.run.batch_total,
+                                            s.run.stop_requested ? ", stopping" : ""));
+  } else {
+    value_row(c, in, row++, "next", s.experiment.next_origin, Role::kDim);
+  }
+}
+
+void render_trial_plot(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
+  const Rect in = inner(area);
+  const bool running = s.run.phase == RunProgress::Phase::kRunning || s.run.phase == RunProgress::Phase::kSettling;
+  PlotOptions options;
+  options.braille = s.unicode;
+  options.x_unit = "s";
+  if (!running && !s.experiment.trials.empty()) {
+    const Trial& t = s.experiment.trials.back();
+    c.frame(area, g, format("Iteration %d: angle and set point (deg)", t.iteration));
+    legend(c, area, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
+    const TrialSeries data = trial_series(t.record);
+    draw_plot(c, in, {{data.time_s, data.angle_deg, Role::kSeries1, '*'}, {data.time_s, data.setpoint_deg, Role::kSeries2, '.'}},
+              options);
+    return;
+  }
+  c.frame(area, g, "Live: angle and set point (deg), last seconds");
+  legend(c, area, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
+  if (s.strip.time_s.size() < 2) {
+    c.put(in.x + 1, in.y, "no trial yet: arm (a), then run a trial (r) or an iteration (n)", Role::kDim, false, in.right());
+    return;
+  }
+  draw_plot(c, in, {{s.strip.time_s, s.strip.angle_deg, Role::kSeries1, '*'}, {s.strip.time_s, s.strip.setpoint_deg, Role::kSeries2, '.'}},
+            options);
+}
+
+void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
+  c.frame(area, g, "RMS per iteration (deg)");
+  const Rect in = inner(area);
+  const auto& trials = s.experiment.trials;
+  if (trials.empty()) {
+    c.put(in.x + 1, in.y, "no iteration yet", Role::kDim, false, in.right());
+    return;
+  }
+  constexpr int kListWidth = 14;
+  const Rect list{in.right() - kListWidth, in.y, kListWidth, in.height};
+  c.put(list.x, list.y, "  it       RMS", Role::kDim);
+  const int rows = list.height - 1;
+  const int count = static_cast<int>(trials.size());
+  const double best = s.experiment.best_rms_deg();
+  for (int i = std::max(0, count - rows), y = list.y + 1; i < count; ++i, ++y) {
+    const Trial& t = trials[static_cast<std::size_t>(i)];
+    const bool is_best = t.summary.rms_deg == best;
+    c.put(list.x, y, format("%4d %9.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : ""),
+          i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1);
+  }
+  const Rect plot{in.x, in.y, in.width - kListWidth - 1, in.height};
+  if (plot.width >= 18 && count >= 2) {
+    const RmsSeries data = rms_series(s.experiment);
+    PlotOptions options;
+    options.braille = s.unicode;
+    options.integer_x = true;
+    options.y_min = 0.0;
+    options.y_format = "%.2f";
+    draw_plot(c, plot, {{data.iteration, data.rms_deg, Role::kSeries1, '*'}}, options);
+  }
+}
+
+void render_correction(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
+  c.frame(area, g, "Correction u_ilc (bar)");
+  const Rect in = inner(area);
+  const CorrectionOverlay overlay = correction_overlay(s);
+  if (overlay.series.empty()) {
+    c.put(in.x + 1, in.y, "zero until the first iteration learns", Role::kDim, false, in.right());
+    return;
+  }
+  std::vector<LegendItem> items;
+  std::vector<PlotSeries> series;
+  for (const auto& o : overlay.series) {
+    items.push_back({o.label, o.role, o.mark});
+    series.push_back({overlay.time_s, o.values, o.role, o.mark});
+  }
+  legend(c, area, items, g);
+  PlotOptions options;
+  options.braille = s.unicode;
+  options.x_unit = "s";
+  options.y_format = "%.3f";
+  draw_plot(c, in, series, options);
+}
+
+}  // namespace
+
+void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  const int left_width = std::clamp(body.width * 3 / 10, 30, 40);
+  const int live_height = std::min(14, body.height - 5);
+  render_live(s, c, {body.x, body.y, left_width, live_height}, g);
+  const Rect log{body.x, body.y + live_height, left_width, body.height - live_height};
+  c.frame(log, g, "Log");
+  render_log_lines(s, c, {log.x + 1, log.y + 1, log.width - 2, log.height - 2});
+
+  const Rect right{body.x + left_width, body.y, body.width - left_width, body.height};
+  const int trial_height = right.height / 2;
+  render_trial_plot(s, c, {right.x, right.y, right.width, trial_height}, g);
+  const Rect bottom{right.x, right.y + trial_height, right.width, right.height - trial_height};
+  const int rms_width = std::clamp(bottom.width / 2, 22, 50);
+  render_rms(s, c, {bottom.x, bottom.y, rms_width, bottom.height}, g);
+  render_correction(s, c, {bottom.x + rms_width, bottom.y, bottom.width - rms_width, bottom.height}, g);
+}
+
+}  // namespace bellows::ui::detail

@@ -1,0 +1,183 @@
+// The list screens: help, trajectory chooser (with its preview), tuning, event log, sessions.
+#include <algorithm>
+#include <cmath>
+
+#include "ui/key_map.hpp"
+#include "ui/plot.hpp"
+#include "ui/render_parts.hpp"
+#include "ui/tuning.hpp"
+
+namespace bellows::ui::detail {
+
+void render_help(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  c.frame(body, g, "Keys (greyed: not available now)");
+  const Rect in = inner(body);
+  int y = in.y;
+  for (const KeyBinding& b : key_bindings()) {
+    if (y >= in.bottom()) break;
+    const Availability a = availability(b.action, s);
+    const Role role = a.available ? Role::kNormal : Role::kDim;
+    c.put(in.x + 1, y, fit(b.key_label, 7), a.available ? Role::kKey : Role::kDim, a.available);
+    int x = c.put(in.x + 9, y, b.description, role, false, in.right());
+    if (!a.available && !a.reason.empty()) c.put(x, y, "  (" + a.reason + ")", Role::kDim, false, in.right());
+    ++y;
+  }
+  const auto extra = screen_keys(s.previous_screen);
+  if (!extra.empty() && y + 2 < in.bottom()) {
+    ++y;
+    c.put(in.x + 1, y++, "On the screen you came from:", Role::kTitle, true);
+    for (const auto& [keys, what] : extra) {
+      if (y >= in.bottom()) break;
+      c.put(in.x + 1, y, fit(keys, 20), Role::kKey);
+      c.put(in.x + 22, y++, what, Role::kNormal, false, in.right());
+    }
+  }
+}
+
+void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  const TrajectoryChooser& ch = s.chooser;
+  const int list_width = std::min(34, body.width / 3);
+  const Rect list{body.x, body.y, list_width, body.height};
+  c.frame(list, g, "Trajectories");
+  const Rect in = inner(list);
+  const std::string current = s.experiment.trajectory ? s.experiment.trajectory->name : "";
+  for (std::size_t i = 0; i < ch.names.size() && static_cast<int>(i) * 2 < in.height; ++i) {
+    const int y = in.y + static_cast<int>(i) * 2;
+    const bool selected = static_cast<int>(i) == ch.selected;
+    std::string label = ch.names[i];
+    if (i + 1 == ch.names.size() && !ch.file_path.empty()) label = "file: " + ch.file_path;
+    if (label == current) label += "  (in use)";
+    c.put(in.x, y, fit((selected ? "> " : "  ") + label, in.width), selected ? Role::kSelected : Role::kNormal, selected);
+    if (i < ch.descriptions.size()) c.put(in.x + 2, y + 1, ch.descriptions[i], Role::kDim, false, in.right());
+  }
+  const Rect preview{list.right(), body.y, body.width - list_width, body.height};
+  c.frame(preview, g, "Preview: angle (deg)");
+  const Rect pin = inner(preview);
+  if (!ch.preview_error.empty()) {
+    c.put(pin.x + 1, pin.y, ch.preview_error, Role::kWarning, true, pin.right());
+    return;
+  }
+  if (!ch.preview) {
+    c.put(pin.x + 1, pin.y, "Enter: give the path of a CSV file (time_s,angle_deg)", Role::kDim, false, pin.right());
+    return;
+  }
+  const Trajectory& t = *ch.preview;
+  const int n = static_cast<int>(t.angle_rad.size());
+  std::vector<double> time(static_cast<std::size_t>(n)), angle(static_cast<std::size_t>(n));
+  double peak_speed = 0.0;
+  for (int k = 0; k < n; ++k) {
+    time[static_cast<std::size_t>(k)] = k * t.sample_time_s;
+    angle[static_cast<std::size_t>(k)] = to_deg(t.angle_rad(k));
+    if (k > 0) peak_speed = std::max(peak_speed, std::abs(to_deg(t.angle_rad(k) - t.angle_rad(k - 1))) / t.sample_time_s);
+  }
+  const auto [lo, hi] = std::minmax_element(angle.begin(), angle.end());
+  c.put(pin.x + 1, pin.y,
+        format("%s: %.1f s, %d samples, %.1f to %.1f deg, peak speed %.0f deg/s", t.name.c_str(), t.duration_s(),
+               t.learning_samples(), *lo, *hi, peak_speed),
+        Role::kNormal, true, pin.right());
+  PlotOptions options;
+  options.braille = s.unicode;
+  options.x_unit = "s";
+  draw_plot(c, {pin.x, pin.y + 2, pin.width, pin.height - 2}, {{time, angle, Role::kSeries1, '*'}}, options);
+}
+
+void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  const int form_height = std::min(body.height, 13);
+  const Rect form{body.x, body.y, body.width, form_height};
+  c.frame(form, g, "Gains and learning weights (changed between trials)");
+  const Rect in = inner(form);
+  const auto& fields = tuning_fields();
+  int y = in.y;
+  c.put(in.x + 1, y++, "PID gains, normalized units: sent to the engine", Role::kTitle, true);
+  for (std::size_t i = 0; i < fields.size() && y < in.bottom(); ++i) {
+    if (i == 4) {
+      const bool norm_optimal = s.law_name.rfind("noilc", 0) == 0;
+      c.put(in.x + 1, y++,
+            norm_optimal ? "Learning weights M, S, W (times I): the law " + s.law_name + " is rebuilt"
+                         : "Learning weights M, S, W: not used by the law " + s.law_name + " ([ilc] law chooses it)",
+            norm_optimal ? Role::kTitle : Role::kDim, true);
+    }
+    const TuningField& f = fields[i];
+    const bool selected = static_cast<int>(i) == s.tuning.selected;
+    const std::string row = format("%s %-5s %12.6g %-4s  %-24s %s", selected ? ">" : " ", f.label,
+                                   tuning_value(s.config, static_cast<int>(i)), f.unit, f.config_key, f.description);
+    c.put(in.x + 1, y++, fit(row, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
+  }
+  if (y < in.bottom() && !s.convergence.empty()) {
+    c.put(in.x + 1, y++, s.convergence, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning,
+          in.right());
+  }
+  const Rect changes{body.x, form.bottom(), body.width, body.height - form_height};
+  if (changes.height < 3) return;
+  c.frame(changes, g, "Changes recorded in the log");
+  const Rect cin = inner(changes);
+  std::vector<const LogEntry*> recorded;
+  for (const LogEntry& e : s.log.entries()) {
+    if (e.source == LogSource::kOperator && e.text.find(" changed ") != std::string::npos) recorded.push_back(&e);
+  }
+  const int count = static_cast<int>(recorded.size());
+  for (int i = std::max(0, count - cin.height), row = 0; i < count; ++i, ++row) {
+    const LogEntry& e = *recorded[static_cast<std::size_t>(i)];
+    c.put(cin.x + 1, cin.y + row, e.clock + "  " + e.text, Role::kNormal, false, cin.right());
+  }
+  if (count == 0) c.put(cin.x + 1, cin.y, "none yet", Role::kDim);
+}
+
+void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  c.frame(body, g, format("Event log (%zu entries)", s.log.entries().size()));
+  const Rect in = inner(body);
+  const auto& entries = s.log.entries();
+  const int count = static_cast<int>(entries.size());
+  const int last = std::max(0, count - 1 - s.log_scroll);
+  const int first = std::max(0, last - in.height + 1);
+  for (int i = first, y = in.y; i <= last && i < count; ++i, ++y) {
+    const LogEntry& e = entries[static_cast<std::size_t>(i)];
+    int x = c.put(in.x + 1, y, e.clock, Role::kDim);
+    x = c.put(x + 1, y, e.engine_time_s >= 0.0 ? format("%9.2f s", e.engine_time_s) : std::string(11, ' '), Role::kDim);
+    x = c.put(x + 1, y, fit(to_string(e.source), 9), Role::kTitle);
+    c.put(x, y, e.text, e.important ? Role::kWarning : Role::kNormal, e.important, in.right());
+  }
+}
+
+void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
+  const Glyphs g = Glyphs::for_unicode(s.unicode);
+  c.frame(body, g, "Saved sessions");
+  const Rect in = inner(body);
+  const SessionBrowser& b = s.browser;
+  if (!s.sessions_available) {
+    c.put(in.x + 1, in.y, "Not available: " + s.sessions_unavailable_reason, Role::kWarning, true, in.right());
+    return;
+  }
+  if (b.loading) {
+    c.put(in.x + 1, in.y, "Reading the saved sessions...", Role::kDim);
+    return;
+  }
+  if (!b.error.empty()) c.put(in.x + 1, in.bottom() - 1, b.error, Role::kWarning, true, in.right());
+  if (b.sessions.empty()) {
+    c.put(in.x + 1, in.y, "No saved session yet: s saves the current one.", Role::kDim);
+    return;
+  }
+  c.put(in.x + 1, in.y, "  started           trajectory   iterations   best RMS  name", Role::kDim);
+  const int rows = in.height - 2;
+  const int count = static_cast<int>(b.sessions.size());
+  const int first = std::clamp(b.selected - rows + 1, 0, std::max(0, count - rows));
+  for (int i = first, y = in.y + 1; i < count && y < in.y + 1 + rows; ++i, ++y) {
+    const SessionListing& l = b.sessions[static_cast<std::size_t>(i)];
+    const bool selected = i == b.selected;
+    std::string row;
+    if (l.error.empty()) {
+      row = format("%s %-17s %-12s %10d   %s  %s", selected ? ">" : " ", l.date.c_str(), l.trajectory.c_str(), l.iterations,
+                   l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str());
+    } else {
+      row = format("%s %s: cannot be read: %s", selected ? ">" : " ", l.name.c_str(), l.error.c_str());
+    }
+    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (l.error.empty() ? Role::kNormal : Role::kDim),
+          selected);
+  }
+}
+
+}  // namespace bellows::ui::detail

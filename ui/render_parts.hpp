@@ -1,0 +1,28 @@
+// The screens and the pieces they share (internal to ui/).
+#pragma once
+
+#include <string>
+
+#include "ui/canvas.hpp"
+#include "ui/console_state.hpp"
+
+namespace bellows::ui::detail {
+
+Role state_role(EngineState state);
+const char* state_words(EngineState state);
+double to_deg(double rad);
+/// Inside of a frame: the area minus its border.
+Rect inner(const Rect& area);
+
+void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_fault(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_help(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_log(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body);
+/// The newest log entries that fit in `area`, one a line, without the routine ones.
+void render_log_lines(const ConsoleState& s, Canvas& c, const Rect& area);
+
+}  // namespace bellows::ui::detail

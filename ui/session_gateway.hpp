@@ -1,0 +1,70 @@
+// How the console saves and opens sessions, without knowing the store's files: app/ gives the
+// console an implementation (sessions/ on disk); without one, save and open say they are not
+// available. Every call runs on a worker thread, never on the UI thread, and gets a copy of what
+// it needs, so a slow disk never stalls the console or its heartbeat.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/configuration.hpp"
+#include "ui/event_log.hpp"
+#include "ui/experiment.hpp"
+
+namespace bellows::ui {
+
+/// What a saved session holds, as the console sees it.
+struct SessionSnapshot {
+  Configuration config;
+  Experiment experiment;          // trajectory, trials, next correction, where it is saved
+  std::vector<LogEntry> events;   // the operator's and the engine's log (the newest entries)
+  std::size_t events_total = 0;   // entries ever logged (EventLog::total()), to tell new ones apart
+  std::string device_name;        // e.g. "sim"
+  std::uint64_t seed = 1;
+};
+
+/// One saved session as the browser lists it.
+struct SessionListing {
+  std::string location;     // what open() takes (a directory)
+  std::string name;
+  std::string date;         // when it started, local time, "2024-05-01 14:03"
+  std::string trajectory;
+  int iterations = 0;
+  double best_rms_deg = -1; // negative: no iteration
+  std::string error;        // not empty: the session cannot be read (the reason)
+};
+
+class SessionGateway {
+ public:
+  virtual ~SessionGateway() = default;
+  virtual bool available() const = 0;
+  /// Why save and open are not available (shown to the operator).
+  virtual std::string unavailable_reason() const { return "saving sessions is not available in this build"; }
+  /// Saves `snapshot`: a new session, or, when `experiment.session_location` is the session this
+  /// gateway opened or saved last, the trials and log entries added since (`experiment.saved_trials`,
+  /// `experiment.saved_events`). Returns the session's location. Throws on failure.
+  virtual std::string save(const SessionSnapshot& snapshot) = 0;
+  /// Saved sessions, oldest first.
+  virtual std::vector<SessionListing> list() = 0;
+  /// Loads a session completely. Throws InputError when it cannot be read.
+  virtual SessionSnapshot open(const std::string& location) = 0;
+};
+
+/// The gateway when no session store is built in: everything says "not available".
+class UnavailableSessionGateway final : public SessionGateway {
+ public:
+  explicit UnavailableSessionGateway(std::string reason) : reason_(std::move(reason)) {}
+  bool available() const override { return false; }
+  std::string unavailable_reason() const override { return reason_; }
+  std::string save(const SessionSnapshot&) override { throw std::runtime_error(reason_); }
+  std::vector<SessionListing> list() override { return {}; }
+  SessionSnapshot open(const std::string&) override { throw std::runtime_error(reason_); }
+
+ private:
+  std::string reason_;
+};
+
+}  // namespace bellows::ui

@@ -1,0 +1,27 @@
+// What the console's prompts do with typed text.
+#pragma once
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace bellows::ui {
+
+/// Removes the last UTF-8 code point (Backspace).
+inline void pop_last_code_point(std::string& text) {
+  while (!text.empty()) {
+    const auto byte = static_cast<unsigned char>(text.back());
+    text.pop_back();
+    if ((byte & 0xC0) != 0x80) break;  // stop after the first byte of a sequence
+  }
+}
+
+/// A whole finite number ("0.45", "2e-5"): false for anything else, trailing text included.
+inline bool parse_number(const std::string& text, double& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end != nullptr && *end == '\0' && std::isfinite(value);
+}
+
+}  // namespace bellows::ui
