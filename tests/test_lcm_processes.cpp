@@ -107,7 +107,6 @@ class Heckler final : public LcmEndpoint {
 
 TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTrust) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
-  isolate_sessions();
   const auto dir = testing::make_temp_dir("bellows-lcm-rms");
   Heckler heckler;
   LcmIoThread bus(kDefaultLcmUrl, {&heckler});
@@ -115,7 +114,7 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
 
   Child rig({kBellows, "io-sim", "--seed", "5", "--json"}, dir / "rig.out", dir / "rig.err");
   ASSERT_TRUE(rig.started());
-  Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"},
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(run.started());
   const auto run_status = run.wait(300.0);
@@ -126,7 +125,7 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   bus.stop();
 
   // The same seed in-process, on the wall clock too.
-  Child local({kBellows, "run", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out",
+  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out",
               dir / "local.err");
   const auto local_status = local.wait(300.0);
   ASSERT_TRUE(local_status.has_value());
