@@ -74,7 +74,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    auto simulated = std::make_unique<SimulatedClock>(core, device);
+    auto simulated = io.simulated_clock(core);
     clock = simulated.get();
     driver = std::move(simulated);
   } else {

@@ -30,26 +30,6 @@ std::string free_log_name(const std::filesystem::path& directory) {
 
 }  // namespace
 
-/// The simulated arm, on the simulated clock with telemetry: after each tick (advance() runs on the
-/// engine's thread, right after the tick) it waits until the tap has room for the next one.
-class RunIo::TapPacedDevice final : public Device {
- public:
-  explicit TapPacedDevice(SimulatedArm& arm) : arm_(arm) {}
-  void set_tap(TelemetryRing* tap) { tap_ = tap; }
-  SensorReading read_sensors() override { return arm_.read_sensors(); }
-  void write_valves(const ValveCommand& command) override { arm_.write_valves(command); }
-  void vent() override { arm_.vent(); }
-  void advance(double dt_s) override {
-    arm_.advance(dt_s);
-    while (tap_ != nullptr && tap_->write_available() == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  const char* name() const override { return arm_.name(); }
-
- private:
-  SimulatedArm& arm_;
-  TelemetryRing* tap_ = nullptr;
-};
-
 nlohmann::json receive_counts_json(const ReceiveCounts& c) {
   return {{"accepted", c.accepted},
           {"ignored",
@@ -81,7 +61,6 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
   if (options.device == "lcm" || telemetry_) session_id_ = LcmDevice::random_session_id();
   if (options.device == "sim") {
     arm_ = std::make_unique<SimulatedArm>(config.plant, seed);
-    if (telemetry_ && options.clock == "sim") paced_ = std::make_unique<TapPacedDevice>(*arm_);
     return;
   }
   lcm_device_ = std::make_unique<LcmDevice>(session_id_);
@@ -94,14 +73,18 @@ RunIo::~RunIo() { stop(); }
 
 Device& RunIo::device() {
   if (lcm_device_) return *lcm_device_;
-  if (paced_) return *paced_;
   return *arm_;
 }
 
 void RunIo::add_telemetry_tap(EngineCore& core) {
   if (!telemetry_) return;
   tap_ = &core.add_telemetry_tap(static_cast<std::size_t>(kTelemetryRing_s / config_.timing.tick_s) + 1);
-  if (paced_) paced_->set_tap(tap_);
+}
+
+std::unique_ptr<SimulatedClock> RunIo::simulated_clock(EngineCore& core) {
+  auto clock = std::make_unique<SimulatedClock>(core, device());
+  clock->pace_by(tap_);  // null without telemetry
+  return clock;
 }
 
 void RunIo::start_telemetry(const std::filesystem::path& session_directory) {

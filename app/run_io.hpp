@@ -17,6 +17,7 @@
 #include "devices/simulated_arm.hpp"
 #include "engine/configuration.hpp"
 #include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
 #include "engine/learning_session.hpp"
 
 namespace bellows {
@@ -39,9 +40,11 @@ class RunIo {
   SimulatedArm* simulated_arm() { return arm_.get(); }
 
   /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
-  /// tick. On the simulated clock the device then waits for the publisher whenever the tap is full,
-  /// so that the log holds every tick (simulated time has no deadline to miss).
+  /// tick and before simulated_clock().
   void add_telemetry_tap(EngineCore& core);
+  /// The simulated clock for `--clock sim`. With telemetry it waits for the publisher whenever the
+  /// tap is full, so that a log holds every tick (simulated time has no deadline to miss).
+  std::unique_ptr<SimulatedClock> simulated_clock(EngineCore& core);
   /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
   /// --lcm-log names no file. Before the first tick.
   void start_telemetry(const std::filesystem::path& session_directory);
@@ -72,13 +75,10 @@ class RunIo {
   std::string warning() const;
 
  private:
-  class TapPacedDevice;
-
   const RunOptions& options_;
   Configuration config_;
   bool telemetry_ = false;
   std::unique_ptr<SimulatedArm> arm_;
-  std::unique_ptr<TapPacedDevice> paced_;
   std::unique_ptr<LcmDevice> lcm_device_;
   std::unique_ptr<LcmIoThread> device_io_;
   TelemetryRing* tap_ = nullptr;

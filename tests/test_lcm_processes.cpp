@@ -107,7 +107,6 @@ class Heckler final : public LcmEndpoint {
 
 TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTrust) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
-  isolate_sessions();
   const auto dir = testing::make_temp_dir("bellows-lcm-rms");
   Heckler heckler;
   LcmIoThread bus(kDefaultLcmUrl, {&heckler});
@@ -313,6 +312,33 @@ TEST(LcmProcesses, LcmLogplayerReplaysASavedLogThatASubscriberDecodesEntirely) {
   EXPECT_GT(telemetry, 480u);
   EXPECT_GE(events, 8u);
   EXPECT_EQ(trials, 2u);
+}
+
+TEST(LcmCli, OnTheSimulatedClockTheLogHoldsEveryTick) {
+  // The simulated clock outruns any publisher: it waits for it, so nothing is dropped.
+  const auto dir = testing::make_temp_dir("bellows-lcm-simlog");
+  const std::string log = (dir / "sim.lcmlog").string();
+  const auto result = testing::run_process(kBellows + " run --no-save --iterations 2 --json --seed 3 --lcm-log " + log);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json report = nlohmann::json::parse(result.out);
+  const nlohmann::json& telemetry = report["lcm"]["telemetry"];
+  EXPECT_EQ(telemetry["dropped_ticks"], 0);
+  EXPECT_EQ(telemetry["trials"], 3);
+  EXPECT_GT(telemetry["ticks"].get<std::uint64_t>(), 3u * 1800u);
+  lcm::LogFile file(log, "r");
+  ASSERT_TRUE(file.good());
+  std::int64_t next_tick = 0;
+  for (const lcm::LogEvent* e = file.readNextEvent(); e != nullptr; e = file.readNextEvent()) {
+    if (e->channel != kTelemetryChannel) continue;
+    telemetry_t t{};
+    ASSERT_EQ(decode_checked(e->data, static_cast<std::size_t>(e->datalen), t), DecodeStatus::kOk);
+    ASSERT_EQ(t.tick, next_tick++);
+  }
+  EXPECT_EQ(static_cast<std::uint64_t>(next_tick), telemetry["ticks"].get<std::uint64_t>());
+  // Same seed, no telemetry: the same learning (waiting for the publisher changes nothing).
+  const auto plain = testing::run_process(kBellows + " run --no-save --iterations 2 --json --seed 3");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out)["iterations"], report["iterations"]);
 }
 
 void expect_refused(const std::string& args, const std::string& fragment) {
