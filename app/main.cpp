@@ -7,9 +7,11 @@
 #include "app/config_file.hpp"
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
+#include "app/io_sim_command.hpp"
 #include "app/run_command.hpp"
-#include "app/signals.hpp"
 #include "app/sessions_command.hpp"
+#include "app/signals.hpp"
+#include "devices/lcm_channels.hpp"
 #include "engine/errors.hpp"
 
 namespace {
@@ -71,6 +73,26 @@ int main(int argc, char** argv) {
   }
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
+  run_cmd->add_option("--device", run.device, "sim: the simulated arm in-process; lcm: a rig over LCM (--clock wall)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sim", "lcm"}));
+  run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find the rig there)");
+  CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
+                                             "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
+                                             "FILE in the session directory")
+                             ->expected(0, 1);
+
+  bellows::IoSimOptions io_sim;
+  CLI::App* io_sim_cmd = app.add_subcommand("io-sim", "Serve the simulated arm over LCM in real time, as a rig would");
+  io_sim_cmd->add_option("--config", io_sim.config_path, "TOML configuration file ([plant], [timing], [lcm])");
+  io_sim_cmd->add_option("--seed", io_sim.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  io_sim_cmd->add_option("--lcm", io_sim.lcm_url, "LCM bus URL")->default_str(bellows::kDefaultLcmUrl);
+  io_sim_cmd->add_option("--rt", io_sim.rt, "Real-time scheduling: enforce (refuse without), try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
+  io_sim_cmd->add_option("--duration", io_sim.duration_s, "Stop after this many seconds (0: at SIGINT/SIGTERM)")
+      ->capture_default_str();
+  io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
@@ -123,7 +145,9 @@ int main(int argc, char** argv) {
   }
 
   try {
+    run.lcm_log = lcm_log->count() > 0;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
+    if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (config_cmd->parsed()) {
       const bellows::Configuration config =
           config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);

@@ -8,10 +8,10 @@
 
 #include "app/config_file.hpp"
 #include "app/learning_report.hpp"
+#include "app/run_io.hpp"
 #include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
-#include "devices/simulated_arm.hpp"
 #include "engine/arm_model.hpp"
 #include "engine/convergence.hpp"
 #include "engine/engine_core.hpp"
@@ -64,25 +64,30 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
 
-  SimulatedArm arm(config.plant, seed);
-  EngineCore core(arm, config.controller, config.timing, config.safety);
+  RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
+  Device& device = io.device();
+  SimulatedArm* arm = io.simulated_arm();
+  EngineCore core(device, config.controller, config.timing, config.safety);
+  io.add_telemetry_tap(core);
+  const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;
   SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
   if (options.clock == "sim") {
-    auto simulated = std::make_unique<SimulatedClock>(core, arm);
+    auto simulated = std::make_unique<SimulatedClock>(core, device);
     clock = simulated.get();
     driver = std::move(simulated);
   } else {
-    auto realtime = std::make_unique<RealtimeLoop>(core, arm, speed);
+    auto realtime = std::make_unique<RealtimeLoop>(core, device, speed);
     loop = realtime.get();
     driver = std::move(realtime);
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
   recording.restore(arm, core, clock, session);  // before the first tick
-  recording.start(config, trajectory, arm.name(), seed, options.iterations);
+  recording.start(config, trajectory, device.name(), seed, options.iterations);
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  io.start_telemetry(recording.directory());  // its LCM log goes into the session
   const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
   if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
@@ -96,10 +101,19 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   nlohmann::json iterations = nlohmann::json::array();
   int status = 0;
   std::string failure;
+  std::string failure_name;
   const int trials = recording.trials(options.iterations);
   try {
-    for (int i = 0; i < trials; ++i) {
+    if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
+      failure = std::move(why);
+      failure_name = "rig-unavailable";
+      status = stop_signal() != 0 ? 128 + stop_signal() : 3;
+      progress << "bellows: " << failure << std::endl;
+      recording.fault(failure);
+    }
+    for (int i = 0; failure.empty() && i < trials; ++i) {
       const IterationSummary s = session.run_trial();
+      io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
       recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
       progress << progress_line(s) << std::endl;
@@ -109,17 +123,20 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     }
   } catch (const EngineFault& fault) {
     failure = fault.what();
+    failure_name = fault_name(core.fault());
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
     recording.fault(failure + " (" + fault_name(fault.code()) + ")");
   } catch (const std::exception& error) {
     if (loop != nullptr) loop->stop();  // vents
-    else arm.vent();
+    else device.vent();
     recording.fault(error.what());
     throw;
   }
   if (loop != nullptr) loop->stop();  // vents
-  else arm.vent();
+  else device.vent();
+  io.stop();  // the rig's last vent command, the rest of the telemetry
+  if (const std::string warning = io.warning(); !warning.empty()) progress << "bellows: " << warning << std::endl;
   if (monitor.windup().detected) {
     progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
              << ": the correction keeps growing where the set points saturate (largest clamped excess "
@@ -128,7 +145,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   if (status == 0) recording.finish(trials);
 
   if (options.json) {
-    nlohmann::json report = {{"device", arm.name()},
+    nlohmann::json report = {{"device", device.name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
                              {"seed", seed},
@@ -139,7 +156,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"session", recording.directory().empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};
-    if (!failure.empty()) report["fault"] = {{"name", fault_name(core.fault())}, {"message", failure}};
+    if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
+    if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
       report["loop"] = {{"ticks", core.ticks()},

@@ -60,12 +60,12 @@ void RunRecording::start(const Configuration& config, const Trajectory& trajecto
                                         kPurpose));
 }
 
-void RunRecording::restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
+void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
   if (!resuming_) return;
   const SessionManifest& m = resumed_.manifest;
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
-    if (m.resume && m.resume->exact()) {
-      restore_arm_state(arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+    if (m.resume && m.resume->exact() && arm != nullptr) {
+      restore_arm_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
       if (clock != nullptr) clock->set_ticks(m.resume->clock_ticks);
       core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
     }
@@ -78,13 +78,13 @@ void RunRecording::restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* 
                                       " more iterations");
 }
 
-void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm,
+void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm* arm,
                         EngineCore& core, const SimulatedClock* clock) {
   if (!writer_) return;
   ResumeState resume;
-  if (clock != nullptr) {  // same thread as the engine: its state is quiet between trials
+  if (clock != nullptr && arm != nullptr) {  // same thread as the engine: its state is quiet between trials
     resume.controller = core.control().state();
-    resume.device = arm_state_to_json(arm);
+    resume.device = arm_state_to_json(*arm);
     resume.clock_ticks = clock->ticks();
   }
   writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(), std::move(resume));

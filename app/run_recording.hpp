@@ -36,12 +36,13 @@ class RunRecording {
              int iterations);
   /// A resumed run, before the engine's first tick: puts the arm, the engine (armed, with its
   /// controllers' state), the clock and the learning where the session stopped, and records the
-  /// resumption. Nothing for a fresh run. `clock` is null on the wall clock.
-  void restore(SimulatedArm& arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
+  /// resumption. Nothing for a fresh run. `clock` is null on the wall clock; `arm` is null for a rig
+  /// over LCM (whose sessions are not resumed).
+  void restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
   /// After a trial and the learning from it. On the wall clock (`clock` null) the loop thread owns
   /// the arm and the controllers, so their state is not captured: such a session resumes with the
-  /// correction and freshly armed controllers.
-  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm& arm, EngineCore& core,
+  /// correction and freshly armed controllers. `arm` is null for a rig over LCM.
+  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm* arm, EngineCore& core,
             const SimulatedClock* clock);
   /// Records a fault; never throws (the fault itself is what the caller reports).
   void fault(const std::string& what) noexcept;

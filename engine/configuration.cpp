@@ -108,6 +108,8 @@ std::vector<ParameterBinding> make_bindings() {
       number("safety", "heartbeat_timeout_s", "s", "console silent this long: fault", kPos, [](C& c) { return &c.safety.heartbeat_timeout_s; }),
       number("safety", "black_box_s", "s", "ticks kept before a fault", kPos, [](C& c) { return &c.safety.black_box_s; }),
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
+      number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", kPos, [](C& c) { return &c.lcm.rig_timeout_s; }),
+      number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", kPos, [](C& c) { return &c.lcm.connect_timeout_s; }),
   };
   ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
   fault.text = [](C& c) { return &c.plant.fault; };

@@ -22,6 +22,7 @@ struct Configuration {
   TimingParameters timing;
   TrajectoryLimits trajectory;
   SafetyParameters safety;
+  LcmParameters lcm;
 };
 
 /// What a parameter's value must satisfy.

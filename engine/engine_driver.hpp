@@ -3,6 +3,9 @@
 // RealtimeLoop ticks it on its own thread on wall-clock deadlines, and await() just waits a little.
 #pragma once
 
+#include <chrono>
+#include <thread>
+
 #include "engine/engine_core.hpp"
 
 namespace bellows {
@@ -35,14 +38,22 @@ class SimulatedClock final : public EngineDriver {
   long long ticks() const { return ticks_; }
   void set_ticks(long long ticks) { ticks_ = ticks; }
 
+  /// Paces await() by a telemetry ring: waits while it is full, so that its consumer (a publisher
+  /// writing a log) sees every tick. Simulated time has no deadline to miss.
+  void pace_by(const TelemetryRing* tap) { pace_ = tap; }
+
   EngineCore& core() override { return core_; }
-  void await() override { step(1); }
+  void await() override {
+    while (pace_ != nullptr && pace_->write_available() == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    step(1);
+  }
   bool simulated() const override { return true; }
 
  private:
   EngineCore& core_;
   Device& device_;
   long long ticks_ = 0;
+  const TelemetryRing* pace_ = nullptr;
 };
 
 }  // namespace bellows

@@ -117,4 +117,10 @@ struct TimingParameters {
   double sample_s() const { return tick_s * ticks_per_sample; }
 };
 
+/// The LCM rig protocol (docs/lcm-protocol.md); the engine itself knows no LCM.
+struct LcmParameters {
+  double rig_timeout_s = 0.05;     // a rig vents by itself when commands stop for this long
+  double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
+};
+
 }  // namespace bellows

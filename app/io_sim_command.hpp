@@ -1,0 +1,26 @@
+// `bellows io-sim`: the simulated arm as its own process, serving the LCM rig protocol in real time
+// (docs/lcm-protocol.md), as a rig would. Runs until SIGINT/SIGTERM (or --duration), then vents.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "engine/realtime_loop.hpp"
+
+namespace bellows {
+
+struct IoSimOptions {
+  std::string config_path;      // [plant], [timing] tick_s, [lcm] rig_timeout_s
+  std::uint64_t seed = 1;       // of the arm's sensor noise
+  std::string lcm_url;          // empty: the default bus
+  RealtimeMode rt = RealtimeMode::kTry;
+  double duration_s = 0.0;      // 0: until a signal
+  bool json = false;            // counters as one JSON object on `out` at exit
+};
+
+/// Serves until stopped. Progress lines go to `progress`. Throws InputError for bad input or a bus
+/// that cannot be opened. Returns the exit status (0 after a signal or the duration).
+int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream& progress);
+
+}  // namespace bellows

@@ -1,0 +1,91 @@
+// What `bellows run` drives and who watches it: the simulated arm in-process (`--device sim`) or a
+// rig over LCM (`--device lcm`), and, with `--lcm URL` or `--lcm-log`, the telemetry publisher.
+// Owns the LCM I/O threads and stops them in the right order.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "app/run_command.hpp"
+#include "bridge/telemetry_publisher.hpp"
+#include "devices/lcm_device.hpp"
+#include "devices/simulated_arm.hpp"
+#include "engine/configuration.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/learning_session.hpp"
+
+namespace bellows {
+
+/// Received-message counters as a JSON object ({"accepted", "ignored": {by reason}}).
+nlohmann::json receive_counts_json(const ReceiveCounts& counts);
+
+class RunIo {
+ public:
+  /// Checks the options against each other and opens the rig's bus (`--device lcm`). Throws
+  /// InputError for a combination that makes no sense or a bus that cannot be opened.
+  RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config);
+  ~RunIo();
+  RunIo(const RunIo&) = delete;
+  RunIo& operator=(const RunIo&) = delete;
+
+  /// The device the engine drives.
+  Device& device();
+  /// The simulated arm, or null for a rig over LCM.
+  SimulatedArm* simulated_arm() { return arm_.get(); }
+
+  /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
+  /// tick. On the simulated clock the device then waits for the publisher whenever the tap is full,
+  /// so that the log holds every tick (simulated time has no deadline to miss).
+  void add_telemetry_tap(EngineCore& core);
+  /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
+  /// --lcm-log names no file. Before the first tick.
+  void start_telemetry(const std::filesystem::path& session_directory);
+  /// With --device lcm: waits (the engine loop running) until a rig serves this session. Returns
+  /// an empty string when it does, else why not; gives up early when `stop` is set.
+  std::string wait_for_rig(const std::atomic<bool>& stop);
+  /// Operator thread, after each completed trial.
+  void post_trial(const IterationSummary& summary, const Eigen::VectorXd& correction_bar);
+  /// After the engine loop stopped: the device's last vent on the bus, the rest of the telemetry,
+  /// the log closed.
+  void stop();
+
+  /// Stops the I/O threads when it goes out of scope: declare it after the EngineCore whose
+  /// telemetry tap the publisher drains, so that an exception never leaves it draining a freed ring.
+  class StopOnExit {
+   public:
+    explicit StopOnExit(RunIo& io) : io_(io) {}
+    ~StopOnExit() { io_.stop(); }
+    StopOnExit(const StopOnExit&) = delete;
+    StopOnExit& operator=(const StopOnExit&) = delete;
+
+   private:
+    RunIo& io_;
+  };
+
+  /// The "lcm" object of the JSON report (null when no LCM was used); a warning line or "".
+  nlohmann::json report() const;
+  std::string warning() const;
+
+ private:
+  class TapPacedDevice;
+
+  const RunOptions& options_;
+  Configuration config_;
+  bool telemetry_ = false;
+  std::unique_ptr<SimulatedArm> arm_;
+  std::unique_ptr<TapPacedDevice> paced_;
+  std::unique_ptr<LcmDevice> lcm_device_;
+  std::unique_ptr<LcmIoThread> device_io_;
+  TelemetryRing* tap_ = nullptr;
+  std::string log_path_;
+  std::unique_ptr<TelemetryPublisher> publisher_;
+  std::unique_ptr<LcmIoThread> publisher_io_;
+  std::int64_t session_id_ = 0;
+};
+
+}  // namespace bellows

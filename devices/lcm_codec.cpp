@@ -1,0 +1,93 @@
+#include "devices/lcm_codec.hpp"
+
+#include <cmath>
+
+namespace bellows {
+
+const char* to_string(DecodeStatus status) {
+  switch (status) {
+    case DecodeStatus::kOk: return "ok";
+    case DecodeStatus::kTruncated: return "truncated";
+    case DecodeStatus::kWrongType: return "wrong-type";
+    case DecodeStatus::kTooLarge: return "too-large";
+    case DecodeStatus::kMalformed: return "malformed";
+  }
+  return "?";
+}
+
+void ReceiveCounters::count(DecodeStatus status) {
+  switch (status) {
+    case DecodeStatus::kOk: return;  // accepted only once its values and order passed too
+    case DecodeStatus::kTruncated: bump(truncated_); return;
+    case DecodeStatus::kWrongType: bump(wrong_type_); return;
+    case DecodeStatus::kTooLarge: bump(too_large_); return;
+    case DecodeStatus::kMalformed: bump(malformed_); return;
+  }
+}
+
+ReceiveCounts ReceiveCounters::snapshot() const {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  ReceiveCounts c;
+  c.accepted = accepted_.load(relaxed);
+  c.truncated = truncated_.load(relaxed);
+  c.wrong_type = wrong_type_.load(relaxed);
+  c.too_large = too_large_.load(relaxed);
+  c.malformed = malformed_.load(relaxed);
+  c.invalid = invalid_.load(relaxed);
+  c.foreign = foreign_.load(relaxed);
+  c.out_of_order = out_of_order_.load(relaxed);
+  return c;
+}
+
+bool valid_command(const io_command_t& command) {
+  if (command.session_id == 0 || command.seq <= 0) return false;
+  for (int i = 0; i < kActuatorCount; ++i) {
+    for (double duty : {command.inlet_duty[i], command.outlet_duty[i]}) {
+      if (!std::isfinite(duty) || duty < 0.0 || duty > 1.0) return false;
+    }
+  }
+  return true;
+}
+
+bool valid_state(const io_state_t& state) {
+  return state.rig_id != 0 && state.seq > 0 && state.command_seq >= 0 && state.session_id >= 0 &&
+         std::isfinite(state.time_s);
+}
+
+ValveCommand to_valves(const io_command_t& command) {
+  if (!command.armed) return ValveCommand::vented();
+  ValveCommand valves;
+  for (int i = 0; i < kActuatorCount; ++i) {
+    valves.inlet_duty[i] = command.inlet_duty[i];
+    valves.outlet_duty[i] = command.outlet_duty[i];
+  }
+  return valves;
+}
+
+void fill_command(const ValveCommand& valves, bool armed, io_command_t& command) {
+  command.armed = armed;
+  for (int i = 0; i < kActuatorCount; ++i) {
+    command.inlet_duty[i] = valves.inlet_duty[i];
+    command.outlet_duty[i] = valves.outlet_duty[i];
+  }
+}
+
+SensorReading to_reading(const io_state_t& state) {
+  SensorReading reading;
+  reading.time_s = state.time_s;
+  reading.angle_rad = state.angle_rad;
+  for (int i = 0; i < kActuatorCount; ++i) reading.chamber_bar[i] = state.chamber_bar[i];
+  reading.supply_bar = state.supply_bar;
+  reading.temperature_K = state.temperature_K;
+  return reading;
+}
+
+void fill_state(const SensorReading& reading, io_state_t& state) {
+  state.time_s = reading.time_s;
+  state.angle_rad = reading.angle_rad;
+  for (int i = 0; i < kActuatorCount; ++i) state.chamber_bar[i] = reading.chamber_bar[i];
+  state.supply_bar = reading.supply_bar;
+  state.temperature_K = reading.temperature_K;
+}
+
+}  // namespace bellows

@@ -1,0 +1,110 @@
+// A rig driven over LCM (`bellows run --device lcm`), the engine's side of docs/lcm-protocol.md.
+//
+// Two threads touch it, through lock-free latest-value buffers only:
+// - the engine thread (Device methods): write_valves()/vent() leave the desired valve state in the
+//   outbox, read_sensors() takes the latest state from the inbox. Neither calls LCM.
+// - the I/O thread (LcmEndpoint methods, run by an LcmIoThread that owns the LCM handle): publishes
+//   each new valve state as an io_command_t with the next sequence number, and checks every
+//   io_state_t received before handing it to the engine.
+//
+// The reading's time_s is the I/O thread's monotonic clock when the last valid state of this
+// session arrived (not the rig's clock, which restarts with the rig). No valid state for
+// [safety] stale_ticks ticks therefore trips the engine's stale-sensor guard, which vents; a rig
+// reporting a fault bit counts as no state. Only fresh valve states are published: if the engine
+// thread stops, the commands stop and the rig vents on its own.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "devices/lcm_codec.hpp"
+#include "devices/lcm_io_thread.hpp"
+#include "engine/device.hpp"
+#include "engine/latest_value.hpp"
+
+namespace bellows {
+
+struct LcmDeviceStats {
+  std::int64_t session_id = 0;
+  std::int64_t rig_id = 0;              // the rig served by, 0: none yet
+  ReceiveCounts states;                  // io_state_t received, by outcome
+  std::uint64_t rig_fault_states = 0;    // states of this session carrying rig fault bits
+  std::int32_t last_fault_bits = 0;
+  std::int64_t last_foreign_session = 0; // the session a rig served when it was not this one
+  std::uint64_t commands_sent = 0;
+  std::uint64_t vent_commands_sent = 0;  // of which armed = false
+  std::uint64_t publish_errors = 0;
+};
+
+class LcmDevice final : public Device, public LcmEndpoint {
+ public:
+  /// `session_id`: nonzero, unique per run (random_session_id()).
+  explicit LcmDevice(std::int64_t session_id);
+
+  /// A random nonzero session id.
+  static std::int64_t random_session_id();
+
+  // ---- Device: engine thread only (one writer of the outbox at a time: the engine thread while
+  // the loop runs, the thread that stopped it afterwards) ----
+  SensorReading read_sensors() override;
+  void write_valves(const ValveCommand& command) override;
+  void vent() override;
+  void advance(double) override {}  // a real rig's time passes on its own
+  const char* name() const override { return "lcm"; }
+
+  // ---- LcmEndpoint: I/O thread only ----
+  void attach(lcm::LCM& bus) override;
+  void on_message(const char* channel, const void* data, std::size_t size) override;
+  double service(lcm::LCM* bus, double now_s) override;
+  void finish(lcm::LCM* bus, double now_s) override;
+
+  // ---- any thread ----
+  std::int64_t session_id() const { return session_id_; }
+  /// Whether a valid state of this session has arrived: a rig has served this engine.
+  bool connected() const { return connected_.load(std::memory_order_acquire); }
+  /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
+  double last_state_s() const { return last_state_s_.load(std::memory_order_relaxed); }
+  LcmDeviceStats stats() const;
+
+ private:
+  struct Outgoing {
+    ValveCommand valves{};
+    bool armed = false;
+  };
+
+  void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
+
+  const std::int64_t session_id_;
+  LatestValue<Outgoing> outbox_;        // engine -> I/O
+  LatestValue<SensorReading> inbox_;    // I/O -> engine
+  SensorReading reading_{};             // engine thread's copy
+
+  // I/O thread state.
+  io_state_t received_{};
+  SensorReading pending_{};
+  bool pending_fresh_ = false;
+  std::int64_t rig_id_ = 0;
+  std::int64_t last_state_seq_ = 0;
+  std::int64_t last_echoed_seq_ = 0;
+  double last_rig_time_s_ = 0.0;
+  double last_reading_time_s_ = 0.0;
+  double origin_s_ = -1.0;
+  std::int64_t seq_ = 0;
+  bool last_armed_ = false;
+  io_command_t command_{};
+  std::vector<std::uint8_t> buffer_;
+
+  ReceiveCounters counters_;
+  std::atomic<bool> connected_{false};
+  std::atomic<double> last_state_s_{-1.0};
+  std::atomic<std::int64_t> stats_rig_id_{0};
+  std::atomic<std::uint64_t> rig_fault_states_{0};
+  std::atomic<std::int32_t> last_fault_bits_{0};
+  std::atomic<std::int64_t> last_foreign_session_{0};
+  std::atomic<std::uint64_t> commands_sent_{0};
+  std::atomic<std::uint64_t> vent_commands_sent_{0};
+  std::atomic<std::uint64_t> publish_errors_{0};
+};
+
+}  // namespace bellows

@@ -1,0 +1,117 @@
+#include "devices/lcm_io_thread.hpp"
+
+#include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "engine/errors.hpp"
+
+namespace bellows {
+namespace {
+
+// Upper bound on one wait, so that a stop request is seen promptly even on an idle bus.
+constexpr double kMaxWait_s = 0.05;
+
+timespec to_timespec(double seconds) {
+  timespec t{};
+  t.tv_sec = static_cast<time_t>(seconds);
+  t.tv_nsec = static_cast<long>((seconds - static_cast<double>(t.tv_sec)) * 1e9);
+  return t;
+}
+
+void deliver(const lcm_recv_buf_t* buffer, const char* channel, void* endpoint) {
+  static_cast<LcmEndpoint*>(endpoint)->on_message(channel, buffer->data, buffer->data_size);
+}
+
+}  // namespace
+
+void LcmEndpoint::subscribe(lcm::LCM& bus, const std::string& channel, int queue_capacity) {
+  lcm_subscription_t* subscription = lcm_subscribe(bus.getUnderlyingLCM(), channel.c_str(), &deliver, this);
+  if (subscription != nullptr && queue_capacity > 0) lcm_subscription_set_queue_capacity(subscription, queue_capacity);
+}
+
+double monotonic_s() {
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  return static_cast<double>(now.tv_sec) + static_cast<double>(now.tv_nsec) * 1e-9;
+}
+
+LcmIoThread::LcmIoThread(std::string url, std::vector<LcmEndpoint*> endpoints)
+    : url_(std::move(url)), endpoints_(std::move(endpoints)) {}
+
+LcmIoThread::~LcmIoThread() { stop(); }
+
+void LcmIoThread::start(RealtimeMode mode, int priority) {
+  if (thread_.joinable()) return;
+  stop_.store(false);
+  ready_.store(false);
+  thread_ = std::thread([this, mode, priority] { serve([this] { return stop_.load(std::memory_order_acquire); }, mode, priority); });
+  while (!ready_.load(std::memory_order_acquire)) std::this_thread::yield();
+  if (!start_error_.empty()) {
+    thread_.join();
+    throw InputError(start_error_);
+  }
+}
+
+void LcmIoThread::run(const std::function<bool()>& should_stop, RealtimeMode mode, int priority) {
+  serve(should_stop, mode, priority);
+  if (!start_error_.empty()) throw InputError(start_error_);
+}
+
+void LcmIoThread::stop() {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  thread_.join();
+}
+
+void LcmIoThread::serve(const std::function<bool()>& should_stop, RealtimeMode mode, int priority) {
+  if (mode != RealtimeMode::kOff) {
+    sched_param param{};
+    param.sched_priority = priority;
+    const int error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+    rt_granted_ = error == 0;
+    if (error != 0 && mode == RealtimeMode::kEnforce) {
+      start_error_ = "--rt enforce: SCHED_FIFO refused for the LCM I/O thread (" + std::string(std::strerror(error)) + ")";
+      ready_.store(true, std::memory_order_release);
+      return;
+    }
+  }
+  // The handle lives and dies on this thread: LCM 1.3.1 allows one thread per handle.
+  std::unique_ptr<lcm::LCM> bus;
+  if (!url_.empty()) {
+    bus = std::make_unique<lcm::LCM>(url_);
+    if (!bus->good()) {
+      start_error_ = "cannot open the LCM bus '" + url_ +
+                     "' (for udpm:// the host needs a multicast route, e.g. `ip route add 224.0.0.0/4 dev lo`)";
+      ready_.store(true, std::memory_order_release);
+      return;
+    }
+    for (LcmEndpoint* endpoint : endpoints_) endpoint->attach(*bus);
+  }
+  ready_.store(true, std::memory_order_release);
+
+  const int fd = bus ? bus->getFileno() : -1;
+  while (!should_stop()) {
+    const double now = monotonic_s();
+    double next = now + kMaxWait_s;
+    for (LcmEndpoint* endpoint : endpoints_) next = std::min(next, endpoint->service(bus.get(), now));
+    const double wait_s = std::clamp(next - monotonic_s(), 0.0, kMaxWait_s);
+    const timespec timeout = to_timespec(wait_s);
+    if (fd >= 0) {
+      pollfd poll_fd{fd, POLLIN, 0};
+      if (ppoll(&poll_fd, 1, &timeout, nullptr) > 0 && (poll_fd.revents & POLLIN) != 0) bus->handle();
+    } else {
+      nanosleep(&timeout, nullptr);
+    }
+  }
+  const double now = monotonic_s();
+  for (LcmEndpoint* endpoint : endpoints_) endpoint->finish(bus.get(), now);
+}
+
+}  // namespace bellows

@@ -1,0 +1,348 @@
+// `bellows io-sim` and `bellows run --device lcm` as separate processes over UDP multicast, inside a
+// private network namespace this test makes for itself (nothing leaves it); lcm-logplayer replaying
+// a saved log; and what the CLI refuses. Tests that need the namespace skip, saying why, where one
+// cannot be made.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <nlohmann/json.hpp>
+
+#include "devices/lcm_channels.hpp"
+#include "devices/lcm_codec.hpp"
+#include "devices/lcm_device.hpp"
+#include "engine/safety.hpp"
+#include "tests/lcm_test_support.hpp"
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::BusRecorder;
+using testing::Child;
+using testing::Recorded;
+
+const std::string kBellows = BELLOWS_BINARY;
+
+/// Sessions of the runs started here go into a fresh directory, never into a real home.
+void isolate_sessions() { setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-lcm-xdg").c_str(), 1); }
+
+#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                              \
+  do {                                                                         \
+    const std::string why_not = testing::enter_private_network_namespace();   \
+    if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
+  } while (false)
+
+template <typename Message>
+Message decode(const Recorded& recorded) {
+  Message message{};
+  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message), DecodeStatus::kOk) << recorded.channel;
+  return message;
+}
+
+std::vector<double> rms_sequence(const nlohmann::json& report) {
+  std::vector<double> rms;
+  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
+  return rms;
+}
+
+nlohmann::json parse_report(const Child& child) {
+  const std::string out = child.out();
+  EXPECT_FALSE(out.empty()) << child.err();
+  return out.empty() ? nlohmann::json::object() : nlohmann::json::parse(out);
+}
+
+/// Publishes, every 50 ms, what no one may trust: truncated bytes, another type, and a command and
+/// a state of another session (a command that, if applied, would open every inlet fully). It
+/// starts once the rig serves someone: a rig serving nobody would rightly take the first session
+/// that asks.
+class Heckler final : public LcmEndpoint {
+ public:
+  void attach(lcm::LCM& bus) override { subscribe(bus, kIoStateChannel); }
+  void on_message(const char*, const void* data, std::size_t size) override {
+    io_state_t state{};
+    if (decode_checked(data, size, state) == DecodeStatus::kOk && state.session_id != 0 && state.session_id != kSession) {
+      rig_taken_ = true;
+    }
+  }
+  double service(lcm::LCM* bus, double now_s) override {
+    if (!rig_taken_) return now_s + 0.01;
+    if (bus == nullptr || now_s < next_s_) return next_s_;
+    next_s_ = now_s + 0.05;
+    const std::uint8_t junk[6] = {0xed, 0xa1, 0xda, 0x01, 0, 0};
+    bus->publish(kIoCommandChannel, junk, sizeof junk);
+    bus->publish(kIoStateChannel, junk, sizeof junk);
+    telemetry_t other{};
+    publish(*bus, kIoStateChannel, other);
+    io_command_t command{};
+    command.session_id = kSession;
+    command.seq = ++seq_;
+    command.armed = true;
+    command.inlet_duty[0] = command.inlet_duty[1] = 1.0;
+    publish(*bus, kIoCommandChannel, command);
+    io_state_t state{};
+    state.rig_id = 888;
+    state.seq = seq_;
+    state.session_id = kSession;
+    state.time_s = 0.01 * static_cast<double>(seq_);
+    publish(*bus, kIoStateChannel, state);
+    ++rounds_;
+    return next_s_;
+  }
+  std::uint64_t rounds() const { return rounds_.load(); }
+
+ private:
+  static constexpr std::int64_t kSession = 777;
+  bool rig_taken_ = false;
+  template <typename Message>
+  void publish(lcm::LCM& bus, const char* channel, const Message& message) {
+    const std::size_t size = encode_into(message, buffer_);
+    bus.publish(channel, buffer_.data(), static_cast<unsigned int>(size));
+  }
+  double next_s_ = 0.0;
+  std::int64_t seq_ = 0;
+  std::vector<std::uint8_t> buffer_;
+  std::atomic<std::uint64_t> rounds_{0};
+};
+
+TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTrust) {
+  ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  isolate_sessions();
+  const auto dir = testing::make_temp_dir("bellows-lcm-rms");
+  Heckler heckler;
+  LcmIoThread bus(kDefaultLcmUrl, {&heckler});
+  bus.start(RealtimeMode::kOff, 0);
+
+  Child rig({kBellows, "io-sim", "--seed", "5", "--json"}, dir / "rig.out", dir / "rig.err");
+  ASSERT_TRUE(rig.started());
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"},
+            dir / "run.out", dir / "run.err");
+  ASSERT_TRUE(run.started());
+  const auto run_status = run.wait(300.0);
+  ASSERT_TRUE(run_status.has_value()) << "bellows run did not finish in 5 minutes";
+  EXPECT_EQ(*run_status, 0) << run.err() << run.out();
+  rig.signal(SIGTERM);
+  ASSERT_TRUE(rig.wait(30.0).has_value()) << "io-sim did not stop on SIGTERM";
+  bus.stop();
+
+  // The same seed in-process, on the wall clock too.
+  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out",
+              dir / "local.err");
+  const auto local_status = local.wait(300.0);
+  ASSERT_TRUE(local_status.has_value());
+  ASSERT_EQ(*local_status, 0) << local.err();
+
+  const nlohmann::json remote_report = parse_report(run);
+  const nlohmann::json local_report = parse_report(local);
+  const nlohmann::json rig_report = parse_report(rig);
+  const std::vector<double> remote = rms_sequence(remote_report);
+  const std::vector<double> reference = rms_sequence(local_report);
+  ASSERT_EQ(remote.size(), 4u);
+  ASSERT_EQ(reference.size(), 4u);
+  for (std::size_t i = 0; i < remote.size(); ++i) {
+    EXPECT_NEAR(remote[i], reference[i], 0.15 * reference[i]) << "iteration " << i;
+    std::cerr << "iteration " << i << ": rms over LCM " << remote[i] << " deg, in-process " << reference[i] << " deg\n";
+  }
+  EXPECT_LT(remote[3], remote[0]);
+  EXPECT_EQ(remote_report["device"], "lcm");
+
+  // Everything the heckler sent was counted and ignored, on both sides.
+  ASSERT_GT(heckler.rounds(), 50u);
+  const nlohmann::json& states = remote_report["lcm"]["rig"]["states"]["ignored"];
+  EXPECT_GT(states["truncated"].get<std::uint64_t>(), 50u);
+  EXPECT_GT(states["wrong_type"].get<std::uint64_t>(), 50u);
+  EXPECT_GT(states["foreign"].get<std::uint64_t>(), 50u);
+  const nlohmann::json& commands = rig_report["commands"]["ignored"];
+  EXPECT_GT(commands["truncated"].get<std::uint64_t>(), 50u);
+  EXPECT_GT(commands["foreign"].get<std::uint64_t>(), 50u);
+  EXPECT_EQ(rig_report["sessions_served"], 1);
+  // The rig applied (nearly) every tick's command: a command is skipped only when two ticks' valve
+  // states meet in the device's latest-value buffer before its I/O thread sends one.
+  const auto ticks = remote_report["loop"]["ticks"].get<double>();
+  EXPECT_GT(rig_report["commands"]["accepted"].get<double>(), 0.9 * ticks);
+}
+
+TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
+  ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  isolate_sessions();
+  const auto dir = testing::make_temp_dir("bellows-lcm-kill");
+  BusRecorder recorder;
+  LcmIoThread bus(kDefaultLcmUrl, {&recorder});
+  bus.start(RealtimeMode::kOff, 0);
+
+  Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
+  Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
+             kDefaultLcmUrl, "--lcm-log", "--name", "killed"},
+            dir / "run.out", dir / "run.err");
+  ASSERT_TRUE(rig.started() && run.started());
+  // Mid-trial: half a second into the first trajectory.
+  const bool mid_trial = testing::eventually(
+      [&] {
+        const auto last = recorder.last(kTelemetryChannel);
+        if (!last) return false;
+        const telemetry_t t = decode<telemetry_t>(*last);
+        return t.state == telemetry_t::STATE_RUNNING && t.sample >= 25;
+      },
+      120.0);
+  ASSERT_TRUE(mid_trial) << run.err();
+  rig.signal(SIGKILL);
+  ASSERT_TRUE(rig.wait(10.0).has_value());
+  const auto status = run.wait(60.0);
+  ASSERT_TRUE(status.has_value()) << "the engine did not stop after the rig died";
+  EXPECT_EQ(*status, 3) << run.err();
+  bus.stop();
+  const nlohmann::json report = parse_report(run);
+  EXPECT_EQ(report["fault"]["name"], "sensor-stale");
+  // The session holds the LCM log (--lcm-log without a FILE).
+  ASSERT_TRUE(report["session"].is_string()) << report.dump();
+  const std::string log = (std::filesystem::path(report["session"].get<std::string>()) / "telemetry.lcmlog").string();
+  EXPECT_EQ(report["lcm"]["telemetry"]["log"], log);
+
+  // In the telemetry log: the first FAULT tick came stale_ticks ticks after the last fresh reading,
+  // during the trial, and its valve command is the vented one.
+  const int stale_ticks = SafetyParameters{}.stale_ticks;
+  lcm::LogFile file(log, "r");
+  ASSERT_TRUE(file.good());
+  std::vector<telemetry_t> ticks;
+  for (const lcm::LogEvent* e = file.readNextEvent(); e != nullptr; e = file.readNextEvent()) {
+    if (e->channel != kTelemetryChannel) continue;
+    telemetry_t t{};
+    ASSERT_EQ(decode_checked(e->data, static_cast<std::size_t>(e->datalen), t), DecodeStatus::kOk);
+    ticks.push_back(t);
+  }
+  std::size_t fault = 0;
+  while (fault < ticks.size() && ticks[fault].state != telemetry_t::STATE_FAULT) ++fault;
+  ASSERT_LT(fault, ticks.size()) << "no FAULT in the telemetry log";
+  ASSERT_GT(fault, static_cast<std::size_t>(stale_ticks));
+  EXPECT_EQ(ticks[fault].fault, static_cast<std::int8_t>(FaultCode::kSensorStale));
+  std::size_t fresh = fault;
+  while (fresh > 0 && ticks[fresh].reading_time_s <= ticks[fresh - 1].reading_time_s) --fresh;
+  EXPECT_EQ(fault - fresh, static_cast<std::size_t>(stale_ticks));
+  EXPECT_EQ(ticks[fresh].state, static_cast<std::int8_t>(telemetry_t::STATE_RUNNING));
+  EXPECT_EQ(ticks[fault].inlet_duty[0], 0.0);
+  EXPECT_EQ(ticks[fault].inlet_duty[1], 0.0);
+  EXPECT_EQ(ticks[fault].outlet_duty[0], 1.0);
+  EXPECT_EQ(ticks[fault].outlet_duty[1], 1.0);
+
+  // On the bus: after the rig's last state, at most stale_ticks (+1 for the tick under way) live
+  // commands, then vent commands to the end.
+  const std::vector<Recorded> messages = recorder.messages();
+  std::size_t last_state = 0;
+  for (std::size_t i = 0; i < messages.size(); ++i) {
+    if (messages[i].channel == kIoStateChannel) last_state = i;
+  }
+  int live_after = 0, vents_after = 0;
+  bool last_command_armed = true;
+  for (std::size_t i = last_state + 1; i < messages.size(); ++i) {
+    if (messages[i].channel != kIoCommandChannel) continue;
+    const io_command_t c = decode<io_command_t>(messages[i]);
+    if (c.armed) {
+      EXPECT_EQ(vents_after, 0) << "a live command after a vent";
+      ++live_after;
+    } else {
+      ++vents_after;
+    }
+    last_command_armed = c.armed;
+  }
+  double first_vent_s = 0.0;
+  for (std::size_t i = last_state + 1; i < messages.size() && first_vent_s == 0.0; ++i) {
+    if (messages[i].channel == kIoCommandChannel && !decode<io_command_t>(messages[i]).armed) first_vent_s = messages[i].received_s;
+  }
+  std::cerr << "after the rig's last state: " << live_after << " live commands, first vent after "
+            << (first_vent_s - messages[last_state].received_s) * 1e3 << " ms\n";
+  EXPECT_LE(live_after, stale_ticks + 1);
+  EXPECT_GE(vents_after, 1);
+  EXPECT_FALSE(last_command_armed);
+}
+
+TEST(LcmProcesses, LcmLogplayerReplaysASavedLogThatASubscriberDecodesEntirely) {
+  const auto dir = testing::make_temp_dir("bellows-lcm-replay");
+  const std::string log = (dir / "run.lcmlog").string();
+  std::string csv = "time_s,angle_deg\n";
+  for (int k = 0; k <= 50; ++k) csv += std::to_string(k * 0.02) + "," + std::to_string(k < 10 ? 0.0 : 15.0) + "\n";
+  const auto trajectory = testing::write_file(dir, "step.csv", csv);
+  const auto config = testing::write_file(dir, "short.toml", "[timing]\nsettle_s = 0.2\n");
+  const auto made = testing::run_process(kBellows + " run --no-save --clock wall --speed 2 --iterations 1 --json --trajectory " +
+                                         trajectory.string() + " --config " + config.string() + " --lcm-log " + log);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_EQ(nlohmann::json::parse(made.out)["lcm"]["telemetry"]["dropped_ticks"], 0);
+
+  std::vector<Recorded> logged;
+  {
+    lcm::LogFile file(log, "r");
+    ASSERT_TRUE(file.good());
+    for (const lcm::LogEvent* e = file.readNextEvent(); e != nullptr; e = file.readNextEvent()) {
+      const auto* data = static_cast<const std::uint8_t*>(e->data);
+      logged.push_back({e->channel, std::vector<std::uint8_t>(data, data + e->datalen), 0.0});
+    }
+  }
+  ASSERT_GT(logged.size(), 2u * 240u);  // two trials of 1.2 s at 200 Hz, and more
+
+  ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  BusRecorder subscriber;
+  LcmIoThread bus(kDefaultLcmUrl, {&subscriber});
+  bus.start(RealtimeMode::kOff, 0);
+  Child player({"lcm-logplayer", "-l", kDefaultLcmUrl, "-s", "2", log}, dir / "player.out", dir / "player.err");
+  ASSERT_TRUE(player.started());
+  const auto status = player.wait(120.0);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 0) << player.err();
+  EXPECT_TRUE(testing::eventually([&] { return subscriber.size() >= logged.size(); }, 10.0));
+  bus.stop();
+
+  const std::vector<Recorded> received = subscriber.messages();
+  ASSERT_EQ(received.size(), logged.size());
+  std::size_t telemetry = 0, events = 0, trials = 0;
+  for (std::size_t i = 0; i < received.size(); ++i) {
+    EXPECT_EQ(received[i].channel, logged[i].channel) << i;
+    EXPECT_EQ(received[i].bytes, logged[i].bytes) << i;
+    if (received[i].channel == kTelemetryChannel) {
+      decode<telemetry_t>(received[i]);
+      ++telemetry;
+    } else if (received[i].channel == kEventChannel) {
+      decode<engine_event_t>(received[i]);
+      ++events;
+    } else if (received[i].channel == kTrialChannel) {
+      const trial_summary_t t = decode<trial_summary_t>(received[i]);
+      EXPECT_EQ(t.samples, 50);
+      ++trials;
+    } else {
+      ADD_FAILURE() << "unexpected channel " << received[i].channel;
+    }
+  }
+  EXPECT_GT(telemetry, 480u);
+  EXPECT_GE(events, 8u);
+  EXPECT_EQ(trials, 2u);
+}
+
+void expect_refused(const std::string& args, const std::string& fragment) {
+  const auto result = testing::run_process(kBellows + " " + args);
+  EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.err;
+  EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
+}
+
+TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
+  const auto dir = testing::make_temp_dir("bellows-lcm-cli");
+  expect_refused("run --device lcm", "--device lcm needs --clock wall");
+  expect_refused("run --device lcm --clock sim", "--device lcm needs --clock wall");
+  expect_refused("run --device lcm --clock wall --speed 2", "--speed must be 1");
+  expect_refused("run --device rig", "--device");
+  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "cannot open the LCM bus");
+  expect_refused("io-sim --lcm nowhere://at-all", "cannot open the LCM bus");
+  const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
+  expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
+  expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
+
+  // memq:// is private to a process: nobody answers there.
+  const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");
+  const auto result = testing::run_process(kBellows + " run --device lcm --clock wall --lcm memq:// --json --config " +
+                                           config.string());
+  EXPECT_EQ(result.exit_code, 3) << result.err;
+  const nlohmann::json report = nlohmann::json::parse(result.out);
+  EXPECT_EQ(report["fault"]["name"], "rig-unavailable");
+  EXPECT_EQ(report["iterations"].size(), 0u);
+  EXPECT_NE(result.err.find("no rig answered on memq://"), std::string::npos) << result.err;
+}
+
+}  // namespace
+}  // namespace bellows
