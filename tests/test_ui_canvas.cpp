@@ -53,6 +53,13 @@ TEST(UiCanvas, FitCutsAndPads) {
   EXPECT_EQ(fit("\u2500\u2500\u2500", 2), "\u2500\u2500");
 }
 
+TEST(UiCanvas, WrapBreaksAtSpaces) {
+  EXPECT_EQ(wrap("one two three", 7), (std::vector<std::string>{"one two", "three"}));
+  EXPECT_EQ(wrap("abcdefghij", 4), (std::vector<std::string>{"abcd", "efgh", "ij"}));
+  EXPECT_EQ(wrap("", 4), std::vector<std::string>{});
+  EXPECT_EQ(wrap("\u2500\u2500 \u2500", 2), (std::vector<std::string>{"\u2500\u2500", "\u2500"}));
+}
+
 TEST(UiCanvas, FrameDrawsBordersAndTitleInBothGlyphSets) {
   Canvas c(12, 4);
   c.frame({0, 0, 12, 4}, Glyphs::for_unicode(false), "T");

@@ -182,4 +182,24 @@ std::string fit(std::string_view text, int width) {
   return out;
 }
 
+std::vector<std::string> wrap(std::string_view text, int width) {
+  std::vector<std::string> lines;
+  if (width <= 0) return lines;
+  const std::u32string glyphs = decode_utf8(text);
+  std::size_t start = 0;
+  while (start < glyphs.size()) {
+    std::size_t end = std::min(glyphs.size(), start + static_cast<std::size_t>(width));
+    if (end < glyphs.size()) {
+      const std::size_t space = glyphs.rfind(U' ', end);
+      if (space != std::u32string::npos && space > start) end = space;
+    }
+    std::string line;
+    for (std::size_t i = start; i < end; ++i) append_utf8(line, glyphs[i]);
+    lines.push_back(line);
+    start = end;
+    while (start < glyphs.size() && glyphs[start] == U' ') ++start;
+  }
+  return lines;
+}
+
 }  // namespace bellows::ui

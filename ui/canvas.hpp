@@ -92,5 +92,7 @@ int text_width(std::string_view text);
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 /// `text` cut or padded with spaces to exactly `width` cells.
 std::string fit(std::string_view text, int width);
+/// `text` broken into lines of at most `width` cells, at spaces where possible.
+std::vector<std::string> wrap(std::string_view text, int width);
 
 }  // namespace bellows::ui

@@ -106,9 +106,9 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
                                    tuning_value(s.config, static_cast<int>(i)), f.unit, f.config_key, f.description);
     c.put(in.x + 1, y++, fit(row, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
   }
-  if (y < in.bottom() && !s.convergence.empty()) {
-    c.put(in.x + 1, y++, s.convergence, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning,
-          in.right());
+  for (const std::string& line : wrap(s.convergence, in.width - 2)) {  // two lines at most fit
+    if (y >= in.bottom()) break;
+    c.put(in.x + 1, y++, line, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning, in.right());
   }
   const Rect changes{body.x, form.bottom(), body.width, body.height - form_height};
   if (changes.height < 3) return;
