@@ -13,10 +13,15 @@ trap 'rm -rf "$work"' EXIT
 # Iterations of the paper trajectory (9 s each with the settle) that fill the time.
 iterations=$(( seconds / 9 ))
 [ "$iterations" -ge 1 ] || iterations=1
+# cyclictest runs from before the engine's first tick until after its last one, so that both
+# distributions cover the same stretch of time (the engine also spends a few seconds arming and
+# settling beyond the trials' own time). SIGINT makes cyclictest write its histogram and exit.
 cyclictest --priority=80 --interval=5000 --threads=1 --mlockall --quiet \
-  --duration="${seconds}s" --histogram=20000 --histfile="$work/cyclic.hist" > /dev/null 2>&1 &
+  --histogram=20000 --histfile="$work/cyclic.hist" > /dev/null 2>&1 &
 cyclic_pid=$!
+sleep 1
 "$bellows" run --clock wall --speed 1 --rt try --iterations "$iterations" --json 2>/dev/null > "$work/engine.json"
+kill -INT "$cyclic_pid"
 wait "$cyclic_pid" || true
 
 python3 - "$work/cyclic.hist" "$work/engine.json" <<'PY'
@@ -39,6 +44,7 @@ def quantile(q):
 loop = engine.get('loop', {})
 print(json.dumps({'cyclictest': {'samples': total, 'p50_us': quantile(0.5), 'p99_us': quantile(0.99), 'max_us': maximum},
                   'engine': {'ticks': loop.get('ticks'), 'missed': loop.get('missed'), 'rt': loop.get('rt'),
+                             'cpu_wakeup_limit_us': loop.get('cpu_wakeup_limit_us'),
                              'p50_us': loop.get('latency_us', {}).get('p50'), 'p99_us': loop.get('latency_us', {}).get('p99'),
                              'max_us': loop.get('latency_us', {}).get('max')},
                   'final_rms_deg': engine['iterations'][-1]['rms_deg'] if engine.get('iterations') else None}))

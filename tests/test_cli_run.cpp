@@ -72,6 +72,43 @@ TEST(CliRun, RunsACsvTrajectory) {
   EXPECT_LT(report["iterations"][3]["rms_deg"].get<double>(), report["iterations"][0]["rms_deg"].get<double>());
 }
 
+// A short step trajectory and a short settle: a wall-clock run that takes about a second.
+std::string short_wall_run_args(const std::string& tag) {
+  const auto dir = testing::make_temp_dir(tag);
+  std::string text = "time_s,angle_deg\n";
+  for (int k = 0; k <= 40; ++k) text += std::to_string(k * 0.02) + "," + std::to_string(k < 10 ? 0.0 : 10.0) + "\n";
+  const auto trajectory = write_file(dir, "step.csv", text);
+  const auto config = write_file(dir, "short.toml", "[timing]\nsettle_s = 0.2\n");
+  return "--iterations 1 --trajectory " + trajectory.string() + " --config " + config.string();
+}
+
+TEST(CliRun, WallClockRunReportsItsLoop) {
+  const nlohmann::json report = run_json("--clock wall --speed 2 " + short_wall_run_args("bellows-wall-loop"));
+  ASSERT_TRUE(report.contains("loop")) << report.dump();
+  const nlohmann::json& loop = report["loop"];
+  // Two trials of 0.8 s plus settles at 200 Hz: hundreds of ticks, each with a wake-up latency.
+  EXPECT_GT(loop["ticks"].get<int>(), 2 * 160);
+  EXPECT_GE(loop["missed"].get<int>(), 0);
+  const nlohmann::json& latency = loop["latency_us"];
+  EXPECT_GE(latency["p50"].get<double>(), 0.0);
+  EXPECT_LE(latency["p50"].get<double>(), latency["p99"].get<double>());
+  EXPECT_LE(latency["p99"].get<double>(), latency["max"].get<double>() + 1.0);  // bins are 1 us wide
+  const std::string rt = loop["rt"].get<std::string>();
+  EXPECT_TRUE(rt == "fifo" || rt == "other") << rt;
+  EXPECT_TRUE(loop["cpu_wakeup_limit_us"].is_null() || loop["cpu_wakeup_limit_us"].get<int>() == 0);
+}
+
+TEST(CliRun, RealtimeOffAsksForNothing) {
+  const nlohmann::json report = run_json("--clock wall --speed 2 --rt off " + short_wall_run_args("bellows-wall-off"));
+  EXPECT_EQ(report["loop"]["rt"], "other");
+  EXPECT_TRUE(report["loop"]["cpu_wakeup_limit_us"].is_null());
+}
+
+TEST(CliRun, SimulatedClockRunHasNoLoopReport) {
+  const nlohmann::json report = run_json(short_wall_run_args("bellows-sim-loop"));
+  EXPECT_FALSE(report.contains("loop"));
+}
+
 void expect_bad_input(const std::string& args, const std::string& fragment) {
   const auto result = run_process(std::string(BELLOWS_BINARY) + " run --json --no-save " + args);
   EXPECT_EQ(result.exit_code, 2) << args;
