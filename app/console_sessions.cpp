@@ -125,6 +125,9 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
     writer_->save_iteration(trial.record, trial.summary, next, ResumeState{});
   }
+  for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
+    writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
+  }
   return writer_->directory().string();
 }
 
@@ -182,8 +185,12 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
     e.next_tried = e.next_correction_bar.isApprox(e.trials.back().correction_bar) ||
                    (e.next_correction_bar.isZero() && e.trials.back().correction_bar.isZero());
   }
+  for (std::size_t i = 0; i < loaded.black_boxes.size(); ++i) {
+    e.faults.push_back({m.black_boxes[i].fault, m.black_boxes[i].iteration, std::move(loaded.black_boxes[i])});
+  }
   e.session_location = directory.string();
   e.saved_trials = static_cast<int>(e.trials.size());
+  e.saved_faults = static_cast<int>(e.faults.size());
   snapshot.events = log_of(m);
   snapshot.events_total = snapshot.events.size();
   writer_.reset();

@@ -129,7 +129,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     failure_name = fault_name(core.fault());
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
-    recording.fault(failure + " (" + fault_name(fault.code()) + ")");
+    recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);
   } catch (const std::exception& error) {
     if (loop != nullptr) loop->stop();  // vents
     else device.vent();

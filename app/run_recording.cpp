@@ -99,6 +99,17 @@ void RunRecording::fault(const std::string& what) noexcept {
   }
 }
 
+void RunRecording::fault(const std::string& what, const EngineCore& core) noexcept {
+  if (!writer_) return;
+  try {
+    const std::vector<TickRecord> ticks = core.black_box().copy_frozen();
+    if (!ticks.empty()) writer_->save_black_box(fault_name(core.fault()), ticks);
+  } catch (...) {
+    // As above: the event below still says what happened.
+  }
+  fault(what);
+}
+
 void RunRecording::finish(int trials_run) {
   if (writer_) writer_->record_event("finish", std::string(kPurpose) + ": " + std::to_string(trials_run) + " trials done");
 }

@@ -46,6 +46,8 @@ class RunRecording {
             const SimulatedClock* clock);
   /// Records a fault; never throws (the fault itself is what the caller reports).
   void fault(const std::string& what) noexcept;
+  /// Records an engine fault and keeps its black box (the engine's frozen record, if any).
+  void fault(const std::string& what, const EngineCore& core) noexcept;
   void finish(int trials_run);
 
   /// The session directory; empty with --no-save.

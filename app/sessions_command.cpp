@@ -1,13 +1,18 @@
 #include "app/sessions_command.hpp"
 
 #include <cstdio>
+#include <numbers>
 #include <ostream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "engine/engine_state.hpp"
 #include "engine/errors.hpp"
+#include "engine/safety.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_export.hpp"
+#include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -109,6 +114,32 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
   return 0;
 }
 
+namespace {
+
+// A black box's last ticks, up to and including the fault tick: what the guard saw.
+void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, const std::vector<TickRecord>& ticks,
+                     double tick_s) {
+  constexpr std::size_t kShown = 5;
+  out << "  " << index << ": " << entry.fault << " during iteration " << entry.iteration << ", saved "
+      << short_time(entry.time_utc) << "; " << entry.ticks << " ticks (" << format("%.2f", entry.ticks * tick_s)
+      << " s) in " << session_layout::black_box_file(index) << "\n";
+  char line[200];
+  std::snprintf(line, sizeof line, "    %9s  %-8s %9s %9s %8s %8s %8s  %s", "TIME [s]", "STATE", "ANGLE", "SET POINT",
+                "P_A", "P_B", "SUPPLY", "INLET/OUTLET DUTY A, B");
+  out << line << "\n";
+  for (std::size_t i = ticks.size() > kShown ? ticks.size() - kShown : 0; i < ticks.size(); ++i) {
+    const TickRecord& t = ticks[i];
+    std::snprintf(line, sizeof line, "    %9.3f  %-8s %9.2f %9.2f %8.3f %8.3f %8.3f  %.2f/%.2f, %.2f/%.2f%s", t.time_s,
+                  to_string(t.state), t.reading.angle_rad * 180.0 / std::numbers::pi,
+                  t.desired_angle_rad * 180.0 / std::numbers::pi, t.reading.chamber_bar[0], t.reading.chamber_bar[1],
+                  t.reading.supply_bar, t.valves.inlet_duty[0], t.valves.outlet_duty[0], t.valves.inlet_duty[1],
+                  t.valves.outlet_duty[1], t.fault != FaultCode::kNone ? (std::string("  <- ") + fault_name(t.fault)).c_str() : "");
+    out << line << "\n";
+  }
+}
+
+}  // namespace
+
 int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   const Session session = load_session(session_dir_of(options));  // checks every file
   const SessionManifest& m = session.manifest;
@@ -120,6 +151,12 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
     Json events = Json::array();
     for (const SessionEvent& e : m.events) {
       events.push_back({{"time_utc", e.time_utc}, {"iteration", e.iteration}, {"kind", e.kind}, {"message", e.message}});
+    }
+    Json black_boxes = Json::array();
+    for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+      const BlackBoxEntry& b = m.black_boxes[i];
+      black_boxes.push_back({{"fault", b.fault}, {"iteration", b.iteration}, {"time_utc", b.time_utc}, {"ticks", b.ticks},
+                             {"file", session_layout::black_box_file(static_cast<int>(i))}});
     }
     const Json report = {{"name", m.name},
                          {"directory", session.directory.string()},
@@ -136,7 +173,8 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                          {"learning", configuration_to_json(c).at("ilc")},
                          {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)},
                          {"iterations", iterations},
-                         {"events", events}};
+                         {"events", events},
+                         {"black_boxes", black_boxes}};
     out << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
     return 0;
   }
@@ -165,6 +203,10 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   if (!m.events.empty()) out << "\nevents\n";
   for (const SessionEvent& e : m.events) {
     out << "  " << short_time(e.time_utc) << "  iteration " << e.iteration << "  " << e.kind << ": " << e.message << "\n";
+  }
+  if (!m.black_boxes.empty()) out << "\nblack boxes (the last ticks before each fault; every tick in the file)\n";
+  for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+    print_black_box(out, static_cast<int>(i), m.black_boxes[i], session.black_boxes[i], c.timing.tick_s);
   }
   out << std::flush;
   return 0;

@@ -61,7 +61,7 @@ void append_csv(std::string& out, const std::vector<CsvColumn>& columns) {
 }
 
 std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,
-                                       const std::string& source) {
+                                       const std::string& source, NonFinite non_finite) {
   if (text.empty()) throw InputError(source + ": the file is empty (expected the header '" + joined(header) + "')");
   if (text.back() != '\n') {
     const auto lines = std::count(text.begin(), text.end(), '\n') + 1;
@@ -96,7 +96,7 @@ std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<
       if (field.empty() || error != std::errc() || end != field.data() + field.size()) {
         throw InputError(where() + ", column " + std::string(header[c]) + ": '" + excerpt(field) + "' is not a number");
       }
-      if (!std::isfinite(value)) {
+      if (!std::isfinite(value) && non_finite == NonFinite::kRefuse) {
         throw InputError(where() + ", column " + std::string(header[c]) + ": '" + excerpt(field) +
                          "' is not a finite number");
       }

@@ -20,9 +20,12 @@ struct CsvColumn {
 /// Appends header and rows to `out`. Throws std::invalid_argument if the columns differ in length.
 void append_csv(std::string& out, const std::vector<CsvColumn>& columns);
 
+/// Whether `nan` and `inf` are values (a black box keeps the bad reading that caused its fault).
+enum class NonFinite { kRefuse, kAccept };
+
 /// Parses `text` whose header must be exactly `header`; one vector per column. Throws InputError
 /// that starts with `source` and names the line (and column) at fault.
 std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,
-                                       const std::string& source);
+                                       const std::string& source, NonFinite non_finite = NonFinite::kRefuse);
 
 }  // namespace bellows

@@ -87,6 +87,20 @@ SessionEvent event_from_json(const JsonReader& r) {
   return {r["time_utc"].text(), r["iteration"].integer(0, kMostIterations), r["kind"].text(), r["message"].text()};
 }
 
+Json black_box_to_json(const BlackBoxEntry& b, int index) {
+  return {{"time_utc", b.time_utc},
+          {"iteration", b.iteration},
+          {"fault", b.fault},
+          {"ticks", b.ticks},
+          {"file", session_layout::black_box_file(index)}};
+}
+
+BlackBoxEntry black_box_from_json(const JsonReader& r) {
+  constexpr int kMostTicks = 100000000;
+  return {r["time_utc"].text(), r["iteration"].integer(0, kMostIterations), r["fault"].text(),
+          r["ticks"].integer(1, kMostTicks)};
+}
+
 }  // namespace
 
 Json configuration_to_json(const Configuration& config) {
@@ -174,6 +188,10 @@ Json manifest_to_json(const SessionManifest& m) {
   for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_to_json(entry));
   Json events = Json::array();
   for (const SessionEvent& event : m.events) events.push_back(event_to_json(event));
+  Json black_boxes = Json::array();
+  for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+    black_boxes.push_back(black_box_to_json(m.black_boxes[i], static_cast<int>(i)));
+  }
   Json out = {
       {"format", kFormat},
       {"schema_version", m.schema_version},
@@ -202,6 +220,7 @@ Json manifest_to_json(const SessionManifest& m) {
       {"configuration", configuration},
       {"iterations", iterations},
       {"events", events},
+      {"black_boxes", black_boxes},
   };
   if (m.resume) {
     Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
@@ -248,6 +267,10 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   }
   const JsonReader events = r["events"];
   for (std::size_t i = 0; i < events.size(); ++i) m.events.push_back(event_from_json(events[i]));
+  if (r.has("black_boxes")) {  // sessions saved before black boxes were kept have none
+    const JsonReader black_boxes = r["black_boxes"];
+    for (std::size_t i = 0; i < black_boxes.size(); ++i) m.black_boxes.push_back(black_box_from_json(black_boxes[i]));
+  }
   if (r.has("resume")) {
     const JsonReader resume = r["resume"];
     const int next = resume["next_iteration"].integer(0, kMostIterations);

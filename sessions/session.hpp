@@ -14,6 +14,7 @@
 
 #include "engine/configuration.hpp"
 #include "engine/control_core.hpp"
+#include "engine/engine_messages.hpp"
 #include "engine/learning_session.hpp"
 #include "engine/trajectory.hpp"
 #include "engine/trial_record.hpp"
@@ -32,6 +33,14 @@ struct SessionEvent {
   int iteration = 0;     // the iteration running or next to run when it happened
   std::string kind;      // "start", "resume", "finish", "fault", "configuration", "note", ...
   std::string message;
+};
+
+/// A fault's black box as the manifest lists it; its ticks are in session_layout::black_box_file().
+struct BlackBoxEntry {
+  std::string time_utc;  // when it was saved
+  int iteration = 0;     // the iteration running or next to run when the fault fired
+  std::string fault;     // fault_name(), e.g. "overpressure"
+  int ticks = 0;         // rows in the file: the ticks before the fault and the fault tick
 };
 
 /// One completed iteration as the manifest lists it.
@@ -64,6 +73,7 @@ struct SessionManifest {
   int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
   std::vector<IterationEntry> iterations;
   std::vector<SessionEvent> events;
+  std::vector<BlackBoxEntry> black_boxes;  // numbered 0, 1, ... in the order the faults fired
   std::optional<ResumeState> resume;  // present once an iteration has completed
 };
 
@@ -78,6 +88,7 @@ struct Session {
   SessionManifest manifest;
   Trajectory trajectory;
   std::vector<IterationData> iterations;  // in the order of manifest.iterations
+  std::vector<std::vector<TickRecord>> black_boxes;  // in the order of manifest.black_boxes, oldest tick first
 };
 
 /// Current UTC time in the manifest's format.

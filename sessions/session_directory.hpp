@@ -17,12 +17,16 @@ namespace bellows {
 /// that uses it, if any.
 SessionLock create_session_directory(const std::filesystem::path& directory, const SessionManifest& manifest,
                                      const Trajectory& trajectory, const std::vector<IterationData>& iterations,
-                                     const std::string& purpose);
+                                     const std::string& purpose,
+                                     const std::vector<std::vector<TickRecord>>& black_boxes = {});
 
 /// Writes iteration `index`'s samples and telemetry files (durable once the caller syncs the
 /// iterations directory). Throws InputError for a value that is not finite.
 void write_iteration_files(const std::filesystem::path& directory, int index, const TrialRecord& record,
                            const Eigen::VectorXd& next_correction_bar);
+
+/// Writes black box `index` into the faults directory (created if needed) and syncs it.
+void write_black_box_file(const std::filesystem::path& directory, int index, const std::vector<TickRecord>& ticks);
 
 /// Writes the manifest, stamping `updated_utc`.
 void write_manifest(const std::filesystem::path& directory, SessionManifest& manifest);

@@ -17,6 +17,7 @@
 
 #include "engine/errors.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/black_box_file.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_directory.hpp"
@@ -149,7 +150,21 @@ Session load_session(const fs::path& directory) {
                        " deg differs from the manifest's " + std::to_string(listed) + " deg");
     }
   }
+  for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+    const std::string file = session_layout::black_box_file(static_cast<int>(i));
+    session.black_boxes.push_back(
+        parse_black_box_csv(read_session_file(directory, file), describe(directory) + ": " + file, m.black_boxes[i].ticks));
+  }
   return session;
+}
+
+void write_black_box_file(const fs::path& directory, int index, const std::vector<TickRecord>& ticks) {
+  const fs::path faults = directory / session_layout::kFaults;
+  std::error_code error;
+  const bool created = fs::create_directories(faults, error);
+  if (error) throw InputError("cannot create " + faults.string() + ": " + error.message());
+  if (created) sync_directory(directory);  // the new directory's entry is durable too
+  write_file_atomic(directory / session_layout::black_box_file(index), format_black_box_csv(ticks), DirectorySync::kNow);
 }
 
 void write_iteration_files(const fs::path& directory, int index, const TrialRecord& record,
@@ -197,9 +212,13 @@ void write_all_iteration_files(const fs::path& directory, const std::vector<Iter
 
 SessionLock create_session_directory(const fs::path& directory, const SessionManifest& manifest,
                                      const Trajectory& trajectory, const std::vector<IterationData>& iterations,
-                                     const std::string& purpose) {
+                                     const std::string& purpose,
+                                     const std::vector<std::vector<TickRecord>>& black_boxes) {
   if (iterations.size() != manifest.iterations.size()) {
     throw std::invalid_argument("create_session_directory: the manifest lists a different number of iterations");
+  }
+  if (black_boxes.size() != manifest.black_boxes.size()) {
+    throw std::invalid_argument("create_session_directory: the manifest lists a different number of black boxes");
   }
   const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
   std::error_code error;
@@ -225,6 +244,7 @@ SessionLock create_session_directory(const fs::path& directory, const SessionMan
     write_file_atomic(building / session_layout::kTrajectory, format_trajectory_csv(trajectory), DirectorySync::kLater);
     write_all_iteration_files(building, iterations);
     sync_directory(building / session_layout::kIterations);
+    for (std::size_t i = 0; i < black_boxes.size(); ++i) write_black_box_file(building, static_cast<int>(i), black_boxes[i]);
     SessionManifest copy = manifest;
     write_manifest(building, copy);
     if (::rename(building.c_str(), directory.c_str()) != 0) {
@@ -241,7 +261,8 @@ SessionLock create_session_directory(const fs::path& directory, const SessionMan
 }
 
 void save_session(const Session& session, const fs::path& directory) {
-  create_session_directory(directory, session.manifest, session.trajectory, session.iterations, "bellows save");
+  create_session_directory(directory, session.manifest, session.trajectory, session.iterations, "bellows save",
+                           session.black_boxes);
 }
 
 std::vector<SessionListing> list_sessions(const fs::path& data_dir) {

@@ -55,6 +55,10 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
     const bool telemetry = fs::remove(directory / session_layout::telemetry_file(i), error);
     if (!samples && !telemetry) break;
   }
+  remove_temporary_files(directory / session_layout::kFaults);
+  for (int i = static_cast<int>(loaded.black_boxes.size());; ++i) {  // likewise for a black box
+    if (!fs::remove(directory / session_layout::black_box_file(i), error)) break;
+  }
   return SessionWriter(directory, loaded.manifest, std::move(lock));
 }
 
@@ -75,6 +79,16 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
   updated.resume = std::move(resume);
   write_manifest(directory_, updated);
   manifest_ = std::move(updated);  // only once it is on disk
+}
+
+void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {
+  if (ticks.empty()) throw std::invalid_argument("SessionWriter::save_black_box: no ticks");
+  const auto index = static_cast<int>(manifest_.black_boxes.size());
+  write_black_box_file(directory_, index, ticks);
+  SessionManifest updated = manifest_;
+  updated.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size())});
+  write_manifest(directory_, updated);
+  manifest_ = std::move(updated);
 }
 
 void SessionWriter::record_event(const std::string& kind, const std::string& message) {

@@ -32,6 +32,9 @@ class SessionWriter {
   /// the correction learned from it and the state to continue from.
   void save_iteration(const TrialRecord& record, const IterationSummary& summary,
                       const Eigen::VectorXd& next_correction_bar, ResumeState resume);
+  /// Keeps a fault's black box (`ticks` oldest first, ending with the fault tick): writes its file,
+  /// then lists it in the manifest. Throws std::invalid_argument when `ticks` is empty.
+  void save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks);
   /// Appends an event and saves the manifest at once.
   void record_event(const std::string& kind, const std::string& message);
   /// Replaces the configuration (e.g. the operator changed gains); saved at once.

@@ -214,6 +214,37 @@ TEST(SessionSaving, AFaultIsRecordedAndEveryCompletedIterationKept) {
   EXPECT_NE(last.message.find("interrupted"), std::string::npos) << last.message;
 }
 
+TEST(SessionSaving, AGuardsFaultKeepsItsBlackBoxWhichShowPrints) {
+  TempDir dir;
+  testing::write_short_run_files(dir.path());
+  // Supply lost 0.9 s in: during iteration 1 (each trial is 0.05 s of settle and 0.5 s of moves).
+  testing::write_text(dir / "short.toml", "[timing]\nsettle_s = 0.05\n[plant]\nfault = \"supply-loss\"\nfault_at_s = 0.9\n");
+  const std::string data = (dir / "data").string();
+  const ProcessResult run = run_bellows(short_run(dir, {"--iterations", "5", "--data-dir", data, "--name", "f"}));
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  const Session session = load_session(dir / "data" / "f");
+  ASSERT_EQ(session.manifest.black_boxes.size(), 1u);
+  const BlackBoxEntry& entry = session.manifest.black_boxes[0];
+  EXPECT_EQ(entry.fault, "supply-low");
+  EXPECT_EQ(entry.iteration, static_cast<int>(session.iterations.size()));
+  ASSERT_EQ(session.black_boxes[0].size(), static_cast<std::size_t>(entry.ticks));
+  const TickRecord& fault_tick = session.black_boxes[0].back();
+  EXPECT_EQ(fault_tick.state, EngineState::kFault);
+  EXPECT_EQ(fault_tick.fault, FaultCode::kSupplyLow);
+  EXPECT_LT(fault_tick.reading.supply_bar, session.manifest.configuration.safety.supply_min_bar);
+  EXPECT_GE(session.black_boxes[0].front().reading.supply_bar, session.manifest.configuration.safety.supply_min_bar);
+
+  const ProcessResult shown = run_bellows({"sessions", "show", (dir / "data" / "f").string()});
+  EXPECT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("black boxes"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("0: supply-low during iteration"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("<- supply-low"), std::string::npos) << shown.out;
+  const nlohmann::json json = run_json({"sessions", "show", (dir / "data" / "f").string(), "--json"});
+  ASSERT_EQ(json["black_boxes"].size(), 1u);
+  EXPECT_EQ(json["black_boxes"][0]["file"], "faults/blackbox_0000.csv");
+  EXPECT_EQ(json["black_boxes"][0]["ticks"], entry.ticks);
+}
+
 TEST(SessionSaving, AWallClockRunSavesAndResumesWithItsCorrection) {
   TempDir dir;
   testing::write_short_run_files(dir.path());

@@ -120,6 +120,35 @@ TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
   EXPECT_FALSE(applied(2).isApprox(applied(1)));
 }
 
+TEST_F(UiSessions, AFaultsBlackBoxIsSavedWithTheSessionAndReopened) {
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(1);
+  f.key(' ');  // emergency stop
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.black_box.empty(); }));
+  ASSERT_EQ(f.state().experiment.faults.size(), 1u);
+  EXPECT_TRUE(f.state().experiment.unsaved());
+  save_and_wait(f);
+  EXPECT_EQ(f.state().experiment.saved_faults, 1);
+  const std::string location = f.state().experiment.session_location;
+  const std::vector<TickRecord> shown = f.state().fault_view.black_box;
+  f.console.reset();
+
+  const Session loaded = load_session(location);
+  ASSERT_EQ(loaded.manifest.black_boxes.size(), 1u);
+  EXPECT_EQ(loaded.manifest.black_boxes[0].fault, "emergency-stop");
+  EXPECT_EQ(loaded.manifest.black_boxes[0].iteration, 1);
+  ASSERT_EQ(loaded.black_boxes[0].size(), shown.size());
+  EXPECT_EQ(loaded.black_boxes[0].back().tick, shown.back().tick);
+  EXPECT_EQ(loaded.black_boxes[0].back().state, EngineState::kFault);
+
+  const ui::SessionSnapshot reopened = gateway.open(location);
+  ASSERT_EQ(reopened.experiment.faults.size(), 1u);
+  EXPECT_EQ(reopened.experiment.saved_faults, 1);
+  EXPECT_EQ(reopened.experiment.faults[0].ticks.size(), shown.size());
+}
+
 TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
   std::string location;
   {

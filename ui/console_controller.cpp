@@ -144,6 +144,10 @@ void ConsoleController::update(double now_s) {
   if (black_box_pending_ && env_.core->black_box().frozen()) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
     black_box_pending_ = false;
+    if (!state_.fault_view.black_box.empty()) {  // kept for the session, saved with the next save
+      state_.experiment.faults.push_back(
+          {fault_name(state_.fault_view.code), state_.experiment.next_iteration(), state_.fault_view.black_box});
+    }
     ++revision_;
   }
   if (env_.latency && (last_loop_stats_s_ < 0.0 || now_s - last_loop_stats_s_ >= kLoopStatsPeriodS)) {

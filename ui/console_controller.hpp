@@ -154,6 +154,7 @@ class ConsoleController {
   BackgroundTask<std::vector<SessionListing>> list_task_;
   BackgroundTask<SessionSnapshot> open_task_;
   int saving_trials_ = 0;
+  int saving_faults_ = 0;
   std::size_t saving_events_ = 0;
   bool saving_settings_changed_ = false;
 };

@@ -23,6 +23,7 @@ void ConsoleController::start_save() {
   snapshot.device_name = env_.device_name;
   snapshot.seed = env_.seed;
   saving_trials_ = static_cast<int>(state_.experiment.trials.size());
+  saving_faults_ = static_cast<int>(state_.experiment.faults.size());
   saving_events_ = state_.log.total();
   saving_settings_changed_ = state_.experiment.settings_changed;
   state_.learner_busy = true;
@@ -54,6 +55,7 @@ void ConsoleController::poll_session_tasks() {
       Experiment& e = state_.experiment;
       e.session_location = location;
       e.saved_trials = saving_trials_;
+      e.saved_faults = saving_faults_;
       e.saved_events = saving_events_;
       // Settings changed while saving stay unsaved.
       if (saving_settings_changed_ == e.settings_changed) e.settings_changed = false;
@@ -115,6 +117,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   for (const LogEntry& entry : snapshot.events) state_.log.add(entry);
   state_.experiment = std::move(snapshot.experiment);
   state_.experiment.saved_trials = static_cast<int>(state_.experiment.trials.size());
+  state_.experiment.saved_faults = static_cast<int>(state_.experiment.faults.size());
   state_.experiment.settings_changed = false;
   state_.experiment.saved_events = state_.log.total();  // what came with the session is saved
   state_.inspector = InspectorView{};

@@ -12,6 +12,7 @@
 
 #include "engine/learning_session.hpp"
 #include "engine/trajectory.hpp"
+#include "engine/engine_messages.hpp"
 #include "engine/trial_record.hpp"
 
 namespace bellows::ui {
@@ -24,6 +25,13 @@ struct Trial {
   std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
 };
 
+/// A fault's black box, kept with the experiment so that saving stores it in the session.
+struct FaultRecord {
+  std::string fault;              // fault_name(), e.g. "overpressure"
+  int iteration = 0;              // the iteration running or next when it fired
+  std::vector<TickRecord> ticks;  // oldest first, ending with the fault tick
+};
+
 struct Experiment {
   std::shared_ptr<const Trajectory> trajectory;
   std::vector<Trial> trials;
@@ -34,13 +42,18 @@ struct Experiment {
   bool settings_changed = false;        // gains or weights changed since the last save
   std::string session_location;         // where it was saved or opened from; empty if never
   std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
+  std::vector<FaultRecord> faults;      // black boxes, in the order the faults fired
+  int saved_faults = 0;                 // black boxes already in the saved session
 
   /// A fresh experiment on `trajectory`: zero correction, no trials.
   static Experiment start(std::shared_ptr<const Trajectory> trajectory);
 
   int samples() const { return trajectory ? trajectory->learning_samples() : 0; }
   int next_iteration() const { return static_cast<int>(trials.size()); }
-  bool unsaved() const { return static_cast<int>(trials.size()) > saved_trials || settings_changed; }
+  bool unsaved() const {
+    return static_cast<int>(trials.size()) > saved_trials || static_cast<int>(faults.size()) > saved_faults ||
+           settings_changed;
+  }
   /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
   void add_trial(Trial trial);
   /// The correction the next trial applies, from `origin`.

@@ -1,0 +1,101 @@
+#include "sessions/black_box_file.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "engine/errors.hpp"
+#include "sessions/csv_table.hpp"
+#include "sessions/iteration_files.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr int kLastState = static_cast<int>(EngineState::kFault);
+constexpr int kLastFault = static_cast<int>(FaultCode::kHeartbeatLost);
+// The codes are part of the session format (docs/session-format.md): new ones go at the end.
+static_assert(static_cast<int>(EngineState::kSafe) == 0 && kLastState == 3);
+static_assert(static_cast<int>(FaultCode::kNone) == 0 && static_cast<int>(FaultCode::kSupplyLow) == 4 &&
+              static_cast<int>(FaultCode::kSensorStale) == 7 && kLastFault == 9);
+
+// A whole number within [low, high] read back from `column`; NaN and fractions fail.
+double whole_at(const Eigen::VectorXd& column, Eigen::Index row, double low, double high, const std::string& source,
+                const char* name) {
+  const double value = column(row);
+  if (!(value == std::floor(value) && value >= low && value <= high)) {
+    throw InputError(source + ": line " + std::to_string(row + 2) + ": " + name + " = " + std::to_string(value) +
+                     " is not a whole number from " + std::to_string(static_cast<long long>(low)) + " to " +
+                     std::to_string(static_cast<long long>(high)));
+  }
+  return value;
+}
+
+}  // namespace
+
+const std::vector<std::string_view>& black_box_columns() {
+  static const std::vector<std::string_view> columns = {
+      "tick",          "time_s",        "sensor_time_s", "state",         "fault",
+      "angle_deg",     "desired_deg",   "pressure_a_bar", "pressure_b_bar",
+      "supply_bar",    "u_total_bar",   "pressure_a_setpoint_bar", "pressure_b_setpoint_bar",
+      "inlet_a_duty",  "outlet_a_duty", "inlet_b_duty",  "outlet_b_duty",
+      "sample",        "trial_id"};
+  return columns;
+}
+
+std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
+  if (ticks.empty()) throw std::invalid_argument("format_black_box_csv: no ticks");
+  const auto rows = static_cast<Eigen::Index>(ticks.size());
+  std::vector<Eigen::VectorXd> c(black_box_columns().size(), Eigen::VectorXd(rows));
+  for (Eigen::Index k = 0; k < rows; ++k) {
+    const TickRecord& t = ticks[static_cast<std::size_t>(k)];
+    const double values[] = {static_cast<double>(t.tick), t.time_s, t.reading.time_s, static_cast<double>(t.state),
+                             static_cast<double>(t.fault), degrees_for_exact_radians(t.reading.angle_rad),
+                             degrees_for_exact_radians(t.desired_angle_rad), t.reading.chamber_bar[0],
+                             t.reading.chamber_bar[1], t.reading.supply_bar, t.u_total_bar, t.setpoints.a_bar,
+                             t.setpoints.b_bar, t.valves.inlet_duty[0], t.valves.outlet_duty[0], t.valves.inlet_duty[1],
+                             t.valves.outlet_duty[1], static_cast<double>(t.sample), static_cast<double>(t.trial_id)};
+    for (std::size_t i = 0; i < c.size(); ++i) c[i](k) = values[i];
+  }
+  std::vector<CsvColumn> columns;
+  for (std::size_t i = 0; i < c.size(); ++i) columns.push_back({black_box_columns()[i], &c[i]});
+  std::string out;
+  append_csv(out, columns);
+  return out;
+}
+
+std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::string& source, int expected_ticks) {
+  const std::vector<Eigen::VectorXd> c = parse_csv(text, black_box_columns(), source, NonFinite::kAccept);
+  if (c[0].size() != expected_ticks) {
+    throw InputError(source + ": expected " + std::to_string(expected_ticks) + " rows (the ticks the manifest lists), found " +
+                     std::to_string(c[0].size()));
+  }
+  std::vector<TickRecord> ticks(static_cast<std::size_t>(expected_ticks));
+  for (Eigen::Index k = 0; k < c[0].size(); ++k) {
+    TickRecord& t = ticks[static_cast<std::size_t>(k)];
+    constexpr double kMostTicks = 9007199254740992.0;  // 2^53: every tick count a double holds exactly
+    t.tick = static_cast<std::uint64_t>(whole_at(c[0], k, 0.0, kMostTicks, source, "tick"));
+    if (k > 0 && t.tick <= ticks[static_cast<std::size_t>(k - 1)].tick) {
+      throw InputError(source + ": line " + std::to_string(k + 2) + ": tick " + std::to_string(t.tick) +
+                       " does not follow tick " + std::to_string(ticks[static_cast<std::size_t>(k - 1)].tick) +
+                       " (ticks increase row by row)");
+    }
+    t.time_s = c[1](k);
+    t.state = static_cast<EngineState>(whole_at(c[3], k, 0, kLastState, source, "state"));
+    t.fault = static_cast<FaultCode>(whole_at(c[4], k, 0, kLastFault, source, "fault"));
+    t.reading.angle_rad = radians_from_degrees(c[5](k));
+    t.reading.time_s = c[2](k);
+    t.desired_angle_rad = radians_from_degrees(c[6](k));
+    t.reading.chamber_bar = {c[7](k), c[8](k)};
+    t.reading.supply_bar = c[9](k);
+    t.u_total_bar = c[10](k);
+    t.setpoints.a_bar = c[11](k);
+    t.setpoints.b_bar = c[12](k);
+    t.valves.inlet_duty = {c[13](k), c[15](k)};
+    t.valves.outlet_duty = {c[14](k), c[16](k)};
+    t.sample = static_cast<int>(whole_at(c[17], k, -1, std::numeric_limits<int>::max(), source, "sample"));
+    t.trial_id = static_cast<std::uint32_t>(whole_at(c[18], k, 0, std::numeric_limits<std::uint32_t>::max(), source, "trial_id"));
+  }
+  return ticks;
+}
+
+}  // namespace bellows
