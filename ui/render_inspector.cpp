@@ -74,13 +74,13 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   readout_row(c, in, row, "iteration", format("%d", t.iteration));
   readout_row(c, in, row, "sample", format("%d / %d", k, t.record.learning_samples));
   readout_row(c, in, row, "time", format("%.2f s", cursor_s));
-  readout_row(c, in, row, "set point", format("%.2f deg", to_deg(samples.setpoint_rad(k))));
-  readout_row(c, in, row, "angle", format("%.2f deg", to_deg(samples.angle_rad(k))));
-  readout_row(c, in, row, "error", format("%.2f deg", to_deg(samples.error_rad(k))));
-  readout_row(c, in, row, "u_pid", format("%.4f bar", samples.u_pid_bar(k)));
-  readout_row(c, in, row, "u_ilc", format("%.4f bar", samples.u_ilc_bar(k)));
-  readout_row(c, in, row, "p A", format("%.3f bar", samples.pressure_a_bar(k)));
-  readout_row(c, in, row, "p B", format("%.3f bar", samples.pressure_b_bar(k)));
+  readout_row(c, in, row, "set point", number("%.2f deg", to_deg(samples.setpoint_rad(k))));
+  readout_row(c, in, row, "angle", number("%.2f deg", to_deg(samples.angle_rad(k))));
+  readout_row(c, in, row, "error", number("%.2f deg", to_deg(samples.error_rad(k))));
+  readout_row(c, in, row, "u_pid", number("%.4f bar", samples.u_pid_bar(k)));
+  readout_row(c, in, row, "u_ilc", number("%.4f bar", samples.u_ilc_bar(k)));
+  readout_row(c, in, row, "p A", number("%.3f bar", samples.pressure_a_bar(k)));
+  readout_row(c, in, row, "p B", number("%.3f bar", samples.pressure_b_bar(k)));
   if (readout.bottom() + 3 <= body.bottom()) {
     const int y = readout.bottom();
     c.put(readout.x + 1, y, "m overlay this iteration", Role::kDim);
