@@ -31,9 +31,13 @@ TEST(UiController, ArmingAsksForConfirmation) {
   f.key('y');
   ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kArmed; }));
   EXPECT_TRUE(f.logged("SAFE -> ARMED (arm)"));
+  EXPECT_NE(f.state().status.find("armed: r runs a trial"), std::string::npos) << f.state().status;
   // The heartbeat keeps the armed engine alive.
   f.pump_for(3.0);
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  f.key('d');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  EXPECT_NE(f.state().status.find("disarmed: the valves are vented"), std::string::npos) << f.state().status;
 }
 
 TEST(UiController, FiveIterationsLowerTheRms) {
