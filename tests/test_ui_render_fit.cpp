@@ -91,6 +91,34 @@ TEST(UiRenderFit, EveryOtherScreenOffersTheWayBack) {
   EXPECT_EQ(render_lines(s).back().find("Esc Back"), std::string::npos);
 }
 
+TEST(UiRenderFit, TheFaultScreenSaysWhichGuardAndWhenInFullAt80Columns) {
+  ConsoleState s = small_state(EngineState::kFault);
+  s.fault = FaultCode::kOverpressure;
+  s.screen = Screen::kFault;
+  s.fault_view.code = FaultCode::kOverpressure;
+  s.fault_view.time_s = 1234.5;
+  for (int i = 0; i < 400; ++i) {
+    TickRecord t;
+    t.time_s = 1234.5 - 0.005 * (399 - i);
+    t.state = i == 399 ? EngineState::kFault : EngineState::kRunning;
+    t.reading.chamber_bar = {1.0 + 0.003 * i, 1.0};
+    t.reading.supply_bar = 3.0;
+    s.fault_view.black_box.push_back(t);
+  }
+  const std::string screen = all(render_lines(s));
+  std::string joined;  // the wrapped lines read as one text
+  for (const std::string& line : render_lines(s)) {
+    const auto first = line.find_first_not_of(' ');
+    if (first != std::string::npos) joined += line.substr(first, line.find_last_not_of(' ') + 1 - first) + " ";
+  }
+  EXPECT_NE(screen.find("overpressure"), std::string::npos) << screen;
+  EXPECT_NE(joined.find("a chamber pressure exceeded p_max plus the safety margin"), std::string::npos) << screen;
+  EXPECT_NE(joined.find("latched: R resets to SAFE, then a arms again."), std::string::npos) << screen;
+  EXPECT_NE(screen.find("Black box"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("Last ticks before the fault"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("FAULT"), std::string::npos) << screen;
+}
+
 TEST(UiRenderFit, NoNegativeZeroInTheReadouts) {
   ConsoleState s = small_state(EngineState::kArmed);
   s.width = 120;

@@ -82,11 +82,12 @@ int segments_width(const std::vector<Segment>& segments) {
   return width;
 }
 
-/// The first line: what must be seen at a glance. Narrow windows get a compact form (labels and
-/// the state's words dropped, then the best RMS) so that the state, trajectory, iteration and RMS
-/// stay on screen down to 80 columns whatever the state.
+/// The first line: what must be seen at a glance. Narrow windows get a compact form (the best RMS
+/// dropped, then the labels and the state's words, then both) so that the state, trajectory,
+/// iteration and RMS stay on screen down to 80 columns whatever the state.
 std::vector<Segment> header_segments(const ConsoleState& s, int level) {
-  const bool labels = level == 0;
+  const bool labels = level < 2;
+  const bool best = level % 2 == 0;
   std::vector<Segment> out;
   out.push_back({0, " Bellows ", Role::kTitle, true});
   std::string state = format(" %s ", to_string(s.engine_state));
@@ -106,7 +107,7 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
   if (!e.trials.empty()) {
     out.push_back({2, "RMS ", Role::kDim, false});
     out.push_back({0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true});
-    if (level < 2) out.push_back({0, format(" (best %.3f)", e.best_rms_deg()), Role::kDim, false});
+    if (best) out.push_back({0, format(" (best %.3f)", e.best_rms_deg()), Role::kDim, false});
   }
   return out;
 }
@@ -141,7 +142,7 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
 
 void render_header(const ConsoleState& s, Canvas& c) {
   std::vector<Segment> line;
-  for (int level = 0; level < 3; ++level) {
+  for (int level = 0; level < 4; ++level) {
     line = header_segments(s, level);
     if (segments_width(line) <= c.width()) break;
   }

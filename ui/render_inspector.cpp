@@ -95,15 +95,20 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(body.x + 2, body.y + 1, "No fault so far.", Role::kDim);
     return;
   }
-  int x = c.put(body.x + 1, body.y, format(" %s ", fault_name(f.code)), Role::kFault, true);
-  c.put(x + 1, body.y, fault_message(f.code), Role::kWarning, true);
+  // The guard and what it means, then when it vented: wrapped, never cut off.
+  int y = body.y;
+  const int x = c.put(body.x + 1, y, format(" %s ", fault_name(f.code)), Role::kFault, true);
+  for (const std::string& line : wrap(fault_message(f.code), body.right() - x - 2)) {
+    c.put(x + 1, y++, line, Role::kWarning, true);
+  }
   const bool latched = s.engine_state == EngineState::kFault;
-  c.put(body.x + 1, body.y + 1,
-        format("at engine time %.3f s; the valves were vented in that tick.  %s", f.time_s,
-               latched ? "Latched: R resets to SAFE, then a arms again." : "Reset since then."),
-        latched ? Role::kNormal : Role::kDim);
+  const std::string when = format("vented at engine time %.3f s, in the tick the fault was seen; %s", f.time_s,
+                                  latched ? "latched: R resets to SAFE, then a arms again." : "reset since then.");
+  for (const std::string& line : wrap(when, body.width - 2)) {
+    c.put(body.x + 1, y++, line, latched ? Role::kNormal : Role::kDim);
+  }
   if (f.black_box.empty()) {
-    c.put(body.x + 1, body.y + 3, "The black box was not captured.", Role::kDim);
+    c.put(body.x + 1, y + 1, "The black box was not captured.", Role::kDim);
     return;
   }
   const std::size_t n = f.black_box.size();
@@ -118,8 +123,8 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     supply[i] = t.reading.supply_bar;
   }
   constexpr int kTableRows = 8;
-  const int plot_height = std::max(6, body.height - 2 - (kTableRows + 3));
-  const Rect left{body.x, body.y + 2, body.width / 2, plot_height};
+  const int plot_height = std::max(6, body.bottom() - y - (kTableRows + 3));
+  const Rect left{body.x, y, body.width / 2, plot_height};
   const Rect right{left.right(), left.y, body.width - left.width, plot_height};
   PlotOptions options;
   options.braille = s.unicode;
