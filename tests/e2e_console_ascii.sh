@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Without a UTF-8 locale the console draws ASCII only (plots with marks instead of braille); with
-# --no-color (or NO_COLOR) it uses attributes alone. A trial runs and its RMS shows as before.
+# --no-color (or NO_COLOR), or on a terminal without colours (TERM=vt100), it uses attributes
+# alone. A trial runs and its RMS shows as before.
 source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 100 30 LC_ALL=C LANG=C -- console --speed max --no-color
@@ -20,6 +21,23 @@ non_ascii="$(e2e_screen | LC_ALL=C tr -d '\000-\177' | wc -c)"
 escaped="$(e2e_tmux capture-pane -p -e -t console)"
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours with --no-color"
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video for the keys and states"
+
+# A terminal without colours (vt100), without --no-color: attributes alone, and it still works.
+e2e_keys q
+e2e_wait_for 'Quit\?'
+e2e_keys q
+[ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
+e2e_start 100 30 TERM=vt100 -- console --speed max
+e2e_wait_for 'law [a-z-]+  M'
+e2e_keys a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys r
+e2e_wait_for 'iteration 0: RMS [0-9]+\.[0-9]{3} deg' 120
+escaped="$(e2e_tmux capture-pane -p -e -t console)"
+echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours on a vt100"
+echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video on a vt100"
 
 # The same screen in a UTF-8 locale with colours: braille and colour escapes.
 e2e_keys q

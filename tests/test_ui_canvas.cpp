@@ -71,6 +71,15 @@ TEST(UiCanvas, FrameDrawsBordersAndTitleInBothGlyphSets) {
   EXPECT_EQ(u.line(0), "\u250c\u2500 T \u2500\u2500\u2500\u2500\u2500\u2500\u2510");
 }
 
+TEST(UiPlot, ALegendOverALongTitleEndsWithTheFrameLine) {
+  Canvas c(24, 4);
+  const Rect area{0, 0, 24, 4};
+  const Glyphs g = Glyphs::for_unicode(false);
+  c.frame(area, g, "Correction u_ilc (bar)");
+  legend(c, area, {{"it 5", Role::kSeries1, '.'}, {"next", Role::kSeries2, '*'}}, g);
+  EXPECT_EQ(c.line(0), "+- Corre . it 5 * next-+");  // not "...next)+": the title's end is covered
+}
+
 TEST(UiPlot, BrailleInUtf8AndOnlyAsciiOtherwise) {
   std::vector<double> x, y;
   for (int i = 0; i <= 100; ++i) {

@@ -31,9 +31,13 @@ TEST(UiController, ArmingAsksForConfirmation) {
   f.key('y');
   ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kArmed; }));
   EXPECT_TRUE(f.logged("SAFE -> ARMED (arm)"));
+  EXPECT_NE(f.state().status.find("armed: r runs a trial"), std::string::npos) << f.state().status;
   // The heartbeat keeps the armed engine alive.
   f.pump_for(3.0);
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  f.key('d');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  EXPECT_NE(f.state().status.find("disarmed: the valves are vented"), std::string::npos) << f.state().status;
 }
 
 TEST(UiController, FiveIterationsLowerTheRms) {
@@ -210,6 +214,12 @@ TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
   EXPECT_DOUBLE_EQ(f.state().config.controller.k_p, 0.45);
   EXPECT_TRUE(f.state().status_important);
   EXPECT_NE(f.state().status.find("k_p"), std::string::npos) << f.state().status;
+  // The question stays open with what was typed and why it was refused; Esc leaves it.
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kEditValue);
+  EXPECT_EQ(f.state().dialog.input, "-1");
+  EXPECT_NE(f.state().dialog.error.find("k_p"), std::string::npos) << f.state().dialog.error;
+  f.key(key::kEscape);
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   // A weight rebuilds the law.
   for (int i = 0; i < 3; ++i) f.key(key::kDown);  // k_i, k_d, M
   f.key(key::kDown);                               // S

@@ -5,78 +5,16 @@
 
 #include "engine/trajectory.hpp"
 #include "ui/key_map.hpp"
+#include "tests/ui_sample_state.hpp"
 #include "ui/render.hpp"
 
 namespace bellows::ui {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-std::string all(const std::vector<std::string>& lines) {
-  std::string out;
-  for (const auto& l : lines) out += l + "\n";
-  return out;
-}
-
-bool ascii_only(const std::string& text) {
-  for (unsigned char c : text) {
-    if (c >= 0x80) return false;
-  }
-  return true;
-}
-
-// A state with `trials` trials on the paper trajectory: trial i tracks with an error that shrinks
-// as 1/(i+1), its correction is a constant 0.01 i bar, its RMS 10/(i+1) deg.
-ConsoleState sample_state(int trials, bool unicode) {
-  ConsoleState s;
-  s.width = 120;
-  s.height = 40;
-  s.unicode = unicode;
-  s.engine_state = EngineState::kArmed;
-  s.device = {"sim", true, "ok"};
-  s.loop.ticks = 123456;
-  s.loop.p50_us = 24;
-  s.loop.p99_us = 51;
-  s.loop.max_us = 80;
-  s.loop.rt = "fifo";
-  s.law_name = "noilc";
-  s.law_ready = true;
-  auto trajectory = std::make_shared<const Trajectory>(library_trajectory("paper", 0.02));
-  s.experiment = Experiment::start(trajectory);
-  const int n = trajectory->learning_samples();
-  for (int i = 0; i < trials; ++i) {
-    Trial t;
-    t.correction_bar = Eigen::VectorXd::Constant(n, 0.01 * i);
-    t.record.prepare(n, 4);
-    TrialSamples& r = t.record.samples;
-    for (int k = 0; k <= n; ++k) {
-      r.time_s(k) = k * 0.02;
-      r.setpoint_rad(k) = trajectory->angle_rad(k);
-      r.angle_rad(k) = trajectory->angle_rad(k) * (1.0 - 0.5 / (i + 1));
-      r.error_rad(k) = r.setpoint_rad(k) - r.angle_rad(k);
-      r.u_pid_bar(k) = 0.001 * k;
-      r.u_ilc_bar(k) = 0.01 * i;
-      r.pressure_a_bar(k) = 1.1;
-      r.pressure_b_bar(k) = 1.05;
-    }
-    t.record.complete = true;
-    t.summary.rms_deg = 10.0 / (i + 1);
-    t.origin = i == 0 ? "feedback only" : "learned from " + std::to_string(i - 1);
-    s.experiment.add_trial(std::move(t));
-  }
-  s.live_valid = true;
-  s.live.reading.angle_rad = 12.5 * kDeg;
-  s.live.desired_angle_rad = 12.0 * kDeg;
-  s.live.reading.chamber_bar = {1.234, 1.1};
-  s.live.reading.supply_bar = 3.0;
-  s.live.valves.inlet_duty = {0.5, 0.0};
-  s.live.valves.outlet_duty = {0.0, 0.25};
-  s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false, "", 0});
-  s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false, "", 0});
-  s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true, "", 0});
-  s.status = "hello operator";
-  return s;
-}
+using testing::all;
+using testing::ascii_only;
+using testing::kDeg;
+using testing::sample_state;
 
 TEST(UiRender, DashboardShowsStateTrajectoryIterationsAndLiveValues) {
   const ConsoleState s = sample_state(3, false);
@@ -200,7 +138,7 @@ TEST(UiRender, BelowTheMinimumSizeAClearMessage) {
   ConsoleState small = sample_state(2, true);
   small.width = 70;
   small.height = 20;
-  small.dialog = {DialogKind::kConfirmQuit, "Quit?", {"2 iterations are not saved."}, "", "q quit without saving   Esc cancel"};
+  small.dialog = {DialogKind::kConfirmQuit, "Quit?", {"2 iterations are not saved."}, "", "q quit without saving   Esc cancel", ""};
   const std::string small_text = all(render_lines(small));
   EXPECT_NE(small_text.find("Quit?"), std::string::npos) << small_text;
   EXPECT_NE(small_text.find("q quit without saving   Esc cancel"), std::string::npos);
@@ -229,7 +167,7 @@ TEST(UiRender, EveryScreenAtEverySizeInBothGlyphSets) {
           s.fault_view.code = FaultCode::kHeartbeatLost;
           s.chooser.names = {"paper", "from a file..."};
           s.chooser.preview = s.experiment.trajectory;
-          if (dialog) s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"text"}, "12345678901234567890123456789012345678901234567890123456789012345678901234567890", "hint"};
+          if (dialog) s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"text"}, "12345678901234567890123456789012345678901234567890123456789012345678901234567890", "hint", ""};
           const auto lines = render_lines(s);
           ASSERT_EQ(static_cast<int>(lines.size()), h);
           for (const auto& line : lines) EXPECT_LE(text_width(line), w);
@@ -272,7 +210,7 @@ TEST(UiRender, InspectorReadsTheValuesAtTheCursor) {
 
 TEST(UiRender, DialogsShowTheirTextInputAndKeys) {
   ConsoleState s = sample_state(1, true);
-  s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"Each iteration learns."}, "12", "Enter run   Esc cancel"};
+  s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"Each iteration learns."}, "12", "Enter run   Esc cancel", ""};
   const std::string text = all(render_lines(s));
   EXPECT_NE(text.find("Run K iterations"), std::string::npos);
   EXPECT_NE(text.find("Each iteration learns."), std::string::npos);

@@ -3,6 +3,7 @@
 #include <clocale>
 #include <ctime>
 
+#include "ui/frame_pacer.hpp"
 #include "ui/keys.hpp"
 #include "ui/render.hpp"
 #include "ui/terminal.hpp"
@@ -10,8 +11,6 @@
 namespace bellows::ui {
 namespace {
 
-constexpr double kFramePeriodS = 1.0 / 30.0;  // redraw at most 30 times a second
-constexpr double kIdleFramePeriodS = 0.1;     // live values only: 10 times a second
 constexpr int kKeyTimeoutMs = 33;
 constexpr double kDisarmWaitS = 1.0;          // on quit: how long the engine may take to disarm
 constexpr std::size_t kTelemetryCapacity = 4096;  // ~20 s of ticks at 200 Hz between two frames
@@ -65,8 +64,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   controller->resize(terminal->width(), terminal->height());
   controller->start(start_s);
   Canvas canvas(terminal->width(), terminal->height());
-  double last_draw_s = -1.0;
-  std::uint64_t drawn_revision = ~0ull;
+  FramePacer pacer;
 
   while (!controller->quit_requested()) {
     int key = terminal->read_key(kKeyTimeoutMs);
@@ -90,14 +88,9 @@ ConsoleReport run_console(ConsoleSetup setup) {
       report.exited_after_time = true;
       break;
     }
-    const double since_draw = now - last_draw_s;
-    const bool changed = controller->revision() != drawn_revision;
-    const double period = controller->active() ? kFramePeriodS : kIdleFramePeriodS;
-    if (last_draw_s < 0.0 || (since_draw >= kFramePeriodS && (changed || since_draw >= period))) {
-      drawn_revision = controller->revision();
+    if (pacer.should_draw(now, controller->revision(), controller->active())) {
       render(controller->state(), canvas);
       terminal->draw(canvas);
-      last_draw_s = now;
       ++report.frames;
     }
   }

@@ -184,6 +184,11 @@ void ConsoleController::on_event(const EngineEvent& event) {
       log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), to_string(event.command)),
           event.to == EngineState::kFault, event.time_s, routine);
     }
+      if (event.command == CommandKind::kArm && event.to == EngineState::kArmed) {
+        set_status("armed: r runs a trial, n learns and runs, N runs K iterations, Space stops");
+      } else if (event.command == CommandKind::kDisarm && event.to == EngineState::kSafe) {
+        set_status("disarmed: the valves are vented (a arms again)");
+      }
       if (event.to == EngineState::kRunning && in_flight_) {
         in_flight_->accepted = true;
         state_.run.phase = RunProgress::Phase::kSettling;

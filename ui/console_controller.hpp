@@ -100,10 +100,13 @@ class ConsoleController {
   void open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
                    std::string input = {});
   void accept_input();
+  void reject_input(std::string why);  // the prompt stays open with the input and the reason
+  void not_an_answer(int key);
   void open_trajectory_chooser();
   void preview_selected_trajectory();
   void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
-  void apply_tuning(int field, const std::string& text);
+  /// Empty when applied; otherwise why not (nothing changed).
+  std::string apply_tuning(int field, const std::string& text);
   void confirm_discard(std::string what, std::function<void()> action);
   void quit_now();
 

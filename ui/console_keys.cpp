@@ -15,6 +15,7 @@ namespace bellows::ui {
 namespace {
 
 constexpr int kMaxBatch = 1000;
+constexpr std::size_t kMaxInputBytes = 512;
 
 }  // namespace
 
@@ -31,16 +32,24 @@ void ConsoleController::handle_key(int k, double now_s) {
     return;
   }
   if (state_.width < kMinWidth || state_.height < kMinHeight) {
-    if (k == 'q') perform(Action::kQuit);  // the too-small screen offers Space and q only
+    if (k == 'q') {
+      perform(Action::kQuit);  // the too-small screen offers Space and q only
+    } else {
+      set_status(key_name(k) + ": the window is too small; enlarge it (Space stops, q quits)", true);
+    }
     return;
   }
   if (handle_screen_key(k)) return;
-  if (const auto action = action_for_key(k)) perform(*action);
+  if (const auto action = action_for_key(k)) {
+    perform(*action);
+  } else {
+    set_status(key_name(k) + " does nothing here; ? lists every key", true);
+  }
 }
 
 void ConsoleController::open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
                                     std::string input) {
-  state_.dialog = Dialog{kind, std::move(title), std::move(text), std::move(input), std::move(hint)};
+  state_.dialog = Dialog{kind, std::move(title), std::move(text), std::move(input), std::move(hint), {}};
 }
 
 bool ConsoleController::handle_dialog_key(int k) {
@@ -58,8 +67,16 @@ bool ConsoleController::handle_dialog_key(int k) {
       accept_input();
     } else if (k == key::kBackspace) {
       pop_last_code_point(d.input);
-    } else if (k >= 0x20 && k < key::kSpecial && d.input.size() < 512) {
-      append_utf8(d.input, static_cast<char32_t>(k));
+      d.error.clear();
+    } else if (k >= 0x20 && k < key::kSpecial) {
+      if (d.input.size() < kMaxInputBytes) {
+        append_utf8(d.input, static_cast<char32_t>(k));
+        d.error.clear();
+      } else {
+        d.error = format("at most %zu characters", kMaxInputBytes);
+      }
+    } else {
+      d.error = key_name(k) + " does nothing here: type, then " + d.hint;
     }
     return true;
   }
@@ -72,6 +89,8 @@ bool ConsoleController::handle_dialog_key(int k) {
       } else if (k == 'n' || k == 'N') {
         state_.dialog = {};
         set_status("not armed");
+      } else {
+        not_an_answer(k);
       }
       return true;
     case DialogKind::kConfirmDiscard:
@@ -84,6 +103,8 @@ bool ConsoleController::handle_dialog_key(int k) {
         state_.dialog = {};
         pending_discard_action_ = nullptr;
         set_status("cancelled");
+      } else {
+        not_an_answer(k);
       }
       return true;
     case DialogKind::kConfirmQuit:
@@ -96,6 +117,11 @@ bool ConsoleController::handle_dialog_key(int k) {
         quit_now();
       } else if (k == 'n' || k == 'c') {
         state_.dialog = {};
+        set_status("cancelled");
+      } else if (k == 's') {
+        d.error = "cannot save: " + state_.sessions_unavailable_reason;
+      } else {
+        not_an_answer(k);
       }
       return true;
     default:
@@ -103,16 +129,25 @@ bool ConsoleController::handle_dialog_key(int k) {
   }
 }
 
+void ConsoleController::not_an_answer(int k) {
+  state_.dialog.error = key_name(k) + " is not an answer here: " + state_.dialog.hint;
+}
+
+void ConsoleController::reject_input(std::string why) {
+  state_.dialog.error = why;  // the dialog stays open with what was typed
+  set_status(std::move(why), true);
+}
+
 void ConsoleController::accept_input() {
-  Dialog d = state_.dialog;
-  state_.dialog = {};
+  const Dialog& d = state_.dialog;
   switch (d.kind) {
     case DialogKind::kAskIterations: {
       double k = 0;
-      if (!parse_number(d.input, k) || k < 1 || k > kMaxBatch || std::floor(k) != k) {
-        set_status(format("K must be a whole number from 1 to %d, not '%s'", kMaxBatch, d.input.c_str()), true);
+      if (!parse_number(trim(d.input), k) || k < 1 || k > kMaxBatch || std::floor(k) != k) {
+        reject_input(format("K must be a whole number from 1 to %d, not '%s'", kMaxBatch, d.input.c_str()));
         return;
       }
+      state_.dialog = {};
       if (!availability(Action::kRunIterations, state_).available) {
         set_status("cannot run iterations now: " + availability(Action::kRunIterations, state_).reason, true);
         return;
@@ -126,14 +161,32 @@ void ConsoleController::accept_input() {
       return;
     }
     case DialogKind::kTrajectoryPath: {
-      state_.chooser.file_path = d.input;
+      const std::string path = expand_home(trim(d.input));
+      if (path.empty()) {
+        reject_input("type the path of a CSV file (time_s,angle_deg), or Esc");
+        return;
+      }
+      state_.dialog = {};
+      state_.chooser.file_path = path;
       preview_selected_trajectory();
+      if (!state_.chooser.preview_error.empty()) {
+        set_status(state_.chooser.preview_error + " (Enter: another path)", true);
+      } else {
+        set_status("preview of " + path + ": Enter uses it");
+      }
       return;
     }
-    case DialogKind::kEditValue:
-      apply_tuning(state_.tuning.selected, d.input);
+    case DialogKind::kEditValue: {
+      const std::string why = apply_tuning(state_.tuning.selected, d.input);
+      if (!why.empty()) {
+        reject_input(why);
+        return;
+      }
+      state_.dialog = {};
       return;
+    }
     default:
+      state_.dialog = {};
       return;
   }
 }

@@ -204,23 +204,22 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
   });
 }
 
-void ConsoleController::apply_tuning(int field, const std::string& text) {
+std::string ConsoleController::apply_tuning(int field, const std::string& text) {
   const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
   double value = 0;
-  if (!parse_number(text, value)) {
-    set_status(std::string(f.label) + ": '" + text + "' is not a number", true);
-    return;
-  }
+  if (!parse_number(trim(text), value)) return std::string(f.label) + ": '" + text + "' is not a number";
   Configuration candidate = state_.config;
   const double old = *f.value(candidate);
   *f.value(candidate) = value;
   try {
     validate_configuration(candidate);
   } catch (const InputError& error) {
-    set_status(error.what(), true);
-    return;
+    return error.what();
   }
-  if (old == value) return;
+  if (old == value) {
+    set_status(format("%s stays %g", f.label, value));
+    return {};
+  }
   state_.config = candidate;
   state_.experiment.settings_changed = true;
   log(LogSource::kOperator, format("%s changed %g -> %g (%s)", f.label, old, value, f.config_key));
@@ -230,6 +229,7 @@ void ConsoleController::apply_tuning(int field, const std::string& text) {
     send_gains();
   }
   set_status(format("%s = %g from the next trial on", f.label, value));
+  return {};
 }
 
 }  // namespace bellows::ui

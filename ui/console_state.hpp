@@ -35,6 +35,7 @@ struct Dialog {
   std::vector<std::string> text;
   std::string input;   // what the operator typed (prompts)
   std::string hint;    // the keys, e.g. "y arm   n cancel"
+  std::string error;   // why the last answer was not taken (the dialog stays open, the input kept)
 };
 
 struct DeviceHealth {

@@ -1,5 +1,6 @@
 #include "ui/key_map.hpp"
 
+#include "ui/canvas.hpp"
 #include "ui/keys.hpp"
 
 namespace bellows::ui {
@@ -137,11 +138,43 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
     candidates = {Action::kArm, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave, Action::kOpen,
                   Action::kLog, Action::kHelp, Action::kQuit};
   }
+  if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
+    const bool stop_first = candidates.front() == Action::kEmergencyStop;
+    candidates.insert(candidates.begin() + (stop_first ? 1 : 0), Action::kMain);
+  }
   std::vector<Action> shown;
   for (Action a : candidates) {
     if (availability(a, s).available) shown.push_back(a);
   }
   return shown;
+}
+
+std::string key_name(int k) {
+  switch (k) {
+    case key::kEnter: return "Enter";
+    case key::kEscape: return "Esc";
+    case key::kUp: return "Up";
+    case key::kDown: return "Down";
+    case key::kLeft: return "Left";
+    case key::kRight: return "Right";
+    case key::kPageUp: return "PgUp";
+    case key::kPageDown: return "PgDn";
+    case key::kHome: return "Home";
+    case key::kEnd: return "End";
+    case key::kBackspace: return "Backspace";
+    case key::kF1: return "F1";
+    case key::kTab: return "Tab";
+    case ' ': return "Space";
+    default: break;
+  }
+  if (k > 0x20 && k < 0x7f) return std::string(1, static_cast<char>(k));
+  if (k >= 0 && k < 0x20) return "Ctrl-" + std::string(1, static_cast<char>('@' + k));
+  if (k >= 0x80 && k < key::kSpecial) {
+    std::string text;
+    append_utf8(text, static_cast<char32_t>(k));
+    return text;
+  }
+  return "this key";
 }
 
 std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {

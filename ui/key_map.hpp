@@ -55,6 +55,9 @@ Availability availability(Action action, const ConsoleState& state);
 /// The commands that matter in the current state, most important first (the function bar).
 std::vector<Action> function_bar_actions(const ConsoleState& state);
 
+/// A key as the operator knows it: "z", "Left", "F5" (for messages about keys).
+std::string key_name(int key);
+
 /// Keys of the current screen beyond the global ones: (key, what it does).
 std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen);
 

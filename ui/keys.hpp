@@ -20,5 +20,6 @@ inline constexpr int kBackspace = kSpecial + 11;
 inline constexpr int kF1 = kSpecial + 12;
 inline constexpr int kResize = kSpecial + 13;
 inline constexpr int kTab = kSpecial + 14;
+inline constexpr int kOther = kSpecial + 15;  // a function key the console has no use for
 
 }  // namespace bellows::ui::key

@@ -215,6 +215,9 @@ void legend(Canvas& canvas, const Rect& frame, const std::vector<LegendItem>& it
     canvas.put_glyph(x++, frame.y, glyphs.unicode ? U'■' : static_cast<char32_t>(item.ascii_mark), item.role, true);
     x = canvas.put(x, frame.y, " " + item.label, Role::kDim);
   }
+  // Up to the corner: the frame's line again (a long title may have run under the legend).
+  const Cell corner = canvas.at(frame.right() - 1, frame.y);
+  for (; x < frame.right() - 1; ++x) canvas.put_glyph(x, frame.y, glyphs.horizontal, corner.role, corner.bold);
 }
 
 }  // namespace bellows::ui

@@ -31,6 +31,16 @@ const char* state_words(EngineState state) {
 
 double to_deg(double rad) { return rad * 180.0 / std::numbers::pi; }
 
+std::string number(const char* fmt, double value) {
+  std::string text = format(fmt, value);
+  const auto minus = text.find('-');
+  if (minus != std::string::npos && text.find_first_of("123456789") == std::string::npos) {
+    text[minus] = ' ';  // a fixed-width field keeps its width
+    if (minus == 0) text.erase(0, 1);
+  }
+  return text;
+}
+
 Rect inner(const Rect& a) { return {a.x + 1, a.y + 1, a.width - 2, a.height - 2}; }
 
 void render_log_lines(const ConsoleState& s, Canvas& c, const Rect& area) {
@@ -54,42 +64,94 @@ namespace {
 
 using namespace detail;
 
-void render_header(const ConsoleState& s, Canvas& c) {
-  int x = c.put(0, 0, " Bellows ", Role::kTitle, true);
+struct Segment {
+  int gap;  // blank columns before it
+  std::string text;
+  Role role;
+  bool bold;
+};
+
+void put_segments(Canvas& c, int y, const std::vector<Segment>& segments) {
+  int x = 0;
+  for (const Segment& g : segments) x = c.put(x + g.gap, y, g.text, g.role, g.bold);
+}
+
+int segments_width(const std::vector<Segment>& segments) {
+  int width = 0;
+  for (const Segment& g : segments) width += g.gap + text_width(g.text);
+  return width;
+}
+
+/// The first line: what must be seen at a glance. Narrow windows get a compact form (the best RMS
+/// dropped, then the labels and the state's words, then both) so that the state, trajectory,
+/// iteration and RMS stay on screen down to 80 columns whatever the state.
+std::vector<Segment> header_segments(const ConsoleState& s, int level) {
+  const bool labels = level < 2;
+  const bool best = level % 2 == 0;
+  std::vector<Segment> out;
+  out.push_back({0, " Bellows ", Role::kTitle, true});
   std::string state = format(" %s ", to_string(s.engine_state));
   if (s.engine_state == EngineState::kFault) state = format(" FAULT: %s ", fault_name(s.fault));
-  x = c.put(x + 1, 0, state, state_role(s.engine_state), true);
-  x = c.put(x, 0, format(" %s ", state_words(s.engine_state)), Role::kDim);
-  x = c.put(x + 1, 0, "device ", Role::kDim);
-  x = c.put(x, 0, s.device.name + ": " + s.device.status, s.device.ok ? Role::kGood : Role::kWarning);
+  out.push_back({1, state, state_role(s.engine_state), true});
+  if (labels) out.push_back({0, format(" %s ", state_words(s.engine_state)), Role::kDim, false});
+  if (labels) out.push_back({1, "device ", Role::kDim, false});
+  out.push_back({labels ? 0 : 2, s.device.name + ": " + s.device.status, s.device.ok ? Role::kGood : Role::kWarning, false});
   const Experiment& e = s.experiment;
   if (e.trajectory) {
-    x = c.put(x + 2, 0, "trajectory ", Role::kDim);
-    x = c.put(x, 0, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()), Role::kNormal, true);
+    if (labels) out.push_back({2, "trajectory ", Role::kDim, false});
+    out.push_back({labels ? 0 : 2, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()),
+                   Role::kNormal, true});
   }
-  x = c.put(x + 2, 0, "iteration ", Role::kDim);
-  x = c.put(x, 0, format("%d", e.next_iteration()), Role::kNormal, true);
+  out.push_back({2, labels ? "iteration " : "it ", Role::kDim, false});
+  out.push_back({0, format("%d", e.next_iteration()), Role::kNormal, true});
   if (!e.trials.empty()) {
-    x = c.put(x + 2, 0, "RMS ", Role::kDim);
-    x = c.put(x, 0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true);
-    c.put(x, 0, format(" (best %.3f)", e.best_rms_deg()), Role::kDim);
+    out.push_back({2, "RMS ", Role::kDim, false});
+    out.push_back({0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true});
+    if (best) out.push_back({0, format(" (best %.3f)", e.best_rms_deg()), Role::kDim, false});
   }
+  return out;
+}
 
+/// The second line: loop health and the learning; compact forms drop the weights (the tuning
+/// screen shows them), then shorten the latency, then drop its labels.
+std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   const LoopHealth& l = s.loop;
-  x = c.put(1, 1, "loop ", Role::kDim);
-  x = c.put(x, 1, format("%.0f Hz x%s %s", l.tick_hz, l.speed.c_str(), l.rt.c_str()));
-  x = c.put(x + 2, 1, "missed ", Role::kDim);
-  x = c.put(x, 1, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood);
+  std::vector<Segment> out;
+  out.push_back({1, level < 3 ? "loop " : "", Role::kDim, false});
+  out.push_back({0, format("%.0f Hz x%s %s", l.tick_hz, l.speed.c_str(), l.rt.c_str()), Role::kNormal, false});
+  out.push_back({2, "missed ", Role::kDim, false});
+  out.push_back({0, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood,
+                 false});
   if (l.realtime && l.speed != "max") {
-    x = c.put(x + 2, 1, "latency ", Role::kDim);
-    x = c.put(x, 1, format("p50 %.0f p99 %.0f max %.0f us", l.p50_us, l.p99_us, l.max_us));
+    out.push_back({2, level < 3 ? "latency " : "", Role::kDim, false});
+    out.push_back({0,
+                   level < 2 ? format("p50 %.0f p99 %.0f max %.0f us", l.p50_us, l.p99_us, l.max_us)
+                             : format("p99 %.0f max %.0f us", l.p99_us, l.max_us),
+                   Role::kNormal, false});
   } else if (l.realtime) {
-    x = c.put(x + 2, 1, "unpaced", Role::kDim);
+    out.push_back({2, "unpaced", Role::kDim, false});
   }
-  x = c.put(x + 2, 1, "law ", Role::kDim);
-  x = c.put(x, 1, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning);
-  x = c.put(x + 2, 1, format("M %g S %g W %g", s.config.ilc.m, s.config.ilc.s, s.config.ilc.w), Role::kDim);
-  if (s.experiment.unsaved() && !s.experiment.trials.empty()) c.put(x + 2, 1, "unsaved", Role::kWarning);
+  out.push_back({2, "law ", Role::kDim, false});
+  out.push_back({0, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning, false});
+  if (level == 0) {
+    out.push_back({2, format("M %g S %g W %g", s.config.ilc.m, s.config.ilc.s, s.config.ilc.w), Role::kDim, false});
+  }
+  if (s.experiment.unsaved() && !s.experiment.trials.empty()) out.push_back({2, "unsaved", Role::kWarning, false});
+  return out;
+}
+
+void render_header(const ConsoleState& s, Canvas& c) {
+  std::vector<Segment> line;
+  for (int level = 0; level < 4; ++level) {
+    line = header_segments(s, level);
+    if (segments_width(line) <= c.width()) break;
+  }
+  put_segments(c, 0, line);
+  for (int level = 0; level < 4; ++level) {
+    line = loop_segments(s, level);
+    if (segments_width(line) <= c.width()) break;
+  }
+  put_segments(c, 1, line);
 }
 
 void render_status(const ConsoleState& s, Canvas& c) {
@@ -120,11 +182,12 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
   int content_width = text_width(d.title) + 4;
   for (const std::string& line : d.text) content_width = std::max(content_width, text_width(line));
-  content_width = std::max({content_width, text_width(d.hint), 40});
+  content_width = std::max({content_width, text_width(d.hint), text_width(d.error), 40});
   const int width = std::min(content_width + 4, c.width() - 4);
   const bool has_input = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
                          d.kind == DialogKind::kEditValue;
-  const int height = static_cast<int>(d.text.size()) + (has_input ? 2 : 0) + 4;
+  const std::vector<std::string> error = d.error.empty() ? std::vector<std::string>{} : wrap(d.error, width - 4);
+  const int height = static_cast<int>(d.text.size() + error.size()) + (has_input ? 2 : 0) + 4;
   const Rect box{(c.width() - width) / 2, std::max(2, (c.height() - height) / 2), width, height};
   c.fill(box, U' ');
   c.frame(box, g, d.title, Role::kWarning);
@@ -143,6 +206,7 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
     c.put(box.x + 4, y, fit(visible + "_", field), Role::kSelected);
     ++y;
   }
+  for (const std::string& line : error) c.put(box.x + 2, y++, line, Role::kWarning, true, box.right() - 2);
   c.put(box.x + 2, box.bottom() - 2, d.hint, Role::kDim, false, box.right() - 2);
 }
 

@@ -49,12 +49,12 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
   }
   const TickRecord& t = s.live;
   int row = 0;
-  value_row(c, in, row++, "angle", format("%7.2f deg", to_deg(t.reading.angle_rad)));
-  value_row(c, in, row++, "set point", format("%7.2f deg", to_deg(t.desired_angle_rad)));
-  value_row(c, in, row++, "error", format("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
-  value_row(c, in, row++, "p A", format("%7.3f bar", t.reading.chamber_bar[0]));
-  value_row(c, in, row++, "p B", format("%7.3f bar", t.reading.chamber_bar[1]));
-  value_row(c, in, row++, "supply", format("%7.3f bar", t.reading.supply_bar),
+  value_row(c, in, row++, "angle", number("%7.2f deg", to_deg(t.reading.angle_rad)));
+  value_row(c, in, row++, "set point", number("%7.2f deg", to_deg(t.desired_angle_rad)));
+  value_row(c, in, row++, "error", number("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
+  value_row(c, in, row++, "p A", number("%7.3f bar", t.reading.chamber_bar[0]));
+  value_row(c, in, row++, "p B", number("%7.3f bar", t.reading.chamber_bar[1]));
+  value_row(c, in, row++, "supply", number("%7.3f bar", t.reading.supply_bar),
             t.reading.supply_bar < s.config.safety.supply_min_bar ? Role::kWarning : Role::kNormal);
   duty_row(c, in, row++, "in A", t.valves.inlet_duty[0], g);
   duty_row(c, in, row++, "out A", t.valves.outlet_duty[0], g);

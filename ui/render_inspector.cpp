@@ -74,13 +74,13 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   readout_row(c, in, row, "iteration", format("%d", t.iteration));
   readout_row(c, in, row, "sample", format("%d / %d", k, t.record.learning_samples));
   readout_row(c, in, row, "time", format("%.2f s", cursor_s));
-  readout_row(c, in, row, "set point", format("%.2f deg", to_deg(samples.setpoint_rad(k))));
-  readout_row(c, in, row, "angle", format("%.2f deg", to_deg(samples.angle_rad(k))));
-  readout_row(c, in, row, "error", format("%.2f deg", to_deg(samples.error_rad(k))));
-  readout_row(c, in, row, "u_pid", format("%.4f bar", samples.u_pid_bar(k)));
-  readout_row(c, in, row, "u_ilc", format("%.4f bar", samples.u_ilc_bar(k)));
-  readout_row(c, in, row, "p A", format("%.3f bar", samples.pressure_a_bar(k)));
-  readout_row(c, in, row, "p B", format("%.3f bar", samples.pressure_b_bar(k)));
+  readout_row(c, in, row, "set point", number("%.2f deg", to_deg(samples.setpoint_rad(k))));
+  readout_row(c, in, row, "angle", number("%.2f deg", to_deg(samples.angle_rad(k))));
+  readout_row(c, in, row, "error", number("%.2f deg", to_deg(samples.error_rad(k))));
+  readout_row(c, in, row, "u_pid", number("%.4f bar", samples.u_pid_bar(k)));
+  readout_row(c, in, row, "u_ilc", number("%.4f bar", samples.u_ilc_bar(k)));
+  readout_row(c, in, row, "p A", number("%.3f bar", samples.pressure_a_bar(k)));
+  readout_row(c, in, row, "p B", number("%.3f bar", samples.pressure_b_bar(k)));
   if (readout.bottom() + 3 <= body.bottom()) {
     const int y = readout.bottom();
     c.put(readout.x + 1, y, "m overlay this iteration", Role::kDim);
@@ -95,15 +95,20 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(body.x + 2, body.y + 1, "No fault so far.", Role::kDim);
     return;
   }
-  int x = c.put(body.x + 1, body.y, format(" %s ", fault_name(f.code)), Role::kFault, true);
-  c.put(x + 1, body.y, fault_message(f.code), Role::kWarning, true);
+  // The guard and what it means, then when it vented: wrapped, never cut off.
+  int y = body.y;
+  const int x = c.put(body.x + 1, y, format(" %s ", fault_name(f.code)), Role::kFault, true);
+  for (const std::string& line : wrap(fault_message(f.code), body.right() - x - 2)) {
+    c.put(x + 1, y++, line, Role::kWarning, true);
+  }
   const bool latched = s.engine_state == EngineState::kFault;
-  c.put(body.x + 1, body.y + 1,
-        format("at engine time %.3f s; the valves were vented in that tick.  %s", f.time_s,
-               latched ? "Latched: R resets to SAFE, then a arms again." : "Reset since then."),
-        latched ? Role::kNormal : Role::kDim);
+  const std::string when = format("vented at engine time %.3f s, in the tick the fault was seen; %s", f.time_s,
+                                  latched ? "latched: R resets to SAFE, then a arms again." : "reset since then.");
+  for (const std::string& line : wrap(when, body.width - 2)) {
+    c.put(body.x + 1, y++, line, latched ? Role::kNormal : Role::kDim);
+  }
   if (f.black_box.empty()) {
-    c.put(body.x + 1, body.y + 3, "The black box was not captured.", Role::kDim);
+    c.put(body.x + 1, y + 1, "The black box was not captured.", Role::kDim);
     return;
   }
   const std::size_t n = f.black_box.size();
@@ -118,8 +123,8 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     supply[i] = t.reading.supply_bar;
   }
   constexpr int kTableRows = 8;
-  const int plot_height = std::max(6, body.height - 2 - (kTableRows + 3));
-  const Rect left{body.x, body.y + 2, body.width / 2, plot_height};
+  const int plot_height = std::max(6, body.bottom() - y - (kTableRows + 3));
+  const Rect left{body.x, y, body.width / 2, plot_height};
   const Rect right{left.right(), left.y, body.width - left.width, plot_height};
   PlotOptions options;
   options.braille = s.unicode;

@@ -133,13 +133,32 @@ void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
   const auto& entries = s.log.entries();
   const int count = static_cast<int>(entries.size());
   const int last = std::max(0, count - 1 - s.log_scroll);
-  const int first = std::max(0, last - in.height + 1);
-  for (int i = first, y = in.y; i <= last && i < count; ++i, ++y) {
+  // Long entries wrap under their text: nothing the operator or the engine said is cut off.
+  const int text_x = in.x + 1 + 8 + 1 + 11 + 1 + 9;  // clock, engine time, source
+  const int text_width_cells = std::max(10, in.right() - text_x);
+  struct Row {
+    const LogEntry* entry;
+    std::string text;
+    bool first;
+  };
+  std::vector<Row> rows;  // newest first, until the screen is full
+  for (int i = last; i >= 0 && i < count && static_cast<int>(rows.size()) < in.height; --i) {
     const LogEntry& e = entries[static_cast<std::size_t>(i)];
-    int x = c.put(in.x + 1, y, e.clock, Role::kDim);
-    x = c.put(x + 1, y, e.engine_time_s >= 0.0 ? format("%9.2f s", e.engine_time_s) : std::string(11, ' '), Role::kDim);
-    x = c.put(x + 1, y, fit(to_string(e.source), 9), Role::kTitle);
-    c.put(x, y, e.text, e.important ? Role::kWarning : Role::kNormal, e.important, in.right());
+    std::vector<std::string> lines = wrap(e.text, text_width_cells);
+    if (lines.empty()) lines.emplace_back();
+    for (std::size_t j = lines.size(); j-- > 0;) rows.push_back({&e, lines[j], j == 0});
+  }
+  const int shown = std::min(static_cast<int>(rows.size()), in.height);
+  for (int r = 0; r < shown; ++r) {
+    const Row& row = rows[static_cast<std::size_t>(shown - 1 - r)];
+    const int y = in.y + r;
+    const LogEntry& e = *row.entry;
+    if (row.first) {
+      int x = c.put(in.x + 1, y, e.clock, Role::kDim);
+      x = c.put(x + 1, y, e.engine_time_s >= 0.0 ? format("%9.2f s", e.engine_time_s) : std::string(11, ' '), Role::kDim);
+      c.put(x + 1, y, fit(to_string(e.source), 9), Role::kTitle);
+    }
+    c.put(text_x, y, row.text, e.important ? Role::kWarning : Role::kNormal, e.important, in.right());
   }
 }
 

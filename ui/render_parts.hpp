@@ -11,6 +11,8 @@ namespace bellows::ui::detail {
 Role state_role(EngineState state);
 const char* state_words(EngineState state);
 double to_deg(double rad);
+/// format(fmt, value) without the sign of a zero that rounding made negative ("-0.00").
+std::string number(const char* fmt, double value);
 /// Inside of a frame: the area minus its border.
 Rect inner(const Rect& area);
 

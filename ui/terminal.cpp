@@ -80,7 +80,7 @@ int translate(int status, wint_t ch) {
       case KEY_BACKSPACE: return key::kBackspace;
       case KEY_ENTER: return key::kEnter;
       case KEY_F(1): return key::kF1;
-      default: return key::kNone;
+      default: return key::kOther;  // said to do nothing, rather than ignored in silence
     }
   }
   switch (ch) {

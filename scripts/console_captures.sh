@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# Captures every console screen from the real binary in tmux, for docs/console.md:
+#   scripts/console_captures.sh build/app/bellows OUT_DIR [WIDTH HEIGHT]
+# One run on the simulated arm (--speed max, --rt off: it never asks for real-time scheduling),
+# in a private data directory; each screen goes to OUT_DIR/NAME.txt as `tmux capture-pane -p`
+# shows it, and the closing summary to OUT_DIR/summary.txt.
+set -euo pipefail
+out="${2:?usage: $0 path/to/bellows OUT_DIR [WIDTH HEIGHT]}"
+width="${3:-100}"
+height="${4:-32}"
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
+source "$(dirname "$0")/../tests/e2e_console_lib.sh" "$1"
+
+capture() { sleep 0.5; e2e_screen > "$out/$1.txt"; }
+
+python3 - "$E2E_DIR/wave.csv" <<'EOF'
+import math, sys
+with open(sys.argv[1], "w") as f:
+    f.write("time_s,angle_deg\n")
+    for i in range(301):
+        f.write("%.2f,%.4f\n" % (i * 0.02, 20 * math.sin(2 * math.pi * 0.5 * i * 0.02)))
+EOF
+
+e2e_start "$width" "$height" -- console --speed max --rt off
+e2e_wait_for 'law [a-z-]+ '
+e2e_keys '?'
+e2e_wait_for 'Keys \(greyed'
+capture help-safe
+e2e_keys Escape a
+e2e_wait_for 'Arm the valves\?'
+capture arm
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+
+e2e_keys N
+e2e_wait_for 'Run K iterations'
+e2e_keys BSpace BSpace 2 . 5 Enter
+e2e_wait_for 'K must be a whole number'
+capture ask-k-refused
+e2e_keys BSpace BSpace BSpace 5 Enter
+e2e_wait_for 'batch of 5 done' 300
+capture main
+e2e_keys q
+e2e_wait_for 'Quit\?'
+capture quit
+e2e_keys Escape
+
+e2e_keys c
+e2e_wait_for 'At the cursor'
+e2e_keys PageDown PageDown PageDown Right Right Right Up Up m Down
+e2e_wait_for 'overlay: it 2'
+capture inspector
+e2e_keys Escape t
+e2e_wait_for 'Trajectories'
+e2e_keys Down Down Down Enter
+e2e_wait_for 'Trajectory file'
+e2e_keys -l "$E2E_DIR/wave.csv"
+e2e_keys Enter
+e2e_wait_for 'wave: 6.0 s'
+capture trajectory-file
+e2e_keys Escape w
+e2e_wait_for 'Gains and learning weights'
+capture tuning
+e2e_keys Escape s
+e2e_wait_for 'saved: '
+e2e_keys l
+e2e_wait_for 'Event log'
+capture log
+e2e_keys Escape d
+e2e_wait_for 'Bellows +SAFE '
+e2e_keys o
+e2e_wait_for 'best RMS'
+capture sessions
+e2e_keys Escape a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys r Space  # a trial starts and is stopped at once (at --speed max it would be over before a look)
+e2e_wait_for 'Last ticks before the fault'
+capture fault
+e2e_resize 70 20
+e2e_wait_for 'Terminal too small'
+capture too-small
+e2e_resize "$width" "$height"
+e2e_wait_for 'R Reset'
+e2e_keys q
+sleep 1
+e2e_screen | grep -q 'Quit?' && e2e_keys q
+e2e_wait_exit > /dev/null
+e2e_history | grep -A3 '^bellows console:' | grep -v '^EXIT STATUS' > "$out/summary.txt"
+echo "captures in $out: $(ls "$out" | tr '\n' ' ')"
