@@ -55,6 +55,7 @@ std::vector<ParameterBinding> make_bindings() {
       number("model", "kappa", "rad/bar", "nominal static gain", kPos, [](C& c) { return &c.model.kappa_rad_per_bar; }),
       number("model", "omega0", "rad/s", "nominal natural frequency", kPos, [](C& c) { return &c.model.omega0_rad_per_s; }),
       number("model", "damping", "", "nominal damping ratio", kPos, [](C& c) { return &c.model.damping; }),
+      number("model", "volume_gain", "1/rad", "beta of V = V0 (1 +- beta alpha) the convergence prediction assumes", kNonNeg, [](C& c) { return &c.model.volume_gain_per_rad; }),
       // [controller]
       number("controller", "k_ff", "", "feed-forward gain (normalized)", kAny, [](C& c) { return &c.controller.k_ff; }),
       number("controller", "k_p", "", "proportional gain (normalized)", kNonNeg, [](C& c) { return &c.controller.k_p; }),
@@ -76,6 +77,7 @@ std::vector<ParameterBinding> make_bindings() {
       whole("ilc", "admm_max_iterations", "noilc-constrained: ADMM iteration limit per update", [](C& c) { return &c.ilc.admm_max_iterations; }),
       number("ilc", "admm_tolerance", "bar", "noilc-constrained: ADMM residual tolerance", kPos, [](C& c) { return &c.ilc.admm_tolerance; }),
       number("ilc", "limit_margin_bar", "bar", "noilc-constrained: keep u_pid + u_ilc this far inside the pressure limits", kNonNeg, [](C& c) { return &c.ilc.limit_margin_bar; }),
+      number("ilc", "limit_recovery_s", "s", "noilc-constrained: errors this long after a set point on the pressure limit are not learned from", kNonNeg, [](C& c) { return &c.ilc.limit_recovery_s; }),
       number("ilc", "pd_kp", "", "pd: proportional learning gain", kAny, [](C& c) { return &c.ilc.pd_kp; }),
       number("ilc", "pd_kd_s", "s", "pd: derivative learning gain", kAny, [](C& c) { return &c.ilc.pd_kd_s; }),
       number("ilc", "pd_q_cutoff_hz", "Hz", "pd: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.pd_q_cutoff_hz; }),

@@ -21,7 +21,8 @@ struct ActuatedArm {
   Eigen::RowVector3d C;
 };
 
-ActuatedArm actuated_arm(const ModelParameters& arm, double tau_p_s, double sample_time_s) {
+ActuatedArm actuated_arm(const ModelParameters& arm, double tau_p_s, double ambient_bar, double sample_time_s) {
+  constexpr double kVelocityScale = 10.0 * std::numbers::pi;  // x2 = alpha_dot / (10 pi), spec section 2
   Eigen::Matrix2d Ac;
   Eigen::Vector2d Bc;
   continuous_arm_model(arm, Ac, Bc);
@@ -30,6 +31,7 @@ ActuatedArm actuated_arm(const ModelParameters& arm, double tau_p_s, double samp
   augmented.block<2, 1>(0, 2) = Bc;  // the arm is driven by the achieved pressure difference
   augmented(2, 2) = -1.0 / tau_p_s;
   augmented(2, 3) = 1.0 / tau_p_s;   // which follows the commanded one with time constant tau_p
+  augmented(2, 1) = -2.0 * ambient_bar * arm.volume_gain_per_rad * kVelocityScale;  // minus the bounce-back
   const Eigen::Matrix4d exponential = (augmented * sample_time_s).exp();
   ActuatedArm d;
   d.A = exponential.topLeftCorner<3, 3>();
@@ -55,7 +57,7 @@ ContractionEstimate estimate(const LearningLaw& law, const Configuration& config
   truth.kappa_rad_per_bar *= kappa_scale;
   truth.omega0_rad_per_s *= omega0_scale;
   const double T = config.timing.sample_s();
-  const ActuatedArm arm = actuated_arm(truth, config.controller.tau_p_s, T);
+  const ActuatedArm arm = actuated_arm(truth, config.controller.tau_p_s, config.controller.gas.ambient_bar, T);
   ContractionEstimate e{kappa_scale, omega0_scale, 0.0, 0.0};
   // Log-spaced from the lowest resolved frequency to Nyquist: slow modes and resonances both matter.
   for (int i = 0; i < points; ++i) {

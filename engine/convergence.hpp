@@ -5,7 +5,8 @@
 // frequency theta as U_{j+1} = Lu U_j + Le E_j. The correction reaches the arm through the PID loop,
 // so the true map from correction to error is the closed loop Pcl = z G / (1 + G C_pid), G the arm
 // (kappa and omega0 scaled by the model error) behind the pressure controllers' designed first-order
-// response (tau_p). Then U_{j+1} = lambda U_j + Le R with lambda = Lu - Le Pcl: each frequency of the
+// response (tau_p), including the damping of the bellows' volume change with angle ([model]
+// volume_gain), which the pressure loop leaves uncompensated. Then U_{j+1} = lambda U_j + Le R with lambda = Lu - Le Pcl: each frequency of the
 // correction (and of the error) contracts by |lambda| per trial. The predicted contraction is the
 // largest |lambda| over the frequencies a trial of N samples resolves, [1/(N T), Nyquist];
 // above 1 somewhere, learning may diverge there.

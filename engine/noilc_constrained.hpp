@@ -8,6 +8,13 @@
 // O(N) sweep); only if that violates a bound it runs ADMM (over-relaxed, scaled form), whose inner
 // step is the O(N) Riccati sweep with a proximal term and whose projection is a clamp. The result is
 // always the projected iterate, so the returned correction is feasible whatever the iteration count.
+//
+// With a trial context (set_input_context), the errors of the outputs within `limit_recovery_s` after
+// an input whose set point sat on the pressure limit in that trial carry no weight: there the valves'
+// flow limit and the bellows' bounce-back shaped the response, which the linear model mispredicts;
+// fitting those errors by pushing the neighbouring samples makes tracking worse on the arm
+// (docs/learning-laws.md has the measurements). Without a context (set_bounds) the update is the
+// plain bounded optimum.
 #pragma once
 
 #include "engine/noilc_riccati.hpp"
@@ -20,6 +27,7 @@ class NormOptimalConstrained final : public LearningLaw {
     int admm_iterations = 0;     // 0 when the unconstrained optimum was feasible
     bool converged = true;       // residuals below tolerance within the iteration limit
     int active_samples = 0;      // samples on a bound
+    int unweighted_errors = 0;   // error samples left out after inputs on the pressure limit
     double primal_residual = 0.0;
     double dual_residual = 0.0;
   };
@@ -34,6 +42,7 @@ class NormOptimalConstrained final : public LearningLaw {
   std::optional<LawFrequencyResponse> frequency_response(double theta_rad_per_sample) const override;
 
   /// Bounds for the next update directly (instead of from the feedback); lower <= upper elementwise.
+  /// Drops the trial context: the next update is the plain bounded optimum.
   void set_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower_bar, const Eigen::Ref<const Eigen::VectorXd>& upper_bar);
   const Eigen::VectorXd& lower_bound() const { return lower_; }
   const Eigen::VectorXd& upper_bound() const { return upper_; }
@@ -41,12 +50,20 @@ class NormOptimalConstrained final : public LearningLaw {
   std::size_t memory_bytes() const;
 
  private:
+  /// Zeroes, in weighted_error_, the errors after the inputs u_j that sat on the limit in the last trial.
+  void leave_out_limited_errors(const Eigen::Ref<const Eigen::VectorXd>& u_j);
+
   DiscreteArmModel model_;
   IlcParameters parameters_;
+  int recovery_samples_;                // outputs left out after an input on the limit
   RiccatiNoilcSolver free_;      // rho = 0: the unconstrained optimum
   RiccatiNoilcSolver proximal_;  // rho = admm_rho: the ADMM step
   Eigen::VectorXd lower_, upper_;
   Eigen::VectorXd x_, z_, z_previous_, dual_, target_;
+  Eigen::VectorXd feedback_, weighted_error_;
+  double reach_bar_ = 0.0;
+  bool has_trial_context_ = false;
+  Eigen::VectorXd previous_lower_, previous_upper_;  // the bounds u_j was planned against
   Report report_;
 };
 

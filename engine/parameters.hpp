@@ -48,6 +48,10 @@ struct ModelParameters {
   double kappa_rad_per_bar = 7.91;
   double omega0_rad_per_s = 14.14;
   double damping = 0.31;
+  // beta of the bellows' volumes V = V0 (1 +- beta alpha). The pressure loop does not compensate the
+  // volume change, so moving the arm changes dp against the motion ("bounce-back"): extra damping
+  // that the convergence prediction includes (docs/learning-laws.md).
+  double volume_gain_per_rad = 0.35;
 };
 
 /// Controllers (spec section 3).
@@ -81,6 +85,10 @@ struct IlcParameters {
   int admm_max_iterations = 2000;
   double admm_tolerance = 1.0e-7;   // bar, on the primal and dual residuals
   double limit_margin_bar = 0.0;    // keep u_pid + u_ilc this far inside the pressure limits
+  // After an input sample whose set point sat on the pressure limit in the last trial, the errors of
+  // this long are not weighted: the valves' flow limit, not the correction, shaped them, and the
+  // nominal model mispredicts them (docs/learning-laws.md). 0 = the plain bounded optimum.
+  double limit_recovery_s = 0.08;
   // pd: u_{j+1} = Q[u_j + k_p e + k_d de/dt]
   // (defaults: the best tuning on the paper scenario among those predicted to converge on the
   // nominal model, see docs/learning-laws.md)

@@ -1,6 +1,8 @@
 // Constraint-aware norm-optimal ILC: the update is the bounded optimum of the paper's cost (checked
 // by the KKT conditions against the dense gradient), equals the unconstrained law when no bound is
-// active, always returns a feasible correction, and on the paper scenario does not wind up.
+// active, always returns a feasible correction, leaves out the errors the pressure limit shaped, and
+// on the paper scenario does not wind up and tracks no worse than the unconstrained law.
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -113,6 +115,49 @@ TEST(NoilcConstrained, BoundsComeFromTheFeedbackAndThePressureLimit) {
   EXPECT_LE((feedback + u).cwiseAbs().maxCoeff(), 0.377 + 1e-15);
 }
 
+// After an input that sat on the pressure limit in the last trial, the next limit_recovery_s of error
+// carry no weight: the update is the bounded optimum for the error with those entries zeroed.
+TEST(NoilcConstrained, LeavesOutTheErrorsAfterInputsOnTheLimit) {
+  std::mt19937 random(13);
+  const int samples = 120;
+  const RandomProblem p = random_problem(samples, random);
+  IlcParameters parameters;
+  parameters.admm_tolerance = 1e-11;
+  parameters.admm_max_iterations = 20000;
+  parameters.limit_recovery_s = 0.08;  // 4 samples at 50 Hz
+  const double limit = 0.3;
+  const Eigen::VectorXd feedback = Eigen::VectorXd::Zero(samples);
+  Eigen::VectorXd u_j = p.u_j;
+  u_j(30) = limit;                     // the set point reached the limit at inputs 30 and 31
+  u_j(31) = -limit - 0.01;             // (beyond it: clamped in the trial)
+  u_j(100) = limit;                    // and at 100
+  NormOptimalConstrained constrained(paper_model(), parameters, samples);
+  constrained.set_input_context(feedback, limit);
+  Eigen::VectorXd actual(samples);
+  constrained.update(u_j, p.e_j, actual);
+  EXPECT_EQ(constrained.last_report().unweighted_errors, 5 + 4);  // entries 30..34 and 100..103
+
+  Eigen::VectorXd e = p.e_j;
+  e.segment(30, 5).setZero();
+  e.segment(100, 4).setZero();
+  NormOptimalConstrained plain(paper_model(), parameters, samples);
+  plain.set_bounds(Eigen::VectorXd::Constant(samples, -limit), Eigen::VectorXd::Constant(samples, limit));
+  Eigen::VectorXd expected(samples);
+  plain.update(u_j, e, expected);
+  EXPECT_EQ(plain.last_report().unweighted_errors, 0);
+  EXPECT_LT((actual - expected).cwiseAbs().maxCoeff(), 1e-8);
+
+  // limit_recovery_s = 0 is the plain bounded optimum of the error as measured.
+  parameters.limit_recovery_s = 0.0;
+  NormOptimalConstrained unmasked(paper_model(), parameters, samples);
+  unmasked.set_input_context(feedback, limit);
+  unmasked.update(u_j, p.e_j, actual);
+  plain.set_bounds(Eigen::VectorXd::Constant(samples, -limit), Eigen::VectorXd::Constant(samples, limit));
+  plain.update(u_j, p.e_j, expected);
+  EXPECT_EQ(unmasked.last_report().unweighted_errors, 0);
+  EXPECT_LT((actual - expected).cwiseAbs().maxCoeff(), 1e-8);
+}
+
 TEST(NoilcConstrained, RejectsBadParametersAndBounds) {
   IlcParameters parameters;
   parameters.admm_rho = 0.0;
@@ -122,6 +167,9 @@ TEST(NoilcConstrained, RejectsBadParametersAndBounds) {
   EXPECT_THROW(constrained.set_bounds(Eigen::VectorXd::Ones(10), Eigen::VectorXd::Zero(10)), InputError);
   IlcParameters wide_margin;
   wide_margin.limit_margin_bar = 0.5;
+  IlcParameters negative_recovery;
+  negative_recovery.limit_recovery_s = -0.01;
+  EXPECT_THROW(NormOptimalConstrained(paper_model(), negative_recovery, 10), InputError);
   NormOptimalConstrained no_room(paper_model(), wide_margin, 10);
   EXPECT_THROW(no_room.set_input_context(Eigen::VectorXd::Zero(10), 0.387), InputError);
 }
@@ -175,8 +223,12 @@ TEST(NoilcConstrainedOnThePaperScenario, NoWindupWhereTheUnconstrainedLawWindsUp
   EXPECT_LT(constrained.largest_clamp_bar, 0.005);
   EXPECT_FALSE(constrained.windup.detected);
   EXPECT_LT(constrained.max_correction_bar.back(), limit + 0.1);
-  // The correction has settled: no growth over the last 50 trials.
-  EXPECT_LT(std::abs(constrained.max_correction_bar.back() - constrained.max_correction_bar[150]), 0.005);
+  // The correction has settled: its largest value over the last 50 trials is no larger than over the
+  // 50 before (the unconstrained one grows by ~0.1 bar per 50 trials there).
+  const auto largest_in = [](const std::vector<double>& v, std::size_t from, std::size_t to) {
+    return *std::max_element(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
+  };
+  EXPECT_LT(largest_in(constrained.max_correction_bar, 151, 201), largest_in(constrained.max_correction_bar, 101, 151) + 0.005);
 
   // The paper's unconstrained update winds up, and the run says so.
   EXPECT_TRUE(free.windup.detected);
@@ -184,10 +236,16 @@ TEST(NoilcConstrainedOnThePaperScenario, NoWindupWhereTheUnconstrainedLawWindsUp
   EXPECT_GT(free.max_correction_bar.back(), free.max_correction_bar[150] + 0.03);
   EXPECT_GT(free.largest_clamp_bar, 0.5);
 
-  // Tracking: the bounded optimum ends within 5 % of the wound-up law at 200 trials (it is about
-  // 3.5 % above it there; see docs/learning-laws.md), with an RMS that no longer drifts upwards.
-  EXPECT_LT(constrained.rms_deg.back(), 1.05 * free.rms_deg.back());
-  EXPECT_LT(constrained.rms_deg.back(), 1.2);
+  // Tracking, same seed and noise, RMS over the same samples: no worse than the unconstrained law at
+  // 200 trials, and no worse on average over the last 50 (not one lucky trial).
+  EXPECT_LE(constrained.rms_deg.back(), free.rms_deg.back());
+  const auto mean_of_last = [](const std::vector<double>& v, std::size_t count) {
+    double sum = 0.0;
+    for (std::size_t i = v.size() - count; i < v.size(); ++i) sum += v[i];
+    return sum / static_cast<double>(count);
+  };
+  EXPECT_LE(mean_of_last(constrained.rms_deg, 50), mean_of_last(free.rms_deg, 50));
+  EXPECT_LT(constrained.rms_deg.back(), 1.0);
   EXPECT_GT(free.rms_deg.back(), free.rms_deg[60]);  // the wound-up law has been getting worse
 }
 
