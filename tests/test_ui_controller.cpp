@@ -2,6 +2,8 @@
 // the engine, the trials and the screens, without a terminal.
 #include <gtest/gtest.h>
 
+#include "engine/learning_law_factory.hpp"
+
 #include <algorithm>
 
 #include "devices/simulated_arm.hpp"
@@ -221,7 +223,7 @@ TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
   f.key(key::kEscape);
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   // A weight rebuilds the law.
-  for (int i = 0; i < 3; ++i) f.key(key::kDown);  // k_i, k_d, M
+  for (int i = 0; i < 4; ++i) f.key(key::kDown);  // k_i, k_d, law, M
   f.key(key::kDown);                               // S
   f.key(key::kEnter);
   for (int i = 0; i < 3; ++i) f.key(key::kBackspace);
@@ -236,6 +238,61 @@ TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   ASSERT_EQ(f.state().experiment.trials.size(), 1u);
   EXPECT_GT(std::abs(f.state().experiment.trials[0].summary.rms_deg - 15.06), 0.3);
+}
+
+TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
+  ConsoleFixture f;
+  f.arm_valves();
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('w');
+  for (int i = 0; i < TuningForm::kLawRow; ++i) f.key(key::kDown);
+  ASSERT_EQ(f.state().tuning.selected, TuningForm::kLawRow);
+  EXPECT_EQ(f.state().config.ilc.law, "noilc");
+  f.key(key::kEnter);  // the next law in the list
+  EXPECT_EQ(f.state().config.ilc.law, "noilc-dense") << f.state().status;
+  EXPECT_TRUE(f.logged("law changed noilc -> noilc-dense ([ilc] law)"));
+  EXPECT_TRUE(f.state().experiment.settings_changed);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  EXPECT_EQ(f.state().law_name, "noilc-dense");
+  f.key(key::kRight);
+  f.key(key::kRight);  // noilc-constrained, pd
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  EXPECT_EQ(f.state().law_name, "pd");
+  for (int i = 0; i < 4; ++i) f.key(key::kLeft);  // noilc-constrained, noilc-dense, noilc, and round to the last
+  ASSERT_EQ(learning_law_names().back(), "inverse");
+  EXPECT_EQ(f.state().config.ilc.law, "inverse");
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  EXPECT_EQ(f.state().law_name, "inverse");
+  // The law learns: two iterations with it lower the RMS.
+  f.run_batch(3);
+  const auto rms = f.state().experiment.rms_history_deg();
+  ASSERT_EQ(rms.size(), 3u);
+  EXPECT_LT(rms[2], rms[0]);
+  // Not while trials run.
+  f.key('N');
+  f.type("5");
+  f.key(key::kEnter);
+  f.key('w');
+  f.key(key::kEnter);
+  EXPECT_EQ(f.state().config.ilc.law, "inverse");
+  EXPECT_TRUE(f.state().status_important);
+  EXPECT_NE(f.state().status.find("between trials"), std::string::npos) << f.state().status;
+}
+
+TEST(UiController, EachIterationsLogLineCarriesTheLearningDiagnostics) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(3);
+  for (const ui::LogEntry& e : f.state().log.entries()) {  // the first trial has nothing to contract from
+    if (e.text.rfind("iteration 0: RMS", 0) == 0) {
+      EXPECT_EQ(e.text.find("contraction"), std::string::npos) << e.text;
+    }
+  }
+  const auto& trials = f.state().experiment.trials;
+  ASSERT_EQ(trials.size(), 3u);
+  const double contraction = trials[2].summary.rms_deg / trials[1].summary.rms_deg;  // same N: norms scale alike
+  EXPECT_TRUE(f.logged(format("iteration 2: RMS %.3f deg", trials[2].summary.rms_deg)));
+  EXPECT_TRUE(f.logged(format("contraction %.3f, correction changed", contraction))) << contraction;
 }
 
 TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {

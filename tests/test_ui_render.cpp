@@ -248,6 +248,12 @@ TEST(UiRender, TuningLogAndSessionScreens) {
   EXPECT_NE(text.find("  W            2e-05"), std::string::npos) << text;
   EXPECT_NE(text.find("12:01:00  k_p changed 0.3 -> 0.4"), std::string::npos);
   EXPECT_NE(text.find("may diverge: contraction 3.6 > 1 at 4.38 Hz"), std::string::npos);
+  EXPECT_NE(text.find("  law          noilc       [ilc] law"), std::string::npos) << text;
+  s.tuning.selected = TuningForm::kLawRow;
+  s.config.ilc.law = "pd";
+  text = all(render_lines(s));
+  EXPECT_NE(text.find("> law             pd       [ilc] law"), std::string::npos) << text;
+  EXPECT_NE(text.find("  M                1"), std::string::npos) << text;  // the weights follow the law's row
 
   s.screen = Screen::kLog;
   text = all(render_lines(s));

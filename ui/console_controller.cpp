@@ -41,7 +41,9 @@ struct ConsoleController::InFlight {
 };
 
 ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajectory, bool unicode)
-    : env_(std::move(env)), model_(discretize_arm_model(env_.config.model, env_.config.timing.sample_s())) {
+    : env_(std::move(env)),
+      model_(discretize_arm_model(env_.config.model, env_.config.timing.sample_s())),
+      diagnostics_(env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar) {
   if (!env_.clock_text) env_.clock_text = system_clock_text;
   state_.unicode = unicode;
   state_.config = env_.config;
@@ -389,12 +391,24 @@ void ConsoleController::finish_trial(double time_s) {
   e.add_trial(std::move(trial));
   const IterationSummary& s = e.trials.back().summary;
   if (follow || state_.inspector.trial < 0) state_.inspector.trial = static_cast<int>(e.trials.size()) - 1;
-  // Saturated samples: the set-point clamp cut the input there (where wind-up starts).
+  // What learning did: the error's contraction, the change of the correction, and the samples whose
+  // set point the clamp cut (where wind-up starts).
+  const IterationDiagnostics& d = diagnostics_.observe_latest(e);
   log(LogSource::kEngine,
-      format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s", s.iteration, s.rms_deg,
+      format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s%s", s.iteration, s.rms_deg,
              s.max_abs_error_deg, s.max_abs_correction_bar,
+             d.contraction ? format(", contraction %.3f, correction changed %.4f bar", *d.contraction,
+                                    d.correction_change_bar).c_str()
+                           : "",
              s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
       false, time_s);
+  if (diagnostics_.windup_just_detected()) {
+    log(LogSource::kLearner,
+        format("wind-up since iteration %d: the correction keeps growing where the set points saturate (%.3f bar "
+               "clamped away); the law noilc-constrained avoids it",
+               diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
+        true, time_s);
+  }
   set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;

@@ -23,6 +23,7 @@
 #include "ui/console_state.hpp"
 #include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
+#include "ui/trial_diagnostics.hpp"
 
 namespace bellows::ui {
 
@@ -107,6 +108,8 @@ class ConsoleController {
   void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
   /// Empty when applied; otherwise why not (nothing changed).
   std::string apply_tuning(int field, const std::string& text);
+  /// The next (+1) or previous (-1) learning law; the law is rebuilt and the change logged.
+  void choose_law_step(int step);
   void confirm_discard(std::string what, std::function<void()> action);
   void quit_now();
 
@@ -141,6 +144,7 @@ class ConsoleController {
   double last_fresh_snapshot_s_ = -1.0;
   double now_s_ = 0.0;
   bool black_box_pending_ = false;
+  TrialDiagnostics diagnostics_;
   std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate
   std::size_t strip_next_ = 0, strip_count_ = 0;
   std::uint64_t strip_revision_ = 0, strip_exported_ = 0;

@@ -177,7 +177,7 @@ void ConsoleController::accept_input() {
       return;
     }
     case DialogKind::kEditValue: {
-      const std::string why = apply_tuning(state_.tuning.selected, d.input);
+      const std::string why = apply_tuning(TuningForm::field_of(state_.tuning.selected), d.input);
       if (!why.empty()) {
         reject_input(why);
         return;

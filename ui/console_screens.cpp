@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "engine/errors.hpp"
+#include "engine/learning_law_factory.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"
@@ -68,25 +69,29 @@ bool ConsoleController::handle_screen_key(int k) {
       }
       return false;
     }
-    case Screen::kTuning:
+    case Screen::kTuning: {
       if (k == key::kUp || k == key::kDown) {
-        state_.tuning.selected = std::clamp(state_.tuning.selected + (k == key::kUp ? -1 : 1), 0, TuningForm::kFields - 1);
+        state_.tuning.selected = std::clamp(state_.tuning.selected + (k == key::kUp ? -1 : 1), 0, TuningForm::kRows - 1);
         return true;
       }
-      if (k == key::kEnter) {
-        if (state_.run.mode != RunProgress::Mode::kIdle || state_.engine_state == EngineState::kRunning) {
-          set_status("gains and weights change between trials: stop the trials first (x)", true);
-        } else if (state_.engine_state == EngineState::kFault) {
-          set_status("a fault is latched: reset it (R) before changing gains", true);
-        } else {
-          const TuningField& f = tuning_fields()[static_cast<std::size_t>(state_.tuning.selected)];
-          open_dialog(DialogKind::kEditValue, std::string("Change ") + f.label,
-                      {std::string(f.description) + " (" + f.config_key + ")"}, "Enter apply   Esc cancel",
-                      format("%g", tuning_value(state_.config, state_.tuning.selected)));
-        }
-        return true;
+      const bool on_law = state_.tuning.selected == TuningForm::kLawRow;
+      const bool choose_law = on_law && (k == key::kEnter || k == key::kLeft || k == key::kRight);
+      if (k != key::kEnter && !choose_law) return false;
+      if (state_.run.mode != RunProgress::Mode::kIdle || state_.engine_state == EngineState::kRunning) {
+        set_status("gains, law and weights change between trials: stop the trials first (x)", true);
+      } else if (state_.engine_state == EngineState::kFault) {
+        set_status("a fault is latched: reset it (R) before changing gains", true);
+      } else if (choose_law) {
+        choose_law_step(k == key::kLeft ? -1 : 1);
+      } else {
+        const int field = TuningForm::field_of(state_.tuning.selected);
+        const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
+        open_dialog(DialogKind::kEditValue, std::string("Change ") + f.label,
+                    {std::string(f.description) + " (" + f.config_key + ")"}, "Enter apply   Esc cancel",
+                    format("%g", tuning_value(state_.config, field)));
       }
-      return false;
+      return true;
+    }
     case Screen::kSessions: {
       SessionBrowser& b = state_.browser;
       const int count = static_cast<int>(b.sessions.size());
@@ -202,6 +207,27 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
     set_status("trajectory " + trajectory->name + ": iteration 0 runs with feedback only");
     state_.screen = Screen::kMain;
   });
+}
+
+void ConsoleController::choose_law_step(int step) {
+  const std::vector<std::string> names = learning_law_names();
+  const auto current = std::find(names.begin(), names.end(), state_.config.ilc.law);
+  const auto count = static_cast<long>(names.size());
+  const long at = current == names.end() ? 0 : (current - names.begin() + step + count) % count;
+  Configuration candidate = state_.config;
+  const std::string old = candidate.ilc.law;
+  candidate.ilc.law = names[static_cast<std::size_t>(at)];
+  try {
+    validate_configuration(candidate);
+  } catch (const InputError& error) {
+    set_status(std::string("law ") + candidate.ilc.law + ": " + error.what(), true);
+    return;
+  }
+  state_.config = candidate;
+  state_.experiment.settings_changed = true;
+  log(LogSource::kOperator, format("law changed %s -> %s ([ilc] law)", old.c_str(), candidate.ilc.law.c_str()));
+  rebuild_law();
+  set_status("law " + candidate.ilc.law + " from the next learning step on: " + learning_law_description(candidate.ilc.law));
 }
 
 std::string ConsoleController::apply_tuning(int field, const std::string& text) {

@@ -88,10 +88,13 @@ struct TrajectoryChooser {
   std::string file_path;                  // the file entry's path, once given
 };
 
-/// The tuning screen's fields, in order: k_ff, k_p, k_i, k_d, M, S, W.
+/// The tuning screen's rows, in order: k_ff, k_p, k_i, k_d, the learning law, M, S, W.
 struct TuningForm {
-  static constexpr int kFields = 7;
+  static constexpr int kRows = 8;
+  static constexpr int kLawRow = 4;
   int selected = 0;
+  /// The tuning_fields() index of a row; -1 for the law row.
+  static int field_of(int row) { return row < kLawRow ? row : (row == kLawRow ? -1 : row - 1); }
 };
 
 struct SessionBrowser {

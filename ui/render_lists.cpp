@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/learning_law_factory.hpp"
 #include "ui/key_map.hpp"
 #include "ui/plot.hpp"
 #include "ui/render_parts.hpp"
@@ -83,28 +84,48 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
   draw_plot(c, {pin.x, pin.y + 2, pin.width, pin.height - 2}, {{time, angle, Role::kSeries1, '*'}}, options);
 }
 
+namespace {
+
+std::string law_choices() {
+  std::string out;
+  for (const std::string& name : learning_law_names()) out += (out.empty() ? "" : " ") + name;
+  return out;
+}
+
+}  // namespace
+
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  const int form_height = std::min(body.height, 13);
+  const int form_height = std::min(body.height, 15);
   const Rect form{body.x, body.y, body.width, form_height};
-  c.frame(form, g, "Gains and learning weights (changed between trials)");
+  c.frame(form, g, "Gains, learning law and weights (changed between trials)");
   const Rect in = inner(form);
   const auto& fields = tuning_fields();
   int y = in.y;
   c.put(in.x + 1, y++, "PID gains, normalized units: sent to the engine", Role::kTitle, true);
-  for (std::size_t i = 0; i < fields.size() && y < in.bottom(); ++i) {
-    if (i == 4) {
+  for (int row = 0; row < TuningForm::kRows && y < in.bottom(); ++row) {
+    const bool selected = row == s.tuning.selected;
+    const int field = TuningForm::field_of(row);
+    if (field < 0) {
+      c.put(in.x + 1, y++, "Learning law: Enter or Left/Right chooses; it is rebuilt", Role::kTitle, true);
+      if (y >= in.bottom()) break;
+      const std::string line = format("%s %-5s %12s %-4s  %-24s %s", selected ? ">" : " ", "law", s.config.ilc.law.c_str(),
+                                      "", "[ilc] law", law_choices().c_str());
+      c.put(in.x + 1, y++, fit(line, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
+      continue;
+    }
+    if (field == TuningForm::kLawRow) {  // M, the first weight
       const bool norm_optimal = s.law_name.rfind("noilc", 0) == 0;
       c.put(in.x + 1, y++,
             norm_optimal ? "Learning weights M, S, W (times I): the law " + s.law_name + " is rebuilt"
-                         : "Learning weights M, S, W: not used by the law " + s.law_name + " ([ilc] law chooses it)",
+                         : "Learning weights M, S, W: not used by the law " + s.law_name,
             norm_optimal ? Role::kTitle : Role::kDim, true);
+      if (y >= in.bottom()) break;
     }
-    const TuningField& f = fields[i];
-    const bool selected = static_cast<int>(i) == s.tuning.selected;
-    const std::string row = format("%s %-5s %12.6g %-4s  %-24s %s", selected ? ">" : " ", f.label,
-                                   tuning_value(s.config, static_cast<int>(i)), f.unit, f.config_key, f.description);
-    c.put(in.x + 1, y++, fit(row, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
+    const TuningField& f = fields[static_cast<std::size_t>(field)];
+    const std::string line = format("%s %-5s %12.6g %-4s  %-24s %s", selected ? ">" : " ", f.label,
+                                    tuning_value(s.config, field), f.unit, f.config_key, f.description);
+    c.put(in.x + 1, y++, fit(line, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
   }
   for (const std::string& line : wrap(s.convergence, in.width - 2)) {  // two lines at most fit
     if (y >= in.bottom()) break;
