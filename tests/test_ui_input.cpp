@@ -195,9 +195,10 @@ TEST(UiInput, ABadNumberForAWeightKeepsTheQuestionAndChangesNothing) {
   ConsoleFixture f;
   f.arm_valves();
   f.key('w');
-  for (int i = 0; i < 4; ++i) f.key(key::kDown);  // M
+  for (int i = 0; i < TuningForm::kLawRow + 1; ++i) f.key(key::kDown);  // past the gains and the law: M
   f.key(key::kEnter);
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kEditValue);
+  EXPECT_EQ(f.state().dialog.title, "Change M");
   for (const std::string bad : {"abc", "1e999", "-1", "2,5"}) {
     SCOPED_TRACE(bad);
     clear_input(f);
