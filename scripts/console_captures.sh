@@ -60,7 +60,7 @@ e2e_keys Enter
 e2e_wait_for 'wave: 6.0 s'
 capture trajectory-file
 e2e_keys Escape w
-e2e_wait_for 'Gains and learning weights'
+e2e_wait_for 'Gains, learning law and weights'
 capture tuning
 e2e_keys Escape s
 e2e_wait_for 'saved: '
