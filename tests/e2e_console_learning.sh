@@ -105,7 +105,10 @@ e2e_keys n
 e2e_wait_for 'iteration 7  RMS' 120
 e2e_keys s
 e2e_wait_for 'saved: /'
-"$BELLOWS" sessions show "$session" | grep -qE '^iterations +7,' || e2e_fail "the session did not grow to 7 iterations"
+# Read whole before matching: `grep -q` would stop reading at the match and, under pipefail, the
+# writer's SIGPIPE would fail the test.
+shown="$("$BELLOWS" sessions show "$session")"
+grep -qE '^iterations +7,' <<<"$shown" || e2e_fail "the session did not grow to 7 iterations: $shown"
 e2e_keys q
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after the relaunch"
 echo "ok: $(echo "$rms" | tr '\n' ' ')"

@@ -71,7 +71,14 @@ class ConsoleController {
   bool active() const;
 
  private:
-  struct InFlight;  // a trial the engine owns until it hands it back
+  struct InFlight {  // a trial the engine owns until it hands it back
+    std::shared_ptr<const Trajectory> trajectory;
+    Eigen::VectorXd correction_bar;
+    TrialRecord record;
+    std::uint32_t id = 0;
+    std::string origin;
+    bool accepted = false;  // the engine took it (went RUNNING)
+  };
 
   // Engine side (console_controller.cpp).
   bool send(const EngineCommand& command, const char* what);

@@ -1,0 +1,209 @@
+// The console's trials and learning: building the law, running a trial through the engine,
+// finishing it (summary, diagnostics, log), and the run modes (one trial, a step, K iterations).
+#include <cmath>
+
+#include "engine/convergence.hpp"
+#include "engine/errors.hpp"
+#include "engine/learning_law_factory.hpp"
+#include "engine/learning_session.hpp"
+#include "ui/canvas.hpp"
+#include "ui/console_controller.hpp"
+
+namespace bellows::ui {
+
+void ConsoleController::rebuild_law() {
+  if (law_build_.busy() || law_update_.busy()) {
+    rebuild_pending_ = true;
+    return;
+  }
+  rebuild_pending_ = false;
+  state_.law_ready = false;
+  law_samples_ = state_.experiment.samples();
+  state_.law_name = state_.config.ilc.law;
+  law_build_.start([config = state_.config, model = model_, samples = law_samples_] {
+    BuiltLaw built;
+    built.law = make_learning_law(config, model, samples);
+    const ConvergencePrediction p = predict_convergence(*built.law, config, samples);
+    if (p.available) {
+      built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
+                                 "off by up to %.0f %%",
+                                 p.nominal.contraction, p.worst.contraction, 100.0 * p.model_error);
+      built.warning = !p.warning.empty();
+      if (built.warning) built.convergence = p.warning;
+    } else {
+      built.convergence = "no convergence prediction for this law";
+    }
+    return built;
+  });
+  ++revision_;
+}
+
+void ConsoleController::poll_tasks() {
+  if (law_build_.ready()) {
+    try {
+      BuiltLaw built = law_build_.take();
+      law_ = std::move(built.law);
+      if (law_->samples() != state_.experiment.samples()) rebuild_pending_ = true;
+      state_.law_ready = !rebuild_pending_;
+      if (state_.law_ready) {
+        state_.convergence = built.convergence;
+        state_.convergence_warning = built.warning;
+        log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
+                                        law_->samples(), state_.config.ilc.m, state_.config.ilc.s, state_.config.ilc.w));
+        if (built.warning) log(LogSource::kLearner, built.convergence, true);
+      }
+    } catch (const std::exception& error) {
+      law_.reset();
+      state_.law_ready = false;
+      log(LogSource::kLearner, std::string("cannot build the learning law: ") + error.what(), true);
+      set_status(std::string("cannot build the learning law: ") + error.what(), true);
+    }
+    ++revision_;
+  }
+  if (law_update_.ready()) {
+    try {
+      Eigen::VectorXd next = law_update_.take();
+      const int from = state_.experiment.trials.back().iteration;
+      state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from));
+      log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
+                                      state_.experiment.next_correction_bar.cwiseAbs().maxCoeff()));
+      state_.run.phase = RunProgress::Phase::kNone;
+      if (state_.run.stop_requested || state_.engine_state != EngineState::kArmed) {
+        end_run(state_.run.stop_requested ? "stopped by the operator" : "stopped: the valves are not armed", false);
+      } else {
+        begin_trial();
+      }
+    } catch (const std::exception& error) {
+      end_run(std::string("learning failed: ") + error.what(), true);
+    }
+    ++revision_;
+  }
+  if (rebuild_pending_ && !law_build_.busy() && !law_update_.busy()) rebuild_law();
+  poll_session_tasks();
+}
+
+void ConsoleController::begin_trial() {
+  Experiment& e = state_.experiment;
+  if (state_.engine_state != EngineState::kArmed) {
+    end_run("arm the valves first (a)", true);
+    return;
+  }
+  auto trial = std::make_unique<InFlight>();
+  trial->trajectory = e.trajectory;
+  trial->correction_bar = e.next_correction_bar;
+  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample);
+  trial->id = ++last_trial_id_;
+  trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
+  const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
+  if (!send(EngineCommand::start_trial(*trial->trajectory, trial->correction_bar, trial->record, settle_ticks, trial->id),
+            "start trial")) {
+    end_run("the trial was not started", true);
+    return;
+  }
+  log(LogSource::kOperator, format("run iteration %d (%s)", e.next_iteration(), trial->origin.c_str()));
+  in_flight_ = std::move(trial);
+  state_.run.phase = RunProgress::Phase::kSettling;
+  state_.run.sample = -1;
+  ++revision_;
+}
+
+void ConsoleController::finish_trial(double time_s) {
+  Experiment& e = state_.experiment;
+  Trial trial;
+  trial.correction_bar = std::move(in_flight_->correction_bar);
+  trial.record = std::move(in_flight_->record);
+  trial.origin = in_flight_->origin;
+  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
+                                  env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
+  in_flight_.reset();
+  const bool follow = state_.inspector.trial == static_cast<int>(e.trials.size()) - 1;
+  e.add_trial(std::move(trial));
+  const IterationSummary& s = e.trials.back().summary;
+  if (follow || state_.inspector.trial < 0) state_.inspector.trial = static_cast<int>(e.trials.size()) - 1;
+  // What learning did: the error's contraction, the change of the correction, and the samples whose
+  // set point the clamp cut (where wind-up starts).
+  const IterationDiagnostics& d = diagnostics_.observe_latest(e);
+  log(LogSource::kEngine,
+      format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s%s", s.iteration, s.rms_deg,
+             s.max_abs_error_deg, s.max_abs_correction_bar,
+             d.contraction ? format(", contraction %.3f, correction changed %.4f bar", *d.contraction,
+                                    d.correction_change_bar).c_str()
+                           : "",
+             s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
+      false, time_s);
+  if (diagnostics_.windup_just_detected()) {
+    log(LogSource::kLearner,
+        format("wind-up since iteration %d: the correction keeps growing where the set points saturate (%.3f bar "
+               "clamped away); the law noilc-constrained avoids it",
+               diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
+        true, time_s);
+  }
+  set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  state_.run.phase = RunProgress::Phase::kNone;
+  state_.run.sample = -1;
+  continue_run();
+}
+
+void ConsoleController::drop_trial(const std::string& why) {
+  in_flight_.reset();
+  state_.run.phase = RunProgress::Phase::kNone;
+  if (state_.run.stop_requested) {
+    end_run("trials stopped by the operator; the unfinished trial is not counted", false);
+  } else {
+    end_run(why + "; it is not counted", state_.engine_state == EngineState::kFault);
+  }
+}
+
+void ConsoleController::continue_run() {
+  RunProgress& r = state_.run;
+  if (r.mode != RunProgress::Mode::kBatch) {
+    end_run("", false);
+    return;
+  }
+  ++r.batch_done;
+  if (r.stop_requested) {
+    end_run(format("batch stopped by the operator after %d of %d", r.batch_done, r.batch_total), false);
+  } else if (state_.experiment.rms_rising(state_.stop_after_rises)) {
+    end_run(format("batch stopped by itself: the RMS rose %d times in a row", state_.stop_after_rises), true);
+  } else if (r.batch_done >= r.batch_total) {
+    end_run(format("batch of %d done: RMS %.3f deg", r.batch_total, state_.experiment.trials.back().summary.rms_deg), false);
+  } else {
+    step();
+  }
+}
+
+void ConsoleController::step() {
+  Experiment& e = state_.experiment;
+  if (!e.next_tried || e.trials.empty()) {
+    begin_trial();
+    return;
+  }
+  if (!state_.law_ready || !law_ || law_build_.busy()) {
+    end_run("the learning law is not ready", true);
+    return;
+  }
+  const Trial& last = e.trials.back();
+  state_.run.phase = RunProgress::Phase::kLearning;
+  const Eigen::Index n = last.correction_bar.size();
+  const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
+  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error(),
+                     feedback = Eigen::VectorXd(last.record.samples.u_pid_bar.head(n)), input_limit_bar] {
+    law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
+    Eigen::VectorXd next(u.size());
+    law->update(u, error, next);
+    return next;
+  });
+  ++revision_;
+}
+
+void ConsoleController::end_run(const std::string& why, bool important) {
+  const bool was_running = state_.run.mode != RunProgress::Mode::kIdle;
+  state_.run = RunProgress{};
+  if (!why.empty() && was_running) {
+    log(LogSource::kOperator, why, important);
+    set_status(why, important);
+  }
+  ++revision_;
+}
+
+}  // namespace bellows::ui
