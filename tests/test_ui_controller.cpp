@@ -413,6 +413,38 @@ TEST(UiController, QuitAsksWhenWorkIsUnsavedAndDisarms) {
   ASSERT_TRUE(f.pump_until([&] { return f.core.state() == EngineState::kSafe; }));
 }
 
+TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
+  Experiment e;
+  EXPECT_EQ(e.unsaved_sentence(), "");
+  e.trials.resize(3);
+  e.saved_trials = 2;
+  EXPECT_EQ(e.unsaved_sentence(), "1 iteration is not saved.");
+  e.saved_trials = 0;
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations are not saved.");
+  e.faults.resize(1);
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations and 1 fault's black box are not saved.");
+  e.settings_changed = true;
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations, 1 fault's black box and changed settings are not saved.");
+  e.saved_trials = 3;
+  e.faults.resize(2);
+  e.settings_changed = false;
+  EXPECT_EQ(e.unsaved_sentence(), "2 faults' black boxes are not saved.");
+  e.saved_faults = 2;
+  e.settings_changed = true;
+  EXPECT_EQ(e.unsaved_sentence(), "changed settings are not saved.");
+}
+
+TEST(UiController, QuitAsksWhenOnlyAFaultsBlackBoxIsUnsaved) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key(' ');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().experiment.faults.empty(); }));
+  f.key('q');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
+  ASSERT_FALSE(f.state().dialog.text.empty());
+  EXPECT_EQ(f.state().dialog.text[0], "1 fault's black box is not saved.");
+}
+
 TEST(UiController, WithoutASessionStoreSaveSaysSo) {
   Configuration c;
   SimulatedArm arm(c.plant, 1);

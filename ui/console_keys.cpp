@@ -271,11 +271,11 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kSessions;
       start_listing();
       return;
-    case Action::kQuit:
-      if (state_.experiment.unsaved() && !state_.experiment.trials.empty()) {
-        const int unsaved = static_cast<int>(state_.experiment.trials.size()) - state_.experiment.saved_trials;
-        std::vector<std::string> text = {format("%d iteration%s not saved%s.", unsaved, unsaved == 1 ? " is" : "s are",
-                                                state_.experiment.settings_changed ? " and settings changed" : "")};
+    case Action::kQuit: {
+      const Experiment& e = state_.experiment;
+      const int unsaved_faults = static_cast<int>(e.faults.size()) - e.saved_faults;
+      if (e.unsaved() && (!e.trials.empty() || unsaved_faults > 0)) {
+        std::vector<std::string> text = {e.unsaved_sentence()};
         if (!state_.sessions_available) text.push_back("Saving is not available: " + state_.sessions_unavailable_reason);
         text.push_back("The valves are vented before the console exits.");
         open_dialog(DialogKind::kConfirmQuit, "Quit?", text,
@@ -285,6 +285,7 @@ void ConsoleController::perform(Action action) {
         quit_now();
       }
       return;
+    }
     case Action::kHeartbeatDrill:
       state_.heartbeat_drill = true;
       drill_started_s_ = now_s_;

@@ -1,6 +1,8 @@
 #include "ui/experiment.hpp"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 namespace bellows::ui {
 
@@ -9,6 +11,22 @@ Experiment Experiment::start(std::shared_ptr<const Trajectory> trajectory) {
   e.trajectory = std::move(trajectory);
   e.next_correction_bar = Eigen::VectorXd::Zero(e.samples());
   return e;
+}
+
+std::string Experiment::unsaved_sentence() const {
+  std::vector<std::string> parts;
+  const int iterations = static_cast<int>(trials.size()) - saved_trials;
+  const int black_boxes = static_cast<int>(faults.size()) - saved_faults;
+  if (iterations > 0) parts.push_back(std::to_string(iterations) + (iterations == 1 ? " iteration" : " iterations"));
+  if (black_boxes > 0) {
+    parts.push_back(std::to_string(black_boxes) + (black_boxes == 1 ? " fault's black box" : " faults' black boxes"));
+  }
+  if (settings_changed) parts.push_back("changed settings");
+  if (parts.empty()) return {};
+  std::string sentence = parts[0];
+  for (std::size_t i = 1; i < parts.size(); ++i) sentence += (i + 1 == parts.size() ? " and " : ", ") + parts[i];
+  const bool one = parts.size() == 1 && (iterations == 1 || black_boxes == 1);
+  return sentence + (one ? " is not saved." : " are not saved.");
 }
 
 void Experiment::add_trial(Trial trial) {

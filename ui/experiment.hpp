@@ -54,6 +54,9 @@ struct Experiment {
     return static_cast<int>(trials.size()) > saved_trials || static_cast<int>(faults.size()) > saved_faults ||
            settings_changed;
   }
+  /// What a save would add, as a sentence: "2 iterations, 1 fault's black box and changed settings
+  /// are not saved."; empty when nothing is unsaved.
+  std::string unsaved_sentence() const;
   /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
   void add_trial(Trial trial);
   /// The correction the next trial applies, from `origin`.

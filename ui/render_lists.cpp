@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/errors.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "ui/key_map.hpp"
 #include "ui/plot.hpp"
@@ -86,10 +87,13 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
 
 namespace {
 
-std::string law_choices() {
-  std::string out;
-  for (const std::string& name : learning_law_names()) out += (out.empty() ? "" : " ") + name;
-  return out;
+// What the chosen law does; the row's title says how to choose another.
+std::string law_summary(const std::string& name) {
+  try {
+    return learning_law_description(name);
+  } catch (const InputError&) {
+    return "unknown law";
+  }
 }
 
 }  // namespace
@@ -107,10 +111,10 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
     const bool selected = row == s.tuning.selected;
     const int field = TuningForm::field_of(row);
     if (field < 0) {
-      c.put(in.x + 1, y++, "Learning law: Enter or Left/Right chooses; it is rebuilt", Role::kTitle, true);
+      c.put(in.x + 1, y++, "Learning law: Enter or Right the next of " + std::to_string(learning_law_names().size()) + ", Left the one before", Role::kTitle, true);
       if (y >= in.bottom()) break;
       const std::string line = format("%s %-5s %12s %-4s  %-24s %s", selected ? ">" : " ", "law", s.config.ilc.law.c_str(),
-                                      "", "[ilc] law", law_choices().c_str());
+                                      "", "[ilc] law", law_summary(s.config.ilc.law).c_str());
       c.put(in.x + 1, y++, fit(line, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
       continue;
     }
