@@ -75,7 +75,7 @@ e2e_wait_for 'iteration 6  RMS'
 # Quit asks while work is unsaved; cancel, save, then quit: the valves are vented before the exit.
 e2e_keys q
 e2e_wait_for 'Quit\?'
-e2e_wait_for '6 iterations are not saved'
+e2e_wait_for "6 iterations and 1 fault's black box"  # the emergency stop's, not saved yet either
 e2e_keys Escape
 e2e_keys s
 e2e_wait_for 'saved: /'
