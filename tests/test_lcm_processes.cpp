@@ -112,9 +112,15 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   LcmIoThread bus(kDefaultLcmUrl, {&heckler});
   bus.start(RealtimeMode::kOff, 0);
 
+  // This test compares learning, not deadline keeping: on a loaded 2-core CI machine a wall-clock
+  // run can stall for more than 5 ticks (25 ms) or its readings for more than 3; the guards for
+  // both have tests of their own (rig killed below, memq staleness, missed-deadline streak).
+  const std::string config =
+      testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n").string();
   Child rig({kBellows, "io-sim", "--seed", "5", "--json"}, dir / "rig.out", dir / "rig.err");
   ASSERT_TRUE(rig.started());
-  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"},
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5",
+             "--config", config},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(run.started());
   const auto run_status = run.wait(300.0);
@@ -125,8 +131,8 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   bus.stop();
 
   // The same seed in-process, on the wall clock too.
-  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out",
-              dir / "local.err");
+  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5", "--config", config},
+              dir / "local.out", dir / "local.err");
   const auto local_status = local.wait(300.0);
   ASSERT_TRUE(local_status.has_value());
   ASSERT_EQ(*local_status, 0) << local.err();
