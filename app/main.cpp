@@ -14,9 +14,7 @@
 #include "devices/lcm_channels.hpp"
 #include "engine/errors.hpp"
 
-namespace {
-constexpr int kExitBadInput = 2;
-}
+using bellows::kExitBadInput;
 
 int main(int argc, char** argv) {
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm"};
@@ -162,9 +160,9 @@ int main(int argc, char** argv) {
     if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);
     // No subcommand (or `console`): the operator console.
     return bellows::console_command(console, std::cout);
-  } catch (const bellows::InputError& error) {
+  } catch (const bellows::BellowsError& error) {
     std::cerr << "bellows: " << error.what() << std::endl;
-    return kExitBadInput;
+    return error.exit_status();
   } catch (const std::exception& error) {
     std::cerr << "bellows: internal error: " << error.what() << std::endl;
     return 1;

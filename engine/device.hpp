@@ -31,7 +31,34 @@ struct ValveCommand {
   }
 };
 
-/// A rig. Calls come from the engine thread only; implementations must not block for long.
+/// How the link to a rig is doing (all zero for an in-process device). The round trip is one
+/// exchange with the rig (for a T7: one read of the inputs and one write of the duties).
+struct DeviceHealth {
+  bool has_link = false;              // false: in-process, nothing to report
+  bool connected = false;             // the link answers
+  double round_trip_p50_ms = 0.0;
+  double round_trip_p99_ms = 0.0;
+  double round_trip_max_ms = 0.0;
+  std::uint64_t exchanges = 0;        // completed exchanges
+  std::uint64_t link_errors = 0;      // failed or timed-out exchanges
+  std::uint64_t stale_readings = 0;   // reads that brought nothing new
+};
+
+/// One analog input as the rig sees it: the raw volts and the calibrated value (rig bring-up).
+struct RawInput {
+  const char* name = "";    // e.g. "chamber_a" (static storage)
+  const char* unit = "";    // unit of `value`: "bar", "deg", "K"
+  double volts = 0.0;
+  double value = 0.0;
+};
+inline constexpr int kMaxRawInputs = 8;
+struct RawInputs {
+  std::array<RawInput, kMaxRawInputs> inputs{};
+  int count = 0;
+};
+
+/// A rig. Calls come from the engine thread only; implementations must not block for long
+/// (except `health()` and `raw_inputs()`, which any thread may call: they read latest values).
 class Device {
  public:
   virtual ~Device() = default;
@@ -46,6 +73,10 @@ class Device {
   virtual void advance(double dt_s) = 0;
   /// A short human name, e.g. "sim" or "lcm".
   virtual const char* name() const = 0;
+  /// The link's figures; any thread. In-process devices report nothing.
+  virtual DeviceHealth health() const { return {}; }
+  /// The raw inputs beside their calibrated values; any thread. Empty where there are no volts.
+  virtual RawInputs raw_inputs() const { return {}; }
 };
 
 }  // namespace bellows
