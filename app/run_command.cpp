@@ -170,7 +170,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                         {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
                         {"speed", options.speed}};
     }
-    out << report.dump() << std::endl;
+    out << report.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace) << std::endl;  // no raw text on a terminal
   }
   return status;
 }
