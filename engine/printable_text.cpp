@@ -28,13 +28,16 @@ std::size_t utf8_sequence(std::string_view text, char32_t& code_point) {
   return length;
 }
 
-/// Code points a terminal acts on or that change how the rest of the line reads.
-bool is_hidden_control(char32_t c) {
-  return (c >= 0x80 && c <= 0x9f) ||                       // C1 controls (CSI, OSC, ...)
+}  // namespace
+
+bool is_terminal_control(char32_t c) {
+  return c < 0x20 || c == 0x7f || (c >= 0x80 && c <= 0x9f) ||                       // C1 controls (CSI, OSC, ...)
          c == 0x061c || c == 0x200e || c == 0x200f ||      // bidirectional marks
          (c >= 0x202a && c <= 0x202e) || (c >= 0x2066 && c <= 0x2069) ||  // bidirectional overrides
          c == 0x2028 || c == 0x2029 || c == 0xfeff;        // line and paragraph separators, BOM
 }
+
+namespace {
 
 void append_escaped_byte(std::string& out, unsigned char c) {
   switch (c) {
@@ -69,7 +72,7 @@ std::string printable(std::string_view text, std::size_t max_bytes) {
       const std::size_t length = utf8_sequence(text.substr(i), code_point);
       if (length == 0) {
         append_escaped_byte(out, c);
-      } else if (is_hidden_control(code_point)) {
+      } else if (is_terminal_control(code_point)) {
         char escaped[16];
         std::snprintf(escaped, sizeof escaped, "\\u{%04x}", static_cast<unsigned>(code_point));
         out += escaped;

@@ -22,4 +22,8 @@ inline constexpr std::size_t kPrintableLine = 4000;
 /// the length of the original.
 std::string printable(std::string_view text, std::size_t max_bytes = kPrintableField);
 
+/// True for a code point a terminal acts on or that changes how the rest of a line reads: C0 and
+/// C1 controls, DEL, bidirectional marks and overrides, line separators, the byte order mark.
+bool is_terminal_control(char32_t code_point);
+
 }  // namespace bellows
