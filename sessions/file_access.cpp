@@ -85,7 +85,7 @@ std::string file_type_name(unsigned mode) {
 }
 
 DirectoryHandle DirectoryHandle::open(const fs::path& path) {
-  FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_NONBLOCK | O_CLOEXEC));
   if (fd.get() < 0) {
     const int error_number = errno;
     throw InputError(shown(path) + ": " + (error_number == ENOENT ? "no such directory" : open_failure(error_number)));
@@ -122,7 +122,13 @@ DirectoryHandle DirectoryHandle::make_subdirectory(const std::string& name) cons
 
 std::optional<FileDescriptor> open_regular_file_at(const DirectoryHandle& directory, const std::string& name, int flags,
                                                    bool single_link) {
-  // O_NONBLOCK: opening a FIFO must not wait for a writer; for a regular file it changes nothing.
+  // Refused before it is opened: opening some devices acts (a tape rewinds, a modem hangs up).
+  struct stat before {};
+  if (::fstatat(directory.fd(), name.c_str(), &before, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISREG(before.st_mode)) {
+    throw InputError(name + (S_ISLNK(before.st_mode) ? " " + open_failure(ELOOP)
+                                                     : " is " + file_type_name(before.st_mode) + ", not a regular file"));
+  }
+  // O_NONBLOCK: should a FIFO take its place meanwhile, opening it must not wait for a writer.
   FileDescriptor fd(::openat(directory.fd(), name.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644));
   if (fd.get() < 0) {
     const int error_number = errno;
@@ -148,6 +154,10 @@ std::optional<std::string> read_regular_file_at(const DirectoryHandle& directory
 
 std::string read_regular_file(const fs::path& path, std::size_t max_bytes, const std::string& what) {
   const std::string where = what + " " + shown(path);
+  struct stat before {};
+  if (::stat(path.c_str(), &before) == 0 && !S_ISREG(before.st_mode)) {  // before opening, as above
+    throw InputError(where + " is " + file_type_name(before.st_mode) + ", not a regular file");
+  }
   FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (fd.get() < 0) throw InputError(where + ": cannot be read: " + std::strerror(errno));
   return read_bounded(fd.get(), max_bytes, where);
