@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
                                   return std::string(error.what());
                                 }
                               },
-                              "NAME"));
+                              ""));
   run_cmd->add_option("--resume", run.resume_dir, "Continue a saved session (a directory, or a name in the data directory)")
       ->excludes(no_save)
       ->excludes(name)
