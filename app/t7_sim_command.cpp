@@ -1,5 +1,8 @@
 #include "app/t7_sim_command.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <chrono>
 #include <ostream>
 
@@ -11,6 +14,12 @@
 #include "engine/errors.hpp"
 
 namespace bellows {
+
+namespace {
+// The simulated T7 answers and runs its watchdog like hardware: real-time where the system allows
+// (the same priority as the engine's device I/O threads), plain scheduling where it refuses.
+constexpr int kSimPriority = 70;
+}  // namespace
 
 int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (options.duration_s < 0.0) throw InputError("--duration must not be negative");
@@ -38,6 +47,10 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (sim.no_supply) out << "; drill: no supply";
   if (sim.silent_after_s >= 0.0) out << "; drill: silent after " << sim.silent_after_s << " s";
   out << std::endl;
+  sched_param param{};
+  param.sched_priority = kSimPriority;
+  const bool realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  if (!realtime) out << "t7-sim: real-time scheduling refused; answers may come late under load" << std::endl;
   const auto start = std::chrono::steady_clock::now();
   server.run(
       [&] {

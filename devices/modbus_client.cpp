@@ -5,6 +5,7 @@
 
 #include <modbus/modbus.h>
 
+#include "devices/t7_registers.hpp"
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -75,7 +76,7 @@ bool ModbusClient::read_u32(int address, std::uint32_t& value) {
 bool ModbusClient::read_float(int address, double& value) {
   std::uint16_t r[2];
   if (!read(address, 2, r)) return false;
-  value = modbus_get_float_abcd(r);
+  value = t7::get_float(r);
   return true;
 }
 
@@ -88,7 +89,7 @@ bool ModbusClient::write_u32(int address, std::uint32_t value) {
 
 bool ModbusClient::write_float(int address, double value) {
   std::uint16_t r[2];
-  modbus_set_float_abcd(static_cast<float>(value), r);
+  t7::put_float(value, r);
   return write(address, 2, r);
 }
 

@@ -10,8 +10,6 @@
 #include <cstdio>
 #include <numbers>
 
-#include <modbus/modbus.h>
-
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -233,7 +231,7 @@ bool T7Device::exchange(const ValveCommand& valves) {
   const RigProfile& p = options_.profile;
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = p.input(role);
-    const double volts = modbus_get_float_abcd(&ain_buffer_[static_cast<std::size_t>(2 * c.ain)]);
+    const double volts = t7::get_float(&ain_buffer_[static_cast<std::size_t>(2 * c.ain)]);
     volts_[static_cast<int>(role)].store(volts, std::memory_order_relaxed);
     const bool valid = c.valid(volts);
     const double value = c.value(volts);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace bellows::t7 {
 
@@ -91,6 +92,21 @@ inline void put_u32(std::uint32_t value, std::uint16_t* registers) {
 }
 inline std::uint32_t get_u32(const std::uint16_t* registers) {
   return (static_cast<std::uint32_t>(registers[0]) << 16) | registers[1];
+}
+// FLOAT32 as the T7 sends it: IEEE 754 bits, high word first, each word big-endian on the wire
+// (libmodbus 3.1.6's modbus_set_float_abcd byte-swaps with htonl and does not match its own
+// modbus_get_float_abcd, so bellows does not use them).
+inline void put_float(double value, std::uint16_t* registers) {
+  const float f = static_cast<float>(value);
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &f, sizeof bits);
+  put_u32(bits, registers);
+}
+inline double get_float(const std::uint16_t* registers) {
+  const std::uint32_t bits = get_u32(registers);
+  float f = 0.0f;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
 }
 
 }  // namespace bellows::t7

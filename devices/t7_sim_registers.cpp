@@ -26,8 +26,8 @@ T7SimRegisters::T7SimRegisters() : registers_(kSize, 0), access_(kSize, kUnknown
                     kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
     allow(first, 2, true);
   }
-  modbus_set_float_abcd(static_cast<float>(kT7ProductId), &registers_[kProductId]);
-  modbus_set_float_abcd(1.0299f, &registers_[kFirmwareVersion]);
+  put_float(kT7ProductId, &registers_[kProductId]);
+  put_float(1.0299, &registers_[kFirmwareVersion]);
   set_u32(kSerialNumber, 470000000u);
   registers_[kClock0Divisor] = 1;
 }
@@ -53,7 +53,7 @@ std::uint32_t T7SimRegisters::u32(int address) const { return t7::get_u32(&regis
 void T7SimRegisters::set_u32(int address, std::uint32_t value) { t7::put_u32(value, &registers_[static_cast<std::size_t>(address)]); }
 
 void T7SimRegisters::set_ain(int ain, double volts) {
-  modbus_set_float_abcd(static_cast<float>(volts), &registers_[static_cast<std::size_t>(t7::kAin(ain))]);
+  t7::put_float(volts, &registers_[static_cast<std::size_t>(t7::kAin(ain))]);
 }
 
 double T7SimRegisters::line_duty(int dio) const {

@@ -128,7 +128,7 @@ TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {
     r = device.read_sensors();
     return r.chamber_bar[1] > 1.5;  // chamber A fills, but its pressure shows on B's input
   }));
-  EXPECT_LT(r.chamber_bar[0], 1.3);
+  EXPECT_LT(r.chamber_bar[0], r.chamber_bar[1] - 0.1);
   device.vent();
 }
 
@@ -145,7 +145,7 @@ TEST(T7Loopback, AnUnknownRegisterGetsTheExceptionAT7Gives) {
   double product = 0.0;
   EXPECT_TRUE(client.read_float(t7::kProductId, product));
   EXPECT_EQ(product, 7.0);
-  EXPECT_EQ(sim.status().exceptions, 2u);
+  EXPECT_TRUE(eventually([&] { return sim.status().exceptions == 2u; })) << sim.status().exceptions;
 }
 
 TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
@@ -160,7 +160,7 @@ TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
   const int actions_before = sim.status().watchdog_actions;
   ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(2), 400000));  // inlet_a fully open
   ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(4), 0));       // outlet_a shut
-  ASSERT_FALSE(sim.status().safe);
+  ASSERT_TRUE(eventually([&] { return !sim.status().safe; }));  // the status is published every 10 ms
   ASSERT_TRUE(eventually([&] { return sim.status().watchdog_actions > actions_before; }));
   const T7SimStatus s = sim.status();
   EXPECT_TRUE(s.safe);

@@ -55,7 +55,7 @@ class T7Processes : public ::testing::Test {
 
   std::unique_ptr<Child> start_run(int iterations, const std::string& name) {
     return std::make_unique<Child>(
-        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "off",
+        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "try",
                                  "--iterations", std::to_string(iterations), "--json", "--no-save"},
         dir_ / (name + ".out"), dir_ / (name + ".err"));
   }

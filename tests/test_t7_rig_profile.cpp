@@ -45,7 +45,8 @@ TEST(RigProfile, ThePaperRigLoadsWithItsWiring) {
 }
 
 TEST(RigProfile, CalibrationInvertsExactly) {
-  const SensorCalibration& c = paper_rig_profile().input(SensorRole::kAngle);
+  const RigProfile profile = paper_rig_profile();
+  const SensorCalibration& c = profile.input(SensorRole::kAngle);
   for (double volts : {0.1, 1.7, 4.9}) EXPECT_NEAR(c.volts(c.value(volts)), volts, 1e-12);
   EXPECT_TRUE(c.valid(2.5));
   EXPECT_FALSE(c.valid(0.0));  // the end of the track: a broken wiper
@@ -92,7 +93,8 @@ TEST(RigProfile, ValidVoltagesOutsideTheInputRangeAreRefused) {
 }
 
 TEST(RigProfile, UnknownKeysMissingValvesAndBadTypesAreRefused) {
-  EXPECT_NE(error_of(paper_rig_profile_text() + "\ncolour = \"red\"\n").find("colour: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("colour = \"red\"\n" + paper_rig_profile_text()).find("bad.toml: colour: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(paper_rig_profile_text() + "\ninlet_c = 0\n").find("[valves] inlet_c: unknown valve"), std::string::npos);
   EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "outlet_b = 5\n", "")).find("[valves] outlet_b: missing"), std::string::npos);
   EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "ain = 4", "ain = \"four\"")).find("[inputs.temperature] ain: expected a whole number"),
             std::string::npos);
