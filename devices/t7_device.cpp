@@ -211,6 +211,9 @@ void T7Device::encode_duties(const ValveCommand& valves) {
 
 bool T7Device::exchange(const ValveCommand& valves) {
   encode_duties(valves);
+  // After a failure, an answer that came too late may still arrive: drop it before asking again,
+  // or it would be taken for the next answer.
+  if (!link_up_.load(std::memory_order_relaxed)) client_.flush();
   const double start = now_s();
   const bool ok = client_.write(t7::kDioEfConfigA(first_dio_), 2 * dio_span_, duty_registers_.data()) &&
                   client_.read(t7::kAin(0), ain_registers_, ain_buffer_.data());
