@@ -1,7 +1,6 @@
 #include "app/t7_wiring.hpp"
 
 #include "app/rig_profile_file.hpp"
-#include "devices/t7_device.hpp"
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -40,7 +39,7 @@ void parse_host_port(const std::string& address, int default_port, std::string& 
   }
 }
 
-std::unique_ptr<Device> open_t7_device(const T7Options& options, const Configuration& config) {
+std::unique_ptr<T7Device> open_t7_device(const T7Options& options, const Configuration& config) {
   T7DeviceOptions device;
   parse_host_port(options.address, kDefaultT7Port, device.host, device.port);
   device.profile = rig_profile_or_default(options.rig_profile);  // InputError before any traffic

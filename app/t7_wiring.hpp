@@ -6,7 +6,7 @@
 #include <string>
 
 #include "engine/configuration.hpp"
-#include "engine/device.hpp"
+#include "devices/t7_device.hpp"
 
 namespace bellows {
 
@@ -24,6 +24,7 @@ void parse_host_port(const std::string& address, int default_port, std::string& 
 
 /// Loads the profile and connects. Throws InputError for a bad address or profile (exit 2) and
 /// EnvironmentError for an address that cannot be reached or is no T7 (exit 4); nothing is armed.
-std::unique_ptr<Device> open_t7_device(const T7Options& options, const Configuration& config);
+/// The T7Device is a Device; it also tells its address(), its profile().name, and stop()s.
+std::unique_ptr<T7Device> open_t7_device(const T7Options& options, const Configuration& config);
 
 }  // namespace bellows

@@ -88,7 +88,9 @@ T7Device::T7Device(T7DeviceOptions options)
   thread_ = std::thread([this] { serve(); });
 }
 
-T7Device::~T7Device() {
+T7Device::~T7Device() { stop(); }
+
+void T7Device::stop() {
   stop_.store(true, std::memory_order_release);
   if (thread_.joinable()) thread_.join();
 }

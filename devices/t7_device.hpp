@@ -48,6 +48,9 @@ class T7Device final : public Device {
   explicit T7Device(T7DeviceOptions options);
   /// Vents (one last write of the duty cycles) and closes the link.
   ~T7Device() override;
+  /// Stops the I/O thread after its last exchange, which vents; the engine loop must have stopped.
+  /// Idempotent (the destructor calls it).
+  void stop();
 
   // ---- Device: engine thread ----
   SensorReading read_sensors() override;

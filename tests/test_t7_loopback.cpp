@@ -114,6 +114,24 @@ TEST(T7Loopback, DutyCyclesReachTheLinesAndCalibratedReadingsComeBack) {
   EXPECT_LE(h.round_trip_p50_ms, h.round_trip_max_ms);
 }
 
+TEST(T7Loopback, WhenTheEngineFallsSilentTheLinkVentsByItselfAndKeepsTheWatchdogFed) {
+  SimThread sim;
+  T7Device device(device_options(sim.port()));
+  ValveCommand open_inlet;
+  open_inlet.inlet_duty = {1.0, 0.0};
+  open_inlet.outlet_duty = {0.0, 1.0};
+  ASSERT_TRUE(eventually([&] {
+    device.write_valves(open_inlet);
+    return sim.status().duty[static_cast<int>(ValveRole::kInletA)] == 1.0;
+  }));
+  // No more commands (a hung engine loop): within [t7] command_timeout_s the I/O thread vents.
+  ASSERT_TRUE(eventually([&] { return sim.status().safe; }));
+  // It keeps exchanging, so the T7's watchdog never has to act while bellows lives.
+  const std::uint64_t exchanges = device.health().exchanges;
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > exchanges + 10; }));
+  EXPECT_EQ(sim.status().watchdog_actions, 0);
+}
+
 TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {
   T7SimOptions options;
   options.swapped_chambers = true;
