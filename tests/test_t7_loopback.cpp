@@ -14,6 +14,7 @@
 #include "devices/t7_device.hpp"
 #include "devices/t7_sim_server.hpp"
 #include "engine/errors.hpp"
+#include "engine/safety.hpp"
 
 namespace bellows {
 namespace {
@@ -148,6 +149,57 @@ TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {
   }));
   EXPECT_LT(r.chamber_bar[0], r.chamber_bar[1] - 0.1);
   device.vent();
+}
+
+TEST(T7Loopback, AVoltageOutsideItsValidRangeIsASensorRangeFault) {
+  SimThread sim;
+  T7DeviceOptions options = device_options(sim.port());
+  options.profile.input(SensorRole::kSupply).volts_max_V = 1.0;  // the simulated supply reads ~2 V
+  T7Device device(options);
+  SensorReading r;
+  ASSERT_TRUE(eventually([&] {
+    r = device.read_sensors();
+    return r.time_s > 0.0;
+  }));
+  EXPECT_EQ(r.supply_bar, kOutOfRangePressure_bar);
+  GuardInputs inputs;
+  inputs.p_max_bar = ControllerParameters{}.p_max_bar;
+  EXPECT_EQ(check_guards(r, inputs, SafetyParameters{}), FaultCode::kSensorOutOfRange);
+}
+
+/// Chamber B after its inlet line has been fully open (outlet shut) for 200 ms.
+double chamber_b_after_inflating(T7SimOptions options, double& supply_bar) {
+  SimThread sim(std::move(options));
+  T7Device device(device_options(sim.port()));
+  ValveCommand inflate_b;
+  inflate_b.inlet_duty = {0.0, 1.0};
+  inflate_b.outlet_duty = {1.0, 0.0};
+  EXPECT_TRUE(eventually([&] {
+    device.write_valves(inflate_b);
+    return sim.status().duty[static_cast<int>(ValveRole::kInletB)] == 1.0;
+  }));
+  for (int i = 0; i < 40; ++i) {  // 200 ms of ticks
+    device.write_valves(inflate_b);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const SensorReading r = device.read_sensors();
+  supply_bar = r.supply_bar;
+  device.vent();
+  return r.chamber_bar[1];
+}
+
+TEST(T7Loopback, DrillsADeadInletAndNoSupply) {
+  const PlantParameters plant;
+  double supply_bar = 0.0;
+  EXPECT_GT(chamber_b_after_inflating({}, supply_bar), plant.gas.ambient_bar + 0.3);  // a healthy rig inflates
+  EXPECT_NEAR(supply_bar, plant.supply_bar, 0.05);
+  T7SimOptions dead;
+  dead.dead_valve = ValveRole::kInletB;
+  EXPECT_LT(chamber_b_after_inflating(dead, supply_bar), plant.gas.ambient_bar + 0.1);  // its line opens, the valve not
+  T7SimOptions no_supply;
+  no_supply.no_supply = true;
+  EXPECT_LT(chamber_b_after_inflating(no_supply, supply_bar), plant.gas.ambient_bar + 0.1);
+  EXPECT_NEAR(supply_bar, plant.gas.ambient_bar, 0.05);
 }
 
 TEST(T7Loopback, AnUnknownRegisterGetsTheExceptionAT7Gives) {
