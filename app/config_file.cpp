@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include "engine/errors.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 
@@ -61,12 +62,11 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
 }
 
 Configuration load_config_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("config " + path + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // A directory, FIFO or device is refused (never read as an empty file, never waited on).
+  constexpr std::size_t kMostConfigBytes = std::size_t{1} << 20;
+  const std::string text = read_regular_file(path, kMostConfigBytes, "config");
   Configuration config;
-  apply_config_toml(text.str(), path, config);
+  apply_config_toml(text, path, config);
   return config;
 }
 
