@@ -112,6 +112,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       manual_ = true;
       pulse_ = command.pulse;
       pulse_remaining_ = command.pulse.ticks;
+      pulse_report_pending_ = false;
       return;
     case CommandKind::kArm: {
       manual_ = false;
@@ -183,15 +184,23 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
       control_.start_trial(*trajectory_, *correction_, *record_);
     }
     if (manual_) {
-      valves = pulse_remaining_ > 0 ? pulse_.valves : pulse_.after;
-      if (pulse_remaining_ > 0 && --pulse_remaining_ == 0) {
-        EngineEvent event;
-        event.kind = EventKind::kValvePulseDone;
-        event.time_s = now_s;
-        event.trial_id = pulse_.id;
-        event.reading = reading;
-        event.from = event.to = state();
-        emit(event);
+      // The pulse's ticks, then `after`; its end is reported from the first `after` tick, whose
+      // reading was taken once every pulse tick had acted on the rig.
+      if (pulse_remaining_ > 0) {
+        valves = pulse_.valves;
+        if (--pulse_remaining_ == 0) pulse_report_pending_ = true;
+      } else {
+        valves = pulse_.after;
+        if (pulse_report_pending_) {
+          pulse_report_pending_ = false;
+          EngineEvent event;
+          event.kind = EventKind::kValvePulseDone;
+          event.time_s = now_s;
+          event.trial_id = pulse_.id;
+          event.reading = reading;
+          event.from = event.to = state();
+          emit(event);
+        }
       }
     } else {
       valves = control_.tick(reading);

@@ -106,6 +106,7 @@ class EngineCore {
   bool manual_ = false;
   ValvePulse pulse_{};
   int pulse_remaining_ = 0;
+  bool pulse_report_pending_ = false;  // the pulse is over: report it with the next tick's reading
 };
 
 }  // namespace bellows

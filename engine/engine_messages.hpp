@@ -76,7 +76,7 @@ enum class EventKind : std::uint8_t {
   kFault,
   kTrialComplete,
   kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
-  kValvePulseDone,  // a valve pulse's `ticks` are over; `reading` is its last tick's, `trial_id` its id
+  kValvePulseDone,  // a valve pulse's `ticks` are over; `reading`: the first one after it; `trial_id`: its id
 };
 
 struct EngineEvent {
@@ -89,7 +89,7 @@ struct EngineEvent {
   FaultCode fault = FaultCode::kNone;
   TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
   std::uint32_t trial_id = 0;
-  SensorReading reading{};                        // kValvePulseDone
+  SensorReading reading{};                        // kValvePulseDone: read after the pulse's last tick
 };
 
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.

@@ -135,6 +135,8 @@ TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
     EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 1.0) << "tick " << i;
     EXPECT_EQ(f.snapshot().valves.outlet_duty[0], 0.0) << "tick " << i;
   }
+  f.clock.step(1);  // the first tick after the pulse reports it, with a reading taken after it
+  EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 0.0);
   bool done = false;
   for (const EngineEvent& e : f.drain_events()) {
     if (e.kind == EventKind::kValvePulseDone) {
