@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/run_io.hpp"
+#include "app/t7_wiring.hpp"
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_device.hpp"
 #include "devices/lcm_io_thread.hpp"
@@ -86,13 +87,27 @@ class LcmRig final : public OpenedDevice {
   LcmIoThread io_;
 };
 
-// The LabJack T7 (Modbus TCP) is built on its own branch; when it lands, this is the one line that
-// changes: `return open_t7_device(device, config, rt);` from app/t7_wiring.hpp.
+// The LabJack T7 over Modbus TCP (app/t7_wiring): connected and configured at open; its I/O thread
+// is the T7Device's own.
+class T7Rig final : public OpenedDevice {
+ public:
+  explicit T7Rig(std::unique_ptr<T7Device> device) : device_(std::move(device)) {}
+  ~T7Rig() override { device_->stop(); }
+  Device& device() override { return *device_; }
+  nlohmann::ordered_json session_info() const override {
+    return {{"t7", device_->address()}, {"rig_profile", device_->profile().name}};
+  }
+  std::string rig_profile_name() const override { return device_->profile().name; }
+  std::string where() const override { return device_->address(); }
+  void stop() override { device_->stop(); }
+
+ private:
+  std::unique_ptr<T7Device> device_;
+};
+
 std::unique_ptr<OpenedDevice> open_t7(const DeviceParameters& device, const Configuration& config, RealtimeMode rt) {
-  (void)config;
-  (void)rt;
-  throw InputError("--device t7" + (device.t7_address.empty() ? std::string() : " --t7 " + device.t7_address) +
-                   ": the LabJack T7 device is not built into this bellows (use sim or lcm)");
+  if (device.t7_address.empty()) throw InputError("--device t7 needs --t7 HOST[:PORT]");
+  return std::make_unique<T7Rig>(open_t7_device({device.t7_address, device.rig_profile, rt != RealtimeMode::kOff}, config));
 }
 
 }  // namespace

@@ -118,6 +118,10 @@ std::vector<ParameterBinding> make_bindings() {
       number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", kPos, [](C& c) { return &c.rig_check.fill_s; }),
       number("rig_check", "valve_pulse_s", "s", "how long the valve under test opens, alone", kPos, [](C& c) { return &c.rig_check.valve_pulse_s; }),
       number("rig_check", "min_change_bar", "bar", "a chamber moved: by at least this, and this much more than the other", kPos, [](C& c) { return &c.rig_check.min_change_bar; }),
+      number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", kPos, [](C& c) { return &c.t7.response_timeout_s; }),
+      number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", kPos, [](C& c) { return &c.t7.connect_timeout_s; }),
+      whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds, at least 1)", [](C& c) { return &c.t7.watchdog_timeout_s; }),
+      number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", kPos, [](C& c) { return &c.t7.command_timeout_s; }),
   };
   // [device]: which rig (names, so text rows), after [lcm]
   const std::vector<std::tuple<const char*, const char*, std::function<std::string*(C&)>>> device_rows = {
@@ -206,6 +210,10 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");
+  }
+  if (config.t7.watchdog_timeout_s < 1) {
+    throw InputError("[t7] watchdog_timeout_s = " + std::to_string(config.t7.watchdog_timeout_s) +
+                     ": the T7's watchdog counts whole seconds, 1 at least");
   }
 }
 

@@ -25,6 +25,7 @@ struct Configuration {
   LcmParameters lcm;
   DeviceParameters device;
   RigCheckParameters rig_check;
+  T7Parameters t7;
 };
 
 /// What a parameter's value must satisfy.

@@ -77,13 +77,13 @@ TEST(DeviceFactory, AnLcmRigOnAnInProcessBusReportsItsLink) {
   opened->stop();
 }
 
-TEST(DeviceFactory, T7IsOneClearLineWhereItIsNotBuilt) {
+TEST(DeviceFactory, T7WithoutAnAddressIsOneClearLine) {
   const Configuration c;
   try {
-    open_device(resolve_device({"t7", "", "127.0.0.1:5020", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
-    SUCCEED() << "t7 is built in";
+    open_device(resolve_device({"t7", "", "", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
+    FAIL() << "t7 opened without an address";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--device t7"), std::string::npos) << e.what();
+    EXPECT_STREQ(e.what(), "--device t7 needs --t7 HOST[:PORT]");
   }
 }
 
