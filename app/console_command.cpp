@@ -1,11 +1,15 @@
 #include "app/console_command.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 
 #include "app/config_file.hpp"
 #include "app/console_sessions.hpp"
+#include "app/device_factory.hpp"
+#include "sessions/session_store.hpp"
 #include "app/cpu_idle_hold.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
@@ -17,33 +21,80 @@
 
 namespace bellows {
 
-int console_command(const ConsoleOptions& options, std::ostream& out) {
-  if (options.device != "sim") {
-    throw InputError("--device '" + options.device + "': unknown device (known: sim)");
+namespace {
+
+// A session reopens on the device it was recorded on (unless --device names one): its [device]
+// section and its manifest's device. Says why when that device cannot be driven from here.
+void take_device_of_session(const std::string& session_dir, const ConsoleOptions& options, Configuration& config) {
+  std::filesystem::path data_dir;
+  try {
+    data_dir = default_data_dir();
+  } catch (const InputError&) {
+    // Without a data directory the session is a path; resolve_session_dir says so otherwise.
   }
+  const std::filesystem::path directory = resolve_session_dir(session_dir, data_dir);
+  const SessionManifest manifest = load_manifest(directory);
+  if (!options.device.kind.empty() && options.device.kind != manifest.device) {
+    throw InputError("session " + directory.string() + " was recorded on the device '" + manifest.device +
+                     "'; --device " + options.device.kind + " cannot continue it (leave --device out to reopen it on " +
+                     manifest.device + ")");
+  }
+  config.device = manifest.configuration.device;
+  config.device.kind = manifest.device;
+}
+
+}  // namespace
+
+int console_command(const ConsoleOptions& options, std::ostream& out) {
   if (options.stop_after_rises < 1) throw InputError("--stop-after-rises must be at least 1");
   if (options.exit_after_s < 0.0) throw InputError("--exit-after must not be negative");
   const double speed = parse_speed(options.speed);
-  const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  if (!options.session_dir.empty()) take_device_of_session(options.session_dir, options, config);
+  config.device = resolve_device(options.device, config.device);
   const double sample_s = config.timing.sample_s();
   auto load_trajectory = [sample_s, limits = config.trajectory](const std::string& name_or_path) {
     return resolve_trajectory(name_or_path, sample_s, limits);
   };
 
-  StoreSessionGateway sessions(options.device);
-  ui::ConsoleSetup setup;
+  // The seed first (a session continues on the simulated arm it was recorded with), then the device.
   std::uint64_t seed = options.seed;
-  if (!options.session_dir.empty()) {
-    setup.session = sessions.open(options.session_dir);  // InputError: missing, busy or damaged
+  std::optional<ui::SessionSnapshot> opened_session;
+  {
+    StoreSessionGateway reader(config.device.kind);
+    if (!options.session_dir.empty()) {
+      opened_session = reader.open(options.session_dir);  // InputError: missing, busy or damaged
+      seed = opened_session->seed;
+    }
+  }
+  std::unique_ptr<OpenedDevice> rig;
+  try {
+    rig = open_device(config.device, config, seed, options.rt, 0);
+  } catch (const BellowsError& error) {
+    if (options.session_dir.empty()) throw;
+    throw InputError("session " + options.session_dir + " was recorded on the device '" + config.device.kind +
+                     "', which this console cannot drive now: " + error.what());
+  }
+  if (rig->needs_real_time() && speed != 1.0) {
+    throw InputError("--device " + config.device.kind + " runs in real time: --speed must be 1");
+  }
+  struct StopRig {  // the device's I/O thread: its last vent goes out after the loop stopped
+    OpenedDevice& rig;
+    ~StopRig() { rig.stop(); }
+  } stop_rig{*rig};
+
+  StoreSessionGateway sessions(config.device.kind, rig->session_info());
+  ui::ConsoleSetup setup;
+  if (opened_session) {
+    setup.session = sessions.open(options.session_dir);  // this gateway saves into it from now on
     setup.trajectory = *setup.session->experiment.trajectory;
-    seed = setup.session->seed;  // the same simulated arm it was recorded with
   } else {
     setup.trajectory = load_trajectory(options.trajectory);
   }
 
-  SimulatedArm arm(config.plant, seed);
-  EngineCore core(arm, config.controller, config.timing, config.safety);
-  RealtimeLoop loop(core, arm, speed);
+  Device& device = rig->device();
+  EngineCore core(device, config.controller, config.timing, config.safety);
+  RealtimeLoop loop(core, device, speed);
   setup.core = &core;
   setup.loop = &loop;
   setup.rt_mode = options.rt;
@@ -51,7 +102,11 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.config = config;
   setup.environment.load_trajectory = load_trajectory;
   setup.environment.sessions = &sessions;
-  setup.environment.device_name = arm.name();
+  setup.environment.device_name = device.name();
+  setup.environment.device_where = rig->where();
+  setup.environment.rig_profile = rig->rig_profile_name();
+  setup.environment.device_health = [&device] { return device.health(); };
+  setup.environment.raw_inputs = [&device] { return device.raw_inputs(); };
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
   setup.stop_flag = &stop_requested();

@@ -5,12 +5,13 @@
 #include <iosfwd>
 #include <string>
 
+#include "app/device_factory.hpp"
 #include "engine/realtime_loop.hpp"
 
 namespace bellows {
 
 struct ConsoleOptions {
-  std::string device = "sim";        // only the simulated arm so far
+  DeviceOptions device;              // --device, --lcm, --t7, --rig-profile over [device]
   std::string speed = "1";           // the simulated arm's time warp: 1, 2, 5, 10 or max
   std::string config_path;
   std::string trajectory = "paper";  // library name or CSV file

@@ -78,7 +78,8 @@ std::string local_date_of(const std::string& utc) {
   return text;
 }
 
-StoreSessionGateway::StoreSessionGateway(std::string device_name) : device_name_(std::move(device_name)) {
+StoreSessionGateway::StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info)
+    : device_name_(std::move(device_name)), device_info_(std::move(device_info)) {
   try {
     data_dir_ = default_data_dir();
   } catch (const InputError& error) {
@@ -111,7 +112,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   } else {
     SessionManifest header;
     header.device = snapshot.device_name;
-    header.device_info = {{"seed", snapshot.seed}};
+    header.device_info = device_info_;
+    if (snapshot.device_name == "sim") header.device_info["seed"] = snapshot.seed;  // the arm it continues with
     header.configuration = snapshot.config;
     for (const ui::LogEntry& entry : snapshot.events) {
       if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
@@ -159,7 +161,8 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   const SessionManifest& m = loaded.manifest;
   if (m.device != device_name_) {
     throw InputError("session " + directory.string() + " was recorded on the device '" + m.device +
-                     "'; this console drives '" + device_name_ + "'");
+                     "'; this console drives '" + device_name_ + "' (open it with bellows console --session " +
+                     directory.string() + ")");
   }
   ui::SessionSnapshot snapshot;
   snapshot.config = m.configuration;

@@ -21,7 +21,8 @@ namespace bellows {
 class StoreSessionGateway final : public ui::SessionGateway {
  public:
   /// `device_name`: the console's device; a session recorded on another one is not opened.
-  explicit StoreSessionGateway(std::string device_name);
+  /// `device_info`: what a new session records about it (seed, bus, address, rig profile).
+  explicit StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info = nlohmann::ordered_json::object());
 
   bool available() const override { return !data_dir_.empty(); }
   std::string unavailable_reason() const override { return reason_; }
@@ -34,6 +35,7 @@ class StoreSessionGateway final : public ui::SessionGateway {
  private:
   std::mutex mutex_;
   std::string device_name_;
+  nlohmann::ordered_json device_info_;
   std::filesystem::path data_dir_;  // empty: not available (reason_ says why)
   std::string reason_;
   std::optional<SessionWriter> writer_;  // the session the console saves into

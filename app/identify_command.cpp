@@ -5,16 +5,21 @@
 #include <fstream>
 #include <ostream>
 #include <sstream>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/device_factory.hpp"
+#include "app/signals.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
 #include "engine/identification.hpp"
 #include "engine/identification_trial.hpp"
+#include "engine/realtime_loop.hpp"
 
 namespace bellows {
 namespace {
@@ -36,15 +41,47 @@ struct TrialFit {
   IdentificationData data;
 };
 
-TrialFit record_trial(const Configuration& config, const std::string& signal, std::uint64_t seed) {
+TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal) {
+  const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
+  TrialRecord record;
+  run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record);
+  return {signal, identification_data(record, config.controller, config.timing.tick_s)};
+}
+
+// The simulated arm: a fresh arm per trial on simulated time (the seed decides its noise).
+TrialFit record_simulated_trial(const Configuration& config, const std::string& signal, std::uint64_t seed) {
   SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
-  const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
-  TrialRecord record;
-  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record);
+  TrialFit fit = record_trial(clock, config, signal);
   arm.vent();
-  return {signal, identification_data(record, config.controller, config.timing.tick_s)};
+  return fit;
+}
+
+// A rig (lcm, t7): both trials on the one device, on the real-time loop; vented however it ends.
+std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, const DeviceParameters& device,
+                                                const IdentifyOptions& options, const std::string& estimation_signal,
+                                                const std::string& validation_signal, std::ostream& progress) {
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0);
+  EngineCore core(rig->device(), config.controller, config.timing, config.safety);
+  RealtimeLoop loop(core, rig->device(), 1.0);
+  loop.start(options.rt);
+  struct StopLoop {  // vents on every way out
+    RealtimeLoop& loop;
+    OpenedDevice& rig;
+    ~StopLoop() {
+      loop.stop();
+      rig.stop();
+    }
+  } stop_loop{loop, *rig};
+  if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
+    throw EnvironmentError(why);
+  }
+  progress << "identification trial (" << estimation_signal << ") on " << device.kind << " " << rig->where() << std::endl;
+  TrialFit estimation = record_trial(loop, config, estimation_signal);
+  progress << "validation trial (" << validation_signal << ")" << std::endl;
+  TrialFit validation = record_trial(loop, config, validation_signal);
+  return {std::move(estimation), std::move(validation)};
 }
 
 nlohmann::json model_json(const ModelParameters& m) {
@@ -133,12 +170,18 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
     apply_config_toml(existing_text, options.write_model_path, check);  // fail before any trial runs
   }
 
-  progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
-           << config.identify.duration_s << " s)" << std::endl;
-  const TrialFit estimation = record_trial(config, estimation_signal, options.seed);
+  const DeviceParameters device = resolve_device(options.device, config.device);
+  TrialFit estimation, validation;
+  if (device.kind == "sim") {
+    progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
+             << config.identify.duration_s << " s)" << std::endl;
+    estimation = record_simulated_trial(config, estimation_signal, options.seed);
+    progress << "validation trial (" << held_out_signal << ")" << std::endl;
+    validation = record_simulated_trial(config, held_out_signal, options.seed + 1);
+  } else {
+    std::tie(estimation, validation) = record_rig_trials(config, device, options, estimation_signal, held_out_signal, progress);
+  }
   const ArmModelFit fit = fit_arm_model(estimation.data, config.model);
-  progress << "validation trial (" << held_out_signal << ")" << std::endl;
-  const TrialFit validation = record_trial(config, held_out_signal, options.seed + 1);
   const double validation_fit =
       normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
   const double nominal_validation_fit =
@@ -151,7 +194,7 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
   }
   if (options.json) {
     const nlohmann::json report = {
-        {"device", "sim"},
+        {"device", device.kind},
         {"signal", estimation_signal},
         {"validation_signal", held_out_signal},
         {"samples", estimation.data.angle_rad.size()},

@@ -7,7 +7,9 @@
 #include <iosfwd>
 #include <string>
 
+#include "app/device_factory.hpp"
 #include "engine/configuration.hpp"
+#include "engine/realtime_loop.hpp"
 
 namespace bellows {
 
@@ -17,6 +19,8 @@ struct IdentifyOptions {
   std::uint64_t seed = 1;
   bool json = false;
   std::string write_model_path;  // config file whose [model] section receives the fit
+  DeviceOptions device;          // --device, --lcm, --t7, --rig-profile over [device]
+  RealtimeMode rt = RealtimeMode::kTry;  // the engine loop on a rig (lcm, t7)
 };
 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress);

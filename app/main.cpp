@@ -8,6 +8,7 @@
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
+#include "app/rig_check_command.hpp"
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
@@ -86,13 +87,8 @@ int main(int argc, char** argv) {
   }
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
-  run_cmd->add_option("--device", run.device,
-                      "sim: the simulated arm in-process; lcm: a rig over LCM; t7: a LabJack T7 over Modbus TCP (both --clock wall)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"sim", "lcm", "t7"}));
-  run_cmd->add_option("--t7", run.t7_address, "--device t7: the T7's address HOST[:PORT] (port 502 by default)");
-  run_cmd->add_option("--rig-profile", run.rig_profile, "--device t7: the rig profile (default: the paper rig's)");
-  run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find the rig there)");
+  bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 need --clock wall
+  run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find an lcm rig there)");
   CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
                                              "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
                                              "FILE in the session directory")
@@ -128,9 +124,7 @@ int main(int argc, char** argv) {
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
-  console_cmd->add_option("--device", console.device, "The rig: sim (the simulated arm)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"sim"}));
+  bellows::add_device_options(*console_cmd, console.device);
   console_cmd->add_option("--speed", console.speed, "The simulated arm's time warp: 1, 2, 5, 10 or max")
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
@@ -162,10 +156,29 @@ int main(int argc, char** argv) {
   CLI::App* identify_cmd =
       app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
   identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
+  bellows::add_device_options(*identify_cmd, identify.device);
+  identify_cmd->add_option("--rt", identify.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
   identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")->capture_default_str();
   identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+
+  bellows::RigCheckOptions rig_check;
+  CLI::App* rig_cmd = app.add_subcommand("rig", "The first day at the bench: check the rig's inputs and valves");
+  rig_cmd->require_subcommand(1);
+  CLI::App* rig_check_cmd =
+      rig_cmd->add_subcommand("check", "Raw inputs beside calibrated values, then each valve pulsed in turn, pass or fail");
+  rig_check_cmd->add_option("--config", rig_check.config_path, "TOML configuration file ([device], [rig_check])");
+  bellows::add_device_options(*rig_check_cmd, rig_check.device);
+  rig_check_cmd->add_option("--seed", rig_check.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  rig_check_cmd->add_option("--rt", rig_check.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
+      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->default_str("try");
+  rig_check_cmd->add_flag("--yes", rig_check.yes, "Pulse the valves without asking (the operator has cleared the arm)");
+  rig_check_cmd->add_flag("--inputs-only", rig_check.inputs_only, "Only show the inputs; open no valve");
+  rig_check_cmd->add_flag("--json", rig_check.json, "Print one JSON object on stdout");
 
   try {
     app.parse(argc, argv);
@@ -189,6 +202,9 @@ int main(int argc, char** argv) {
     }
     if (identify_cmd->parsed()) {
       return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
+    }
+    if (rig_check_cmd->parsed()) {
+      return bellows::rig_check_command(rig_check, std::cin, std::cout, rig_check.json ? std::cerr : std::cout);
     }
     if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
     if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);

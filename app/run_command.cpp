@@ -86,7 +86,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
   recording.restore(arm, core, clock, session);  // before the first tick
-  recording.start(config, trajectory, device.name(), seed, options.iterations);
+  Configuration recorded = config;  // the device as opened, whatever [device] said
+  recorded.device = io.device_parameters();
+  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info());
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
   io.start_telemetry(recording.directory());  // its LCM log goes into the session
   const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
@@ -149,6 +151,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
 
   if (options.json) {
     nlohmann::json report = {{"device", device.name()},
+                             {"rig_profile", io.opened().rig_profile_name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
                              {"seed", seed},

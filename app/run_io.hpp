@@ -22,12 +22,14 @@
 
 namespace bellows {
 
+class OpenedDevice;
+
 /// Received-message counters as a JSON object ({"accepted", "ignored": {by reason}}).
 nlohmann::json receive_counts_json(const ReceiveCounts& counts);
 
 class RunIo {
  public:
-  /// Checks the options against each other and opens the rig's bus (`--device lcm`). Throws
+  /// Checks the options against each other and opens the device (app/device_factory). Throws
   /// InputError for a combination that makes no sense or a bus that cannot be opened.
   RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config);
   ~RunIo();
@@ -36,8 +38,11 @@ class RunIo {
 
   /// The device the engine drives.
   Device& device();
-  /// The simulated arm, or null for a rig over LCM.
-  SimulatedArm* simulated_arm() { return arm_.get(); }
+  /// The simulated arm, or null for a rig.
+  SimulatedArm* simulated_arm();
+  /// The device as opened (its session record, its name).
+  const OpenedDevice& opened() const { return *device_; }
+  const DeviceParameters& device_parameters() const { return device_parameters_; }
 
   /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
   /// tick and before simulated_clock().
@@ -48,7 +53,7 @@ class RunIo {
   /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
   /// --lcm-log names no file. Before the first tick.
   void start_telemetry(const std::filesystem::path& session_directory);
-  /// With --device lcm: waits (the engine loop running) until a rig serves this session. Returns
+  /// With a rig (lcm, t7): waits (the engine loop running) until a rig serves this session. Returns
   /// an empty string when it does, else why not; gives up early when `stop` is set.
   std::string wait_for_rig(const std::atomic<bool>& stop);
   /// Operator thread, after each completed trial.
@@ -78,10 +83,8 @@ class RunIo {
   const RunOptions& options_;
   Configuration config_;
   bool telemetry_ = false;
-  std::unique_ptr<SimulatedArm> arm_;
-  std::unique_ptr<LcmDevice> lcm_device_;
-  std::unique_ptr<Device> t7_device_;  // --device t7 (app/t7_wiring.hpp)
-  std::unique_ptr<LcmIoThread> device_io_;
+  DeviceParameters device_parameters_;
+  std::unique_ptr<OpenedDevice> device_;
   TelemetryRing* tap_ = nullptr;
   std::string log_path_;
   std::unique_ptr<TelemetryPublisher> publisher_;

@@ -13,6 +13,8 @@ namespace {
 // a command leaves within about a millisecond of the tick that wrote it, without waking the I/O
 // thread from the engine thread (that would be a system call in the real-time loop).
 constexpr double kOutboxPoll_s = 0.001;
+// health(): the link counts as up while a valid state arrived this recently (20 ticks at 200 Hz).
+constexpr double kLinkAlive_s = 0.1;
 
 void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
@@ -34,7 +36,7 @@ std::int64_t LcmDevice::random_session_id() {
 // ---- engine thread ----
 
 SensorReading LcmDevice::read_sensors() {
-  inbox_.read(reading_);
+  if (!inbox_.read(reading_)) bump(stale_reads_);
   return reading_;
 }
 
@@ -76,6 +78,9 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   }
   if (s.seq <= last_state_seq_ || !(s.time_s > last_rig_time_s_)) return counters_.out_of_order();
   if (s.command_seq > seq_ || s.command_seq < last_echoed_seq_) return counters_.invalid();  // a command never sent
+  if (s.command_seq > last_echoed_seq_ && seq_ - s.command_seq < static_cast<std::int64_t>(sent_s_.size())) {
+    round_trips_.record(1e3 * (monotonic_s() - sent_s_[static_cast<std::size_t>(s.command_seq) % sent_s_.size()]));
+  }
   last_state_seq_ = s.seq;
   last_rig_time_s_ = s.time_s;
   last_echoed_seq_ = s.command_seq;
@@ -109,6 +114,7 @@ void LcmDevice::finish(lcm::LCM* bus, double now_s) {
 
 void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   command_.seq = ++seq_;
+  sent_s_[static_cast<std::size_t>(seq_) % sent_s_.size()] = now_s;
   command_.utime = static_cast<std::int64_t>(now_s * 1e6);
   fill_command(outgoing.valves, outgoing.armed, command_);
   last_armed_ = outgoing.armed;
@@ -119,6 +125,18 @@ void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   }
   bump(commands_sent_);
   if (!outgoing.armed) bump(vent_commands_sent_);
+}
+
+DeviceHealth LcmDevice::health() const {
+  DeviceHealth h;
+  h.has_link = true;
+  h.connected = connected() && monotonic_s() - last_state_s() < kLinkAlive_s;
+  round_trips_.summarize(h);
+  const ReceiveCounts c = counters_.snapshot();
+  h.link_errors = c.truncated + c.wrong_type + c.too_large + c.malformed + c.invalid + c.foreign + c.out_of_order +
+                  rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
+  h.stale_readings = stale_reads_.load(std::memory_order_relaxed);
+  return h;
 }
 
 LcmDeviceStats LcmDevice::stats() const {

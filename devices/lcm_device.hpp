@@ -20,6 +20,7 @@
 
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_io_thread.hpp"
+#include "devices/round_trip_stats.hpp"
 #include "engine/device.hpp"
 #include "engine/latest_value.hpp"
 
@@ -66,6 +67,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
   double last_state_s() const { return last_state_s_.load(std::memory_order_relaxed); }
   LcmDeviceStats stats() const;
+  /// The link: round trip from a command to the first state echoing it, rejected messages and
+  /// rig fault states as errors, engine reads without a new state as stale; connected while a
+  /// valid state arrived within the last kLinkAlive_s.
+  DeviceHealth health() const override;
 
  private:
   struct Outgoing {
@@ -105,6 +110,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<std::uint64_t> commands_sent_{0};
   std::atomic<std::uint64_t> vent_commands_sent_{0};
   std::atomic<std::uint64_t> publish_errors_{0};
+  // health(): when each recent command went out (I/O thread), round trips, stale engine reads.
+  std::array<double, 64> sent_s_{};
+  RoundTripStats round_trips_;
+  std::atomic<std::uint64_t> stale_reads_{0};
 };
 
 }  // namespace bellows

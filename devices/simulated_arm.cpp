@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "engine/errors.hpp"
 #include "engine/valve_flow.hpp"
@@ -22,17 +23,20 @@ const char* to_string(SimulatedFault fault) {
     case SimulatedFault::kSupplyLoss: return "supply-loss";
     case SimulatedFault::kNanAngle: return "nan-angle";
     case SimulatedFault::kPressureSpike: return "pressure-spike";
+    case SimulatedFault::kSwappedChambers: return "swapped-chambers";
+    case SimulatedFault::kDeadInlet: return "dead-inlet";
   }
   return "?";
 }
 
 SimulatedFault simulated_fault_from_string(const std::string& name) {
   for (auto fault : {SimulatedFault::kNone, SimulatedFault::kSensorDropout, SimulatedFault::kStuckInlet,
-                     SimulatedFault::kSupplyLoss, SimulatedFault::kNanAngle, SimulatedFault::kPressureSpike}) {
+                     SimulatedFault::kSupplyLoss, SimulatedFault::kNanAngle, SimulatedFault::kPressureSpike,
+                     SimulatedFault::kSwappedChambers, SimulatedFault::kDeadInlet}) {
     if (name == to_string(fault)) return fault;
   }
   throw InputError("unknown simulated fault '" + name +
-                   "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike)");
+                   "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet)");
 }
 
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
@@ -120,6 +124,11 @@ SimulatedArm::Openings SimulatedArm::openings_at(double phase_s) const {
     open.outlet[i] = phase_s < state_.command.outlet_duty[i] * period;
   }
   if (state_.fault == SimulatedFault::kStuckInlet) open.inlet[0] = true;
+  if (state_.fault == SimulatedFault::kDeadInlet) open.inlet[0] = false;
+  if (state_.fault == SimulatedFault::kSwappedChambers) {
+    std::swap(open.inlet[0], open.inlet[1]);
+    std::swap(open.outlet[0], open.outlet[1]);
+  }
   return open;
 }
 

@@ -23,9 +23,12 @@ enum class SimulatedFault : std::uint8_t {
   kSupplyLoss,      // the supply pressure falls to ambient
   kNanAngle,        // the encoder reads NaN
   kPressureSpike,   // chamber A's sensor reads a spike of `spike_bar` for `spike_s`
+  kSwappedChambers, // the tubes are crossed: A's valves feed and vent chamber B, and B's chamber A
+  kDeadInlet,       // actuator A's inlet valve never opens whatever is commanded
 };
 
-/// "none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike".
+/// "none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike",
+/// "swapped-chambers", "dead-inlet".
 const char* to_string(SimulatedFault fault);
 /// Throws InputError for an unknown name.
 SimulatedFault simulated_fault_from_string(const std::string& name);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include "engine/errors.hpp"
 
@@ -112,12 +113,30 @@ std::vector<ParameterBinding> make_bindings() {
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
       number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", kPos, [](C& c) { return &c.lcm.rig_timeout_s; }),
       number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", kPos, [](C& c) { return &c.lcm.connect_timeout_s; }),
+      // [rig_check]: the valve test of the first day (docs/rig-bring-up.md)
+      number("rig_check", "vent_s", "s", "both outlets open before each valve's test (back to ambient)", kPos, [](C& c) { return &c.rig_check.vent_s; }),
+      number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", kPos, [](C& c) { return &c.rig_check.fill_s; }),
+      number("rig_check", "valve_pulse_s", "s", "how long the valve under test opens, alone", kPos, [](C& c) { return &c.rig_check.valve_pulse_s; }),
+      number("rig_check", "min_change_bar", "bar", "a chamber moved: by at least this, and this much more than the other", kPos, [](C& c) { return &c.rig_check.min_change_bar; }),
       number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", kPos, [](C& c) { return &c.t7.response_timeout_s; }),
       number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", kPos, [](C& c) { return &c.t7.connect_timeout_s; }),
       whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds, at least 1)", [](C& c) { return &c.t7.watchdog_timeout_s; }),
       number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", kPos, [](C& c) { return &c.t7.command_timeout_s; }),
   };
-  ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
+  // [device]: which rig (names, so text rows), after [lcm]
+  const std::vector<std::tuple<const char*, const char*, std::function<std::string*(C&)>>> device_rows = {
+      {"kind", "the rig: sim (the simulated arm), lcm (a rig over LCM) or t7 (a LabJack T7 over Modbus TCP)", [](C& c) { return &c.device.kind; }},
+      {"lcm", "lcm: the rig's LCM bus URL (empty: udpm://239.255.76.67:7667?ttl=0)", [](C& c) { return &c.device.lcm_url; }},
+      {"t7", "t7: the T7's address HOST[:PORT] (port 502 by default)", [](C& c) { return &c.device.t7_address; }},
+      {"rig_profile", "t7: the rig profile file (empty: the paper's rig)", [](C& c) { return &c.device.rig_profile; }},
+  };
+  auto after_lcm = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "rig_check"; });
+  for (const auto& [key, description, member] : device_rows) {
+    ParameterBinding row{"device", key, "", description, Constraint::kAny, {}, {}, {}};
+    row.text = member;
+    after_lcm = std::next(b.insert(after_lcm, row));
+  }
+  ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet", Constraint::kAny, {}, {}, {}};
   fault.text = [](C& c) { return &c.plant.fault; };
   const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
   b.insert(after_plant, fault);
@@ -185,6 +204,9 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.trajectory.max_abs_angle_deg >= config.safety.angle_limit_deg) {
     throw InputError("[trajectory] max_abs_angle_deg must be below [safety] angle_limit_deg");
+  }
+  if (config.device.kind != "sim" && config.device.kind != "lcm" && config.device.kind != "t7") {
+    throw InputError("[device] kind = '" + config.device.kind + "': unknown device (known: sim, lcm, t7)");
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");

@@ -23,6 +23,8 @@ struct Configuration {
   TrajectoryLimits trajectory;
   SafetyParameters safety;
   LcmParameters lcm;
+  DeviceParameters device;
+  RigCheckParameters rig_check;
   T7Parameters t7;
 };
 

@@ -60,6 +60,7 @@ void EngineCore::hand_back_trial(EventKind kind, double now_s) {
 
 void EngineCore::enter_fault(FaultCode code, double now_s) {
   fault_.store(code, std::memory_order_release);
+  manual_ = false;
   device_.vent();
   hand_back_trial(EventKind::kTrialAborted, now_s);
   change_state(EngineState::kFault, now_s, CommandKind::kEmergencyStop);
@@ -107,7 +108,14 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       control_.set_controller_gains(gains);
       return;
     }
+    case CommandKind::kValvePulse:
+      manual_ = true;
+      pulse_ = command.pulse;
+      pulse_remaining_ = command.pulse.ticks;
+      pulse_report_pending_ = false;
+      return;
     case CommandKind::kArm: {
+      manual_ = false;
       // Fresh controllers, holding the trajectory's start (or where the arm is, without one).
       control_.pid().reset();
       const double hold = trajectory_ != nullptr ? trajectory_->angle_rad(0) : last_angle_rad_;
@@ -124,6 +132,10 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
         refuse("the trial's trajectory, correction or record is missing or not prepared to its length");
         return;
       }
+      if (manual_) {  // back from the operator's valves: fresh controllers
+        manual_ = false;
+        control_.pid().reset();
+      }
       trajectory_ = command.trajectory;
       correction_ = command.correction;
       record_ = command.record;
@@ -135,6 +147,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       break;
     case CommandKind::kAbortTrial:
     case CommandKind::kDisarm:
+      manual_ = false;
       hand_back_trial(EventKind::kTrialAborted, now_s);
       break;
     case CommandKind::kReset:
@@ -170,7 +183,28 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
     if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
       control_.start_trial(*trajectory_, *correction_, *record_);
     }
-    valves = control_.tick(reading);
+    if (manual_) {
+      // The pulse's ticks, then `after`; its end is reported from the first `after` tick, whose
+      // reading was taken once every pulse tick had acted on the rig.
+      if (pulse_remaining_ > 0) {
+        valves = pulse_.valves;
+        if (--pulse_remaining_ == 0) pulse_report_pending_ = true;
+      } else {
+        valves = pulse_.after;
+        if (pulse_report_pending_) {
+          pulse_report_pending_ = false;
+          EngineEvent event;
+          event.kind = EventKind::kValvePulseDone;
+          event.time_s = now_s;
+          event.trial_id = pulse_.id;
+          event.reading = reading;
+          event.from = event.to = state();
+          emit(event);
+        }
+      }
+    } else {
+      valves = control_.tick(reading);
+    }
     device_.write_valves(valves);
     if (record_ != nullptr && record_->complete) {
       EngineEvent event;

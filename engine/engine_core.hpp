@@ -102,6 +102,11 @@ class EngineCore {
   int stale_count_ = 0;
   int missed_streak_ = 0;
   double last_heartbeat_s_ = 0.0;
+  // The operator's valves (kValvePulse): instead of the control scheme while `manual_` is set.
+  bool manual_ = false;
+  ValvePulse pulse_{};
+  int pulse_remaining_ = 0;
+  bool pulse_report_pending_ = false;  // the pulse is over: report it with the next tick's reading
 };
 
 }  // namespace bellows

@@ -20,6 +20,15 @@ struct PidGains {
   double k_ff = 0.0, k_p = 0.0, k_i_per_s = 0.0, k_d_s = 0.0;
 };
 
+/// The operator holds the valves (the valve test of rig bring-up): `valves` for `ticks` ticks, then
+/// `after` until the next pulse, a disarm or a trial. The guards keep running; the PID does not.
+struct ValvePulse {
+  ValveCommand valves{};
+  ValveCommand after{};      // default: every valve closed (the chambers keep their air)
+  int ticks = 0;
+  std::uint32_t id = 0;      // echoed in the kValvePulseDone event
+};
+
 /// An operator command. Buffers named by pointer stay owned by the sender, who must keep them
 /// alive and unchanged until the engine hands them back (TrialComplete / TrialAborted event).
 struct EngineCommand {
@@ -31,6 +40,7 @@ struct EngineCommand {
   int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains
+  ValvePulse pulse{};                           // kValvePulse
 
   /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
   static EngineCommand of(CommandKind kind) {
@@ -48,6 +58,11 @@ struct EngineCommand {
     c.trial_id = trial_id;
     return c;
   }
+  static EngineCommand valve_pulse(const ValvePulse& pulse) {
+    EngineCommand c = of(CommandKind::kValvePulse);
+    c.pulse = pulse;
+    return c;
+  }
   static EngineCommand select_trajectory(const Trajectory& trajectory) {
     EngineCommand c = of(CommandKind::kSelectTrajectory);
     c.trajectory = &trajectory;
@@ -61,6 +76,7 @@ enum class EventKind : std::uint8_t {
   kFault,
   kTrialComplete,
   kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
+  kValvePulseDone,  // a valve pulse's `ticks` are over; `reading`: the first one after it; `trial_id`: its id
 };
 
 struct EngineEvent {
@@ -73,6 +89,7 @@ struct EngineEvent {
   FaultCode fault = FaultCode::kNone;
   TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
   std::uint32_t trial_id = 0;
+  SensorReading reading{};                        // kValvePulseDone: read after the pulse's last tick
 };
 
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.

@@ -35,6 +35,11 @@ Transition transition(EngineState state, CommandKind command) {
       if (state == S::kSafe || state == S::kArmed) return allow(state);
       if (state == S::kRunning) return refuse("not while a trial is running");
       return refuse("a fault is latched: reset it first");
+    case CommandKind::kValvePulse:
+      if (state == S::kArmed) return allow(state);
+      if (state == S::kSafe) return refuse("arm the valves first");
+      if (state == S::kRunning) return refuse("not while a trial is running");
+      return refuse("a fault is latched: reset it and arm");
   }
   return refuse("unknown command");
 }
@@ -60,6 +65,7 @@ const char* to_string(CommandKind command) {
     case CommandKind::kSelectTrajectory: return "select trajectory";
     case CommandKind::kHeartbeat: return "heartbeat";
     case CommandKind::kSetGains: return "set gains";
+    case CommandKind::kValvePulse: return "valve pulse";
   }
   return "?";
 }

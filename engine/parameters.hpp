@@ -131,6 +131,24 @@ struct LcmParameters {
   double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
 };
 
+/// Which rig the commands drive (`[device]`; `--device`, `--lcm`, `--t7`, `--rig-profile` override
+/// it). The engine never looks at it: app/device_factory opens the device it names.
+struct DeviceParameters {
+  std::string kind = "sim";     // sim (the simulated arm in-process), lcm (a rig over LCM), t7 (a LabJack T7)
+  std::string lcm_url;          // the rig's LCM bus; empty: the default udpm URL
+  std::string t7_address;       // HOST[:PORT] of the T7 (Modbus TCP, port 502 by default)
+  std::string rig_profile;      // the rig profile file (t7); empty: the shipped profile of the paper's rig
+};
+
+/// The valve test of the first day at the bench (`bellows rig check`, the console's Rig screen):
+/// each valve opened alone for `valve_pulse_s`, the chamber pressures compared before and after.
+struct RigCheckParameters {
+  double vent_s = 1.0;            // both outlets open before each valve, so every test starts at ambient
+  double fill_s = 0.03;           // both inlets open before an outlet's test: air for the outlet to let out
+  double valve_pulse_s = 0.03;    // the valve under test alone, fully open
+  double min_change_bar = 0.01;   // a chamber "moved": at least this much, and this much more than the other
+};
+
 /// A LabJack T7 over Modbus TCP (docs/labjack-t7.md); the engine itself knows no Modbus.
 struct T7Parameters {
   double response_timeout_s = 0.004;  // one Modbus request waits this long for its answer (under a tick)

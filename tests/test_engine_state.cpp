@@ -16,7 +16,7 @@ struct Row {
   S next;
 };
 
-// The whole table: 4 states x 9 commands.
+// The whole table: 4 states x 10 commands.
 const Row kTable[] = {
     // SAFE: only arming (and e-stop) changes anything; a trial cannot start.
     {S::kSafe, C::kArm, true, S::kArmed},
@@ -28,6 +28,7 @@ const Row kTable[] = {
     {S::kSafe, C::kSelectTrajectory, true, S::kSafe},
     {S::kSafe, C::kHeartbeat, true, S::kSafe},
     {S::kSafe, C::kSetGains, true, S::kSafe},
+    {S::kSafe, C::kValvePulse, false, S::kSafe},
     // ARMED
     {S::kArmed, C::kArm, false, S::kArmed},
     {S::kArmed, C::kDisarm, true, S::kSafe},
@@ -38,6 +39,7 @@ const Row kTable[] = {
     {S::kArmed, C::kSelectTrajectory, true, S::kArmed},
     {S::kArmed, C::kHeartbeat, true, S::kArmed},
     {S::kArmed, C::kSetGains, true, S::kArmed},
+    {S::kArmed, C::kValvePulse, true, S::kArmed},
     // RUNNING: nothing changes the trial's conditions under it.
     {S::kRunning, C::kArm, false, S::kRunning},
     {S::kRunning, C::kDisarm, true, S::kSafe},
@@ -48,6 +50,7 @@ const Row kTable[] = {
     {S::kRunning, C::kSelectTrajectory, false, S::kRunning},
     {S::kRunning, C::kHeartbeat, true, S::kRunning},
     {S::kRunning, C::kSetGains, false, S::kRunning},
+    {S::kRunning, C::kValvePulse, false, S::kRunning},
     // FAULT: latched. Arming alone cannot clear it; reset leads to SAFE, never straight to ARMED.
     {S::kFault, C::kArm, false, S::kFault},
     {S::kFault, C::kDisarm, false, S::kFault},
@@ -58,6 +61,7 @@ const Row kTable[] = {
     {S::kFault, C::kSelectTrajectory, false, S::kFault},
     {S::kFault, C::kHeartbeat, true, S::kFault},
     {S::kFault, C::kSetGains, false, S::kFault},
+    {S::kFault, C::kValvePulse, false, S::kFault},
 };
 
 TEST(EngineStateMachine, EveryTransitionAllowedAndRefused) {
@@ -72,7 +76,7 @@ TEST(EngineStateMachine, EveryTransitionAllowedAndRefused) {
 }
 
 TEST(EngineStateMachine, TableCoversEveryPair) {
-  EXPECT_EQ(std::size(kTable), 4u * 9u);
+  EXPECT_EQ(std::size(kTable), 4u * 10u);
 }
 
 TEST(EngineStateMachine, ValvesAreLiveOnlyWhenArmedOrRunning) {

@@ -23,7 +23,9 @@ TEST(UiCli, WithoutATerminalTheConsoleSaysSo) {
 }
 
 TEST(UiCli, BadOptionsAreRefused) {
-  expect_refused("console --device lcm", "--device");
+  expect_refused("console --device usb", "--device");
+  expect_refused("console --device t7", "--device t7");
+  expect_refused("console --device sim --t7 127.0.0.1", "--t7 and --rig-profile are for --device t7");
   expect_refused("console --speed 3", "--speed");
   expect_refused("console --rt sometimes", "--rt");
   expect_refused("console --stop-after-rises 0", "--stop-after-rises");

@@ -129,6 +129,7 @@ void ConsoleController::update(double now_s) {
   now_s_ = now_s;
   heartbeat(now_s);
   poll_engine(now_s);
+  refresh_rig(now_s);  // the link's figures before the health line uses them
   poll_snapshot_and_telemetry(now_s);
   poll_tasks();
   if (black_box_pending_ && env_.core->black_box().frozen()) {
@@ -164,6 +165,7 @@ void ConsoleController::poll_engine(double /*now_s*/) {
 }
 
 void ConsoleController::on_event(const EngineEvent& event) {
+  forward_to_valve_test(event);
   switch (event.kind) {
     case EventKind::kStateChanged:
       state_.engine_state = event.to;
@@ -209,6 +211,8 @@ void ConsoleController::on_event(const EngineEvent& event) {
         drop_trial("trial aborted");
       }
       return;
+    case EventKind::kValvePulseDone:  // the valve test's (forwarded above)
+      return;
   }
 }
 
@@ -232,6 +236,7 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
       health = {env_.device_name, true, "ok"};
     }
   }
+  add_link_health(health);
   if (health.ok != state_.device.ok || health.status != state_.device.status) {
     state_.device = health;
     ++revision_;
@@ -279,6 +284,10 @@ void ConsoleController::emergency_stop(const std::string& why) {
     nanosleep(&pause, nullptr);
   }
   if (state_.run.mode != RunProgress::Mode::kIdle) state_.run.stop_requested = true;
+  if (valve_test_ && valve_test_->running()) {
+    valve_test_->abandon("emergency stop");
+    show_valve_verdicts();
+  }
   state_.dialog = {};
   log(LogSource::kOperator, why + (sent ? "" : " (NOT SENT: the command queue stayed full)"), true);
   set_status("EMERGENCY STOP: valves vented", true);

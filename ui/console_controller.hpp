@@ -19,6 +19,7 @@
 #include "engine/engine_core.hpp"
 #include "engine/learning_law.hpp"
 #include "engine/realtime_loop.hpp"
+#include "engine/valve_test.hpp"
 #include "ui/background_task.hpp"
 #include "ui/console_state.hpp"
 #include "ui/key_map.hpp"
@@ -39,6 +40,10 @@ struct ConsoleEnvironment {
   std::function<Trajectory(const std::string&)> load_trajectory;
   SessionGateway* sessions = nullptr;
   std::string device_name = "sim";
+  std::string device_where;                      // the link, e.g. an LCM URL ("in-process" for sim)
+  std::string rig_profile;                       // the rig profile's name, "" without one
+  std::function<bellows::DeviceHealth()> device_health;  // Device::health() (any thread); optional
+  std::function<RawInputs()> raw_inputs;         // Device::raw_inputs() (any thread); optional
   std::uint64_t seed = 1;
   int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
   std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
@@ -120,6 +125,14 @@ class ConsoleController {
   void confirm_discard(std::string what, std::function<void()> action);
   void quit_now();
 
+  // The Rig screen and the valve test (console_rig.cpp).
+  bool handle_rig_key(int key);
+  void start_valve_test();
+  void forward_to_valve_test(const EngineEvent& event);
+  void show_valve_verdicts();
+  void refresh_rig(double now_s);
+  void add_link_health(DeviceHealth& health);
+
   // Sessions (console_sessions.cpp).
   void start_save();
   void start_listing();
@@ -150,6 +163,9 @@ class ConsoleController {
   double last_loop_stats_s_ = -1.0;
   double last_fresh_snapshot_s_ = -1.0;
   double now_s_ = 0.0;
+  double last_rig_refresh_s_ = -1.0;
+  bellows::DeviceHealth link_{};  // the device's link, refreshed with the loop statistics
+  std::unique_ptr<ValveTest> valve_test_;
   bool black_box_pending_ = false;
   TrialDiagnostics diagnostics_;
   std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate

@@ -93,6 +93,17 @@ bool ConsoleController::handle_dialog_key(int k) {
         not_an_answer(k);
       }
       return true;
+    case DialogKind::kConfirmValveTest:
+      if (k == 'y' || k == 'Y') {
+        state_.dialog = {};
+        start_valve_test();
+      } else if (k == 'n' || k == 'N') {
+        state_.dialog = {};
+        set_status("valve test cancelled: no valve opened");
+      } else {
+        not_an_answer(k);
+      }
+      return true;
     case DialogKind::kConfirmDiscard:
       if (k == 'y' || k == 'Y') {
         state_.dialog = {};
@@ -266,6 +277,7 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kLog;
       return;
     case Action::kFaultView: state_.screen = Screen::kFault; return;
+    case Action::kRig: state_.screen = Screen::kRig; return;
     case Action::kSave: start_save(); return;
     case Action::kOpen:
       state_.screen = Screen::kSessions;

@@ -126,6 +126,8 @@ bool ConsoleController::handle_screen_key(int k) {
       scroll = std::max(0, scroll);
       return true;
     }
+    case Screen::kRig:
+      return handle_rig_key(k);
     case Screen::kMain:
     case Screen::kHelp:
     case Screen::kFault:

@@ -17,7 +17,7 @@
 
 namespace bellows::ui {
 
-enum class Screen { kMain, kHelp, kTrajectory, kInspector, kTuning, kLog, kSessions, kFault };
+enum class Screen { kMain, kHelp, kTrajectory, kInspector, kTuning, kLog, kSessions, kFault, kRig };
 
 enum class DialogKind {
   kNone,
@@ -27,6 +27,7 @@ enum class DialogKind {
   kEditValue,        // a number for the tuning field
   kConfirmQuit,      // s / q / Esc
   kConfirmDiscard,   // y/n: unsaved trials would be lost
+  kConfirmValveTest, // y/n: the valves open one by one, the arm moves
 };
 
 struct Dialog {
@@ -41,7 +42,24 @@ struct Dialog {
 struct DeviceHealth {
   std::string name = "sim";
   bool ok = false;
-  std::string status = "no data";
+  std::string status = "no data";  // with a link: its round trip, errors and stale readings too
+};
+
+/// The Rig screen (the first day at the bench): the inputs live and the valve test.
+struct RigView {
+  std::string where;          // the link: "in-process", an LCM URL, a T7's address
+  std::string rig_profile;    // its name ("" without one)
+  RawInputs raw;              // raw volts beside calibrated values (none for the simulated arm)
+  struct ValveLine {
+    std::string valve;        // "inlet A"
+    bool tested = false;
+    bool pass = false;
+    std::string text;         // the changes, or the problem
+  };
+  std::vector<ValveLine> valves;  // the last valve test's verdicts (empty: none yet)
+  bool test_running = false;
+  bool verdicts_logged = false;  // the finished test's verdicts are in the log
+  std::string test_progress;  // "inlet B: pulsing (2 of 4)", "done", "stopped: ..."
 };
 
 struct LoopHealth {
@@ -151,6 +169,7 @@ struct ConsoleState {
   TuningForm tuning;
   SessionBrowser browser;
   FaultView fault_view;
+  RigView rig;
   EventLog log;
 
   bool sessions_available = false;

@@ -43,6 +43,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
       {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
+      {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
       {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
   };
   return bindings;
@@ -70,6 +71,7 @@ Availability availability(Action action, const ConsoleState& s) {
     case Action::kTuning:
     case Action::kQuit:
     case Action::kMain:
+    case Action::kRig:
       return {};
     case Action::kArm:
       if (s.engine_state == EngineState::kFault) return no("a fault is latched: reset it first (R)");
@@ -136,7 +138,7 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
                   Action::kHelp, Action::kQuit};
   } else {
     candidates = {Action::kArm, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave, Action::kOpen,
-                  Action::kLog, Action::kHelp, Action::kQuit};
+                  Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
   }
   if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
     const bool stop_first = candidates.front() == Action::kEmergencyStop;
@@ -196,6 +198,8 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
       return {{"Up/Down, PgUp/PgDn", "scroll"}, {"End", "newest"}};
     case Screen::kFault:
       return {{"R", "reset the fault"}};
+    case Screen::kRig:
+      return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"}};
     case Screen::kMain:
     case Screen::kHelp:
       break;

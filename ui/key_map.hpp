@@ -29,6 +29,7 @@ enum class Action {
   kOpen,
   kQuit,
   kHeartbeatDrill,
+  kRig,
   kMain,
 };
 

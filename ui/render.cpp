@@ -250,6 +250,7 @@ void render(const ConsoleState& s, Canvas& c) {
     case Screen::kTuning: render_tuning(s, c, body); break;
     case Screen::kLog: render_log(s, c, body); break;
     case Screen::kSessions: render_sessions(s, c, body); break;
+    case Screen::kRig: render_rig(s, c, body); break;
   }
   render_status(s, c);
   render_function_bar(s, c);

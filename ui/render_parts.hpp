@@ -24,6 +24,7 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_log(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body);
+void render_rig(const ConsoleState& s, Canvas& c, const Rect& body);
 /// The newest log entries that fit in `area`, one a line, without the routine ones.
 void render_log_lines(const ConsoleState& s, Canvas& c, const Rect& area);
 

@@ -1,0 +1,147 @@
+#include "app/rig_check_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <istream>
+#include <memory>
+#include <numbers>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/config_file.hpp"
+#include "app/signals.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
+#include "engine/errors.hpp"
+#include "engine/valve_test.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+std::string line_of(const char* pattern, auto... values) {
+  char text[400];
+  std::snprintf(text, sizeof text, pattern, values...);
+  return text;
+}
+
+// The calibrated values as the engine sees them (every device has these).
+nlohmann::json reading_json(const SensorReading& r) {
+  return {{"angle_deg", r.angle_rad * kDegPerRad},
+          {"chamber_a_bar", r.chamber_bar[0]},
+          {"chamber_b_bar", r.chamber_bar[1]},
+          {"supply_bar", r.supply_bar},
+          {"temperature_K", r.temperature_K}};
+}
+
+void print_inputs(const RawInputs& raw, const SensorReading& r, const std::string& device, std::ostream& progress) {
+  if (raw.count == 0) {
+    progress << "inputs (" << device << ": no volts, the values the engine reads):\n"
+             << line_of("  angle        %9.3f deg\n  chamber A    %9.4f bar\n  chamber B    %9.4f bar\n"
+                        "  supply       %9.4f bar\n  temperature  %9.2f K\n",
+                        r.angle_rad * kDegPerRad, r.chamber_bar[0], r.chamber_bar[1], r.supply_bar, r.temperature_K);
+    return;
+  }
+  progress << "inputs (" << device << "): raw volts -> calibrated value\n";
+  for (int i = 0; i < raw.count; ++i) {
+    const RawInput& in = raw.inputs[i];
+    progress << line_of("  %-12s %8.4f V -> %10.4f %s\n", in.name, in.volts, in.value, in.unit);
+  }
+}
+
+}  // namespace
+
+int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress) {
+  const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  const DeviceParameters device = resolve_device(options.device, config.device);
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0);
+  EngineCore core(rig->device(), config.controller, config.timing, config.safety);
+  std::unique_ptr<EngineDriver> driver;
+  RealtimeLoop* loop = nullptr;
+  if (rig->needs_real_time()) {
+    auto realtime = std::make_unique<RealtimeLoop>(core, rig->device(), 1.0);
+    loop = realtime.get();
+    driver = std::move(realtime);
+    loop->start(options.rt);
+  } else {
+    driver = std::make_unique<SimulatedClock>(core, rig->device());
+  }
+  struct StopLoop {  // vents on every way out
+    RealtimeLoop* loop;
+    OpenedDevice& rig;
+    ~StopLoop() {
+      if (loop != nullptr) loop->stop();
+      rig.stop();
+    }
+  } stop_loop{loop, *rig};
+  if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
+    throw EnvironmentError(why);
+  }
+
+  TickRecord latest;
+  while (!core.read_snapshot(latest)) driver->await();
+  const RawInputs raw = rig->device().raw_inputs();
+  progress << "rig check on " << device.kind << " (" << rig->where() << ")"
+           << (rig->rig_profile_name().empty() ? "" : ", rig profile " + rig->rig_profile_name()) << "\n";
+  print_inputs(raw, latest.reading, device.kind, progress);
+  nlohmann::json report = {{"device", device.kind},
+                           {"rig_profile", rig->rig_profile_name()},
+                           {"reading", reading_json(latest.reading)},
+                           {"inputs", nlohmann::json::array()}};
+  for (int i = 0; i < raw.count; ++i) {
+    report["inputs"].push_back({{"name", raw.inputs[i].name},
+                                {"volts", raw.inputs[i].volts},
+                                {"value", raw.inputs[i].value},
+                                {"unit", raw.inputs[i].unit}});
+  }
+  if (options.inputs_only) {
+    if (options.json) out << report.dump() << std::endl;
+    return 0;
+  }
+
+  const RigCheckParameters& check = config.rig_check;
+  if (!options.yes) {
+    progress << line_of("The valve test opens each valve alone for %.3f s (inlet A, inlet B, outlet A, outlet B); the "
+                        "arm will move. Clear it, then type y to go on: ",
+                        check.valve_pulse_s)
+             << std::flush;
+    std::string answer;
+    std::getline(in, answer);
+    if (answer.empty() || (answer[0] != 'y' && answer[0] != 'Y')) {
+      throw InputError("valve test not confirmed: no valve was opened (--yes skips the question)");
+    }
+  }
+  const ValveTestReport result =
+      run_valve_test(*driver, check, config.safety, config.controller.gas.ambient_bar,
+                     config.model.volume_gain_per_rad, &stop_requested());
+  report["valves"] = nlohmann::json::array();
+  int failed = 0;
+  progress << "valves:\n";
+  for (const ValveVerdict& v : result.valves) {
+    if (v.pass) {
+      progress << line_of("  %-9s pass  (own chamber %+.3f bar, other %+.3f bar)\n", valve_name(v.valve),
+                          v.own_change_bar, v.other_change_bar);
+    } else {
+      ++failed;
+      progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << "\n";
+    }
+    report["valves"].push_back({{"valve", valve_name(v.valve)},
+                                {"pass", v.pass},
+                                {"tested", v.tested},
+                                {"own_change_bar", v.own_change_bar},
+                                {"other_change_bar", v.other_change_bar},
+                                {"problem", v.problem}});
+  }
+  if (!result.aborted.empty()) progress << "stopped early: " << result.aborted << "\n";
+  progress << (failed == 0 ? "rig check: every valve passed" : line_of("rig check: %d of %d valves failed", failed, kValveCount))
+           << std::endl;
+  report["aborted"] = result.aborted;
+  report["all_pass"] = result.all_pass();
+  if (options.json) out << report.dump() << std::endl;
+  if (stop_signal() != 0) return 128 + stop_signal();
+  return result.all_pass() ? 0 : kExitRigCheckFailed;
+}
+
+}  // namespace bellows

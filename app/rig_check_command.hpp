@@ -1,0 +1,34 @@
+// `bellows rig check`: the first day at the bench, headless. Shows every input (raw volts beside
+// the calibrated value, where the device has volts), then, with the operator's confirmation, pulses
+// each valve in turn through the engine (engine/valve_test) and reports each pass or fail.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "app/device_factory.hpp"
+#include "engine/realtime_loop.hpp"
+
+namespace bellows {
+
+/// Exit status of a rig check in which a valve failed (or the test could not finish).
+inline constexpr int kExitRigCheckFailed = 5;
+
+struct RigCheckOptions {
+  std::string config_path;
+  DeviceOptions device;
+  std::uint64_t seed = 1;
+  RealtimeMode rt = RealtimeMode::kTry;
+  bool yes = false;          // no question before the valves open
+  bool inputs_only = false;  // no valve opens
+  bool json = false;
+};
+
+/// Runs the check. The question comes from `in` (a line starting with y goes on); the report goes to
+/// `progress` (one line per valve; failed ones start with "FAIL"), JSON to `out`. Returns 0 when
+/// every valve passed, kExitRigCheckFailed otherwise, 128 + N after signal N. Throws InputError for
+/// bad options or an unconfirmed test (nothing opened), EnvironmentError when no rig answers.
+int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress);
+
+}  // namespace bellows

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# The console drives every device: for each one (default: sim lcm) arm, one iteration, emergency
+# stop, save, quit; then the saved session reopens in the console on the device it was made on,
+# and the Rig screen's valve test passes every valve. The LCM rig is `bellows io-sim` over UDP
+# multicast inside a private network namespace this script makes for itself (`unshare -n`, loopback
+# multicast set up inside it only): nothing leaves the namespace.
+#
+# usage: e2e_console_devices.sh path/to/bellows [DEVICE...]
+# A device is one line in device_setup below: what to start beside the console, and its options.
+BELLOWS_ARG="${1:?usage: $0 path/to/bellows [DEVICE...]}"
+if [ -z "${BELLOWS_E2E_NETNS:-}" ]; then
+  if ! command -v unshare >/dev/null || ! unshare -n true 2>/dev/null; then
+    echo "SKIP: cannot make a private network namespace (unshare -n); the LCM rig needs one"
+    exit 0
+  fi
+  exec env BELLOWS_E2E_NETNS=1 unshare -n bash "$0" "$@"
+fi
+ip link set lo up
+ip link set lo multicast on
+ip route add 224.0.0.0/4 dev lo
+
+source "$(dirname "$0")/e2e_console_lib.sh"
+shift
+DEVICES=("$@")
+[ ${#DEVICES[@]} -gt 0 ] || DEVICES=(sim lcm)
+
+RIG_PID=""
+stop_rig() {
+  if [ -n "$RIG_PID" ]; then
+    kill -TERM "$RIG_PID" 2>/dev/null || true
+    wait "$RIG_PID" 2>/dev/null || true
+    RIG_PID=""
+  fi
+}
+trap 'stop_rig; e2e_cleanup' EXIT
+
+# device_setup DEVICE: starts what the device needs beside the console and sets DEVICE_ARGS.
+device_setup() {
+  case "$1" in
+    sim) DEVICE_ARGS=(--device sim --speed 2) ;;
+    lcm) "$BELLOWS" io-sim --rt off >"$E2E_DIR/io-sim.out" 2>&1 & RIG_PID=$!
+         DEVICE_ARGS=(--device lcm) ;;
+    t7)  "$BELLOWS" t7-sim >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
+         DEVICE_ARGS=(--device t7 --t7 127.0.0.1:5020) ;;
+    *) e2e_fail "unknown device '$1'" ;;
+  esac
+}
+
+for device in "${DEVICES[@]}"; do
+  device_setup "$device"
+  e2e_start 120 40 -- console "${DEVICE_ARGS[@]}" --trajectory steps
+  e2e_wait_for 'Bellows +SAFE '
+  e2e_wait_for "device $device: ok"
+  e2e_wait_for 'law [a-z-]+  M'
+
+  # Arm, one iteration.
+  e2e_keys a
+  e2e_wait_for 'Arm the valves\?'
+  e2e_keys y
+  e2e_wait_for 'Bellows +ARMED '
+  e2e_keys r
+  e2e_wait_for 'iteration 1  RMS' 120
+
+  # Emergency stop: FAULT, vented.
+  e2e_keys Space
+  e2e_wait_for 'FAULT: emergency-stop'
+  e2e_keys R
+  e2e_wait_for 'Bellows +SAFE '
+
+  # The Rig screen: the inputs, then the valve test (asks first), every valve passes.
+  e2e_keys b
+  e2e_wait_for "Inputs: $device"
+  e2e_wait_for 'chamber A'
+  e2e_keys v
+  e2e_wait_for 'Valve test: open each valve alone\?'
+  e2e_keys y
+  e2e_wait_for 'valve test: every valve passed' 120
+  for valve in 'inlet A' 'inlet B' 'outlet A' 'outlet B'; do
+    e2e_screen | grep -qE "$valve +pass" || e2e_fail "$device: $valve did not pass"
+  done
+  e2e_keys Escape
+
+  # Save and quit: the valves are vented before the exit.
+  e2e_keys s
+  e2e_wait_for 'saved: /'
+  session="$(e2e_screen | grep -oE 'saved: /[^ ]+' | head -1 | cut -c8-)"
+  [ -f "$session/manifest.json" ] || e2e_fail "$device: no session at '$session'"
+  grep -q "\"device\": *\"$device\"" "$session/manifest.json" || e2e_fail "$device: the session does not record its device"
+  e2e_keys q
+  [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "$device: exit status after quit"
+  e2e_output_has 'valves vented'
+
+  # The session reopens in the console, on the device it was made on.
+  e2e_start 120 40 -- console --session "$session" $([ "$device" = sim ] && echo --speed 2)
+  e2e_wait_for 'iteration 1  RMS'
+  e2e_wait_for "device $device: ok"
+  e2e_keys q
+  [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "$device: exit status after the reopened session"
+  stop_rig
+  echo "ok: $device"
+done

@@ -1,0 +1,245 @@
+// The valve test of the first day (engine/valve_test): through the engine on the simulated arm,
+// healthy and with injected faults (swapped chamber wiring, a dead inlet, no supply), and
+// `bellows rig check`'s exit status and lines.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "engine/valve_test.hpp"
+#include "tests/engine_fixture.hpp"
+#include "tests/process_runner.hpp"
+
+#include <nlohmann/json.hpp>
+
+// app/rig_check_command.hpp: kExitRigCheckFailed (the test does not link the app)
+constexpr int kRigCheckFailedStatus = 5;
+
+namespace bellows {
+namespace {
+
+using testing::EngineFixture;
+
+Configuration with_fault(const std::string& fault) {
+  Configuration c;
+  c.plant.fault = fault;
+  c.plant.fault_at_s = 0.0;
+  return c;
+}
+
+ValveTestReport check(const Configuration& c) {
+  EngineFixture f(c);
+  ValveTestReport report = run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+  EXPECT_EQ(f.core.state(), EngineState::kSafe) << "the test ends disarmed (vented)";
+  return report;
+}
+
+const ValveVerdict& verdict(const ValveTestReport& r, ValveId v) { return r.valves[static_cast<int>(v)]; }
+
+TEST(ValveTest, EveryValveOfAHealthyArmPasses) {
+  const ValveTestReport r = check(Configuration{});
+  ASSERT_TRUE(r.finished);
+  EXPECT_EQ(r.aborted, "");
+  for (const ValveVerdict& v : r.valves) {
+    EXPECT_TRUE(v.tested) << valve_name(v.valve);
+    EXPECT_TRUE(v.pass) << valve_name(v.valve) << ": " << v.problem;
+    EXPECT_GT(std::abs(v.own_change_bar), std::abs(v.other_change_bar)) << valve_name(v.valve);
+  }
+  EXPECT_GT(verdict(r, ValveId::kInletA).own_change_bar, 0.0);
+  EXPECT_LT(verdict(r, ValveId::kOutletB).own_change_bar, 0.0);
+  EXPECT_TRUE(r.all_pass());
+  EXPECT_TRUE(r.failure_lines().empty());
+}
+
+TEST(ValveTest, SwappedChamberWiringIsNamedForEveryValve) {
+  const ValveTestReport r = check(with_fault("swapped-chambers"));
+  ASSERT_TRUE(r.finished);
+  EXPECT_EQ(r.aborted, "");
+  EXPECT_FALSE(r.all_pass());
+  for (const ValveVerdict& v : r.valves) {
+    EXPECT_FALSE(v.pass) << valve_name(v.valve);
+    EXPECT_NE(v.problem.find("swapped"), std::string::npos) << valve_name(v.valve) << ": " << v.problem;
+  }
+  EXPECT_EQ(r.failure_lines().size(), 4u);
+}
+
+TEST(ValveTest, ADeadInletIsNamedAndTheOthersPass) {
+  const ValveTestReport r = check(with_fault("dead-inlet"));
+  ASSERT_TRUE(r.finished);
+  const ValveVerdict& dead = verdict(r, ValveId::kInletA);
+  EXPECT_FALSE(dead.pass);
+  EXPECT_NE(dead.problem.find("dead valve"), std::string::npos) << dead.problem;
+  EXPECT_TRUE(verdict(r, ValveId::kInletB).pass) << verdict(r, ValveId::kInletB).problem;
+  EXPECT_TRUE(verdict(r, ValveId::kOutletB).pass) << verdict(r, ValveId::kOutletB).problem;
+  // Outlet A has no air to let out when inlet A is dead: said so, not blamed.
+  const ValveVerdict& outlet = verdict(r, ValveId::kOutletA);
+  EXPECT_FALSE(outlet.pass);
+  EXPECT_NE(outlet.problem.find("see inlet A"), std::string::npos) << outlet.problem;
+}
+
+TEST(ValveTest, NoSupplyIsNamedAndNothingIsArmed) {
+  EngineFixture f(with_fault("supply-loss"));
+  const ValveTestReport r = run_valve_test(f.clock, f.config.rig_check, f.config.safety, f.config.controller.gas.ambient_bar, f.config.model.volume_gain_per_rad);
+  ASSERT_TRUE(r.finished);
+  for (const ValveVerdict& v : r.valves) EXPECT_FALSE(v.pass);
+  EXPECT_NE(verdict(r, ValveId::kInletA).problem.find("no supply"), std::string::npos);
+  EXPECT_NE(verdict(r, ValveId::kOutletB).problem.find("no supply"), std::string::npos);
+  for (const EngineEvent& e : f.drain_events()) {
+    EXPECT_FALSE(e.kind == EventKind::kStateChanged && e.to == EngineState::kArmed) << "armed without supply";
+  }
+  EXPECT_EQ(f.core.state(), EngineState::kSafe);
+}
+
+TEST(ValveTest, AGuardStillVentsDuringAPulse) {
+  // A pulse far too long for the pressure limit: the overpressure guard must end it, not the test.
+  Configuration c;
+  c.rig_check.valve_pulse_s = 3.0;
+  EngineFixture f(c);
+  const ValveTestReport r = run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+  ASSERT_TRUE(r.finished);
+  EXPECT_NE(r.aborted.find("the engine vented"), std::string::npos) << r.aborted;
+  EXPECT_EQ(f.core.state(), EngineState::kFault);
+  EXPECT_FALSE(r.all_pass());
+  EXPECT_NE(verdict(r, ValveId::kOutletB).problem.find("not tested"), std::string::npos);
+}
+
+TEST(ValveTest, TheEmergencyStopEndsTheTest) {
+  EngineFixture f;
+  std::atomic<bool> stop{true};
+  const ValveTestReport r = run_valve_test(f.clock, f.config.rig_check, f.config.safety, f.config.controller.gas.ambient_bar, f.config.model.volume_gain_per_rad, &stop);
+  EXPECT_NE(r.aborted.find("emergency stop"), std::string::npos) << r.aborted;
+  EXPECT_EQ(f.core.state(), EngineState::kFault);
+}
+
+TEST(ValveTest, JudgeNamesAValveThatMovesItsChamberTheWrongWay) {
+  RigCheckParameters check;
+  SensorReading before, after;
+  before.chamber_bar = {1.2, 1.2};
+  before.supply_bar = after.supply_bar = 3.0;
+  after.chamber_bar = {1.3, 1.2};  // outlet A raised chamber A
+  const ValveVerdict v = judge_valve(ValveId::kOutletA, before, after, 1.013, check, 2.0, 0.35);
+  EXPECT_FALSE(v.pass);
+  EXPECT_NE(v.problem.find("inlet and outlet of A are swapped"), std::string::npos) << v.problem;
+}
+
+TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
+  EngineFixture f;
+  f.clock.step(1);
+  f.send(CommandKind::kArm);
+  ValvePulse pulse;
+  pulse.valves.inlet_duty = {1.0, 0.0};
+  pulse.ticks = 3;
+  pulse.id = 7;
+  f.core.send(EngineCommand::valve_pulse(pulse));
+  for (int i = 0; i < 3; ++i) {
+    f.clock.step(1);
+    EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 1.0) << "tick " << i;
+    EXPECT_EQ(f.snapshot().valves.outlet_duty[0], 0.0) << "tick " << i;
+  }
+  f.clock.step(1);  // the first tick after the pulse reports it, with a reading taken after it
+  EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 0.0);
+  bool done = false;
+  for (const EngineEvent& e : f.drain_events()) {
+    if (e.kind == EventKind::kValvePulseDone) {
+      done = true;
+      EXPECT_EQ(e.trial_id, 7u);
+      EXPECT_GT(e.reading.chamber_bar[0], e.reading.chamber_bar[1]) << "inlet A filled chamber A";
+    }
+  }
+  EXPECT_TRUE(done);
+  f.clock.step(5);
+  EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 0.0) << "then every valve closed";
+  EXPECT_EQ(f.snapshot().valves.outlet_duty[1], 0.0);
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  f.send(CommandKind::kDisarm);
+  f.clock.step(1);
+  EXPECT_EQ(f.snapshot().valves.outlet_duty[0], 1.0) << "disarmed: vented";
+}
+
+TEST(ValveTest, ThePulseCommandNeedsArmedValves) {
+  EngineFixture f;
+  f.core.send(EngineCommand::valve_pulse({ValveCommand{}, ValveCommand{}, 10, 1}));
+  f.clock.step(2);
+  bool refused = false;
+  for (const EngineEvent& e : f.drain_events()) refused |= e.kind == EventKind::kCommandRefused && e.command == CommandKind::kValvePulse;
+  EXPECT_TRUE(refused);
+}
+
+}  // namespace
+}  // namespace bellows
+
+namespace bellows {
+namespace {
+
+using testing::run_process;
+using testing::write_file;
+
+struct CheckRun {
+  int status;
+  std::string out, err;
+};
+
+CheckRun rig_check(const std::string& args, const std::string& fault = "", const std::string& answer = "") {
+  const auto dir = testing::make_temp_dir("bellows-rig-check");
+  std::string config_arg;
+  if (!fault.empty()) {
+    config_arg = " --config '" + write_file(dir, "rig.toml", "[plant]\nfault = \"" + fault + "\"\nfault_at_s = 0.0\n").string() + "'";
+  }
+  const std::string input = answer.empty() ? "/dev/null" : write_file(dir, "answer", answer + "\n").string();
+  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + " " + args + " < '" + input + "'");
+  return {r.exit_code, r.out, r.err};
+}
+
+int count_of(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(RigCheckCli, AHealthyArmPassesWithStatusZero) {
+  const CheckRun r = rig_check("--yes");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(count_of(r.out, " pass "), 4) << r.out;
+  EXPECT_NE(r.out.find("no volts"), std::string::npos) << "the simulated arm says it has no volts: " << r.out;
+  EXPECT_NE(r.out.find("supply"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rig check: every valve passed"), std::string::npos) << r.out;
+}
+
+TEST(RigCheckCli, EachDrilledProblemIsNamedWithOneLinePerFailedValve) {
+  const CheckRun swapped = rig_check("--yes", "swapped-chambers");
+  EXPECT_EQ(swapped.status, kRigCheckFailedStatus) << swapped.out << swapped.err;
+  EXPECT_EQ(count_of(swapped.out, "FAIL "), 4) << swapped.out;
+  EXPECT_EQ(count_of(swapped.out, "are swapped"), 4) << swapped.out;
+
+  const CheckRun dead = rig_check("--yes", "dead-inlet");
+  EXPECT_EQ(dead.status, kRigCheckFailedStatus) << dead.out << dead.err;
+  EXPECT_NE(dead.out.find("FAIL inlet A: dead valve"), std::string::npos) << dead.out;
+  EXPECT_EQ(dead.out.find("FAIL inlet B"), std::string::npos) << dead.out;
+
+  const CheckRun no_supply = rig_check("--yes", "supply-loss");
+  EXPECT_EQ(no_supply.status, kRigCheckFailedStatus) << no_supply.out << no_supply.err;
+  EXPECT_NE(no_supply.out.find("FAIL inlet A: no supply"), std::string::npos) << no_supply.out;
+  EXPECT_NE(no_supply.out.find("FAIL inlet B: no supply"), std::string::npos) << no_supply.out;
+}
+
+TEST(RigCheckCli, NothingOpensWithoutTheOperatorsYes) {
+  const CheckRun r = rig_check("", "", "n");
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("not confirmed: no valve was opened"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find(" pass "), std::string::npos) << r.out;
+  EXPECT_EQ(rig_check("", "", "y").status, 0);
+}
+
+TEST(RigCheckCli, JsonNamesEveryValve) {
+  const CheckRun r = rig_check("--yes --json", "dead-inlet");
+  ASSERT_EQ(r.status, kRigCheckFailedStatus) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report.at("device"), "sim");
+  ASSERT_EQ(report.at("valves").size(), 4u);
+  EXPECT_EQ(report.at("valves")[0].at("valve"), "inlet A");
+  EXPECT_FALSE(report.at("valves")[0].at("pass").get<bool>());
+  EXPECT_TRUE(report.at("valves")[1].at("pass").get<bool>());
+  EXPECT_FALSE(report.at("all_pass").get<bool>());
+}
+
+}  // namespace
+}  // namespace bellows
