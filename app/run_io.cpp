@@ -39,7 +39,9 @@ nlohmann::json receive_counts_json(const ReceiveCounts& c) {
             {"malformed", c.malformed},
             {"invalid", c.invalid},
             {"foreign", c.foreign},
-            {"out_of_order", c.out_of_order}}}};
+            {"out_of_order", c.out_of_order},
+            {"old_version", c.old_version},
+            {"unauthenticated", c.unauthenticated}}}};
 }
 
 RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config)
@@ -63,7 +65,7 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     arm_ = std::make_unique<SimulatedArm>(config.plant, seed);
     return;
   }
-  lcm_device_ = std::make_unique<LcmDevice>(session_id_);
+  lcm_device_ = std::make_unique<LcmDevice>(session_id_, load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path()));
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
   device_io_ = std::make_unique<LcmIoThread>(url, std::vector<LcmEndpoint*>{lcm_device_.get()});
   device_io_->start(options.rt, kDeviceIoPriority);
@@ -107,7 +109,13 @@ std::string RunIo::wait_for_rig(const std::atomic<bool>& stop) {
     if (std::chrono::steady_clock::now() > deadline) {
       const LcmDeviceStats s = lcm_device_->stats();
       char why[320];
-      if (s.states.foreign > 0 && s.last_foreign_session != 0) {
+      if (s.states.unauthenticated > 0 && s.states.accepted == 0) {
+        std::snprintf(why, sizeof why, "a rig answers on %s but its states fail authentication (%llu): a different [lcm] key_file?",
+                      device_io_->url().c_str(), static_cast<unsigned long long>(s.states.unauthenticated));
+      } else if (s.states.old_version > 0 && s.states.accepted == 0) {
+        std::snprintf(why, sizeof why, "a rig answers on %s in protocol version 1, which this bellows no longer speaks: update it",
+                      device_io_->url().c_str());
+      } else if (s.states.foreign > 0 && s.last_foreign_session != 0) {
         std::snprintf(why, sizeof why, "a rig answers on %s but serves another session (%lld)", device_io_->url().c_str(),
                       static_cast<long long>(s.last_foreign_session));
       } else {
@@ -143,7 +151,10 @@ nlohmann::json RunIo::report() const {
                   {"last_fault_bits", s.last_fault_bits},
                   {"commands_sent", s.commands_sent},
                   {"vent_commands_sent", s.vent_commands_sent},
-                  {"publish_errors", s.publish_errors}};
+                  {"publish_errors", s.publish_errors},
+                  {"authenticated", s.keyed},
+                  {"commands_not_ours", s.commands_not_ours},
+                  {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}}};
   }
   if (publisher_) {
     const TelemetryPublisherStats s = publisher_->stats();
@@ -158,7 +169,18 @@ nlohmann::json RunIo::report() const {
   return lcm;
 }
 
+std::string RunIo::explain_fault(FaultCode code) const {
+  // No fresh state is what a rig taken over by another sender looks like from here: say so.
+  if (!lcm_device_ || code != FaultCode::kSensorStale) return "";
+  const LcmDeviceStats s = lcm_device_->stats();
+  if (s.commands_not_ours == 0 && s.states.unauthenticated == 0) return "";
+  return lcm_device_->diagnosis();
+}
+
 std::string RunIo::warning() const {
+  if (lcm_device_) {
+    if (std::string why = lcm_device_->diagnosis(); !why.empty()) return why;
+  }
   if (!publisher_) return "";
   const TelemetryPublisherStats s = publisher_->stats();
   if (s.dropped_ticks == 0 && s.errors == 0) return "";

@@ -7,15 +7,23 @@
 //   each new valve state as an io_command_t with the next sequence number, and checks every
 //   io_state_t received before handing it to the engine.
 //
+// Binding: commands are addressed to one rig (`rig_id`) and echo its binding offer. Until a free
+// rig's offer is seen they are addressed to none (rig_id 0) and every rig ignores them; the engine
+// vents until a rig serves it, so the command that binds is a vent. A new offer (the rig restarted,
+// or dropped the session) is taken only while the engine is venting. With a key, states whose MAC
+// does not match are counted and ignored, and every command is signed.
+//
 // The reading's time_s is the I/O thread's monotonic clock when the last valid state of this
 // session arrived (not the rig's clock, which restarts with the rig). No valid state for
 // [safety] stale_ticks ticks therefore trips the engine's stale-sensor guard, which vents; a rig
-// reporting a fault bit counts as no state. Only fresh valve states are published: if the engine
+// reporting a sensor or valve fault counts as no state (its limit bits do not: the engine's own
+// guards judge the reading). Only fresh valve states are published: if the engine
 // thread stops, the commands stop and the rig vents on its own.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "devices/lcm_codec.hpp"
@@ -35,15 +43,19 @@ struct LcmDeviceStats {
   std::uint64_t commands_sent = 0;
   std::uint64_t vent_commands_sent = 0;  // of which armed = false
   std::uint64_t publish_errors = 0;
+  std::uint64_t commands_not_ours = 0;   // states of this session echoing a command it never sent
+  std::int64_t rig_foreign_commands = 0;          // what the rig says it refused (its last state)
+  std::int64_t rig_unauthenticated_commands = 0;
+  bool keyed = false;                     // [lcm] key_file set
 };
 
 class LcmDevice final : public Device, public LcmEndpoint {
  public:
   /// `session_id`: nonzero, unique per run (random_session_id()).
-  explicit LcmDevice(std::int64_t session_id);
+  explicit LcmDevice(std::int64_t session_id, LcmKey key = {});
 
   /// A random nonzero session id.
-  static std::int64_t random_session_id();
+  static std::int64_t random_session_id() { return random_nonzero_id(); }
 
   // ---- Device: engine thread only (one writer of the outbox at a time: the engine thread while
   // the loop runs, the thread that stopped it afterwards) ----
@@ -66,6 +78,9 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
   double last_state_s() const { return last_state_s_.load(std::memory_order_relaxed); }
   LcmDeviceStats stats() const;
+  /// Evidence that someone else is on this rig's bus, for people: "another sender is commanding
+  /// this rig: ..." or "" when there is none.
+  std::string diagnosis() const;
 
  private:
   struct Outgoing {
@@ -76,6 +91,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
 
   const std::int64_t session_id_;
+  const LcmKey key_;
   LatestValue<Outgoing> outbox_;        // engine -> I/O
   LatestValue<SensorReading> inbox_;    // I/O -> engine
   SensorReading reading_{};             // engine thread's copy
@@ -84,7 +100,9 @@ class LcmDevice final : public Device, public LcmEndpoint {
   io_state_t received_{};
   SensorReading pending_{};
   bool pending_fresh_ = false;
-  std::int64_t rig_id_ = 0;
+  std::int64_t rig_id_ = 0;        // the rig addressed, 0: none yet
+  std::int64_t binding_ = 0;       // its offer this session answers
+  bool bound_ = false;             // its last state served this session
   std::int64_t last_state_seq_ = 0;
   std::int64_t last_echoed_seq_ = 0;
   double last_rig_time_s_ = 0.0;
@@ -105,6 +123,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<std::uint64_t> commands_sent_{0};
   std::atomic<std::uint64_t> vent_commands_sent_{0};
   std::atomic<std::uint64_t> publish_errors_{0};
+  std::atomic<std::uint64_t> commands_not_ours_{0};
+  std::atomic<std::int64_t> rig_foreign_commands_{0}, rig_unauthenticated_commands_{0};
 };
 
 }  // namespace bellows

@@ -112,7 +112,14 @@ std::vector<ParameterBinding> make_bindings() {
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
       number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", kPos, [](C& c) { return &c.lcm.rig_timeout_s; }),
       number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", kPos, [](C& c) { return &c.lcm.connect_timeout_s; }),
+      whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers, at most 1000000", [](C& c) { return &c.lcm.seq_window; }),
+      number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", kNonNeg, [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
+      number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", kPos, [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
   };
+  ParameterBinding key_file{"lcm", "key_file", "", "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and states; empty: none",
+                            Constraint::kAny, {}, {}, {}};
+  key_file.text = [](C& c) { return &c.lcm.key_file; };
+  b.push_back(key_file);
   ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
   fault.text = [](C& c) { return &c.plant.fault; };
   const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
@@ -181,6 +188,16 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.trajectory.max_abs_angle_deg >= config.safety.angle_limit_deg) {
     throw InputError("[trajectory] max_abs_angle_deg must be below [safety] angle_limit_deg");
+  }
+  if (config.lcm.seq_window > 1000000) {
+    throw InputError("[lcm] seq_window = " + std::to_string(config.lcm.seq_window) + ": must be at most 1000000");
+  }
+  if (config.lcm.rig_pressure_margin_bar < config.safety.pressure_margin_bar) {
+    throw InputError("[lcm] rig_pressure_margin_bar must not be below [safety] pressure_margin_bar: the engine's guard acts first");
+  }
+  if (config.lcm.rig_angle_limit_deg < config.safety.angle_limit_deg || config.lcm.rig_angle_limit_deg > 180.0) {
+    throw InputError("[lcm] rig_angle_limit_deg = " + format_number(config.lcm.rig_angle_limit_deg) +
+                     ": must be in [[safety] angle_limit_deg, 180]: the engine's guard acts first");
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");
