@@ -65,7 +65,8 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     arm_ = std::make_unique<SimulatedArm>(config.plant, seed);
     return;
   }
-  lcm_device_ = std::make_unique<LcmDevice>(session_id_, load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path()));
+  lcm_device_ = std::make_unique<LcmDevice>(session_id_, load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path()),
+                                            config.lcm.rig_timeout_s);
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
   device_io_ = std::make_unique<LcmIoThread>(url, std::vector<LcmEndpoint*>{lcm_device_.get()});
   device_io_->start(options.rt, kDeviceIoPriority);

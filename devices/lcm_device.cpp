@@ -17,7 +17,8 @@ void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_rela
 
 }  // namespace
 
-LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key) : session_id_(session_id), key_(key) {
+LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s)
+    : session_id_(session_id), key_(key), rig_silence_s_(rig_silence_s) {
   command_.session_id = session_id_;
   buffer_.resize(static_cast<std::size_t>(command_.getEncodedSize()));
   // Nothing goes out before the engine's first tick: a rig serving nobody takes the first session
@@ -53,13 +54,17 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   if (status != DecodeStatus::kOk) return counters_.count(status);
   const io_state_t& s = received_;
   if (!valid_state(s)) return counters_.invalid();
+  const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
+  if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
   if (s.session_id == 0) {  // a free rig's offer
-    if (s.rig_id == rig_id_) bound_ = false;  // ours dropped this session (timeout, angle range, restart)
+    if (s.rig_id == rig_id_) bound_ = false;  // ours dropped this session (timeout, angle range)
     // Never switch while the valves are live; while vented, take the offer of any free rig until one
-    // serves this session, and a new offer of the rig addressed.
-    if (!last_armed_ && (!bound_ || s.rig_id == rig_id_) && (s.rig_id != rig_id_ || s.binding != binding_)) {
+    // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
+    if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) && (s.rig_id != rig_id_ || s.binding != binding_)) {
       rig_id_ = s.rig_id;
       binding_ = s.binding;
+      bound_ = false;
+      last_rig_state_s_ = now_s_;
       stats_rig_id_.store(rig_id_, std::memory_order_relaxed);
       last_state_seq_ = 0;
       last_echoed_seq_ = 0;
@@ -85,8 +90,8 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   last_rig_time_s_ = s.time_s;
   last_echoed_seq_ = s.command_seq;
   last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
-  constexpr std::int32_t kNoReading = io_state_t::FAULT_NO_SESSION | io_state_t::FAULT_COMMAND_TIMEOUT |
-                                      io_state_t::FAULT_SENSOR | io_state_t::FAULT_VALVE;
+  constexpr std::int32_t kNoReading = std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} |
+                                      std::int32_t{io_state_t::FAULT_SENSOR} | std::int32_t{io_state_t::FAULT_VALVE};
   if ((s.fault_bits & kNoReading) != 0) return bump(rig_fault_states_);  // not a reading to control with
   counters_.accepted();
   pending_ = to_reading(s);
@@ -94,6 +99,7 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
 }
 
 double LcmDevice::service(lcm::LCM* bus, double now_s) {
+  now_s_ = now_s;
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.

@@ -52,7 +52,8 @@ struct LcmDeviceStats {
 class LcmDevice final : public Device, public LcmEndpoint {
  public:
   /// `session_id`: nonzero, unique per run (random_session_id()).
-  explicit LcmDevice(std::int64_t session_id, LcmKey key = {});
+  /// `rig_silence_s`: a rig silent this long is gone ([lcm] rig_timeout_s): another may be bound.
+  explicit LcmDevice(std::int64_t session_id, LcmKey key = {}, double rig_silence_s = 0.05);
 
   /// A random nonzero session id.
   static std::int64_t random_session_id() { return random_nonzero_id(); }
@@ -92,6 +93,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   const std::int64_t session_id_;
   const LcmKey key_;
+  const double rig_silence_s_;
   LatestValue<Outgoing> outbox_;        // engine -> I/O
   LatestValue<SensorReading> inbox_;    // I/O -> engine
   SensorReading reading_{};             // engine thread's copy
@@ -103,6 +105,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::int64_t rig_id_ = 0;        // the rig addressed, 0: none yet
   std::int64_t binding_ = 0;       // its offer this session answers
   bool bound_ = false;             // its last state served this session
+  double now_s_ = 0.0;             // of the last service()
+  double last_rig_state_s_ = 0.0;  // when the rig addressed last sent anything valid
   std::int64_t last_state_seq_ = 0;
   std::int64_t last_echoed_seq_ = 0;
   double last_rig_time_s_ = 0.0;

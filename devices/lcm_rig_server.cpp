@@ -10,12 +10,6 @@ namespace bellows {
 namespace {
 void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
-bool same(const ValveCommand& a, const ValveCommand& b) {
-  for (int i = 0; i < kActuatorCount; ++i) {
-    if (a.inlet_duty[i] != b.inlet_duty[i] || a.outlet_duty[i] != b.outlet_duty[i]) return false;
-  }
-  return true;
-}
 }  // namespace
 
 RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id)
@@ -53,6 +47,11 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   const io_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();
   if (c.rig_id != rig_id_) return bump(not_addressed_);  // to another rig, or to none yet: not for us to count as foreign
+  const bool outside_range = (limit_bits_ & io_state_t::FAULT_ANGLE_LIMIT) != 0;
+  if (session_ == 0 && c.binding == binding_ && !c.armed && outside_range) {
+    notice(Notice::kForeign, "session " + std::to_string(c.session_id) + " tried to bind while the arm is beyond the rig's angle range");
+    return counters_.foreign();
+  }
   if (session_ == 0 && c.binding == binding_ && !c.armed) {  // free: a session binds with a vent echoing the offer
     session_ = c.session_id;
     last_seq_ = c.seq - 1;
@@ -96,6 +95,7 @@ void RigServer::apply_limits(bool write) {
   const LimitedValves limited = enforce_rig_limits(commanded_, arm_.read_sensors(), params_.limits);
   const std::int32_t before = limit_bits_;
   limit_bits_ = limited.fault_bits;
+  limit_bits_since_state_ |= limit_bits_;
   const auto rising = [&](std::int32_t bit) { return (limit_bits_ & bit) != 0 && (before & bit) == 0; };
   if (rising(io_state_t::FAULT_PRESSURE_LIMIT)) {
     bump(pressure_trips_);
@@ -109,7 +109,7 @@ void RigServer::apply_limits(bool write) {
   }
   if (limited.angle_exceeded) {
     commanded_ = ValveCommand::vented();
-    if (session_ != 0) release(io_state_t::FAULT_NO_SESSION | io_state_t::FAULT_ANGLE_LIMIT);
+    if (session_ != 0) release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT});
   }
   // Written only when something changed: every write starts a new PWM period.
   if (write || limit_bits_ != 0 || before != 0) arm_.write_valves(limited.valves);
@@ -184,7 +184,8 @@ void RigServer::publish_state(lcm::LCM& bus, double now_s) {
   state_.session_id = session_;
   state_.command_seq = applied_seq_;
   state_.utime = static_cast<std::int64_t>(now_s * 1e6);
-  state_.fault_bits = fault_bits_ | limit_bits_;
+  state_.fault_bits = fault_bits_ | limit_bits_ | limit_bits_since_state_;  // a limit that acted between two states too
+  limit_bits_since_state_ = 0;
   const ReceiveCounts c = counters_.snapshot();
   state_.foreign_commands = static_cast<std::int64_t>(c.foreign + c.out_of_order + c.old_version);
   state_.unauthenticated_commands = static_cast<std::int64_t>(c.unauthenticated);

@@ -87,6 +87,7 @@ class RigServer final : public LcmEndpoint {
   bool pending_in_sequence_ = false;  // the session's own command (else a vent obeyed out of sequence)
   ValveCommand commanded_ = ValveCommand::vented();  // the session's latest, before the limits
   std::int32_t limit_bits_ = 0;     // the limits acting now
+  std::int32_t limit_bits_since_state_ = 0;  // and those that acted since the last state
   std::int64_t binding_ = 0;        // offered while free, in force while serving
   std::int64_t session_ = 0;        // bound now
   std::int64_t last_seq_ = 0;
