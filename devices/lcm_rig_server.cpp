@@ -20,6 +20,7 @@ RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t
   if (params_.seq_window < 1) throw InputError("the rig's sequence window must be at least 1");
   arm_.vent();  // the safe state until a session binds
   binding_ = random_nonzero_id();
+  binding_shown_.store(binding_, std::memory_order_relaxed);
   state_.rig_id = rig_id_;
   buffer_.resize(static_cast<std::size_t>(state_.getEncodedSize()));
 }
@@ -122,6 +123,7 @@ void RigServer::release(std::int32_t fault_bits) {
   serving_.store(0, std::memory_order_relaxed);
   applied_seq_ = 0;
   binding_ = random_nonzero_id();  // commands of the old binding, replayed or late, now bind nothing
+  binding_shown_.store(binding_, std::memory_order_relaxed);
   fault_bits_ = fault_bits;
   std::fill(std::begin(reported_), std::end(reported_), false);
 }
@@ -207,6 +209,7 @@ RigServerStats RigServer::stats() const {
   s.angle_limit_trips = angle_trips_.load(relaxed);
   s.missed_periods = missed_periods_.load(relaxed);
   s.serving = serving_.load(relaxed);
+  s.binding = binding_shown_.load(relaxed);
   return s;
 }
 

@@ -50,6 +50,7 @@ struct RigServerStats {
   std::uint64_t angle_limit_trips = 0;     // times the arm left the range: vented, session dropped
   std::uint64_t missed_periods = 0;  // periods skipped because the thread woke too late
   std::int64_t serving = 0;          // the session bound now, 0: none
+  std::int64_t binding = 0;          // offered now (free) or in force (serving): public, in every state
 };
 
 class RigServer final : public LcmEndpoint {
@@ -105,7 +106,7 @@ class RigServer final : public LcmEndpoint {
   ReceiveCounters counters_;
   std::atomic<std::uint64_t> states_published_{0}, sessions_served_{0}, timeouts_{0}, missed_periods_{0};
   std::atomic<std::uint64_t> not_addressed_{0}, vents_out_of_sequence_{0}, pressure_trips_{0}, angle_trips_{0};
-  std::atomic<std::int64_t> serving_{0};
+  std::atomic<std::int64_t> serving_{0}, binding_shown_{0};
 };
 
 }  // namespace bellows
