@@ -115,11 +115,16 @@ std::vector<ParameterBinding> make_bindings() {
       whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers, at most 1000000", [](C& c) { return &c.lcm.seq_window; }),
       number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", kNonNeg, [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
       number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", kPos, [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
+      number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", kPos, [](C& c) { return &c.t7.response_timeout_s; }),
+      number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", kPos, [](C& c) { return &c.t7.connect_timeout_s; }),
+      whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds, at least 1)", [](C& c) { return &c.t7.watchdog_timeout_s; }),
+      number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", kPos, [](C& c) { return &c.t7.command_timeout_s; }),
   };
   ParameterBinding key_file{"lcm", "key_file", "", "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and states; empty: none",
                             Constraint::kAny, {}, {}, {}};
   key_file.text = [](C& c) { return &c.lcm.key_file; };
-  b.push_back(key_file);
+  const auto after_lcm = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "rig_angle_limit_deg"; });
+  b.insert(after_lcm + 1, key_file);
   ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike", Constraint::kAny, {}, {}, {}};
   fault.text = [](C& c) { return &c.plant.fault; };
   const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
@@ -201,6 +206,10 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");
+  }
+  if (config.t7.watchdog_timeout_s < 1) {
+    throw InputError("[t7] watchdog_timeout_s = " + std::to_string(config.t7.watchdog_timeout_s) +
+                     ": the T7's watchdog counts whole seconds, 1 at least");
   }
 }
 

@@ -135,4 +135,12 @@ struct LcmParameters {
   double rig_angle_limit_deg = 100.0;     // a rig vents and drops its session beyond this angle
 };
 
+/// A LabJack T7 over Modbus TCP (docs/labjack-t7.md); the engine itself knows no Modbus.
+struct T7Parameters {
+  double response_timeout_s = 0.004;  // one Modbus request waits this long for its answer (under a tick)
+  double connect_timeout_s = 2.0;     // opening the TCP connection and configuring the T7
+  int watchdog_timeout_s = 1;         // the T7 vents by itself after this much silence (whole s, >= 1)
+  double command_timeout_s = 0.05;    // the I/O thread vents when the engine sends no command this long
+};
+
 }  // namespace bellows
