@@ -69,7 +69,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   }
   std::unique_ptr<OpenedDevice> rig;
   try {
-    rig = open_device(config.device, config, seed, options.rt, 0);
+    rig = open_device(config.device, config, seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   } catch (const BellowsError& error) {
     if (options.session_dir.empty()) throw;
     throw InputError("session " + options.session_dir + " was recorded on the device '" + config.device.kind +

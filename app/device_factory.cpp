@@ -9,6 +9,7 @@
 #include "app/run_io.hpp"
 #include "app/t7_wiring.hpp"
 #include "devices/lcm_channels.hpp"
+#include "devices/lcm_auth.hpp"
 #include "devices/lcm_device.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "engine/errors.hpp"
@@ -38,8 +39,8 @@ class SimulatedDevice final : public OpenedDevice {
 
 class LcmRig final : public OpenedDevice {
  public:
-  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id)
-      : device_(session_id), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
+  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s)
+      : device_(session_id, std::move(key), rig_silence_s), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
     io_.start(rt, kDeviceIoPriority);
   }
   ~LcmRig() override { io_.stop(); }
@@ -56,7 +57,13 @@ class LcmRig final : public OpenedDevice {
       if (std::chrono::steady_clock::now() > deadline) {
         const LcmDeviceStats s = device_.stats();
         char why[320];
-        if (s.states.foreign > 0 && s.last_foreign_session != 0) {
+        if (s.states.unauthenticated > 0 && s.states.accepted == 0) {
+          std::snprintf(why, sizeof why, "a rig answers on %s but its states fail authentication (%llu): a different [lcm] key_file?",
+                        io_.url().c_str(), static_cast<unsigned long long>(s.states.unauthenticated));
+        } else if (s.states.old_version > 0 && s.states.accepted == 0) {
+          std::snprintf(why, sizeof why, "a rig answers on %s in protocol version 1, which this bellows no longer speaks: update it",
+                        io_.url().c_str());
+        } else if (s.states.foreign > 0 && s.last_foreign_session != 0) {
           std::snprintf(why, sizeof why, "a rig answers on %s but serves another session (%lld)", io_.url().c_str(),
                         static_cast<long long>(s.last_foreign_session));
         } else {
@@ -79,7 +86,10 @@ class LcmRig final : public OpenedDevice {
             {"last_fault_bits", s.last_fault_bits},
             {"commands_sent", s.commands_sent},
             {"vent_commands_sent", s.vent_commands_sent},
-            {"publish_errors", s.publish_errors}};
+            {"publish_errors", s.publish_errors},
+            {"authenticated", s.keyed},
+            {"commands_not_ours", s.commands_not_ours},
+            {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}}};
   }
 
  private:
@@ -137,10 +147,12 @@ DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParamete
 }
 
 std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const Configuration& config,
-                                          std::uint64_t seed, RealtimeMode rt, std::int64_t session_id) {
+                                          std::uint64_t seed, RealtimeMode rt, std::int64_t session_id,
+                                          const std::filesystem::path& config_dir) {
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
-    return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id());
+    return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
+                                    load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s);
   }
   if (device.kind == "t7") return open_t7(device, config, rt);
   throw InputError("--device '" + device.kind + "': unknown device (known: sim, lcm, t7)");

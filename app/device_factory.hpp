@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -64,9 +65,11 @@ class OpenedDevice {
 };
 
 /// Opens the device `device` names. `seed`: the simulated arm's noise; `rt`: the I/O thread's
-/// scheduling; `session_id`: the LCM session (0: a random one). Throws InputError for bad options (and a
+/// scheduling; `session_id`: the LCM session (0: a random one); `config_dir`: where a relative
+/// [lcm] key_file is found (the configuration file's folder). Throws InputError for bad options (and a
 /// device this build does not have), EnvironmentError for a bus that cannot be opened.
 std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const Configuration& config,
-                                          std::uint64_t seed, RealtimeMode rt, std::int64_t session_id);
+                                          std::uint64_t seed, RealtimeMode rt, std::int64_t session_id,
+                                          const std::filesystem::path& config_dir = {});
 
 }  // namespace bellows

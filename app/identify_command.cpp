@@ -62,7 +62,7 @@ TrialFit record_simulated_trial(const Configuration& config, const std::string& 
 std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, const DeviceParameters& device,
                                                 const IdentifyOptions& options, const std::string& estimation_signal,
                                                 const std::string& validation_signal, std::ostream& progress) {
-  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0);
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   RealtimeLoop loop(core, rig->device(), 1.0);
   loop.start(options.rt);

@@ -1,5 +1,6 @@
 #include "app/io_sim_command.hpp"
 
+#include <filesystem>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -8,7 +9,7 @@
 #include "app/run_io.hpp"
 #include "app/signals.hpp"
 #include "devices/lcm_channels.hpp"
-#include "devices/lcm_device.hpp"
+#include "devices/lcm_auth.hpp"
 #include "devices/lcm_rig_server.hpp"
 #include "engine/errors.hpp"
 
@@ -27,12 +28,19 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   RigServerParameters params;
   params.period_s = config.timing.tick_s;
   params.command_timeout_s = config.lcm.rig_timeout_s;
-  RigServer rig(arm, params, LcmDevice::random_session_id());
+  params.seq_window = config.lcm.seq_window;
+  params.limits = RigLimits::from(config);
+  params.key = load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path());
+  params.log = [&progress](const std::string& line) { progress << "io-sim: " << line << std::endl; };
+  const bool keyed = params.key.present();
+  RigServer rig(arm, std::move(params), random_nonzero_id());
   LcmIoThread io(url, {&rig});
 
   progress << "io-sim: serving the simulated arm on " << url << " (rig " << rig.stats().rig_id << ", state every "
-           << params.period_s * 1e3 << " ms, vents after " << params.command_timeout_s * 1e3 << " ms without commands)"
-           << std::endl;
+           << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
+           << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
+           << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
+           << ")" << std::endl;
   const double start_s = monotonic_s();
   io.run(
       [&] {
@@ -42,9 +50,12 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
       options.rt, kRigPriority);
 
   const RigServerStats s = rig.stats();
-  progress << "io-sim: " << s.commands.accepted << " commands applied, " << s.commands.ignored() << " ignored, "
-           << s.sessions_served << " sessions, " << s.timeouts << " timeouts, " << s.states_published
-           << " states published; valves vented" << std::endl;
+  progress << "io-sim: " << s.commands.accepted << " commands applied, " << s.commands.ignored() << " ignored ("
+           << s.commands.foreign << " of other sessions, " << s.commands.out_of_order << " out of sequence, "
+           << s.commands.unauthenticated << " unauthenticated, " << s.commands.old_version << " of protocol version 1), "
+           << s.sessions_served << " sessions, " << s.timeouts << " timeouts, " << s.pressure_limit_trips << " + "
+           << s.angle_limit_trips << " pressure + angle limit trips, " << s.states_published << " states published; valves vented"
+           << std::endl;
   if (options.json) {
     nlohmann::json report = {{"rig_id", s.rig_id},
                              {"url", url},
@@ -53,6 +64,11 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
                              {"states_published", s.states_published},
                              {"sessions_served", s.sessions_served},
                              {"timeouts", s.timeouts},
+                             {"not_addressed", s.not_addressed},
+                             {"vents_obeyed_out_of_sequence", s.vents_obeyed_out_of_sequence},
+                             {"pressure_limit_trips", s.pressure_limit_trips},
+                             {"angle_limit_trips", s.angle_limit_trips},
+                             {"authenticated", keyed},
                              {"missed_periods", s.missed_periods}};
     out << report.dump() << std::endl;
   }

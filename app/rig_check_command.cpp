@@ -56,7 +56,7 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
 int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress) {
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   const DeviceParameters device = resolve_device(options.device, config.device);
-  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0);
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   std::unique_ptr<EngineDriver> driver;
   RealtimeLoop* loop = nullptr;

@@ -129,6 +129,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   } catch (const EngineFault& fault) {
     failure = fault.what();
     failure_name = fault_name(core.fault());
+    if (std::string why = io.explain_fault(fault.code()); !why.empty()) {
+      failure = std::move(why);
+      failure_name = "foreign-sender";
+    }
     status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
     recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);

@@ -35,7 +35,9 @@ nlohmann::json receive_counts_json(const ReceiveCounts& c) {
             {"malformed", c.malformed},
             {"invalid", c.invalid},
             {"foreign", c.foreign},
-            {"out_of_order", c.out_of_order}}}};
+            {"out_of_order", c.out_of_order},
+            {"old_version", c.old_version},
+            {"unauthenticated", c.unauthenticated}}}};
 }
 
 RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config)
@@ -57,7 +59,8 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with --device " + kind);
   }
   if (kind == "lcm" || telemetry_) session_id_ = LcmDevice::random_session_id();
-  device_ = open_device(device_parameters_, config, seed, options.rt, session_id_);
+  device_ = open_device(device_parameters_, config, seed, options.rt, session_id_,
+                        std::filesystem::path(options.config_path).parent_path());
 }
 
 RunIo::~RunIo() { stop(); }
@@ -116,7 +119,18 @@ nlohmann::json RunIo::report() const {
   return lcm;
 }
 
+std::string RunIo::explain_fault(FaultCode code) const {
+  // No fresh state is what a rig taken over by another sender looks like from here: say so.
+  if (!lcm_device_ || code != FaultCode::kSensorStale) return "";
+  const LcmDeviceStats s = lcm_device_->stats();
+  if (s.commands_not_ours == 0 && s.states.unauthenticated == 0) return "";
+  return lcm_device_->diagnosis();
+}
+
 std::string RunIo::warning() const {
+  if (lcm_device_) {
+    if (std::string why = lcm_device_->diagnosis(); !why.empty()) return why;
+  }
   if (!publisher_) return "";
   const TelemetryPublisherStats s = publisher_->stats();
   if (s.dropped_ticks == 0 && s.errors == 0) return "";

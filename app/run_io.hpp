@@ -78,6 +78,9 @@ class RunIo {
   /// The "lcm" object of the JSON report (null when no LCM was used); a warning line or "".
   nlohmann::json report() const;
   std::string warning() const;
+  /// A better account of an engine fault than its name, or "": a sensor-stale fault while another
+  /// sender commands the rig (or forges its states) is that sender's doing.
+  std::string explain_fault(FaultCode code) const;
 
  private:
   const RunOptions& options_;

@@ -1,6 +1,10 @@
 #include "devices/lcm_codec.hpp"
 
+#include <sodium.h>
+
+#include <climits>
 #include <cmath>
+#include <stdexcept>
 
 namespace bellows {
 
@@ -11,8 +15,35 @@ const char* to_string(DecodeStatus status) {
     case DecodeStatus::kWrongType: return "wrong-type";
     case DecodeStatus::kTooLarge: return "too-large";
     case DecodeStatus::kMalformed: return "malformed";
+    case DecodeStatus::kOldVersion: return "old-version";
+    case DecodeStatus::kUnauthenticated: return "unauthenticated";
   }
   return "?";
+}
+
+const char* explain(DecodeStatus status) {
+  switch (status) {
+    case DecodeStatus::kOk: return "accepted";
+    case DecodeStatus::kTruncated: return "shorter than its type";
+    case DecodeStatus::kWrongType: return "not of the expected type";
+    case DecodeStatus::kTooLarge: return "longer than any valid message of its type";
+    case DecodeStatus::kMalformed: return "malformed";
+    case DecodeStatus::kOldVersion:
+      return "of protocol version 1, which this bellows no longer speaks (update the sender: docs/lcm-protocol.md)";
+    case DecodeStatus::kUnauthenticated:
+      return "not signed with this [lcm] key_file (another sender, or a different key)";
+  }
+  return "?";
+}
+
+std::int64_t random_nonzero_id() {
+  if (sodium_init() < 0) throw std::runtime_error("libsodium cannot be initialized");
+  std::uint64_t id = 0;
+  while (id == 0 || id > static_cast<std::uint64_t>(INT64_MAX)) {
+    randombytes_buf(&id, sizeof id);
+    id >>= 1;  // positive
+  }
+  return static_cast<std::int64_t>(id);
 }
 
 void ReceiveCounters::count(DecodeStatus status) {
@@ -22,6 +53,8 @@ void ReceiveCounters::count(DecodeStatus status) {
     case DecodeStatus::kWrongType: bump(wrong_type_); return;
     case DecodeStatus::kTooLarge: bump(too_large_); return;
     case DecodeStatus::kMalformed: bump(malformed_); return;
+    case DecodeStatus::kOldVersion: bump(old_version_); return;
+    case DecodeStatus::kUnauthenticated: bump(unauthenticated_); return;
   }
 }
 
@@ -36,6 +69,8 @@ ReceiveCounts ReceiveCounters::snapshot() const {
   c.invalid = invalid_.load(relaxed);
   c.foreign = foreign_.load(relaxed);
   c.out_of_order = out_of_order_.load(relaxed);
+  c.old_version = old_version_.load(relaxed);
+  c.unauthenticated = unauthenticated_.load(relaxed);
   return c;
 }
 

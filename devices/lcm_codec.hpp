@@ -16,6 +16,10 @@
 #include <bellows/io_state_t.hpp>
 #include <bellows/telemetry_t.hpp>
 #include <bellows/trial_summary_t.hpp>
+#include <bellows_v1/io_command_t.hpp>
+#include <bellows_v1/io_state_t.hpp>
+
+#include "devices/lcm_auth.hpp"
 
 #include "engine/device.hpp"
 
@@ -27,6 +31,8 @@ enum class DecodeStatus : std::uint8_t {
   kWrongType,  // fingerprint of another type (or of another version of this one)
   kTooLarge,   // longer than any valid message of the type
   kMalformed,  // lengths or contents that do not parse, or bytes left over
+  kOldVersion,       // the fingerprint of an earlier protocol version of this type (lcmtypes/v1/)
+  kUnauthenticated,  // the right shape, but its MAC does not match the key ([lcm] key_file)
 };
 const char* to_string(DecodeStatus status);
 
@@ -40,8 +46,12 @@ struct ReceiveCounts {
   std::uint64_t truncated = 0, wrong_type = 0, too_large = 0, malformed = 0;  // did not decode
   std::uint64_t invalid = 0;       // decoded, but values no valid sender sends
   std::uint64_t foreign = 0;       // another session (or rig) than the one served
-  std::uint64_t out_of_order = 0;  // sequence number or time not after the last accepted one
-  std::uint64_t ignored() const { return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order; }
+  std::uint64_t out_of_order = 0;  // sequence number or time not after the last accepted one, or a jump
+  std::uint64_t old_version = 0;   // an earlier protocol version's message
+  std::uint64_t unauthenticated = 0;  // MAC missing or wrong (only with a key)
+  std::uint64_t ignored() const {
+    return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version + unauthenticated;
+  }
 };
 
 /// The same, counted by the one thread that receives and read by any other.
@@ -57,7 +67,7 @@ class ReceiveCounters {
  private:
   static void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
   std::atomic<std::uint64_t> accepted_{0}, truncated_{0}, wrong_type_{0}, too_large_{0}, malformed_{0};
-  std::atomic<std::uint64_t> invalid_{0}, foreign_{0}, out_of_order_{0};
+  std::atomic<std::uint64_t> invalid_{0}, foreign_{0}, out_of_order_{0}, old_version_{0}, unauthenticated_{0};
 };
 
 namespace detail {
@@ -66,6 +76,20 @@ inline std::uint64_t read_big_endian(const std::uint8_t* p, int bytes) {
   std::uint64_t value = 0;
   for (int i = 0; i < bytes; ++i) value = (value << 8) | p[i];
   return value;
+}
+
+/// The fingerprint the previous protocol version gave a type (0: none).
+template <typename Message>
+std::int64_t previous_version_hash() {
+  return 0;
+}
+template <>
+inline std::int64_t previous_version_hash<io_command_t>() {
+  return bellows_v1::io_command_t::getHash();
+}
+template <>
+inline std::int64_t previous_version_hash<io_state_t>() {
+  return bellows_v1::io_state_t::getHash();
 }
 
 /// Encoded size of a message type with no variable-length field.
@@ -105,16 +129,22 @@ inline SizeRange size_range(const trial_summary_t&, const std::uint8_t* bytes, s
 
 }  // namespace detail
 
-/// Decodes `size` bytes into `out` (only meaningful when the result is kOk).
+/// Decodes `size` bytes into `out` (only meaningful when the result is kOk). With a `key` (the I/O
+/// messages), the MAC in the last 32 bytes is checked before anything is decoded.
 template <typename Message>
-DecodeStatus decode_checked(const void* data, std::size_t size, Message& out) {
+DecodeStatus decode_checked(const void* data, std::size_t size, Message& out, const LcmKey* key = nullptr) {
   const auto* bytes = static_cast<const std::uint8_t*>(data);
   if (data == nullptr || size < 8) return DecodeStatus::kTruncated;
-  if (static_cast<std::int64_t>(detail::read_big_endian(bytes, 8)) != Message::getHash()) return DecodeStatus::kWrongType;
+  const auto hash = static_cast<std::int64_t>(detail::read_big_endian(bytes, 8));
+  if (hash != Message::getHash()) {
+    const std::int64_t previous = detail::previous_version_hash<Message>();
+    return previous != 0 && hash == previous ? DecodeStatus::kOldVersion : DecodeStatus::kWrongType;
+  }
   const detail::SizeRange range = detail::size_range(out, bytes, size);
   if (range.status != DecodeStatus::kOk) return range.status;
   if (size < range.min) return DecodeStatus::kTruncated;
   if (size > range.max || size > static_cast<std::size_t>(INT_MAX)) return DecodeStatus::kTooLarge;
+  if (key != nullptr && !key->verify(bytes, size)) return DecodeStatus::kUnauthenticated;
   try {
     const int used = out.decode(data, 0, static_cast<int>(size));
     if (used < 0) return DecodeStatus::kMalformed;
@@ -135,9 +165,24 @@ std::size_t encode_into(const Message& message, std::vector<std::uint8_t>& buffe
   return static_cast<std::size_t>(size);
 }
 
+/// The same for the I/O messages, whose last 32 bytes are the MAC: signed with `key` (zeros without).
+template <typename Message>
+std::size_t encode_signed(const Message& message, const LcmKey& key, std::vector<std::uint8_t>& buffer) {
+  static_assert(sizeof(message.mac) == kLcmMacBytes, "the MAC is the message's last field");
+  const std::size_t size = encode_into(message, buffer);
+  key.sign(buffer.data(), size);
+  return size;
+}
+
 // ---- the I/O protocol's values ----
 
-/// A command a rig may apply: a session, a sequence number, every duty cycle finite in [0, 1].
+/// Why a status was refused, for a log line ("an old protocol version (update the sender)", ...).
+const char* explain(DecodeStatus status);
+
+/// A random nonzero 64-bit id (sessions, rigs, binding offers), from libsodium's generator.
+std::int64_t random_nonzero_id();
+
+/// A command a rig may consider: a session, a sequence number, every duty cycle finite in [0, 1].
 bool valid_command(const io_command_t& command);
 /// A state an engine may read: a rig, a sequence number, a finite rig time. Sensor values are not
 /// judged here: a NaN or an absurd pressure reaches the engine's guards, which fault on it.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include "devices/lcm_channels.hpp"
 
@@ -20,17 +19,12 @@ void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_rela
 
 }  // namespace
 
-LcmDevice::LcmDevice(std::int64_t session_id) : session_id_(session_id) {
+LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s)
+    : session_id_(session_id), key_(key), rig_silence_s_(rig_silence_s) {
   command_.session_id = session_id_;
   buffer_.resize(static_cast<std::size_t>(command_.getEncodedSize()));
   // Nothing goes out before the engine's first tick: a rig serving nobody takes the first session
   // that commands it, and would time out (and serve nobody again) if that session then fell silent.
-}
-
-std::int64_t LcmDevice::random_session_id() {
-  std::random_device entropy;
-  std::uniform_int_distribution<std::int64_t> pick(1, INT64_MAX);
-  return pick(entropy);
 }
 
 // ---- engine thread ----
@@ -58,26 +52,42 @@ void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(), false});
 void LcmDevice::attach(lcm::LCM& bus) { subscribe(bus, kIoStateChannel); }
 
 void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  // io_state_t only
-  const DecodeStatus status = decode_checked(data, size, received_);
+  const DecodeStatus status = decode_checked(data, size, received_, key_.present() ? &key_ : nullptr);
   if (status != DecodeStatus::kOk) return counters_.count(status);
   const io_state_t& s = received_;
   if (!valid_state(s)) return counters_.invalid();
-  if (s.session_id != session_id_) {  // a rig serving nobody yet, or someone else
+  const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
+  if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
+  if (s.session_id == 0) {  // a free rig's offer
+    if (s.rig_id == rig_id_) bound_ = false;  // ours dropped this session (timeout, angle range)
+    // Never switch while the valves are live; while vented, take the offer of any free rig until one
+    // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
+    if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) && (s.rig_id != rig_id_ || s.binding != binding_)) {
+      rig_id_ = s.rig_id;
+      binding_ = s.binding;
+      bound_ = false;
+      last_rig_state_s_ = now_s_;
+      stats_rig_id_.store(rig_id_, std::memory_order_relaxed);
+      last_state_seq_ = 0;
+      last_echoed_seq_ = 0;
+      last_rig_time_s_ = -INFINITY;
+    }
+    return counters_.foreign();
+  }
+  if (s.session_id != session_id_) {  // a rig serving someone else
     last_foreign_session_.store(s.session_id, std::memory_order_relaxed);
     return counters_.foreign();
   }
-  if (s.rig_id != rig_id_) {
-    // Another rig answering for this session. Never switch while the valves are live; while
-    // vented, the rig may have restarted: follow the new one.
-    if (rig_id_ != 0 && last_armed_) return counters_.foreign();
-    rig_id_ = s.rig_id;
-    stats_rig_id_.store(rig_id_, std::memory_order_relaxed);
-    last_state_seq_ = 0;
-    last_echoed_seq_ = 0;
-    last_rig_time_s_ = -INFINITY;
-  }
+  if (s.rig_id != rig_id_ || s.binding != binding_) return counters_.foreign();  // not the binding this session made
+  bound_ = true;
   if (s.seq <= last_state_seq_ || !(s.time_s > last_rig_time_s_)) return counters_.out_of_order();
-  if (s.command_seq > seq_ || s.command_seq < last_echoed_seq_) return counters_.invalid();  // a command never sent
+  if (s.command_seq < last_echoed_seq_) return counters_.invalid();
+  rig_foreign_commands_.store(s.foreign_commands, std::memory_order_relaxed);
+  rig_unauthenticated_commands_.store(s.unauthenticated_commands, std::memory_order_relaxed);
+  if (s.command_seq > seq_) {  // the rig applies a command of this session that this engine never sent
+    bump(commands_not_ours_);
+    return counters_.invalid();
+  }
   if (s.command_seq > last_echoed_seq_ && seq_ - s.command_seq < static_cast<std::int64_t>(sent_s_.size())) {
     round_trips_.record(1e3 * (monotonic_s() - sent_s_[static_cast<std::size_t>(s.command_seq) % sent_s_.size()]));
   }
@@ -85,13 +95,16 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   last_rig_time_s_ = s.time_s;
   last_echoed_seq_ = s.command_seq;
   last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
-  if (s.fault_bits != 0) return bump(rig_fault_states_);  // not a reading to control with
+  constexpr std::int32_t kNoReading = std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} |
+                                      std::int32_t{io_state_t::FAULT_SENSOR} | std::int32_t{io_state_t::FAULT_VALVE};
+  if ((s.fault_bits & kNoReading) != 0) return bump(rig_fault_states_);  // not a reading to control with
   counters_.accepted();
   pending_ = to_reading(s);
   pending_fresh_ = true;
 }
 
 double LcmDevice::service(lcm::LCM* bus, double now_s) {
+  now_s_ = now_s;
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.
@@ -115,10 +128,12 @@ void LcmDevice::finish(lcm::LCM* bus, double now_s) {
 void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   command_.seq = ++seq_;
   sent_s_[static_cast<std::size_t>(seq_) % sent_s_.size()] = now_s;
+  command_.rig_id = rig_id_;
+  command_.binding = binding_;
   command_.utime = static_cast<std::int64_t>(now_s * 1e6);
   fill_command(outgoing.valves, outgoing.armed, command_);
   last_armed_ = outgoing.armed;
-  const std::size_t size = encode_into(command_, buffer_);
+  const std::size_t size = encode_signed(command_, key_, buffer_);
   if (bus.publish(kIoCommandChannel, buffer_.data(), static_cast<unsigned int>(size)) != 0) {
     bump(publish_errors_);
     return;
@@ -151,7 +166,33 @@ LcmDeviceStats LcmDevice::stats() const {
   s.commands_sent = commands_sent_.load(relaxed);
   s.vent_commands_sent = vent_commands_sent_.load(relaxed);
   s.publish_errors = publish_errors_.load(relaxed);
+  s.commands_not_ours = commands_not_ours_.load(relaxed);
+  s.rig_foreign_commands = rig_foreign_commands_.load(relaxed);
+  s.rig_unauthenticated_commands = rig_unauthenticated_commands_.load(relaxed);
+  s.keyed = key_.present();
   return s;
+}
+
+std::string LcmDevice::diagnosis() const {
+  const LcmDeviceStats s = stats();
+  const std::string advice = s.keyed ? "" : " (set the same [lcm] key_file on the rig and the engine: docs/lcm-protocol.md)";
+  if (s.commands_not_ours > 0) {
+    return "another sender is commanding this rig: it applied commands this session never sent (" +
+           std::to_string(s.commands_not_ours) + " states)" + advice;
+  }
+  if (s.states.unauthenticated > 0) {
+    return "another sender publishes rig states on this bus: " + std::to_string(s.states.unauthenticated) +
+           " failed authentication and were ignored (or the rig has a different [lcm] key_file)";
+  }
+  if (s.states.old_version > 0) {
+    return "a rig on this bus speaks protocol version 1: " + std::to_string(s.states.old_version) +
+           " states ignored (update it: docs/lcm-protocol.md)";
+  }
+  if (s.rig_foreign_commands > 0 || s.rig_unauthenticated_commands > 0) {
+    return "other senders are on this rig's bus: the rig ignored " + std::to_string(s.rig_foreign_commands) +
+           " commands of other sessions and " + std::to_string(s.rig_unauthenticated_commands) + " unauthenticated ones" + advice;
+  }
+  return "";
 }
 
 }  // namespace bellows

@@ -7,15 +7,23 @@
 //   each new valve state as an io_command_t with the next sequence number, and checks every
 //   io_state_t received before handing it to the engine.
 //
+// Binding: commands are addressed to one rig (`rig_id`) and echo its binding offer. Until a free
+// rig's offer is seen they are addressed to none (rig_id 0) and every rig ignores them; the engine
+// vents until a rig serves it, so the command that binds is a vent. A new offer (the rig restarted,
+// or dropped the session) is taken only while the engine is venting. With a key, states whose MAC
+// does not match are counted and ignored, and every command is signed.
+//
 // The reading's time_s is the I/O thread's monotonic clock when the last valid state of this
 // session arrived (not the rig's clock, which restarts with the rig). No valid state for
 // [safety] stale_ticks ticks therefore trips the engine's stale-sensor guard, which vents; a rig
-// reporting a fault bit counts as no state. Only fresh valve states are published: if the engine
+// reporting a sensor or valve fault counts as no state (its limit bits do not: the engine's own
+// guards judge the reading). Only fresh valve states are published: if the engine
 // thread stops, the commands stop and the rig vents on its own.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "devices/lcm_codec.hpp"
@@ -36,15 +44,20 @@ struct LcmDeviceStats {
   std::uint64_t commands_sent = 0;
   std::uint64_t vent_commands_sent = 0;  // of which armed = false
   std::uint64_t publish_errors = 0;
+  std::uint64_t commands_not_ours = 0;   // states of this session echoing a command it never sent
+  std::int64_t rig_foreign_commands = 0;          // what the rig says it refused (its last state)
+  std::int64_t rig_unauthenticated_commands = 0;
+  bool keyed = false;                     // [lcm] key_file set
 };
 
 class LcmDevice final : public Device, public LcmEndpoint {
  public:
   /// `session_id`: nonzero, unique per run (random_session_id()).
-  explicit LcmDevice(std::int64_t session_id);
+  /// `rig_silence_s`: a rig silent this long is gone ([lcm] rig_timeout_s): another may be bound.
+  explicit LcmDevice(std::int64_t session_id, LcmKey key = {}, double rig_silence_s = 0.05);
 
   /// A random nonzero session id.
-  static std::int64_t random_session_id();
+  static std::int64_t random_session_id() { return random_nonzero_id(); }
 
   // ---- Device: engine thread only (one writer of the outbox at a time: the engine thread while
   // the loop runs, the thread that stopped it afterwards) ----
@@ -71,6 +84,9 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// rig fault states as errors, engine reads without a new state as stale; connected while a
   /// valid state arrived within the last kLinkAlive_s.
   DeviceHealth health() const override;
+  /// Evidence that someone else is on this rig's bus, for people: "another sender is commanding
+  /// this rig: ..." or "" when there is none.
+  std::string diagnosis() const;
 
  private:
   struct Outgoing {
@@ -81,6 +97,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
 
   const std::int64_t session_id_;
+  const LcmKey key_;
+  const double rig_silence_s_;
   LatestValue<Outgoing> outbox_;        // engine -> I/O
   LatestValue<SensorReading> inbox_;    // I/O -> engine
   SensorReading reading_{};             // engine thread's copy
@@ -89,7 +107,11 @@ class LcmDevice final : public Device, public LcmEndpoint {
   io_state_t received_{};
   SensorReading pending_{};
   bool pending_fresh_ = false;
-  std::int64_t rig_id_ = 0;
+  std::int64_t rig_id_ = 0;        // the rig addressed, 0: none yet
+  std::int64_t binding_ = 0;       // its offer this session answers
+  bool bound_ = false;             // its last state served this session
+  double now_s_ = 0.0;             // of the last service()
+  double last_rig_state_s_ = 0.0;  // when the rig addressed last sent anything valid
   std::int64_t last_state_seq_ = 0;
   std::int64_t last_echoed_seq_ = 0;
   double last_rig_time_s_ = 0.0;
@@ -114,6 +136,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::array<double, 64> sent_s_{};
   RoundTripStats round_trips_;
   std::atomic<std::uint64_t> stale_reads_{0};
+  std::atomic<std::uint64_t> commands_not_ours_{0};
+  std::atomic<std::int64_t> rig_foreign_commands_{0}, rig_unauthenticated_commands_{0};
 };
 
 }  // namespace bellows

@@ -9,44 +9,134 @@
 namespace bellows {
 namespace {
 void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
+
 }  // namespace
 
-RigServer::RigServer(SimulatedArm& arm, const RigServerParameters& params, std::int64_t rig_id)
-    : arm_(arm), params_(params), rig_id_(rig_id) {
-  if (!(params.period_s > 0.0) || !(params.command_timeout_s > 0.0)) {
+RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id)
+    : arm_(arm), params_(std::move(params)), rig_id_(rig_id) {
+  if (!(params_.period_s > 0.0) || !(params_.command_timeout_s > 0.0)) {
     throw InputError("the rig's period and command timeout must be positive");
   }
-  arm_.vent();  // the safe state until the first valid command
+  if (params_.seq_window < 1) throw InputError("the rig's sequence window must be at least 1");
+  arm_.vent();  // the safe state until a session binds
+  binding_ = random_nonzero_id();
+  binding_shown_.store(binding_, std::memory_order_relaxed);
   state_.rig_id = rig_id_;
   buffer_.resize(static_cast<std::size_t>(state_.getEncodedSize()));
 }
 
 void RigServer::attach(lcm::LCM& bus) { subscribe(bus, kIoCommandChannel); }
 
+void RigServer::say(const std::string& line) const {
+  if (params_.log) params_.log(line);
+}
+
+void RigServer::notice(Notice kind, const std::string& line) {
+  bool& reported = reported_[static_cast<int>(kind)];
+  if (!reported) say(line + (kind < Notice::kPressureLimit ? ": counted and ignored (further ones only counted)" : " (further ones only counted)"));
+  reported = true;
+}
+
 void RigServer::on_message(const char*, const void* data, std::size_t size) {  // io_command_t only
-  const DecodeStatus status = decode_checked(data, size, received_);
-  if (status != DecodeStatus::kOk) return counters_.count(status);
+  const DecodeStatus status = decode_checked(data, size, received_, params_.key.present() ? &params_.key : nullptr);
+  if (status != DecodeStatus::kOk) {
+    counters_.count(status);
+    if (status == DecodeStatus::kOldVersion) notice(Notice::kOldVersion, std::string("a command ") + explain(status));
+    if (status == DecodeStatus::kUnauthenticated) notice(Notice::kUnauthenticated, std::string("a command ") + explain(status));
+    return;
+  }
   const io_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();
-  if (session_ != 0 && c.session_id != session_) return counters_.foreign();
-  if (c.session_id == last_session_ && c.seq <= last_seq_) return counters_.out_of_order();
-  if (session_ == 0) {  // the first valid command since the start or since a timeout
+  if (c.rig_id != rig_id_) return bump(not_addressed_);  // to another rig, or to none yet: not for us to count as foreign
+  const bool outside_range = (limit_bits_ & io_state_t::FAULT_ANGLE_LIMIT) != 0;
+  if (session_ == 0 && c.binding == binding_ && !c.armed && outside_range) {
+    notice(Notice::kForeign, "session " + std::to_string(c.session_id) + " tried to bind while the arm is beyond the rig's angle range");
+    return counters_.foreign();
+  }
+  if (session_ == 0 && c.binding == binding_ && !c.armed) {  // free: a session binds with a vent echoing the offer
     session_ = c.session_id;
+    last_seq_ = c.seq - 1;
     serving_.store(session_, std::memory_order_relaxed);
     bump(sessions_served_);
+    std::fill(std::begin(reported_), std::end(reported_), false);
+    say("bound to session " + std::to_string(session_));
   }
-  last_session_ = c.session_id;
-  last_seq_ = c.seq;
-  pending_ = c;
-  pending_fresh_ = true;
-  counters_.accepted();
+  const bool own = session_ != 0 && c.session_id == session_ && c.binding == binding_;
+  if (own && c.seq > last_seq_ && c.seq - last_seq_ <= params_.seq_window) {
+    last_seq_ = c.seq;
+    pending_ = c;
+    pending_in_sequence_ = true;
+    pending_fresh_ = true;
+    return counters_.accepted();
+  }
+  if (!c.armed) {  // a vent is obeyed whatever its session or sequence number: it only makes the rig safer
+    if (!pending_fresh_ || !pending_in_sequence_) {  // never overwrite the session's own command unapplied
+      pending_ = c;
+      pending_in_sequence_ = false;
+      pending_fresh_ = true;
+    } else {
+      pending_.armed = false;  // the session's command, vented
+    }
+    bump(vents_out_of_sequence_);
+    return;
+  }
+  if (!own) {
+    notice(Notice::kForeign, session_ == 0 ? "a command of session " + std::to_string(c.session_id) + " that did not bind first"
+                                            : "a command of session " + std::to_string(c.session_id) +
+                                                  " while serving session " + std::to_string(session_));
+    return counters_.foreign();
+  }
+  if (c.seq <= last_seq_) return counters_.out_of_order();
+  notice(Notice::kJump, "a command of session " + std::to_string(session_) + " jumping from seq " + std::to_string(last_seq_) +
+                             " to " + std::to_string(c.seq) + " (more than [lcm] seq_window)");
+  counters_.out_of_order();
+}
+
+void RigServer::apply_limits(bool write) {
+  const LimitedValves limited = enforce_rig_limits(commanded_, arm_.read_sensors(), params_.limits);
+  const std::int32_t before = limit_bits_;
+  limit_bits_ = limited.fault_bits;
+  limit_bits_since_state_ |= limit_bits_;
+  const auto rising = [&](std::int32_t bit) { return (limit_bits_ & bit) != 0 && (before & bit) == 0; };
+  if (rising(io_state_t::FAULT_PRESSURE_LIMIT)) {
+    bump(pressure_trips_);
+    notice(Notice::kPressureLimit, "a chamber above the rig's ceiling of " + std::to_string(params_.limits.pressure_ceiling_bar) +
+                                       " bar: that chamber vented");
+  }
+  if (rising(io_state_t::FAULT_ANGLE_LIMIT)) {
+    bump(angle_trips_);
+    notice(Notice::kAngleLimit, "the arm beyond the rig's angle range: vented" +
+                                    (session_ != 0 ? ", session " + std::to_string(session_) + " dropped" : std::string()));
+  }
+  if (limited.angle_exceeded) {
+    commanded_ = ValveCommand::vented();
+    if (session_ != 0) release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT});
+  }
+  // Written only when something changed: every write starts a new PWM period.
+  if (write || limit_bits_ != 0 || before != 0) arm_.write_valves(limited.valves);
+}
+
+void RigServer::release(std::int32_t fault_bits) {
+  arm_.vent();
+  commanded_ = ValveCommand::vented();
+  session_ = 0;
+  serving_.store(0, std::memory_order_relaxed);
+  applied_seq_ = 0;
+  binding_ = random_nonzero_id();  // commands of the old binding, replayed or late, now bind nothing
+  binding_shown_.store(binding_, std::memory_order_relaxed);
+  fault_bits_ = fault_bits;
+  std::fill(std::begin(reported_), std::end(reported_), false);
 }
 
 void RigServer::advance_to(double now_s) {
+  // The limits are checked at every integration step, as a driver checks them at every sensor read.
+  const double step_s = arm_.parameters().integration_step_s;
   const double target_s = now_s - origin_s_;
-  if (target_s > device_time_s_) {
-    arm_.advance(target_s - device_time_s_);
-    device_time_s_ = target_s;
+  while (target_s > device_time_s_) {
+    const double dt = std::min(step_s, target_s - device_time_s_);
+    arm_.advance(dt);
+    device_time_s_ += dt;
+    apply_limits(false);
   }
 }
 
@@ -57,18 +147,18 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
   }
   advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
   if (pending_fresh_) {
-    arm_.write_valves(to_valves(pending_));
-    applied_seq_ = pending_.seq;
-    last_command_s_ = now_s;
-    fault_bits_ = 0;
+    commanded_ = to_valves(pending_);
+    if (pending_in_sequence_) {  // only the session's own commands keep it bound
+      applied_seq_ = pending_.seq;
+      last_command_s_ = now_s;
+      fault_bits_ = 0;
+    }
     pending_fresh_ = false;
+    apply_limits(true);
   }
   if (session_ != 0 && now_s - last_command_s_ > params_.command_timeout_s) {
-    arm_.vent();
-    session_ = 0;
-    serving_.store(0, std::memory_order_relaxed);
-    applied_seq_ = 0;
-    fault_bits_ = std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT};
+    say("the commands of session " + std::to_string(session_) + " stopped: vented, session dropped");
+    release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT});
     bump(timeouts_);
   }
   if (now_s >= next_publish_s_) {
@@ -84,25 +174,24 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
 }
 
 void RigServer::finish(lcm::LCM* bus, double now_s) {
-  arm_.vent();
-  session_ = 0;
-  serving_.store(0, std::memory_order_relaxed);
-  applied_seq_ = 0;
-  fault_bits_ = io_state_t::FAULT_NO_SESSION;
-  if (bus != nullptr && origin_s_ >= 0.0) {
-    advance_to(now_s);
-    publish_state(*bus, now_s);
-  }
+  if (bus != nullptr && origin_s_ >= 0.0) advance_to(now_s);
+  release(io_state_t::FAULT_NO_SESSION);
+  if (bus != nullptr && origin_s_ >= 0.0) publish_state(*bus, now_s);
 }
 
 void RigServer::publish_state(lcm::LCM& bus, double now_s) {
   fill_state(arm_.read_sensors(), state_);
   state_.seq = ++state_seq_;
+  state_.binding = binding_;
   state_.session_id = session_;
   state_.command_seq = applied_seq_;
   state_.utime = static_cast<std::int64_t>(now_s * 1e6);
-  state_.fault_bits = fault_bits_;
-  const std::size_t size = encode_into(state_, buffer_);
+  state_.fault_bits = fault_bits_ | limit_bits_ | limit_bits_since_state_;  // a limit that acted between two states too
+  limit_bits_since_state_ = 0;
+  const ReceiveCounts c = counters_.snapshot();
+  state_.foreign_commands = static_cast<std::int64_t>(c.foreign + c.out_of_order + c.old_version);
+  state_.unauthenticated_commands = static_cast<std::int64_t>(c.unauthenticated);
+  const std::size_t size = encode_signed(state_, params_.key, buffer_);
   if (bus.publish(kIoStateChannel, buffer_.data(), static_cast<unsigned int>(size)) == 0) bump(states_published_);
 }
 
@@ -111,11 +200,16 @@ RigServerStats RigServer::stats() const {
   RigServerStats s;
   s.rig_id = rig_id_;
   s.commands = counters_.snapshot();
+  s.vents_obeyed_out_of_sequence = vents_out_of_sequence_.load(relaxed);
+  s.not_addressed = not_addressed_.load(relaxed);
   s.states_published = states_published_.load(relaxed);
   s.sessions_served = sessions_served_.load(relaxed);
   s.timeouts = timeouts_.load(relaxed);
+  s.pressure_limit_trips = pressure_trips_.load(relaxed);
+  s.angle_limit_trips = angle_trips_.load(relaxed);
   s.missed_periods = missed_periods_.load(relaxed);
   s.serving = serving_.load(relaxed);
+  s.binding = binding_shown_.load(relaxed);
   return s;
 }
 

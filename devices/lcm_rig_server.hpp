@@ -1,20 +1,28 @@
 // The simulated arm served as a rig over LCM (`bellows io-sim`): the reference for anyone writing a
 // driver for real hardware (docs/lcm-protocol.md).
 //
-// On its own clock, every `period_s`, it publishes an io_state_t. It applies the latest valid
-// io_command_t of the session it serves as soon as it arrives (integrating the arm's physics up to
-// that moment first). Until the first valid command it holds the safe state (inlets closed, outlets
-// open) and serves nobody; it then serves that command's session only. When that session's commands
-// stop for `command_timeout_s` it vents by itself and serves nobody again. Anything malformed, out
-// of order or from another session is counted and ignored.
+// On its own clock, every `period_s`, it publishes an io_state_t. While free it holds the safe
+// state (inlets closed, outlets open) and offers a random binding in its states; a session binds
+// with a vent command addressed to this rig that echoes the offer, and from then on the rig applies
+// that session's commands only, as soon as they arrive (the arm's physics integrated up to that
+// moment first), provided each sequence number is above the last by at most `seq_window`. A vent
+// addressed to this rig is obeyed whatever its session or sequence number. When the session's
+// commands stop for `command_timeout_s`, or the arm leaves the rig's angle range, it vents, drops
+// the session and offers a new binding. A chamber above the rig's ceiling is vented whatever the
+// command. With a key, a command whose MAC does not match is counted and ignored, and every state
+// is signed. Everything refused is counted, in the states and in the log.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
+#include "devices/lcm_auth.hpp"
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_io_thread.hpp"
+#include "devices/lcm_rig_limits.hpp"
 #include "devices/simulated_arm.hpp"
 
 namespace bellows {
@@ -22,22 +30,33 @@ namespace bellows {
 struct RigServerParameters {
   double period_s = 1.0 / 200.0;     // state publication period, [timing] tick_s
   double command_timeout_s = 0.05;   // [lcm] rig_timeout_s
+  std::int64_t seq_window = 100;     // [lcm] seq_window
+  RigLimits limits;                  // RigLimits::from(configuration)
+  LcmKey key;                        // [lcm] key_file; none: nothing checked or signed
+  /// Called on the I/O thread with one line per notable event (a session bound or dropped, the
+  /// first refusal of each kind per binding, a limit acted on). May be empty.
+  std::function<void(const std::string&)> log;
 };
 
 struct RigServerStats {
   std::int64_t rig_id = 0;
   ReceiveCounts commands;            // io_command_t received, by outcome
+  std::uint64_t not_addressed = 0;   // valid commands addressed to another rig or to none (not in `commands`)
+  std::uint64_t vents_obeyed_out_of_sequence = 0;  // vents applied whose session or seq did not fit
   std::uint64_t states_published = 0;
-  std::uint64_t sessions_served = 0; // sessions accepted, one after another
+  std::uint64_t sessions_served = 0; // sessions bound, one after another
   std::uint64_t timeouts = 0;        // times the rig vented because commands stopped
+  std::uint64_t pressure_limit_trips = 0;  // times a chamber crossed the ceiling and was vented
+  std::uint64_t angle_limit_trips = 0;     // times the arm left the range: vented, session dropped
   std::uint64_t missed_periods = 0;  // periods skipped because the thread woke too late
-  std::int64_t serving = 0;          // the session served now, 0: none
+  std::int64_t serving = 0;          // the session bound now, 0: none
+  std::int64_t binding = 0;          // offered now (free) or in force (serving): public, in every state
 };
 
 class RigServer final : public LcmEndpoint {
  public:
-  /// `rig_id`: nonzero, unique per start (LcmDevice::random_session_id() will do).
-  RigServer(SimulatedArm& arm, const RigServerParameters& params, std::int64_t rig_id);
+  /// `rig_id`: nonzero, unique per start (random_nonzero_id()).
+  RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id);
 
   void attach(lcm::LCM& bus) override;
   void on_message(const char* channel, const void* data, std::size_t size) override;
@@ -48,7 +67,14 @@ class RigServer final : public LcmEndpoint {
   RigServerStats stats() const;
 
  private:
+  // What the log reports once per binding (the refusals first).
+  enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
+
   void advance_to(double now_s);
+  void apply_limits(bool write);
+  void release(std::int32_t fault_bits);  // vent, drop the session, offer a new binding
+  void notice(Notice kind, const std::string& line);
+  void say(const std::string& line) const;
   void publish_state(lcm::LCM& bus, double now_s);
 
   SimulatedArm& arm_;
@@ -59,11 +85,16 @@ class RigServer final : public LcmEndpoint {
   io_command_t received_{};
   io_command_t pending_{};
   bool pending_fresh_ = false;
-  std::int64_t session_ = 0;        // served now
-  std::int64_t last_session_ = 0;   // served last (its sequence numbers still count after a timeout)
+  bool pending_in_sequence_ = false;  // the session's own command (else a vent obeyed out of sequence)
+  ValveCommand commanded_ = ValveCommand::vented();  // the session's latest, before the limits
+  std::int32_t limit_bits_ = 0;     // the limits acting now
+  std::int32_t limit_bits_since_state_ = 0;  // and those that acted since the last state
+  std::int64_t binding_ = 0;        // offered while free, in force while serving
+  std::int64_t session_ = 0;        // bound now
   std::int64_t last_seq_ = 0;
   std::int64_t applied_seq_ = 0;
   std::int32_t fault_bits_ = io_state_t::FAULT_NO_SESSION;
+  bool reported_[static_cast<int>(Notice::kCount)] = {};  // one log line per kind per binding
   double origin_s_ = -1.0;
   double device_time_s_ = 0.0;
   double last_command_s_ = 0.0;
@@ -74,7 +105,8 @@ class RigServer final : public LcmEndpoint {
 
   ReceiveCounters counters_;
   std::atomic<std::uint64_t> states_published_{0}, sessions_served_{0}, timeouts_{0}, missed_periods_{0};
-  std::atomic<std::int64_t> serving_{0};
+  std::atomic<std::uint64_t> not_addressed_{0}, vents_out_of_sequence_{0}, pressure_trips_{0}, angle_trips_{0};
+  std::atomic<std::int64_t> serving_{0}, binding_shown_{0};
 };
 
 }  // namespace bellows

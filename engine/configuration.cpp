@@ -113,6 +113,9 @@ std::vector<ParameterBinding> make_bindings() {
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
       number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", kPos, [](C& c) { return &c.lcm.rig_timeout_s; }),
       number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", kPos, [](C& c) { return &c.lcm.connect_timeout_s; }),
+      whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers, at most 1000000", [](C& c) { return &c.lcm.seq_window; }),
+      number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", kNonNeg, [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
+      number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", kPos, [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
       // [rig_check]: the valve test of the first day (docs/rig-bring-up.md)
       number("rig_check", "vent_s", "s", "both outlets open before each valve's test (back to ambient)", kPos, [](C& c) { return &c.rig_check.vent_s; }),
       number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", kPos, [](C& c) { return &c.rig_check.fill_s; }),
@@ -123,6 +126,11 @@ std::vector<ParameterBinding> make_bindings() {
       whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds, at least 1)", [](C& c) { return &c.t7.watchdog_timeout_s; }),
       number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", kPos, [](C& c) { return &c.t7.command_timeout_s; }),
   };
+  ParameterBinding key_file{"lcm", "key_file", "", "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and states; empty: none",
+                            Constraint::kAny, {}, {}, {}};
+  key_file.text = [](C& c) { return &c.lcm.key_file; };
+  const auto after_rig_angle = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "rig_angle_limit_deg"; });
+  b.insert(after_rig_angle + 1, key_file);
   // [device]: which rig (names, so text rows), after [lcm]
   const std::vector<std::tuple<const char*, const char*, std::function<std::string*(C&)>>> device_rows = {
       {"kind", "the rig: sim (the simulated arm), lcm (a rig over LCM) or t7 (a LabJack T7 over Modbus TCP)", [](C& c) { return &c.device.kind; }},
@@ -207,6 +215,16 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.device.kind != "sim" && config.device.kind != "lcm" && config.device.kind != "t7") {
     throw InputError("[device] kind = '" + config.device.kind + "': unknown device (known: sim, lcm, t7)");
+  }
+  if (config.lcm.seq_window > 1000000) {
+    throw InputError("[lcm] seq_window = " + std::to_string(config.lcm.seq_window) + ": must be at most 1000000");
+  }
+  if (config.lcm.rig_pressure_margin_bar < config.safety.pressure_margin_bar) {
+    throw InputError("[lcm] rig_pressure_margin_bar must not be below [safety] pressure_margin_bar: the engine's guard acts first");
+  }
+  if (config.lcm.rig_angle_limit_deg < config.safety.angle_limit_deg || config.lcm.rig_angle_limit_deg > 180.0) {
+    throw InputError("[lcm] rig_angle_limit_deg = " + format_number(config.lcm.rig_angle_limit_deg) +
+                     ": must be in [[safety] angle_limit_deg, 180]: the engine's guard acts first");
   }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");

@@ -129,6 +129,10 @@ struct TimingParameters {
 struct LcmParameters {
   double rig_timeout_s = 0.05;     // a rig vents by itself when commands stop for this long
   double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
+  std::string key_file;            // shared key authenticating commands and states ("": none)
+  int seq_window = 100;            // largest step a rig accepts between a session's sequence numbers
+  double rig_pressure_margin_bar = 0.35;  // a rig vents a chamber above [controller] p_max_bar + this
+  double rig_angle_limit_deg = 100.0;     // a rig vents and drops its session beyond this angle
 };
 
 /// Which rig the commands drive (`[device]`; `--device`, `--lcm`, `--t7`, `--rig-profile` override

@@ -16,6 +16,7 @@
 #include "engine/learning_session.hpp"
 #include "engine/noilc_dense.hpp"
 #include "engine/realtime_loop.hpp"
+#include "tests/lcm_bench.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/process_runner.hpp"
 
@@ -23,41 +24,20 @@ namespace bellows {
 namespace {
 
 using testing::BusRecorder;
+using testing::decode;
+using testing::publish;
+using testing::publish_garbage;
+using testing::pump;
 using testing::Recorded;
+using testing::RigBench;
+using testing::vented;
 
-/// Dispatches everything queued on a memq bus.
-void pump(lcm::LCM& bus) {
-  while (bus.handleTimeout(0) > 0) {
-  }
-}
-
-template <typename Message>
-void publish(lcm::LCM& bus, const char* channel, const Message& message) {
-  std::vector<std::uint8_t> bytes;
-  const std::size_t size = encode_into(message, bytes);
-  bus.publish(channel, bytes.data(), static_cast<unsigned int>(size));
-}
-
-template <typename Message>
-Message decode(const Recorded& recorded) {
-  Message message{};
-  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message), DecodeStatus::kOk) << recorded.channel;
-  return message;
-}
-
-io_command_t command(std::int64_t session, std::int64_t seq, double inlet_a, bool armed = true) {
-  io_command_t c{};
-  c.session_id = session;
-  c.seq = seq;
-  c.armed = armed;
-  c.inlet_duty[0] = inlet_a;
-  c.outlet_duty[1] = 0.2;
-  return c;
-}
+constexpr std::int64_t kBinding = 4242;  // the hand-made rig's offer in the device tests
 
 io_state_t state(std::int64_t rig, std::int64_t session, std::int64_t seq, double time_s, std::int64_t command_seq = 0) {
   io_state_t s{};
   s.rig_id = rig;
+  s.binding = kBinding;
   s.session_id = session;
   s.seq = seq;
   s.time_s = time_s;
@@ -69,106 +49,102 @@ io_state_t state(std::int64_t rig, std::int64_t session, std::int64_t seq, doubl
   return s;
 }
 
-void publish_garbage(lcm::LCM& bus, const char* channel) {
-  const std::uint8_t short_bytes[5] = {1, 2, 3, 4, 5};
-  bus.publish(channel, short_bytes, sizeof short_bytes);  // truncated
-  const telemetry_t other{};
-  publish(bus, channel, other);  // another type
-}
-
-bool vented(const ValveCommand& c) {
-  return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
-}
-
-TEST(LcmRigServer, HoldsTheSafeStateServesOneSessionAndVentsWhenCommandsStop) {
-  lcm::LCM bus("memq://");
-  ASSERT_TRUE(bus.good());
-  Configuration config;
-  SimulatedArm arm(config.plant, 1);
-  RigServer rig(arm, {0.005, 0.05}, 77);
-  BusRecorder states(kIoStateChannel);
-  rig.attach(bus);
-  states.attach(bus);
-  double t = 100.0;
-  const auto step = [&](double dt) {
-    pump(bus);
-    t += dt;
-    rig.service(&bus, t);
-    pump(bus);
+TEST(LcmRigServer, HoldsTheSafeStateBindsOneSessionAndVentsWhenCommandsStop) {
+  RigBench b;
+  const std::int64_t rig = RigBench::kRig;
+  const auto command = [&](std::int64_t session, std::int64_t seq, double inlet_a, bool armed, std::int64_t binding) {
+    return testing::command(session, seq, inlet_a, armed, rig, binding);
   };
-
-  step(0.0);
-  EXPECT_TRUE(vented(arm.state().command));
-  ASSERT_EQ(states.size(), 1u);
-  io_state_t s = decode<io_state_t>(states.messages().back());
-  EXPECT_EQ(s.rig_id, 77);
+  b.step(0.0);
+  EXPECT_TRUE(vented(b.arm.state().command));
+  ASSERT_EQ(b.states.size(), 1u);
+  io_state_t s = b.last_state();
+  EXPECT_EQ(s.rig_id, rig);
   EXPECT_EQ(s.session_id, 0);
+  EXPECT_NE(s.binding, 0) << "a free rig offers a binding";
   EXPECT_EQ(s.fault_bits, io_state_t::FAULT_NO_SESSION);
+  const std::int64_t offer = s.binding;
 
-  // Nothing invalid, malformed or foreign-typed opens a valve.
-  io_command_t bad = command(5, 1, 1.5);
-  publish(bus, kIoCommandChannel, bad);
-  publish_garbage(bus, kIoCommandChannel);
-  step(0.001);
-  EXPECT_TRUE(vented(arm.state().command));
-  EXPECT_EQ(rig.stats().serving, 0);
+  // Nothing invalid, malformed, foreign-typed, addressed elsewhere or armed before binding opens a valve.
+  b.send(command(5, 1, 1.5, false, offer));                        // a duty beyond 1
+  b.send(testing::command(5, 1, 0.5, false, rig + 1, offer));      // another rig
+  b.send(command(5, 1, 0.5, true, offer));                         // armed before binding
+  b.send(command(5, 1, 0.5, false, offer + 1));                    // a stale offer: a vent, obeyed, binds nothing
+  publish_garbage(b.bus, kIoCommandChannel);
+  b.step(0.001);
+  EXPECT_TRUE(vented(b.arm.state().command));
+  EXPECT_EQ(b.rig.stats().serving, 0);
 
-  // The first valid command: served from now on, applied at once.
-  publish(bus, kIoCommandChannel, command(5, 1, 0.5));
-  step(0.001);
-  EXPECT_EQ(arm.state().command.inlet_duty[0], 0.5);
-  EXPECT_EQ(rig.stats().serving, 5);
-  // Another session, an old sequence number: counted, ignored.
-  publish(bus, kIoCommandChannel, command(6, 1, 0.9));
-  publish(bus, kIoCommandChannel, command(5, 1, 0.9));
-  step(0.001);
-  EXPECT_EQ(arm.state().command.inlet_duty[0], 0.5);
-  publish(bus, kIoCommandChannel, command(5, 2, 0.4));
-  step(0.003);  // the next state is due
-  EXPECT_EQ(arm.state().command.inlet_duty[0], 0.4);
-  s = decode<io_state_t>(states.messages().back());
+  // The handshake: a vent echoing the offer binds; the session's next commands are applied at once.
+  b.send(command(5, 1, 0.0, false, offer));
+  b.step(0.001);
+  EXPECT_EQ(b.rig.stats().serving, 5);
+  EXPECT_TRUE(b.logged("bound to session 5"));
+  b.send(command(5, 2, 0.5, true, offer));
+  b.step(0.001);
+  EXPECT_EQ(b.arm.state().command.inlet_duty[0], 0.5);
+  // Another session, an old sequence number, a jump beyond the window: counted, ignored, logged.
+  b.send(command(6, 3, 0.9, true, offer));
+  b.send(command(5, 2, 0.9, true, offer));
+  b.send(command(5, 2 + b.config.lcm.seq_window + 1, 0.9, true, offer));
+  b.step(0.001);
+  EXPECT_EQ(b.arm.state().command.inlet_duty[0], 0.5);
+  EXPECT_TRUE(b.logged("a command of session 6 while serving session 5"));
+  EXPECT_TRUE(b.logged("jumping from seq 2 to 103"));
+  b.send(command(5, 2 + b.config.lcm.seq_window, 0.4, true, offer));  // the largest step allowed
+  b.step(0.003);  // the next state is due
+  EXPECT_EQ(b.arm.state().command.inlet_duty[0], 0.4);
+  s = b.last_state();
   EXPECT_EQ(s.session_id, 5);
-  EXPECT_EQ(s.command_seq, 2);
+  EXPECT_EQ(s.binding, offer);
+  EXPECT_EQ(s.command_seq, 2 + b.config.lcm.seq_window);
   EXPECT_EQ(s.fault_bits, 0);
+  EXPECT_EQ(s.foreign_commands, 4) << "the state says what the rig refused: unbound, another session, old, jump";
   EXPECT_GT(s.time_s, 0.0);
 
-  RigServerStats stats = rig.stats();
-  EXPECT_EQ(stats.commands.accepted, 2u);
+  RigServerStats stats = b.rig.stats();
+  EXPECT_EQ(stats.commands.accepted, 3u);
   EXPECT_EQ(stats.commands.invalid, 1u);
   EXPECT_EQ(stats.commands.truncated, 1u);
   EXPECT_EQ(stats.commands.wrong_type, 1u);
-  EXPECT_EQ(stats.commands.foreign, 1u);
-  EXPECT_EQ(stats.commands.out_of_order, 1u);
+  EXPECT_EQ(stats.commands.foreign, 2u);  // armed before binding, another session
+  EXPECT_EQ(stats.commands.out_of_order, 2u);
+  EXPECT_EQ(stats.not_addressed, 1u);
 
-  // Commands stop: within the timeout the rig vents by itself and serves nobody.
-  for (int i = 0; i < 12; ++i) step(0.005);
-  EXPECT_TRUE(vented(arm.state().command));
-  stats = rig.stats();
+  // Commands stop: within the timeout the rig vents by itself, serves nobody and offers anew.
+  for (int i = 0; i < 12; ++i) b.step(0.005);
+  EXPECT_TRUE(vented(b.arm.state().command));
+  stats = b.rig.stats();
   EXPECT_EQ(stats.timeouts, 1u);
   EXPECT_EQ(stats.serving, 0);
-  s = decode<io_state_t>(states.messages().back());
+  s = b.last_state();
   EXPECT_EQ(s.session_id, 0);
+  EXPECT_NE(s.binding, offer);
   EXPECT_EQ(s.fault_bits, std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT});
 
-  // Now another session may take it.
-  publish(bus, kIoCommandChannel, command(6, 1, 0.3));
-  step(0.001);
-  EXPECT_EQ(rig.stats().serving, 6);
-  EXPECT_EQ(rig.stats().sessions_served, 2u);
-  EXPECT_EQ(arm.state().command.inlet_duty[0], 0.3);
+  // The old binding binds nothing any more (a late or replayed command); the new offer does.
+  b.send(command(5, 200, 0.0, false, offer));
+  b.step(0.001);
+  EXPECT_EQ(b.rig.stats().serving, 0);
+  b.send(command(6, 1, 0.0, false, s.binding));
+  b.send(command(6, 2, 0.3, true, s.binding));
+  b.step(0.001);
+  EXPECT_EQ(b.rig.stats().serving, 6);
+  EXPECT_EQ(b.rig.stats().sessions_served, 2u);
+  EXPECT_EQ(b.arm.state().command.inlet_duty[0], 0.3);
 
   // Its states are published every period, their rig time strictly increasing.
   double last_time = -1.0;
   std::int64_t last_seq = 0;
-  for (const Recorded& r : states.messages()) {
+  for (const Recorded& r : b.states.messages()) {
     const io_state_t each = decode<io_state_t>(r);
     EXPECT_GT(each.time_s, last_time);
     EXPECT_EQ(each.seq, last_seq + 1);
     last_time = each.time_s;
     last_seq = each.seq;
   }
-  rig.finish(&bus, t + 0.001);
-  EXPECT_TRUE(vented(arm.state().command));
+  b.rig.finish(&b.bus, b.t + 0.001);
+  EXPECT_TRUE(vented(b.arm.state().command));
 }
 
 struct DeviceBench {
@@ -215,13 +191,20 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   b.step();
   EXPECT_EQ(b.commands.size(), 2u) << "no new valve state from the engine: nothing is sent";
   EXPECT_FALSE(b.device.connected());
+  EXPECT_EQ(c.rig_id, 0) << "no rig offered yet: addressed to none";
+  b.device.vent();  // offers are taken only while venting
+  b.step();
 
   publish(b.bus, kIoStateChannel, state(55, 999, 1, 0.1));  // another session
-  publish(b.bus, kIoStateChannel, state(55, 0, 2, 0.2));    // a rig serving nobody
+  publish(b.bus, kIoStateChannel, state(55, 0, 2, 0.2));    // a rig serving nobody: its offer is taken
   publish_garbage(b.bus, kIoStateChannel);
   b.step();
   EXPECT_FALSE(b.device.connected());
   EXPECT_EQ(b.device.read_sensors().time_s, 0.0);
+  b.device.vent();
+  b.step();
+  EXPECT_EQ(b.last_command().rig_id, 55) << "commands now address the rig that offered";
+  EXPECT_EQ(b.last_command().binding, kBinding);
 
   publish(b.bus, kIoStateChannel, state(55, 1234, 3, 0.3, 2));
   b.step();
@@ -230,6 +213,8 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   EXPECT_DOUBLE_EQ(r.angle_rad, 0.03);
   EXPECT_GT(r.time_s, 0.0);
   const double first_time = r.time_s;
+  b.device.write_valves(valves);
+  b.step();
 
   publish(b.bus, kIoStateChannel, state(55, 1234, 3, 0.4, 2));   // repeated sequence number
   publish(b.bus, kIoStateChannel, state(55, 1234, 4, 0.3, 2));   // rig time not advancing
@@ -238,33 +223,50 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   faulty.fault_bits = io_state_t::FAULT_SENSOR;                 // the rig says its sensors are bad
   publish(b.bus, kIoStateChannel, faulty);
   publish(b.bus, kIoStateChannel, state(66, 1234, 1, 0.1, 0));  // another rig while the valves are live
+  io_state_t other_binding = state(55, 1234, 7, 0.65, 2);
+  other_binding.binding = kBinding + 1;                         // not the binding this session made
+  publish(b.bus, kIoStateChannel, other_binding);
   b.step();
   EXPECT_EQ(b.device.read_sensors().time_s, first_time) << "none of these is a fresh reading";
+  EXPECT_NE(b.device.diagnosis().find("another sender is commanding this rig"), std::string::npos) << b.device.diagnosis();
 
-  publish(b.bus, kIoStateChannel, state(55, 1234, 7, 0.7, 2));
+  io_state_t limited = state(55, 1234, 8, 0.7, 2);
+  limited.fault_bits = io_state_t::FAULT_PRESSURE_LIMIT;  // a rig limit acting: the reading is still one
+  publish(b.bus, kIoStateChannel, limited);
   b.step();
   r = b.device.read_sensors();
   EXPECT_GT(r.time_s, first_time);
-  EXPECT_DOUBLE_EQ(r.angle_rad, 0.07);
+  EXPECT_DOUBLE_EQ(r.angle_rad, 0.08);
 
-  // Vented, the device follows a restarted rig (new id, its sequence from 1).
+  // Vented, the device follows a restarted rig (new id, a new offer, its sequence from 1) once the
+  // old one has been silent for the rig timeout.
+  b.device.vent();
+  for (int i = 0; i < 12; ++i) b.step();
+  EXPECT_FALSE(b.last_command().armed);
+  io_state_t offer = state(66, 0, 1, 0.005, 0);
+  offer.binding = 99;
+  publish(b.bus, kIoStateChannel, offer);
+  b.step();
   b.device.vent();
   b.step();
-  EXPECT_FALSE(b.last_command().armed);
-  publish(b.bus, kIoStateChannel, state(66, 1234, 1, 0.01, 3));
+  EXPECT_EQ(b.last_command().rig_id, 66);
+  io_state_t served = state(66, 1234, 2, 0.01, 3);
+  served.binding = 99;
+  publish(b.bus, kIoStateChannel, served);
   b.step();
-  EXPECT_DOUBLE_EQ(b.device.read_sensors().angle_rad, 0.01);
+  EXPECT_DOUBLE_EQ(b.device.read_sensors().angle_rad, 0.02);
 
   const LcmDeviceStats s = b.device.stats();
   EXPECT_EQ(s.rig_id, 66);
   EXPECT_EQ(s.states.accepted, 3u);
-  EXPECT_EQ(s.states.foreign, 3u);  // another session, nobody's, another rig while live
+  EXPECT_EQ(s.states.foreign, 5u);  // another session, two offers, another rig while live, another binding
   EXPECT_EQ(s.states.truncated, 1u);
   EXPECT_EQ(s.states.wrong_type, 1u);
   EXPECT_EQ(s.states.out_of_order, 2u);
   EXPECT_EQ(s.states.invalid, 1u);
+  EXPECT_EQ(s.commands_not_ours, 1u);
   EXPECT_EQ(s.rig_fault_states, 1u);
-  EXPECT_EQ(s.last_foreign_session, 0);
+  EXPECT_EQ(s.last_foreign_session, 999);
 
   // Closing leaves the rig vented.
   b.device.write_valves(valves);
@@ -281,7 +283,8 @@ void expect_stale_fault_after(int stale_ticks) {
   config.safety.stale_ticks = stale_ticks;
   DeviceBench b;
   EngineCore core(b.device, config.controller, config.timing, config.safety);
-  std::int64_t rig_seq = 0;
+  std::int64_t rig_seq = 1;
+  publish(b.bus, kIoStateChannel, state(55, 0, rig_seq, 0.0));  // the rig's offer
   double engine_s = 0.0;
   const auto tick = [&](bool rig_answers) {
     if (rig_answers) {
@@ -345,7 +348,8 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   // rightly calls stale; the stale guard has its own tests above (exact tick counts).
   c.safety.stale_ticks = 40;
   SimulatedArm arm(c.plant, 3);
-  RigServer rig(arm, {c.timing.tick_s, c.lcm.rig_timeout_s}, 77);
+  std::vector<std::string> rig_log;
+  RigServer rig(arm, RigBench::parameters(c, LcmKey{}, rig_log), 77);
   LcmDevice device(LcmDevice::random_session_id());
   BusRecorder recorder(kIoStateChannel);
   LcmIoThread io("memq://", {&device, &rig, &recorder});  // memq: one handle, so one thread for both ends

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <nlohmann/json.hpp>
 
@@ -52,16 +53,17 @@ nlohmann::json parse_report(const Child& child) {
   return out.empty() ? nlohmann::json::object() : nlohmann::json::parse(out);
 }
 
-/// Publishes, every 50 ms, what no one may trust: truncated bytes, another type, and a command and
-/// a state of another session (a command that, if applied, would open every inlet fully). It
-/// starts once the rig serves someone: a rig serving nobody would rightly take the first session
-/// that asks.
+/// Publishes, every 50 ms, what no one may trust, as a host on the bus without the key would:
+/// truncated bytes, another type, a command of its own session addressed to the rig, the issue's
+/// takeover (the served session's id with seq 2^62), and a state of the served session claiming
+/// 60 deg. It starts once the rig serves someone (from the states it reads, unverified).
 class Heckler final : public LcmEndpoint {
  public:
   void attach(lcm::LCM& bus) override { subscribe(bus, kIoStateChannel); }
   void on_message(const char*, const void* data, std::size_t size) override {
     io_state_t state{};
     if (decode_checked(data, size, state) == DecodeStatus::kOk && state.session_id != 0 && state.session_id != kSession) {
+      served_ = state;
       rig_taken_ = true;
     }
   }
@@ -77,14 +79,18 @@ class Heckler final : public LcmEndpoint {
     io_command_t command{};
     command.session_id = kSession;
     command.seq = ++seq_;
+    command.rig_id = served_.rig_id;
+    command.binding = served_.binding;
     command.armed = true;
     command.inlet_duty[0] = command.inlet_duty[1] = 1.0;
     publish(*bus, kIoCommandChannel, command);
-    io_state_t state{};
-    state.rig_id = 888;
-    state.seq = seq_;
-    state.session_id = kSession;
-    state.time_s = 0.01 * static_cast<double>(seq_);
+    command.session_id = served_.session_id;
+    command.seq = std::int64_t{1} << 62;
+    publish(*bus, kIoCommandChannel, command);
+    io_state_t state = served_;
+    state.seq = served_.seq + 1000000;
+    state.time_s = served_.time_s + 1000.0;
+    state.angle_rad = 60.0 * 3.14159265358979 / 180.0;
     publish(*bus, kIoStateChannel, state);
     ++rounds_;
     return next_s_;
@@ -94,9 +100,12 @@ class Heckler final : public LcmEndpoint {
  private:
   static constexpr std::int64_t kSession = 777;
   bool rig_taken_ = false;
+  io_state_t served_{};
   template <typename Message>
   void publish(lcm::LCM& bus, const char* channel, const Message& message) {
-    const std::size_t size = encode_into(message, buffer_);
+    std::size_t size = 0;
+    if constexpr (requires { message.mac; }) size = encode_signed(message, LcmKey{}, buffer_);
+    else size = encode_into(message, buffer_);
     bus.publish(channel, buffer_.data(), static_cast<unsigned int>(size));
   }
   double next_s_ = 0.0;
@@ -115,9 +124,12 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   // This test compares learning, not deadline keeping: on a loaded 2-core CI machine a wall-clock
   // run can stall for more than 5 ticks (25 ms) or its readings for more than 3; the guards for
   // both have tests of their own (rig killed below, memq staleness, missed-deadline streak).
+  // The rig and the engine share a key: what the heckler forges is refused for want of it.
+  const auto key = testing::write_file(dir, "rig.key", std::string(32, 'q'));
+  chmod(key.c_str(), 0600);
   const std::string config =
-      testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n").string();
-  Child rig({kBellows, "io-sim", "--seed", "5", "--json"}, dir / "rig.out", dir / "rig.err");
+      testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nkey_file = \"rig.key\"\n").string();
+  Child rig({kBellows, "io-sim", "--seed", "5", "--json", "--config", config}, dir / "rig.out", dir / "rig.err");
   ASSERT_TRUE(rig.started());
   Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5",
              "--config", config},
@@ -131,7 +143,9 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   bus.stop();
 
   // The same seed in-process, on the wall clock too.
-  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5", "--config", config},
+  const std::string plain_config =
+      testing::write_file(dir, "plain.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n").string();
+  Child local({kBellows, "run", "--no-save", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5", "--config", plain_config},
               dir / "local.out", dir / "local.err");
   const auto local_status = local.wait(300.0);
   ASSERT_TRUE(local_status.has_value());
@@ -151,15 +165,22 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   EXPECT_LT(remote[3], remote[0]);
   EXPECT_EQ(remote_report["device"], "lcm");
 
-  // Everything the heckler sent was counted and ignored, on both sides.
+  // Everything the heckler sent was counted and ignored, on both sides: its forged 60 deg never
+  // reached the engine, its takeover never reached the valves.
   ASSERT_GT(heckler.rounds(), 50u);
+  EXPECT_EQ(remote_report["lcm"]["rig"]["authenticated"], true);
+  EXPECT_EQ(rig_report["authenticated"], true);
   const nlohmann::json& states = remote_report["lcm"]["rig"]["states"]["ignored"];
   EXPECT_GT(states["truncated"].get<std::uint64_t>(), 50u);
   EXPECT_GT(states["wrong_type"].get<std::uint64_t>(), 50u);
-  EXPECT_GT(states["foreign"].get<std::uint64_t>(), 50u);
+  EXPECT_GT(states["unauthenticated"].get<std::uint64_t>(), 50u);
   const nlohmann::json& commands = rig_report["commands"]["ignored"];
   EXPECT_GT(commands["truncated"].get<std::uint64_t>(), 50u);
-  EXPECT_GT(commands["foreign"].get<std::uint64_t>(), 50u);
+  EXPECT_GT(commands["unauthenticated"].get<std::uint64_t>(), 2u * 50u);
+  EXPECT_EQ(commands["foreign"], 0);
+  EXPECT_EQ(remote_report["lcm"]["rig"]["rig_refused"]["unauthenticated"].get<std::uint64_t>() > 50u, true);
+  EXPECT_NE(run.err().find("another sender publishes rig states on this bus"), std::string::npos) << run.err();
+  EXPECT_NE(rig.err().find("not signed with this [lcm] key_file"), std::string::npos) << rig.err();
   EXPECT_EQ(rig_report["sessions_served"], 1);
   // The rig applied (nearly) every tick's command: a command is skipped only when two ticks' valve
   // states meet in the device's latest-value buffer before its I/O thread sends one.

@@ -11,3 +11,8 @@ add_test(NAME fuzz_session_readers
                  -DCLANGXX=${BELLOWS_CLANGXX} -DTARGET=fuzz_session_readers -DSECONDS=${BELLOWS_FUZZ_SECONDS}
                  -P ${CMAKE_CURRENT_LIST_DIR}/run_fuzz.cmake)
 set_tests_properties(fuzz_session_readers PROPERTIES TIMEOUT 1800 LABELS fuzz SKIP_REGULAR_EXPRESSION "SKIPPED:")
+add_test(NAME fuzz_rig_commands
+         COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DBUILD_DIR=${CMAKE_BINARY_DIR}/fuzz
+                 -DCLANGXX=${BELLOWS_CLANGXX} -DTARGET=fuzz_rig_commands -DSECONDS=${BELLOWS_FUZZ_SECONDS}
+                 -P ${CMAKE_CURRENT_LIST_DIR}/run_fuzz.cmake)
+set_tests_properties(fuzz_rig_commands PROPERTIES TIMEOUT 1800 LABELS fuzz SKIP_REGULAR_EXPRESSION "SKIPPED:")
