@@ -6,6 +6,7 @@
 
 #include "app/config_file.hpp"
 #include "app/console_sessions.hpp"
+#include "app/plot_console.hpp"
 #include "app/cpu_idle_hold.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
@@ -51,6 +52,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.config = config;
   setup.environment.load_trajectory = load_trajectory;
   setup.environment.sessions = &sessions;
+  setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
+    return write_console_figures(snapshot, root);
+  };
   setup.environment.device_name = arm.name();
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;

@@ -39,7 +39,7 @@ fs::path default_paper_rms_path() {
 std::vector<fs::path> write_session_figures(const Session& session, const FigureRequest& request, const fs::path& directory,
                                             bool force) {
   const std::vector<Figure> figures = session_figures(session, request);  // checks the request first
-  if (is_inside(directory, session.directory)) {
+  if (!session.directory.empty() && is_inside(directory, session.directory)) {
     throw InputError("will not write figures inside the session " + session.directory.string() + " (choose another --output)");
   }
   std::error_code error;

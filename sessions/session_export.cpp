@@ -60,7 +60,7 @@ void check_export_targets(const Session& session, const std::vector<fs::path>& p
                      (fs::exists(folder, error) ? " is not a directory" : " does not exist"));
   }
   for (const fs::path& path : paths) {
-    if (is_inside(path, session.directory)) {
+    if (!session.directory.empty() && is_inside(path, session.directory)) {
       throw InputError("will not write " + path.string() + " inside the session " + session.directory.string() +
                        " it exports (choose another --output)");
     }
