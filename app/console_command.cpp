@@ -10,6 +10,7 @@
 #include "app/console_sessions.hpp"
 #include "app/device_factory.hpp"
 #include "sessions/session_store.hpp"
+#include "app/plot_console.hpp"
 #include "app/cpu_idle_hold.hpp"
 #include "app/run_command.hpp"
 #include "app/signals.hpp"
@@ -107,6 +108,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.rig_profile = rig->rig_profile_name();
   setup.environment.device_health = [&device] { return device.health(); };
   setup.environment.raw_inputs = [&device] { return device.raw_inputs(); };
+  setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
+    return write_console_figures(snapshot, root);
+  };
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
   setup.stop_flag = &stop_requested();

@@ -9,6 +9,7 @@
 #include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
 #include "app/rig_check_command.hpp"
+#include "app/plot_command.hpp"
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
@@ -71,12 +72,12 @@ int main(int argc, char** argv) {
       ->excludes("--seed");
 
   bellows::SessionsOptions sessions;
-  CLI::App* sessions_cmd = app.add_subcommand("sessions", "List, show and export saved sessions");
+  CLI::App* sessions_cmd = app.add_subcommand("sessions", "List, show, export, plot, rename and remove saved sessions");
   sessions_cmd->require_subcommand(1);
   const std::string data_dir_help = "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions)";
   CLI::App* list_cmd = sessions_cmd->add_subcommand("list", "A table of the saved sessions");
   CLI::App* show_cmd = sessions_cmd->add_subcommand("show", "One session: summary and RMS per iteration");
-  CLI::App* export_cmd = sessions_cmd->add_subcommand("export", "Export a session to CSV or MATLAB (v7.3)");
+  CLI::App* export_cmd = sessions_cmd->add_subcommand("export", "Export a session to CSV or a MATLAB MAT file");
   for (CLI::App* command : {list_cmd, show_cmd, export_cmd}) {
     command->add_option("--data-dir", sessions.data_dir, data_dir_help);
     command->add_flag("--json", sessions.json, "Print JSON on stdout");
@@ -87,6 +88,34 @@ int main(int argc, char** argv) {
   }
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
+  export_cmd->add_option("--mat-version", sessions.mat_version, "MAT file version: 5 (default; read everywhere) or 7.3 (HDF5)")
+      ->check(CLI::IsMember({"5", "7.3"}));
+  export_cmd->add_flag("--force", sessions.force, "Replace existing files");
+  CLI::App* rm_cmd = sessions_cmd->add_subcommand("rm", "Remove a session (asks first unless --yes)");
+  CLI::App* rename_cmd = sessions_cmd->add_subcommand("rename", "Give a session another name");
+  for (CLI::App* command : {rm_cmd, rename_cmd}) {
+    command->add_option("--data-dir", sessions.data_dir, data_dir_help);
+    command->add_flag("--json", sessions.json, "Print JSON on stdout");
+    command->add_option("session", sessions.session, "Session directory, or a session name in the data directory")
+        ->required();
+  }
+  rm_cmd->add_flag("--yes,-y", sessions.yes, "Remove without asking");
+  rename_cmd->add_option("new_name", sessions.new_name, "The new name")->required();
+  bellows::PlotOptions plot;
+  CLI::App* plot_cmd = sessions_cmd->add_subcommand("plot", "Figures of a session (PNG, SVG, PDF) drawn by gnuplot");
+  plot_cmd->add_option("session", plot.session, "Session directory, or a session name in the data directory")->required();
+  plot_cmd->add_option("--data-dir", plot.data_dir, data_dir_help);
+  plot_cmd->add_option("--output", plot.output, "Folder for the figures (default: <session>_figures here)");
+  plot_cmd->add_option("--iterations", plot.iterations, "Iterations in the angle and u_ilc figures, e.g. 0,5,10 "
+                       "(default: first, second, middle, last)")->delimiter(',');
+  plot_cmd->add_option("--trial", plot.trial, "Iteration whose pressures are drawn (default: the last)");
+  plot_cmd->add_option("--formats", plot.formats, "png, svg and/or pdf, e.g. png,pdf")->delimiter(',')->default_str("png,svg")
+      ->check(CLI::IsMember({"png", "svg", "pdf"}));
+  plot_cmd->add_option("--paper", plot.paper, "CSV (iteration,rms_deg) overlaid on the RMS figure "
+                       "(default for the paper trajectory: the paper's curve, when available)");
+  plot_cmd->add_flag("--no-paper", plot.no_paper, "No overlay on the RMS figure");
+  plot_cmd->add_flag("--force", plot.force, "Replace existing figures");
+  plot_cmd->add_flag("--json", plot.json, "Print JSON on stdout");
   bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 need --clock wall
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find an lcm rig there)");
   CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
@@ -209,6 +238,9 @@ int main(int argc, char** argv) {
     if (list_cmd->parsed()) return bellows::sessions_list_command(sessions, std::cout, std::cerr);
     if (show_cmd->parsed()) return bellows::sessions_show_command(sessions, std::cout);
     if (export_cmd->parsed()) return bellows::sessions_export_command(sessions, std::cout);
+    if (rm_cmd->parsed()) return bellows::sessions_rm_command(sessions, std::cin, std::cout, std::cerr);
+    if (rename_cmd->parsed()) return bellows::sessions_rename_command(sessions, std::cout);
+    if (plot_cmd->parsed()) return bellows::sessions_plot_command(plot, std::cout);
     // No subcommand (or `console`): the operator console.
     return bellows::console_command(console, std::cout);
   } catch (const bellows::BellowsError& error) {

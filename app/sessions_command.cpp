@@ -1,6 +1,10 @@
 #include "app/sessions_command.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <istream>
 #include <numbers>
 #include <ostream>
 #include <string>
@@ -11,9 +15,11 @@
 #include "engine/errors.hpp"
 #include "engine/printable_text.hpp"
 #include "engine/safety.hpp"
+#include "sessions/atomic_file.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_export.hpp"
 #include "sessions/session_layout.hpp"
+#include "sessions/session_lock.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -90,7 +96,8 @@ Json listing_json(const fs::path& directory, const SessionManifest& m) {
 
 int sessions_list_command(const SessionsOptions& options, std::ostream& out, std::ostream& err) {
   const fs::path data_dir = data_dir_of(options);
-  const std::vector<SessionListing> listings = list_sessions(data_dir);
+  std::vector<SessionListing> listings = list_sessions(data_dir);
+  std::reverse(listings.begin(), listings.end());  // newest first, as the console's browser
   for (const SessionListing& listing : listings) {
     if (!listing.error.empty()) err << "bellows: warning: " << printable(listing.error, kPrintableLine) << std::endl;
   }
@@ -237,11 +244,19 @@ int sessions_export_command(const SessionsOptions& options, std::ostream& out) {
   if (options.format != "csv" && options.format != "mat") {
     throw InputError("--format must be csv or mat, not '" + options.format + "'");
   }
+  if (!options.mat_version.empty() && options.format != "mat") {
+    throw InputError("--mat-version applies to --format mat only");
+  }
+  if (!options.mat_version.empty() && options.mat_version != "5" && options.mat_version != "7.3") {
+    throw InputError("--mat-version must be 5 or 7.3, not '" + options.mat_version + "'");
+  }
   const Session session = load_session(session_dir_of(options));
   const fs::path output =
       options.output.empty() ? fs::path(session.directory.filename().string() + "." + options.format) : fs::path(options.output);
-  const std::vector<fs::path> files = options.format == "csv" ? export_session_csv(session, output)
-                                                              : std::vector<fs::path>{export_session_mat(session, output)};
+  const MatVersion version = options.mat_version == "7.3" ? MatVersion::kV73 : MatVersion::kV5;
+  const std::vector<fs::path> files =
+      options.format == "csv" ? export_session_csv(session, output, options.force)
+                              : std::vector<fs::path>{export_session_mat(session, output, version, options.force)};
   if (options.json) {
     Json paths = Json::array();
     for (const fs::path& file : files) paths.push_back(file.string());
@@ -250,6 +265,83 @@ int sessions_export_command(const SessionsOptions& options, std::ostream& out) {
   }
   for (const fs::path& file : files) out << "wrote " << file.string() << "\n";
   out << std::flush;
+  return 0;
+}
+
+namespace {
+
+/// The session named by `options`, checked to be a bellows session (its manifest loads, or at
+/// least is there when it is damaged), so that rm never removes a directory that is not one.
+fs::path existing_session(const SessionsOptions& options) {
+  const fs::path directory = session_dir_of(options);
+  std::error_code error;
+  if (!fs::is_regular_file(directory / session_layout::kManifest, error)) {
+    throw InputError(directory.string() + " is not a bellows session (no " + session_layout::kManifest + ")");
+  }
+  return directory;
+}
+
+}  // namespace
+
+int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::ostream& out, std::ostream& err) {
+  const fs::path directory = existing_session(options);
+  std::string description = "session " + directory.string();
+  try {
+    const SessionManifest m = load_manifest(directory);
+    description += " (" + std::to_string(m.iterations.size()) + " iterations, started " + short_time(m.started_utc) + ")";
+  } catch (const InputError&) {
+    description += " (damaged)";
+  }
+  const SessionLock lock(directory, "bellows sessions rm");  // not while a run or a console writes it
+  if (!options.yes) {
+    err << "remove " << description << "? [y/N] " << std::flush;
+    std::string answer;
+    std::getline(in, answer);
+    if (answer != "y" && answer != "Y" && answer != "yes") {
+      err << "bellows: not removed" << (in ? "" : " (no answer; --yes removes without asking)") << std::endl;
+      return 1;
+    }
+  }
+  // Out of sight first (hidden names are not sessions), so a removal cut short leaves no half session.
+  std::string hidden_name = ".";
+  hidden_name += directory.filename().string();
+  hidden_name += ".removing-" + std::to_string(::getpid());
+  const fs::path hidden = directory.parent_path() / hidden_name;
+  std::error_code error;
+  fs::rename(directory, hidden, error);
+  if (error) throw InputError("cannot remove " + directory.string() + ": " + error.message());
+  fs::remove_all(hidden, error);
+  if (error) throw InputError("cannot remove " + hidden.string() + " (renamed from " + directory.string() + "): " + error.message());
+  sync_directory(directory.parent_path().empty() ? fs::path(".") : directory.parent_path());
+  if (options.json) {
+    out << Json{{"removed", directory.string()}}.dump() << std::endl;
+  } else {
+    out << "removed " << directory.string() << std::endl;
+  }
+  return 0;
+}
+
+int sessions_rename_command(const SessionsOptions& options, std::ostream& out) {
+  validate_session_name(options.new_name);
+  const fs::path directory = existing_session(options);
+  SessionManifest manifest = load_manifest(directory);
+  const fs::path target = directory.parent_path() / options.new_name;
+  std::error_code error;
+  if (fs::symlink_status(target, error).type() != fs::file_type::not_found) {
+    throw InputError("cannot rename " + directory.string() + ": " + target.string() + " exists already");
+  }
+  const SessionLock lock(directory, "bellows sessions rename");
+  fs::rename(directory, target, error);
+  if (error) throw InputError("cannot rename " + directory.string() + " to " + target.string() + ": " + error.message());
+  manifest.name = options.new_name;  // the manifest names its session too
+  manifest.updated_utc = utc_now();
+  write_file_atomic(target / session_layout::kManifest, format_manifest(manifest));
+  sync_directory(target.parent_path().empty() ? fs::path(".") : target.parent_path());
+  if (options.json) {
+    out << Json{{"renamed", directory.string()}, {"directory", target.string()}}.dump() << std::endl;
+  } else {
+    out << "renamed " << directory.string() << " to " << target.string() << std::endl;
+  }
   return 0;
 }
 

@@ -1,10 +1,13 @@
 #include "sessions/black_box_file.hpp"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
+#include "engine/engine_state.hpp"
 #include "engine/errors.hpp"
+#include "engine/safety.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
 
@@ -13,10 +16,13 @@ namespace {
 
 constexpr int kLastState = static_cast<int>(EngineState::kFault);
 constexpr int kLastFault = static_cast<int>(FaultCode::kHeartbeatLost);
-// The codes are part of the session format (docs/session-format.md): new ones go at the end.
+// Legacy files store these codes (docs/session-format.md): they must keep their meaning.
 static_assert(static_cast<int>(EngineState::kSafe) == 0 && kLastState == 3);
 static_assert(static_cast<int>(FaultCode::kNone) == 0 && static_cast<int>(FaultCode::kSupplyLow) == 4 &&
               static_cast<int>(FaultCode::kSensorStale) == 7 && kLastFault == 9);
+
+std::string state_name(int code) { return to_string(static_cast<EngineState>(code)); }
+std::string fault_name_of(int code) { return fault_name(static_cast<FaultCode>(code)); }
 
 // A whole number within [low, high] read back from `column`; NaN and fractions fail.
 double whole_at(const Eigen::VectorXd& column, Eigen::Index row, double low, double high, const std::string& source,
@@ -30,9 +36,80 @@ double whole_at(const Eigen::VectorXd& column, Eigen::Index row, double low, dou
   return value;
 }
 
+/// `text` with the state and fault fields of every row after the header replaced by `replace`
+/// (column, field, line number). Rows too short to have them are left for parse_csv to refuse.
+std::string with_named_fields_replaced(std::string_view text,
+                                       const std::function<std::string(std::size_t, std::string_view, std::size_t)>& replace) {
+  std::string out;
+  out.reserve(text.size() + text.size() / 8);
+  std::size_t line_number = 1;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    const bool has_end = end != std::string_view::npos;
+    if (!has_end) end = text.size();
+    const std::string_view line = text.substr(start, end - start);
+    if (line_number == 1) {
+      out += line;
+    } else {
+      std::size_t column = 0, field_start = 0;
+      while (true) {
+        const std::size_t comma = line.find(',', field_start);
+        const std::string_view field = line.substr(field_start, comma == std::string_view::npos ? std::string_view::npos
+                                                                                                 : comma - field_start);
+        if (column > 0) out += ',';
+        const bool named = column == kBlackBoxStateColumn || column == kBlackBoxFaultColumn;
+        out += named ? replace(column, field, line_number) : std::string(field);
+        if (comma == std::string_view::npos) break;
+        field_start = comma + 1;
+        ++column;
+      }
+    }
+    if (has_end) out += '\n';
+    start = end + 1;
+    ++line_number;
+  }
+  return out;
+}
+
+/// The code of `name` among the names of codes 0..last, or an InputError.
+int code_of(std::string_view name, int last, std::string (*name_of)(int), const std::string& source, std::size_t line,
+            const char* what) {
+  std::string known;
+  for (int code = 0; code <= last; ++code) {
+    if (name == name_of(code)) return code;
+    if (code > 0) known += ", ";
+    known += name_of(code);
+  }
+  std::string shown(name.substr(0, 40));
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  }
+  throw InputError(source + ": line " + std::to_string(line) + ": " + what + " '" + shown + "' is not one of " + known);
+}
+
+std::string joined_header(const std::vector<std::string_view>& names) {
+  std::string out;
+  for (std::string_view name : names) {
+    if (!out.empty()) out += ',';
+    out += name;
+  }
+  return out;
+}
+
 }  // namespace
 
 const std::vector<std::string_view>& black_box_columns() {
+  static const std::vector<std::string_view> columns = {
+      "tick",          "time_s",        "sensor_time_s", "state",         "fault",
+      "angle_deg",     "angle_setpoint_deg", "pressure_a_bar", "pressure_b_bar",
+      "supply_bar",    "u_tot_bar",     "pressure_a_setpoint_bar", "pressure_b_setpoint_bar",
+      "inlet_a_duty",  "outlet_a_duty", "inlet_b_duty",  "outlet_b_duty",
+      "sample",        "trial_id"};
+  return columns;
+}
+
+const std::vector<std::string_view>& legacy_black_box_columns() {
   static const std::vector<std::string_view> columns = {
       "tick",          "time_s",        "sensor_time_s", "state",         "fault",
       "angle_deg",     "desired_deg",   "pressure_a_bar", "pressure_b_bar",
@@ -42,8 +119,7 @@ const std::vector<std::string_view>& black_box_columns() {
   return columns;
 }
 
-std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
-  if (ticks.empty()) throw std::invalid_argument("format_black_box_csv: no ticks");
+std::vector<Eigen::VectorXd> black_box_values(const std::vector<TickRecord>& ticks) {
   const auto rows = static_cast<Eigen::Index>(ticks.size());
   std::vector<Eigen::VectorXd> c(black_box_columns().size(), Eigen::VectorXd(rows));
   for (Eigen::Index k = 0; k < rows; ++k) {
@@ -56,15 +132,40 @@ std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
                              t.valves.outlet_duty[1], static_cast<double>(t.sample), static_cast<double>(t.trial_id)};
     for (std::size_t i = 0; i < c.size(); ++i) c[i](k) = values[i];
   }
+  return c;
+}
+
+std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
+  if (ticks.empty()) throw std::invalid_argument("format_black_box_csv: no ticks");
+  const std::vector<Eigen::VectorXd> c = black_box_values(ticks);
   std::vector<CsvColumn> columns;
   for (std::size_t i = 0; i < c.size(); ++i) columns.push_back({black_box_columns()[i], &c[i]});
-  std::string out;
-  append_csv(out, columns);
-  return out;
+  std::string numeric;
+  append_csv(numeric, columns);
+  return with_named_fields_replaced(numeric, [](std::size_t column, std::string_view field, std::size_t) {
+    const int code = std::stoi(std::string(field));
+    return column == kBlackBoxStateColumn ? state_name(code) : fault_name_of(code);
+  });
 }
 
 std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::string& source, int expected_ticks) {
-  const std::vector<Eigen::VectorXd> c = parse_csv(text, black_box_columns(), source, NonFinite::kAccept);
+  std::string_view header = text.substr(0, text.find('\n'));
+  while (!header.empty() && (header.back() == '\r' || header.back() == ' ' || header.back() == '\t')) header.remove_suffix(1);
+  std::vector<Eigen::VectorXd> c;
+  if (header == joined_header(legacy_black_box_columns())) {
+    c = parse_csv(text, legacy_black_box_columns(), source, NonFinite::kAccept);
+  } else if (header != joined_header(black_box_columns())) {
+    c = parse_csv(text, black_box_columns(), source, NonFinite::kAccept);  // refuses the header, naming the current one
+  } else {
+    // Names back to codes, then the strict numeric reader checks everything else.
+    const std::string numeric =
+        with_named_fields_replaced(text, [&](std::size_t column, std::string_view field, std::size_t line) {
+          return column == kBlackBoxStateColumn
+                     ? std::to_string(code_of(field, kLastState, state_name, source, line, "state"))
+                     : std::to_string(code_of(field, kLastFault, fault_name_of, source, line, "fault"));
+        });
+    c = parse_csv(numeric, black_box_columns(), source, NonFinite::kAccept);
+  }
   if (c[0].size() != expected_ticks) {
     throw InputError(source + ": expected " + std::to_string(expected_ticks) + " rows (the ticks the manifest lists), found " +
                      std::to_string(c[0].size()));

@@ -1,35 +1,23 @@
 #include "sessions/session_export.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-#include <memory>
 #include <string>
-
-#include <matio.h>
 
 #include "engine/errors.hpp"
 #include "sessions/atomic_file.hpp"
-#include "sessions/csv_table.hpp"
+#include "sessions/black_box_file.hpp"
 #include "sessions/iteration_files.hpp"
-#include "sessions/manifest_json.hpp"
 
 namespace bellows {
 namespace fs = std::filesystem;
 namespace {
 
-/// Stacks one table per iteration under a leading `iteration` column.
-void append_stacked(std::string& out, const std::vector<std::string>& tables) {
-  bool header_written = false;
+/// Stacks tables of the same columns under a leading `key` column holding each table's index.
+std::string stacked(const std::string& key, const std::vector<std::string>& tables) {
+  std::string out;
   for (std::size_t i = 0; i < tables.size(); ++i) {
     const std::string& table = tables[i];
     const std::size_t header_end = table.find('\n');
-    if (!header_written) {
-      out += "iteration," + table.substr(0, header_end + 1);
-      header_written = true;
-    }
+    if (i == 0) out += key + "," + table.substr(0, header_end + 1);
     const std::string prefix = std::to_string(i) + ",";
     std::size_t line = header_end + 1;
     while (line < table.size()) {
@@ -39,188 +27,67 @@ void append_stacked(std::string& out, const std::vector<std::string>& tables) {
       line = end + 1;
     }
   }
+  return out;
 }
 
 fs::path sibling(const fs::path& path, const std::string& suffix) {
   return path.parent_path() / (path.stem().string() + suffix + path.extension().string());
 }
 
-// ---- MATLAB ------------------------------------------------------------------------------------
-
-struct MatVarDeleter {
-  void operator()(matvar_t* var) const { Mat_VarFree(var); }
-};
-using MatVar = std::unique_ptr<matvar_t, MatVarDeleter>;
-
-/// MATLAB field names: a letter first, then letters, digits and underscores.
-std::string matlab_name(const std::string& name) {
-  std::string out;
-  for (char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-    out += ok ? c : '_';
-  }
-  if (out.empty() || !((out[0] >= 'a' && out[0] <= 'z') || (out[0] >= 'A' && out[0] <= 'Z'))) out = "x" + out;
-  return out;
-}
-
-MatVar column(const Eigen::VectorXd& values) {
-  size_t dims[2] = {static_cast<size_t>(values.size()), 1};
-  return MatVar(Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, const_cast<double*>(values.data()), 0));
-}
-
-MatVar scalar(double value) {
-  size_t dims[2] = {1, 1};
-  return MatVar(Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &value, 0));
-}
-
-MatVar text(const std::string& value) {
-  size_t dims[2] = {1, value.size()};
-  return MatVar(Mat_VarCreate(nullptr, MAT_C_CHAR, MAT_T_UTF8, 2, dims, const_cast<char*>(value.data()), 0));
-}
-
-/// A struct (array) with the given fields; set them with set_field().
-MatVar structure(const std::vector<std::string>& fields, size_t count = 1) {
-  std::vector<const char*> names;
-  for (const std::string& field : fields) names.push_back(field.c_str());
-  names.push_back(nullptr);
-  size_t dims[2] = {1, count};
-  return MatVar(Mat_VarCreateStruct2(nullptr, 2, dims, names.data()));
-}
-
-void set_field(matvar_t* parent, const std::string& field, size_t index, MatVar value) {
-  if (value == nullptr) throw std::runtime_error("libmatio could not create field " + field);
-  Mat_VarSetStructFieldByName(parent, field.c_str(), index, value.release());  // the parent owns it now
-}
-
-MatVar columns_struct(const std::vector<std::string_view>& names, const std::vector<const Eigen::VectorXd*>& values) {
-  std::vector<std::string> fields(names.begin(), names.end());
-  MatVar out = structure(fields);
-  for (std::size_t i = 0; i < fields.size(); ++i) set_field(out.get(), fields[i], 0, column(*values[i]));
-  return out;
-}
-
-MatVar samples_struct(const IterationData& data) {
-  const TrialSamples& s = data.record.samples;
-  const Eigen::VectorXd setpoint = degrees_of(s.setpoint_rad), angle = degrees_of(s.angle_rad),
-                        error = degrees_of(s.error_rad);
-  const Eigen::VectorXd time_s = rounded_times(s.time_s);
-  Eigen::VectorXd next = Eigen::VectorXd::Zero(s.time_s.size());
-  next.head(data.next_correction_bar.size()) = data.next_correction_bar;
-  return columns_struct(samples_columns(), {&time_s, &setpoint, &angle, &error, &s.u_pid_bar, &s.u_ilc_bar,
-                                            &s.u_total_bar, &s.pressure_a_bar, &s.pressure_b_bar, &s.setpoint_a_bar,
-                                            &s.setpoint_b_bar, &next});
-}
-
-MatVar telemetry_struct(const TrialTicks& t) {
-  const Eigen::VectorXd angle = degrees_of(t.angle_rad);
-  const Eigen::VectorXd time_s = rounded_times(t.time_s);
-  return columns_struct(telemetry_columns(), {&time_s, &angle, &t.pressure_a_bar, &t.pressure_b_bar, &t.supply_bar,
-                                              &t.setpoint_a_bar, &t.setpoint_b_bar, &t.inlet_a, &t.outlet_a,
-                                              &t.inlet_b, &t.outlet_b});
-}
-
-MatVar configuration_struct(const Configuration& config) {
-  const nlohmann::ordered_json json = configuration_to_json(config);
-  std::vector<std::string> sections;
-  for (const auto& item : json.items()) sections.push_back(matlab_name(item.key()));
-  MatVar out = structure(sections);
-  std::size_t s = 0;
-  for (const auto& [section, values] : json.items()) {
-    std::vector<std::string> keys;
-    for (const auto& item : values.items()) keys.push_back(matlab_name(item.key()));
-    MatVar inner = structure(keys);
-    std::size_t k = 0;
-    for (const auto& [key, value] : values.items()) {
-      set_field(inner.get(), keys[k++], 0, value.is_string() ? text(value.get<std::string>()) : scalar(value.get<double>()));
-    }
-    set_field(out.get(), sections[s++], 0, std::move(inner));
-  }
-  return out;
-}
-
-MatVar session_struct(const Session& session) {
-  const SessionManifest& m = session.manifest;
-  MatVar out = structure({"name", "program_version", "device", "started_utc", "updated_utc", "configuration",
-                          "trajectory", "summary", "events"});
-  set_field(out.get(), "name", 0, text(m.name));
-  set_field(out.get(), "program_version", 0, text(m.program_version));
-  set_field(out.get(), "device", 0, text(m.device));
-  set_field(out.get(), "started_utc", 0, text(m.started_utc));
-  set_field(out.get(), "updated_utc", 0, text(m.updated_utc));
-  set_field(out.get(), "configuration", 0, configuration_struct(m.configuration));
-
-  const Trajectory& trajectory = session.trajectory;
-  Eigen::VectorXd times(trajectory.angle_rad.size());
-  for (Eigen::Index k = 0; k < times.size(); ++k) times(k) = static_cast<double>(k) * trajectory.sample_time_s;
-  MatVar trajectory_var = structure({"name", "time_s", "angle_deg"});
-  set_field(trajectory_var.get(), "name", 0, text(trajectory.name));
-  set_field(trajectory_var.get(), "time_s", 0, column(rounded_times(times)));
-  set_field(trajectory_var.get(), "angle_deg", 0, column(degrees_of(trajectory.angle_rad)));
-  set_field(out.get(), "trajectory", 0, std::move(trajectory_var));
-
-  const auto n = static_cast<Eigen::Index>(m.iterations.size());
-  Eigen::VectorXd iteration(n), rms(n), max_error(n), max_correction(n), saturated(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const IterationSummary& s = m.iterations[static_cast<std::size_t>(i)].summary;
-    iteration(i) = s.iteration;
-    rms(i) = s.rms_deg;
-    max_error(i) = s.max_abs_error_deg;
-    max_correction(i) = s.max_abs_correction_bar;
-    saturated(i) = s.saturated_samples;
-  }
-  set_field(out.get(), "summary", 0,
-            columns_struct({"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples"},
-                           {&iteration, &rms, &max_error, &max_correction, &saturated}));
-
-  MatVar events = structure({"time_utc", "iteration", "kind", "message"}, m.events.size());
-  for (std::size_t e = 0; e < m.events.size(); ++e) {
-    const SessionEvent& event = m.events[e];
-    set_field(events.get(), "time_utc", e, text(event.time_utc));
-    set_field(events.get(), "iteration", e, scalar(event.iteration));
-    set_field(events.get(), "kind", e, text(event.kind));
-    set_field(events.get(), "message", e, text(event.message));
-  }
-  set_field(out.get(), "events", 0, std::move(events));
-  return out;
-}
-
-MatVar iterations_struct(const Session& session) {
-  MatVar out = structure({"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples",
-                          "completed_utc", "samples", "telemetry"},
-                         session.iterations.size());
-  for (std::size_t i = 0; i < session.iterations.size(); ++i) {
-    const IterationEntry& entry = session.manifest.iterations[i];
-    set_field(out.get(), "iteration", i, scalar(entry.summary.iteration));
-    set_field(out.get(), "rms_deg", i, scalar(entry.summary.rms_deg));
-    set_field(out.get(), "max_abs_error_deg", i, scalar(entry.summary.max_abs_error_deg));
-    set_field(out.get(), "max_abs_correction_bar", i, scalar(entry.summary.max_abs_correction_bar));
-    set_field(out.get(), "saturated_samples", i, scalar(entry.summary.saturated_samples));
-    set_field(out.get(), "completed_utc", i, text(entry.completed_utc));
-    set_field(out.get(), "samples", i, samples_struct(session.iterations[i]));
-    set_field(out.get(), "telemetry", i, telemetry_struct(session.iterations[i].record.ticks));
-  }
-  return out;
-}
-
-void write_named(mat_t* file, MatVar var, const char* name, const fs::path& path) {
-  // Top-level variables need a name; Mat_VarFree releases it with the rest.
-  var->name = strdup(name);
-  if (Mat_VarWrite(file, var.get(), MAT_COMPRESSION_NONE) != 0) {
-    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string());
-  }
+/// Whether `path` lies inside `directory` (both resolved: `..`, symbolic links).
+bool is_inside(const fs::path& path, const fs::path& directory) {
+  std::error_code error;
+  const fs::path inner = fs::weakly_canonical(fs::absolute(path), error);
+  const fs::path outer = fs::weakly_canonical(fs::absolute(directory), error);
+  if (error) return false;
+  const fs::path relative = inner.lexically_relative(outer);
+  return !relative.empty() && *relative.begin() != "..";
 }
 
 }  // namespace
 
-std::vector<fs::path> export_session_csv(const Session& session, const fs::path& samples_path) {
+void check_export_targets(const Session& session, const std::vector<fs::path>& paths, const std::string& extension,
+                          bool force) {
+  const fs::path& first = paths.front();
+  if (first.extension() != extension) {
+    throw InputError("the output " + first.string() + " must end in " + extension + " for this format" +
+                     (first.extension().empty() ? "" : " (not " + first.extension().string() + ")"));
+  }
+  const fs::path folder = first.parent_path().empty() ? fs::path(".") : first.parent_path();
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) {
+    throw InputError("cannot write " + first.string() + ": the folder " + folder.string() +
+                     (fs::exists(folder, error) ? " is not a directory" : " does not exist"));
+  }
+  for (const fs::path& path : paths) {
+    if (!session.directory.empty() && is_inside(path, session.directory)) {
+      throw InputError("will not write " + path.string() + " inside the session " + session.directory.string() +
+                       " it exports (choose another --output)");
+    }
+    if (!force && fs::symlink_status(path, error).type() != fs::file_type::not_found) {
+      throw InputError(path.string() + " exists already (--force replaces it)");
+    }
+  }
+}
+
+std::vector<fs::path> csv_export_paths(const Session& session, const fs::path& samples_path) {
+  std::vector<fs::path> paths = {samples_path, sibling(samples_path, "_telemetry"), sibling(samples_path, "_summary")};
+  if (!session.black_boxes.empty()) paths.push_back(sibling(samples_path, "_blackbox"));
+  return paths;
+}
+
+std::vector<fs::path> export_session_csv(const Session& session, const fs::path& samples_path, bool force) {
+  const std::vector<fs::path> paths = csv_export_paths(session, samples_path);
+  check_export_targets(session, paths, ".csv", force);
   std::vector<std::string> samples, telemetry;
   for (const IterationData& data : session.iterations) {
     samples.push_back(format_samples_csv(data.record, data.next_correction_bar));
     telemetry.push_back(format_telemetry_csv(data.record));
   }
-  std::string samples_text, telemetry_text;
-  append_stacked(samples_text, samples);
-  append_stacked(telemetry_text, telemetry);
+  if (samples.empty()) {  // the header alone
+    samples.push_back(format_samples_csv(TrialRecord{}, Eigen::VectorXd{}));
+    telemetry.push_back(format_telemetry_csv(TrialRecord{}));
+  }
   std::string summary = "iteration,rms_deg,max_abs_error_deg,max_abs_correction_bar,saturated_samples\n";
   for (const IterationEntry& entry : session.manifest.iterations) {
     const nlohmann::json row = {entry.summary.iteration, entry.summary.rms_deg, entry.summary.max_abs_error_deg,
@@ -228,50 +95,15 @@ std::vector<fs::path> export_session_csv(const Session& session, const fs::path&
     std::string line = row.dump();  // "[0,12.3,...]": numbers in shortest round-trip form
     summary += line.substr(1, line.size() - 2) + "\n";
   }
-  if (samples_text.empty()) {
-    samples_text = "iteration," + std::string(format_samples_csv(TrialRecord{}, Eigen::VectorXd{}));
-    telemetry_text = "iteration," + std::string(format_telemetry_csv(TrialRecord{}));
-  }
-  const std::vector<fs::path> paths = {samples_path, sibling(samples_path, "_telemetry"), sibling(samples_path, "_summary")};
-  write_file_atomic(paths[0], samples_text);
-  write_file_atomic(paths[1], telemetry_text);
+  write_file_atomic(paths[0], stacked("iteration", samples));
+  write_file_atomic(paths[1], stacked("iteration", telemetry));
   write_file_atomic(paths[2], summary);
+  if (!session.black_boxes.empty()) {
+    std::vector<std::string> boxes;
+    for (const std::vector<TickRecord>& ticks : session.black_boxes) boxes.push_back(format_black_box_csv(ticks));
+    write_file_atomic(paths[3], stacked("black_box", boxes));
+  }
   return paths;
-}
-
-fs::path export_session_mat(const Session& session, const fs::path& path) {
-  const fs::path directory = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  const fs::path temporary = temporary_path_for(path);
-  std::error_code error;
-  fs::remove(temporary, error);
-  mat_t* file = Mat_CreateVer(temporary.c_str(), nullptr, MAT_FT_MAT73);
-  if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
-  try {
-    write_named(file, session_struct(session), "session", path);
-    write_named(file, iterations_struct(session), "iterations", path);
-  } catch (...) {
-    Mat_Close(file);
-    fs::remove(temporary, error);
-    throw;
-  }
-  Mat_Close(file);
-  // libmatio does not sync: flush it ourselves before the rename makes it visible.
-  const int fd = ::open(temporary.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    const int error_number = errno;
-    if (fd >= 0) ::close(fd);
-    fs::remove(temporary, error);
-    throw InputError("cannot flush " + path.string() + ": " + std::strerror(error_number));
-  }
-  ::close(fd);
-  fs::rename(temporary, path, error);
-  if (error) {
-    const std::string reason = error.message();
-    fs::remove(temporary, error);
-    throw InputError("cannot write " + path.string() + ": " + reason);
-  }
-  sync_directory(directory);
-  return path;
 }
 
 }  // namespace bellows

@@ -48,8 +48,10 @@ class MemorySessions final : public ui::SessionGateway {
 
 struct ConsoleFixture {
   /// `gateway`: where sessions go (default: `sessions`, in memory).
+  /// `write_figures`: the figure key's writer (default: none, the key says so).
   explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
-                          ui::SessionGateway* gateway = nullptr)
+                          ui::SessionGateway* gateway = nullptr,
+                          std::function<std::string(const ui::SessionSnapshot&)> write_figures = {})
       : config(c), arm(c.plant, 1), core(arm, c.controller, c.timing, c.safety), clock(core, arm) {
     ui::ConsoleEnvironment env;
     env.core = &core;
@@ -58,6 +60,7 @@ struct ConsoleFixture {
     env.load_trajectory = [c](const std::string& name) { return resolve_trajectory(name, c.timing.sample_s(), c.trajectory); };
     env.sessions = gateway != nullptr ? gateway : &sessions;
     env.stop_after_rises = stop_after_rises;
+    env.write_figures = std::move(write_figures);
     env.clock_text = [] { return std::string("12:00:00"); };
     console = std::make_unique<ui::ConsoleController>(env, library_trajectory("paper", c.timing.sample_s()), false);
     console->resize(120, 40);

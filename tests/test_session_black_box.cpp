@@ -145,12 +145,13 @@ TEST(SessionBlackBox, DamageIsReportedWithTheFileAndLine) {
   EXPECT_NE(damaged(good.substr(0, third_line)).find("expected 400 rows"), std::string::npos);
   EXPECT_NE(damaged(good.substr(0, good.size() - 3)).find("truncated"), std::string::npos);
   EXPECT_NE(damaged("tick,time\n" + good.substr(second_line)).find("line 1: the header"), std::string::npos);
-  // A state code that does not exist, on line 2.
+  // A state that does not exist (a code where a name belongs), on line 2.
   std::string bad_state = good;
   std::size_t field = second_line;
   for (int comma = 0; comma < 3; ++comma) field = bad_state.find(',', field) + 1;
   bad_state.replace(field, bad_state.find(',', field) - field, "7");
-  EXPECT_NE(damaged(bad_state).find("line 2: state = 7"), std::string::npos) << damaged(bad_state);
+  EXPECT_NE(damaged(bad_state).find("line 2: state '7' is not one of SAFE, ARMED, RUNNING, FAULT"), std::string::npos)
+      << damaged(bad_state);
   // Ticks out of order.
   const std::string swapped = good.substr(0, second_line) + good.substr(third_line, good.find('\n', third_line) + 1 - third_line) +
                               good.substr(second_line, third_line - second_line) + good.substr(good.find('\n', third_line) + 1);

@@ -12,6 +12,7 @@
 #include "session_test_support.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
+#include "sessions/session_lock.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -289,16 +290,18 @@ TEST_F(SessionsCommand, ListIsATableAndJson) {
   EXPECT_NE(row.find(" short "), std::string::npos) << row;
   EXPECT_NE(row.find(" 4 "), std::string::npos) << row;
 
+  EXPECT_LT(table.out.find("\nsecond "), first_line);  // newest first, as the console's browser
+
   const nlohmann::json list = nlohmann::json::parse(run_bellows({"sessions", "list", "--data-dir", data_, "--json"}).out);
   ASSERT_EQ(list.size(), 2u);
-  EXPECT_EQ(list[0]["name"], "first");
-  EXPECT_EQ(list[0]["iterations"], 4);
-  EXPECT_EQ(list[0]["device"], "sim");
-  EXPECT_EQ(list[0]["trajectory"], "short");
+  EXPECT_EQ(list[0]["name"], "second");
+  EXPECT_EQ(list[1]["name"], "first");
+  EXPECT_EQ(list[1]["iterations"], 4);
+  EXPECT_EQ(list[1]["device"], "sim");
+  EXPECT_EQ(list[1]["trajectory"], "short");
   double best = 1e9;
   for (const auto& iteration : first_["iterations"]) best = std::min(best, iteration["rms_deg"].get<double>());
-  EXPECT_EQ(list[0]["best_rms_deg"].get<double>(), best);
-  EXPECT_EQ(list[1]["name"], "second");
+  EXPECT_EQ(list[1]["best_rms_deg"].get<double>(), best);
 
   const ProcessResult empty = run_bellows({"sessions", "list", "--data-dir", (dir_ / "none").string()});
   EXPECT_EQ(empty.exit_code, 0);
@@ -379,7 +382,8 @@ std::vector<double> mat_column(matvar_t* parent, const char* field, std::size_t 
 
 TEST_F(SessionsCommand, ExportsMatlabV73WithOneStructPerIteration) {
   const fs::path out = dir_ / "first.mat";
-  const ProcessResult result = run_bellows({"sessions", "export", data_ + "/first", "--format", "mat", "--output", out.string()});
+  const ProcessResult result = run_bellows(
+      {"sessions", "export", data_ + "/first", "--format", "mat", "--mat-version", "7.3", "--output", out.string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(result.out, "wrote " + out.string() + "\n");
   mat_t* file = Mat_Open(out.c_str(), MAT_ACC_RDONLY);
@@ -422,6 +426,50 @@ TEST_F(SessionsCommand, ExportRejectsAnUnknownFormat) {
   const ProcessResult result = run_bellows({"sessions", "export", data_ + "/first", "--format", "xlsx"});
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.err.find("--format"), std::string::npos) << result.err;
+}
+
+TEST_F(SessionsCommand, RmAsksFirstAndRemovesOnlyWhenConfirmed) {
+  const std::string first = data_ + "/first";
+  // No answer (stdin at its end): nothing removed, exit status 1.
+  const ProcessResult unanswered = run_bellows({"sessions", "rm", "first", "--data-dir", data_});
+  EXPECT_EQ(unanswered.exit_code, 1);
+  EXPECT_NE(unanswered.err.find("remove session " + first + " (4 iterations"), std::string::npos) << unanswered.err;
+  EXPECT_NE(unanswered.err.find("not removed"), std::string::npos) << unanswered.err;
+  EXPECT_TRUE(fs::exists(first));
+  const ProcessResult yes = run_bellows({"sessions", "rm", "first", "--data-dir", data_, "--yes"});
+  EXPECT_EQ(yes.exit_code, 0) << yes.err;
+  EXPECT_EQ(yes.out, "removed " + first + "\n");
+  EXPECT_FALSE(fs::exists(first));
+  EXPECT_EQ(list_sessions(dir_ / "data").size(), 1u);
+  // Never a directory that is not a session.
+  fs::create_directories(dir_ / "data" / "photos");
+  const ProcessResult other = run_bellows({"sessions", "rm", "photos", "--data-dir", data_, "--yes"});
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("is not a bellows session"), std::string::npos) << other.err;
+  EXPECT_TRUE(fs::exists(dir_ / "data" / "photos"));
+}
+
+TEST_F(SessionsCommand, RmRefusesASessionInUse) {
+  const SessionLock lock(dir_ / "data" / "first", "bellows run");
+  const ProcessResult result = run_bellows({"sessions", "rm", "first", "--data-dir", data_, "--yes"});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("in use"), std::string::npos) << result.err;
+  EXPECT_TRUE(fs::exists(dir_ / "data" / "first"));
+}
+
+TEST_F(SessionsCommand, RenameMovesTheSessionAndItsManifestName) {
+  const ProcessResult result = run_bellows({"sessions", "rename", "first", "paper-run", "--data-dir", data_});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_FALSE(fs::exists(dir_ / "data" / "first"));
+  const Session renamed = load_session(dir_ / "data" / "paper-run");
+  EXPECT_EQ(renamed.manifest.name, "paper-run");
+  EXPECT_EQ(renamed.iterations.size(), 4u);
+  const ProcessResult taken = run_bellows({"sessions", "rename", "paper-run", "second", "--data-dir", data_});
+  EXPECT_EQ(taken.exit_code, 2);
+  EXPECT_NE(taken.err.find("exists already"), std::string::npos) << taken.err;
+  const ProcessResult bad = run_bellows({"sessions", "rename", "paper-run", "a/b", "--data-dir", data_});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(fs::exists(dir_ / "data" / "paper-run"));
 }
 
 }  // namespace

@@ -47,6 +47,8 @@ struct ConsoleEnvironment {
   std::uint64_t seed = 1;
   int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
   std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
+  /// Draws figures of the trials so far (on a background task); returns where. Empty: not available.
+  std::function<std::string(const SessionSnapshot&)> write_figures;
 };
 
 class ConsoleController {
@@ -137,6 +139,7 @@ class ConsoleController {
   void start_save();
   void start_listing();
   void start_open(const std::string& location);
+  void start_figures();
   void poll_session_tasks();
   void adopt(SessionSnapshot snapshot, bool at_start);
 
@@ -183,6 +186,7 @@ class ConsoleController {
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;
   BackgroundTask<SessionSnapshot> open_task_;
+  BackgroundTask<std::string> figure_task_;
   int saving_trials_ = 0;
   int saving_faults_ = 0;
   std::size_t saving_events_ = 0;

@@ -279,6 +279,7 @@ void ConsoleController::perform(Action action) {
     case Action::kFaultView: state_.screen = Screen::kFault; return;
     case Action::kRig: state_.screen = Screen::kRig; return;
     case Action::kSave: start_save(); return;
+    case Action::kFigures: start_figures(); return;
     case Action::kOpen:
       state_.screen = Screen::kSessions;
       start_listing();

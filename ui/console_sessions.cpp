@@ -32,6 +32,24 @@ void ConsoleController::start_save() {
   save_task_.start([gateway = env_.sessions, snapshot = std::move(snapshot)] { return gateway->save(snapshot); });
 }
 
+void ConsoleController::start_figures() {
+  if (!env_.write_figures) {
+    set_status("figures are not available in this console", true);
+    return;
+  }
+  if (figure_task_.busy()) {
+    set_status("already writing figures");
+    return;
+  }
+  SessionSnapshot snapshot;  // a copy: the trials go on while gnuplot draws
+  snapshot.config = state_.config;
+  snapshot.experiment = state_.experiment;
+  snapshot.device_name = env_.device_name;
+  snapshot.seed = env_.seed;
+  log(LogSource::kSession, format("writing figures of %d iterations", static_cast<int>(snapshot.experiment.trials.size())));
+  figure_task_.start([write = env_.write_figures, snapshot = std::move(snapshot)] { return write(snapshot); });
+}
+
 void ConsoleController::start_listing() {
   if (list_task_.busy()) return;
   state_.browser.loading = true;
@@ -67,6 +85,17 @@ void ConsoleController::poll_session_tasks() {
       set_status(std::string("save failed: ") + error.what(), true);
     }
     quit_after_save_ = false;
+    ++revision_;
+  }
+  if (figure_task_.ready()) {
+    try {
+      const std::string folder = figure_task_.take();
+      log(LogSource::kSession, "figures written to " + folder);
+      set_status("figures: " + folder);
+    } catch (const std::exception& error) {
+      log(LogSource::kSession, std::string("figures failed: ") + error.what(), true);
+      set_status(std::string("figures failed: ") + error.what(), true);
+    }
     ++revision_;
   }
   if (list_task_.ready()) {

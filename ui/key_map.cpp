@@ -41,6 +41,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kFaultView, 'f', key::kNone, "f", "Fault", "the last fault: which guard fired and the black box"},
       {Action::kSave, 's', key::kNone, "s", "Save", "save the session"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
+      {Action::kFigures, 'g', key::kNone, "g", "Figures", "write figures of this session (PNG, SVG; the engine goes on)"},
       {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
@@ -111,6 +112,9 @@ Availability availability(Action action, const ConsoleState& s) {
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
       if (!s.experiment.unsaved()) return no("nothing new to save");
       if (s.learner_busy && s.learner_task == "saving") return no("already saving");
+      return {};
+    case Action::kFigures:
+      if (s.experiment.trials.empty()) return no("no trial has run yet");
       return {};
     case Action::kOpen:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);

@@ -27,6 +27,7 @@ enum class Action {
   kFaultView,
   kSave,
   kOpen,
+  kFigures,
   kQuit,
   kHeartbeatDrill,
   kRig,

@@ -1,0 +1,101 @@
+#include "app/plot_command.hpp"
+
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/plot_gnuplot.hpp"
+#include "engine/errors.hpp"
+#include "sessions/atomic_file.hpp"
+#include "sessions/session_store.hpp"
+
+#ifndef BELLOWS_PAPER_RMS_CSV
+#define BELLOWS_PAPER_RMS_CSV ""
+#endif
+
+namespace bellows {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kScriptName = "figures.gp";
+
+bool is_inside(const fs::path& path, const fs::path& directory) {
+  std::error_code error;
+  const fs::path inner = fs::weakly_canonical(fs::absolute(path), error);
+  const fs::path outer = fs::weakly_canonical(fs::absolute(directory), error);
+  if (error) return false;
+  const fs::path relative = inner.lexically_relative(outer);
+  return !relative.empty() && *relative.begin() != "..";
+}
+
+}  // namespace
+
+fs::path default_paper_rms_path() {
+  const fs::path path = BELLOWS_PAPER_RMS_CSV;
+  std::error_code error;
+  return !path.empty() && fs::is_regular_file(path, error) ? path : fs::path();
+}
+
+std::vector<fs::path> write_session_figures(const Session& session, const FigureRequest& request, const fs::path& directory,
+                                            bool force) {
+  const std::vector<Figure> figures = session_figures(session, request);  // checks the request first
+  if (!session.directory.empty() && is_inside(directory, session.directory)) {
+    throw InputError("will not write figures inside the session " + session.directory.string() + " (choose another --output)");
+  }
+  std::error_code error;
+  const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
+  if (!fs::is_directory(parent, error)) {
+    throw InputError("cannot write figures into " + directory.string() + ": the folder " + parent.string() + " does not exist");
+  }
+  if (fs::exists(directory, error) && !fs::is_directory(directory, error)) {
+    throw InputError("cannot write figures into " + directory.string() + ": it is not a directory");
+  }
+  std::vector<fs::path> files = figure_files(figures, request.formats, directory);
+  files.insert(files.begin(), directory / kScriptName);
+  for (const fs::path& file : files) {
+    if (!force && fs::symlink_status(file, error).type() != fs::file_type::not_found) {
+      throw InputError(file.string() + " exists already (--force replaces it)");
+    }
+  }
+  fs::create_directory(directory, error);
+  if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
+  write_file_atomic(files.front(), gnuplot_script(figures, request.formats));
+  run_gnuplot(files.front(), directory);
+  for (const fs::path& file : files) {
+    if (fs::file_size(file, error) == 0 || error) throw InputError("gnuplot wrote no " + file.string());
+  }
+  return files;
+}
+
+int sessions_plot_command(const PlotOptions& options, std::ostream& out) {
+  if (options.no_paper && !options.paper.empty()) throw InputError("--paper and --no-paper exclude each other");
+  fs::path data_dir;
+  try {
+    data_dir = options.data_dir.empty() ? default_data_dir() : fs::path(options.data_dir);
+  } catch (const InputError&) {
+    // Then only a path can name the session; resolve_session_dir() says so if it is not one.
+  }
+  const Session session = load_session(resolve_session_dir(options.session, data_dir));
+  FigureRequest request;
+  request.iterations = options.iterations;
+  request.pressure_trial = options.trial;
+  request.formats = options.formats;
+  fs::path paper = options.paper;
+  if (paper.empty() && !options.no_paper && session.manifest.trajectory_name == "paper") paper = default_paper_rms_path();
+  if (!paper.empty()) request.paper_rms = read_paper_rms(paper);
+  const fs::path directory =
+      options.output.empty() ? fs::path(session.directory.filename().string() + "_figures") : fs::path(options.output);
+  const std::vector<fs::path> files = write_session_figures(session, request, directory, options.force);
+  if (options.json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const fs::path& file : files) list.push_back(file.string());
+    out << nlohmann::json{{"directory", directory.string()}, {"paper", paper.string()}, {"files", list}}.dump() << std::endl;
+    return 0;
+  }
+  for (const fs::path& file : files) out << "wrote " << file.string() << "\n";
+  if (!paper.empty()) out << "paper's RMS curve from " << paper.string() << "\n";
+  out << std::flush;
+  return 0;
+}
+
+}  // namespace bellows
