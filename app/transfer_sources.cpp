@@ -54,7 +54,7 @@ void check_transfer_source(const Session& session, const Configuration& target, 
   const double theirs = session.manifest.configuration.timing.sample_s(), ours = target.timing.sample_s();
   if (std::abs(theirs - ours) > 1e-9 * ours) {
     char line[160];
-    std::snprintf(line, sizeof line, " was sampled every %g s, this run every %g s", theirs, ours);
+    std::snprintf(line, sizeof line, ": it was sampled every %g s, this run every %g s", theirs, ours);
     throw InputError("cannot transfer from " + describe(session) + line);
   }
   if (session.manifest.device != device) {
