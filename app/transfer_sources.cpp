@@ -1,7 +1,6 @@
 #include "app/transfer_sources.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include "engine/errors.hpp"
 #include "sessions/session_store.hpp"
@@ -12,26 +11,6 @@ namespace {
 std::string describe(const Session& session) {
   const std::string name = session.manifest.name.empty() ? session.directory.filename().string() : session.manifest.name;
   return "session '" + name + "'";
-}
-
-/// The simulated arm's physical keys ([plant] without fault injection): what makes it the same arm.
-std::string plant_difference(const Configuration& a, const Configuration& b) {
-  Configuration ca = a, cb = b;  // the bindings hand out pointers into a mutable configuration
-  for (const ParameterBinding& binding : parameter_bindings()) {
-    if (binding.section != "plant" || !binding.real || binding.key.rfind("fault", 0) == 0 || binding.key.rfind("spike", 0) == 0) {
-      continue;
-    }
-    const double x = *binding.real(ca), y = *binding.real(cb);
-    if (std::abs(x - y) > 1e-9 * std::max(std::abs(x), std::abs(y))) {
-      return "[plant] " + binding.key + " is " + std::to_string(x) + " there, " + std::to_string(y) + " here";
-    }
-  }
-  for (const ParameterBinding& binding : parameter_bindings()) {
-    if (binding.section == "plant" && binding.integer && *binding.integer(ca) != *binding.integer(cb)) {
-      return "[plant] " + binding.key + " differs";
-    }
-  }
-  return {};
 }
 
 }  // namespace
@@ -51,20 +30,9 @@ TransferSource transfer_source_from_session(const Session& session) {
 }
 
 void check_transfer_source(const Session& session, const Configuration& target, const std::string& device) {
-  const double theirs = session.manifest.configuration.timing.sample_s(), ours = target.timing.sample_s();
-  if (std::abs(theirs - ours) > 1e-9 * ours) {
-    char line[160];
-    std::snprintf(line, sizeof line, ": it was sampled every %g s, this run every %g s", theirs, ours);
-    throw InputError("cannot transfer from " + describe(session) + line);
-  }
-  if (session.manifest.device != device) {
-    throw InputError("cannot transfer from " + describe(session) + ": it was recorded on the device '" +
-                     session.manifest.device + "', this run drives '" + device + "'");
-  }
-  if (device == "sim") {
-    if (const std::string why = plant_difference(session.manifest.configuration, target); !why.empty()) {
-      throw InputError("cannot transfer from " + describe(session) + ": it was recorded on another simulated arm (" + why + ")");
-    }
+  if (const std::string why = transfer_mismatch(session.manifest.configuration, session.manifest.device, target, device);
+      !why.empty()) {
+    throw InputError("cannot transfer from " + describe(session) + ": " + why);
   }
   if (session.iterations.empty()) throw InputError("cannot transfer from " + describe(session) + ": it has no completed trial");
 }

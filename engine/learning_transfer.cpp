@@ -46,6 +46,34 @@ Eigen::VectorXd trial_error(const Trajectory& trajectory, const TransferTrial& t
 
 }  // namespace
 
+std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
+                              const std::string& target_device) {
+  const double theirs = source.timing.sample_s(), ours = target.timing.sample_s();
+  char line[200];
+  if (std::abs(theirs - ours) > 1e-9 * ours) {
+    std::snprintf(line, sizeof line, "it was sampled every %g s, this run every %g s", theirs, ours);
+    return line;
+  }
+  if (source_device != target_device) {
+    return "it was recorded on the device '" + source_device + "', this run drives '" + target_device + "'";
+  }
+  if (target_device != "sim") return {};
+  Configuration a = source, b = target;  // the bindings hand out pointers into a mutable configuration
+  for (const ParameterBinding& binding : parameter_bindings()) {
+    if (binding.section != "plant" || binding.key.rfind("fault", 0) == 0 || binding.key.rfind("spike", 0) == 0) continue;
+    const bool differs = binding.real ? std::abs(*binding.real(a) - *binding.real(b)) >
+                                            1e-9 * std::max(std::abs(*binding.real(a)), std::abs(*binding.real(b)))
+                                      : binding.integer && *binding.integer(a) != *binding.integer(b);
+    if (differs && binding.real) {
+      std::snprintf(line, sizeof line, "it was recorded on another simulated arm ([plant] %s is %g there, %g here)",
+                    binding.key.c_str(), *binding.real(a), *binding.real(b));
+      return line;
+    }
+    if (differs) return "it was recorded on another simulated arm ([plant] " + binding.key + " differs)";
+  }
+  return {};
+}
+
 std::string transfer_method_name(TransferMethod method) {
   switch (method) {
     case TransferMethod::kAuto: return "auto";

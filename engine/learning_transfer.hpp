@@ -23,6 +23,7 @@
 
 #include <Eigen/Dense>
 
+#include "engine/configuration.hpp"
 #include "engine/learning_transfer_fit.hpp"
 #include "engine/parameters.hpp"
 #include "engine/trajectory.hpp"
@@ -43,6 +44,12 @@ struct TransferSource {
   ControllerParameters controller;
   std::vector<TransferTrial> trials;  // in iteration order; the last is the best-learned
 };
+
+/// Why trials recorded with `source` on the device `source_device` cannot teach a run with `target`
+/// on `target_device` (another sample time, device, or simulated arm: a physical [plant] key differs);
+/// empty when they can. Gains, weights, laws, seeds and lengths may differ.
+std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
+                              const std::string& target_device);
 
 enum class TransferMethod { kAuto, kReferenceFir, kBasis, kInverseFir };
 std::string transfer_method_name(TransferMethod method);

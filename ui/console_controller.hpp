@@ -21,6 +21,7 @@
 #include "engine/realtime_loop.hpp"
 #include "ui/background_task.hpp"
 #include "ui/console_state.hpp"
+#include "ui/console_transfer.hpp"
 #include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
 #include "ui/trial_diagnostics.hpp"
@@ -120,6 +121,12 @@ class ConsoleController {
   void confirm_discard(std::string what, std::function<void()> action);
   void quit_now();
 
+  // Learning transfer (console_transfer.cpp).
+  void remember_taught();  // the current experiment's trials, before another trajectory replaces it
+  void offer_transfer();   // a trajectory with no correction: compute what the others taught
+  void poll_transfer();
+  bool handle_transfer_key(int key);
+
   // Sessions (console_sessions.cpp).
   void start_save();
   void start_listing();
@@ -167,6 +174,10 @@ class ConsoleController {
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;
   BackgroundTask<SessionSnapshot> open_task_;
+  BackgroundTask<TransferOffer> transfer_task_;
+  std::vector<TransferSource> taught_;  // earlier experiments of this console
+  TransferOffer transfer_offer_;
+  bool transfer_wanted_ = false;
   int saving_trials_ = 0;
   int saving_faults_ = 0;
   std::size_t saving_events_ = 0;
