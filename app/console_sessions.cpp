@@ -152,6 +152,31 @@ std::vector<ui::SessionListing> StoreSessionGateway::list() {
   return out;
 }
 
+ui::SessionSnapshot StoreSessionGateway::read_trials(const std::string& location) {
+  std::filesystem::path directory;
+  {
+    const std::lock_guard<std::mutex> guard(mutex_);
+    directory = resolve_session_dir(location, data_dir_);
+  }
+  Session loaded = load_session(directory);  // read only: no lock, our own session unchanged
+  ui::SessionSnapshot snapshot;
+  snapshot.config = loaded.manifest.configuration;
+  snapshot.device_name = loaded.manifest.device;
+  snapshot.experiment = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
+  const int n = loaded.trajectory.learning_samples();
+  for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
+    ui::Trial trial;
+    trial.iteration = static_cast<int>(i);
+    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
+    trial.record = std::move(loaded.iterations[i].record);
+    trial.summary = loaded.manifest.iterations[i].summary;
+    trial.origin = "saved";
+    snapshot.experiment.trials.push_back(std::move(trial));
+  }
+  snapshot.experiment.session_location = directory.string();
+  return snapshot;
+}
+
 ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const std::filesystem::path directory = resolve_session_dir(location, data_dir_);

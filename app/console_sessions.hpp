@@ -29,6 +29,7 @@ class StoreSessionGateway final : public ui::SessionGateway {
   std::string save(const ui::SessionSnapshot& snapshot) override;
   std::vector<ui::SessionListing> list() override;
   ui::SessionSnapshot open(const std::string& location) override;
+  ui::SessionSnapshot read_trials(const std::string& location) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
 

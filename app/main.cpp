@@ -71,6 +71,13 @@ int main(int argc, char** argv) {
       ->excludes("--config")
       ->excludes("--seed");
 
+  run_cmd->add_option("--transfer-from", run.transfer_from,
+                      "Start from what these saved sessions taught (a directory or a name; repeatable)")
+      ->excludes("--resume");
+  run_cmd->add_option("--transfer-method", run.transfer_method,
+                      "How: auto, reference-fir, basis or inverse-fir (docs/learning-laws.md)")
+      ->capture_default_str();
+
   bellows::SessionsOptions sessions;
   CLI::App* sessions_cmd = app.add_subcommand("sessions", "List, show, export, plot, rename and remove saved sessions");
   sessions_cmd->require_subcommand(1);

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
+#include "app/transfer_sources.hpp"
 #include "engine/arm_model.hpp"
 #include "engine/convergence.hpp"
 #include "engine/engine_core.hpp"
@@ -20,6 +22,7 @@
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_monitor.hpp"
 #include "engine/learning_session.hpp"
+#include "sessions/session_store.hpp"
 
 namespace bellows {
 namespace {
@@ -37,6 +40,23 @@ nlohmann::json to_json(const IterationSummary& s) {
           {"max_abs_error_deg", s.max_abs_error_deg},
           {"max_abs_correction_bar", s.max_abs_correction_bar},
           {"saturated_samples", s.saturated_samples}};
+}
+
+/// --transfer-from: the first correction learned from saved sessions (before anything starts, so that
+/// a session that does not fit is refused with nothing created).
+std::optional<TransferReport> transfer_for(const RunOptions& options, const Configuration& config, const Trajectory& trajectory,
+                                           bool resuming) {
+  if (options.transfer_from.empty()) return std::nullopt;
+  if (resuming) throw InputError("--transfer-from gives a new session its first correction; a resumed session has one");
+  const TransferMethod method = parse_transfer_method(options.transfer_method);
+  std::filesystem::path data_dir;
+  try {
+    data_dir = options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
+  } catch (const InputError&) {
+    // Without a data directory the sources must be paths; resolve_session_dir() says so.
+  }
+  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config, options.device);
+  return compute_transfer(sessions, config, trajectory, method);
 }
 
 }  // namespace
@@ -64,6 +84,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());
+  const std::optional<TransferReport> transfer = transfer_for(options, config, trajectory, resumed != nullptr);
 
   RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
   Device& device = io.device();
@@ -88,7 +109,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   recording.restore(arm, core, clock, session);  // before the first tick
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
-  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info());
+  if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
+  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(),
+                  transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
+  if (transfer) progress << transfer_line(*transfer) << std::endl;
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
   io.start_telemetry(recording.directory());  // its LCM log goes into the session
   const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
@@ -166,6 +190,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"session", recording.directory().empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};
+    if (transfer) report["transfer"] = transfer_json(*transfer);
     if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
     if (loop != nullptr) {

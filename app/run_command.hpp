@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "app/device_factory.hpp"
 #include "engine/configuration.hpp"
@@ -29,6 +30,8 @@ struct RunOptions {
   std::string lcm_url;         // --lcm URL: publish telemetry there (and find an lcm rig there)
   bool lcm_log = false;        // --lcm-log [FILE]: an LCM event log of the telemetry,
   std::string lcm_log_file;    //   in FILE, or (no FILE) in the session directory
+  std::vector<std::string> transfer_from;  // --transfer-from SESSION...: the first correction from these
+  std::string transfer_method = "auto";    // --transfer-method
 };
 
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.

@@ -244,6 +244,7 @@ Json manifest_to_json(const SessionManifest& m) {
       {"events", events},
       {"black_boxes", black_boxes},
   };
+  if (!m.first_correction.is_null()) out["first_correction"] = m.first_correction;
   if (m.resume) {
     Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
     if (m.resume->exact()) {
@@ -293,6 +294,10 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   if (r.has("black_boxes")) {  // sessions saved before black boxes were kept have none
     const JsonReader black_boxes = r["black_boxes"];
     for (std::size_t i = 0; i < black_boxes.size(); ++i) m.black_boxes.push_back(black_box_from_json(black_boxes[i]));
+  }
+  if (r.has("first_correction")) {  // absent: the run started with feedback only
+    r["first_correction"].expect_object();
+    m.first_correction = r["first_correction"].json();
   }
   if (r.has("resume")) {
     const JsonReader resume = r["resume"];

@@ -79,6 +79,9 @@ struct SessionManifest {
   std::vector<SessionEvent> events;
   std::vector<BlackBoxEntry> black_boxes;  // numbered 0, 1, ... in the order the faults fired
   std::optional<ResumeState> resume;  // present once an iteration has completed
+  // Where the first trial's correction came from when it was not zero (a learning transfer: its
+  // sources, method and prediction); null for a run that started with feedback only.
+  nlohmann::ordered_json first_correction;
 };
 
 /// One iteration's signals: the trial record and the correction learned from it for the next trial.

@@ -42,6 +42,7 @@ class MemorySessions final : public ui::SessionGateway {
     s.experiment.session_location = location;
     return s;
   }
+  ui::SessionSnapshot read_trials(const std::string& location) override { return open(location); }
   std::map<std::string, ui::SessionSnapshot> saved;
   int saves = 0;
 };

@@ -22,6 +22,7 @@
 #include "engine/valve_test.hpp"
 #include "ui/background_task.hpp"
 #include "ui/console_state.hpp"
+#include "ui/console_transfer.hpp"
 #include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
 #include "ui/trial_diagnostics.hpp"
@@ -134,6 +135,11 @@ class ConsoleController {
   void show_valve_verdicts();
   void refresh_rig(double now_s);
   void add_link_health(DeviceHealth& health);
+  // Learning transfer (console_transfer.cpp).
+  void remember_taught();  // the current experiment's trials, before another trajectory replaces it
+  void offer_transfer();   // a trajectory with no correction: compute what the others taught
+  void poll_transfer();
+  bool handle_transfer_key(int key);
 
   // Sessions (console_sessions.cpp).
   void start_save();
@@ -187,6 +193,10 @@ class ConsoleController {
   BackgroundTask<std::vector<SessionListing>> list_task_;
   BackgroundTask<SessionSnapshot> open_task_;
   BackgroundTask<std::string> figure_task_;
+  BackgroundTask<TransferOffer> transfer_task_;
+  std::vector<TransferSource> taught_;  // earlier experiments of this console
+  TransferOffer transfer_offer_;
+  bool transfer_wanted_ = false;
   int saving_trials_ = 0;
   int saving_faults_ = 0;
   std::size_t saving_events_ = 0;

@@ -39,7 +39,7 @@ void ConsoleController::handle_key(int k, double now_s) {
     }
     return;
   }
-  if (handle_screen_key(k)) return;
+  if (handle_screen_key(k) || handle_transfer_key(k)) return;
   if (const auto action = action_for_key(k)) {
     perform(*action);
   } else {

@@ -201,6 +201,7 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
   confirm_discard("the trajectory " + trajectory->name, [this, trajectory] {
     const int old_samples = state_.experiment.samples();
     select_trajectory(trajectory);
+    remember_taught();
     state_.experiment = Experiment::start(trajectory);
     state_.inspector = InspectorView{};
     if (trajectory->learning_samples() != old_samples || !law_) rebuild_law();
@@ -208,6 +209,7 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
                                      trajectory->learning_samples()));
     set_status("trajectory " + trajectory->name + ": iteration 0 runs with feedback only");
     state_.screen = Screen::kMain;
+    offer_transfer();
   });
 }
 

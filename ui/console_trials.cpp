@@ -39,6 +39,7 @@ void ConsoleController::rebuild_law() {
 }
 
 void ConsoleController::poll_tasks() {
+  poll_transfer();
   if (law_build_.ready()) {
     try {
       BuiltLaw built = law_build_.take();

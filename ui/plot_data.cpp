@@ -45,6 +45,10 @@ CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chose
     out.series.push_back({label_of(chosen), Role::kSeries3, 'o', to_vector(correction_of(chosen), 1.0, n)});
   }
   if (primary < trials) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
+  // A transferred start stays in view beside what was learned from it.
+  if (trials > 0 && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 && previous != 0 && chosen != 0) {
+    out.series.insert(out.series.begin(), {"transferred", Role::kSeries3, '+', to_vector(e.trials.front().correction_bar, 1.0, n)});
+  }
   return out;
 }
 

@@ -51,6 +51,10 @@ class SessionGateway {
   virtual std::vector<SessionListing> list() = 0;
   /// Loads a session completely. Throws InputError when it cannot be read.
   virtual SessionSnapshot open(const std::string& location) = 0;
+  /// Reads a session's configuration, device, trajectory and trials only, to learn from (a transfer):
+  /// no lock is taken and the session the console saves into stays what it was. Throws when it
+  /// cannot be read; the default says it is not available.
+  virtual SessionSnapshot read_trials(const std::string& /*location*/) { throw std::runtime_error(unavailable_reason()); }
 };
 
 /// The gateway when no session store is built in: everything says "not available".

@@ -1,0 +1,54 @@
+// Saved sessions as the sources of a learning transfer (engine/learning_transfer): loading them,
+// refusing those that cannot teach the target run, and the report (`bellows run --json`'s
+// "transfer", the progress line, the session's `first_correction`).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/configuration.hpp"
+#include "engine/learning_transfer.hpp"
+#include "sessions/session.hpp"
+
+namespace bellows {
+
+/// Where a source came from, for the report.
+struct TransferSourceInfo {
+  std::string name;        // the session's name
+  std::string directory;
+  std::string trajectory;  // its trajectory's name
+  int trials = 0;
+  double last_rms_deg = 0.0;
+};
+
+/// The trials of `session` as a transfer source.
+TransferSource transfer_source_from_session(const Session& session);
+
+/// Checks that `session` can teach a run of `target` on `device`: same sample time, same device and
+/// the same simulated plant ([plant]: the same arm). Throws InputError naming the session and why.
+void check_transfer_source(const Session& session, const Configuration& target, const std::string& device);
+
+/// Loads and checks every session (`names`: directories or names in `data_dir`). InputError names the
+/// first session that is missing, damaged, empty or does not fit.
+std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names, const std::filesystem::path& data_dir,
+                                            const Configuration& target, const std::string& device);
+
+struct TransferReport {
+  std::vector<TransferSourceInfo> sources;
+  TransferResult result;
+};
+
+/// Sets up the transfer from `sessions` and solves it for `target`.
+TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config, const Trajectory& target,
+                                TransferMethod method = TransferMethod::kAuto);
+
+/// {"sources": [...], "method", "status", "reason", "prediction": {...}, ...}
+nlohmann::json transfer_json(const TransferReport& report);
+/// One line for the progress stream, e.g. "transfer from a, b: inverse-fir, predicted first trial 1.9 deg RMS
+/// (feedback only 8.6 deg)" or "transfer from a: none, the first trial runs with feedback only: <why>".
+std::string transfer_line(const TransferReport& report);
+
+}  // namespace bellows

@@ -1,0 +1,143 @@
+#include "ui/console_transfer.hpp"
+
+#include <algorithm>
+#include <exception>
+
+#include "ui/canvas.hpp"
+#include "ui/console_controller.hpp"
+
+namespace bellows::ui {
+
+std::string TransferOffer::offer_line() const {
+  return format("%c: start from what %d session%s taught (%s): predicted %.1f deg RMS, feedback only %.1f deg", kTransferKey,
+                source_count, source_count == 1 ? "" : "s", method.c_str(), predicted_rms_deg, feedback_only_rms_deg);
+}
+
+TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config) {
+  TransferSource source;
+  if (!experiment.trajectory) return source;
+  source.name = experiment.trajectory->name;
+  source.trajectory = *experiment.trajectory;
+  source.controller = config.controller;
+  const Eigen::Index n = experiment.samples();
+  for (const Trial& trial : experiment.trials) {
+    const TrialSamples& s = trial.record.samples;
+    if (!trial.record.complete || s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1) continue;
+    source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
+  }
+  return source;
+}
+
+TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
+                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved) {
+  TransferOffer offer;
+  offer.trajectory = target;
+  try {
+    std::vector<TransferSource> sources;
+    for (TransferSource& s : taught) {
+      if (!s.trials.empty()) sources.push_back(std::move(s));
+    }
+    if (sessions != nullptr && sessions->available()) {
+      std::vector<SessionListing> listed = sessions->list();
+      std::reverse(listed.begin(), listed.end());  // newest first
+      int used = 0;
+      for (const SessionListing& listing : listed) {
+        if (used >= max_saved) break;
+        if (!listing.error.empty() || listing.iterations == 0) continue;
+        try {
+          const SessionSnapshot snapshot = sessions->read_trials(listing.location);
+          if (!transfer_mismatch(snapshot.config, snapshot.device_name, config, device).empty()) continue;
+          TransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
+          if (source.trials.empty()) continue;
+          source.name = listing.name + " (saved)";
+          sources.push_back(std::move(source));
+          ++used;
+        } catch (const std::exception&) {
+          continue;  // an unreadable session teaches nothing; the browser says why
+        }
+      }
+    }
+    if (sources.empty()) {
+      offer.why_not = "no earlier trials of this arm to learn from";
+      return offer;
+    }
+    for (const TransferSource& s : sources) offer.sources += (offer.sources.empty() ? "" : ", ") + s.name;
+    offer.source_count = static_cast<int>(sources.size());
+    LearningTransfer transfer;
+    transfer.setup(std::move(sources), config.controller, config.timing.sample_s());
+    const TransferResult result = transfer.solve(*target);
+    offer.method = result.method;
+    offer.predicted_rms_deg = result.predicted_rms_deg;
+    offer.feedback_only_rms_deg = result.predicted_feedback_only_rms_deg;
+    if (result.status != TransferStatus::kTransferred) {
+      offer.why_not = result.reason;
+      return offer;
+    }
+    offer.correction_bar = result.correction_bar;
+    offer.useful = true;
+  } catch (const std::exception& error) {
+    offer.why_not = error.what();
+  }
+  return offer;
+}
+
+// The controller's side: remembering what was taught, offering, taking the offer.
+
+void ConsoleController::remember_taught() {
+  TransferSource source = transfer_source_of(state_.experiment, env_.config);
+  if (!source.trials.empty()) taught_.push_back(std::move(source));
+}
+
+void ConsoleController::offer_transfer() {
+  transfer_offer_ = TransferOffer{};
+  if (!state_.experiment.trials.empty() || state_.experiment.next_correction_bar.cwiseAbs().maxCoeff() > 0.0) return;
+  if (transfer_task_.busy()) {  // one at a time: ask again when the running one is done
+    transfer_wanted_ = true;
+    return;
+  }
+  transfer_wanted_ = false;
+  transfer_task_.start([taught = taught_, sessions = env_.sessions, config = env_.config, device = env_.device_name,
+                        target = state_.experiment.trajectory] {
+    return compute_transfer_offer(taught, sessions, config, device, target);
+  });
+}
+
+void ConsoleController::poll_transfer() {
+  if (!transfer_task_.ready()) return;
+  TransferOffer offer = transfer_task_.take();
+  ++revision_;
+  if (transfer_wanted_ || offer.trajectory != state_.experiment.trajectory) {
+    offer_transfer();  // computed for a trajectory no longer selected
+    return;
+  }
+  if (!state_.experiment.trials.empty()) return;
+  if (!offer.useful) {
+    if (offer.source_count > 0) log(LogSource::kLearner, "no transfer offered: " + offer.why_not, false, -2.0, true);
+    return;
+  }
+  log(LogSource::kLearner, "transfer from " + offer.sources + " ready: " + offer.offer_line());
+  set_status(offer.offer_line());
+  transfer_offer_ = std::move(offer);
+}
+
+bool ConsoleController::handle_transfer_key(int k) {
+  if (k != kTransferKey || state_.screen != Screen::kMain) return false;
+  if (!transfer_offer_.useful || transfer_offer_.trajectory != state_.experiment.trajectory) {
+    set_status(format("%c: no transfer is offered for this trajectory (offered when one with no correction is chosen)", kTransferKey),
+               true);
+    return true;
+  }
+  if (!state_.experiment.trials.empty() || state_.run.mode != RunProgress::Mode::kIdle) {
+    set_status(format("%c: a transfer starts a trajectory; this one has trials already", kTransferKey), true);
+    return true;
+  }
+  const TransferOffer& o = transfer_offer_;
+  state_.experiment.set_next(o.correction_bar, "transferred (" + o.method + ")");
+  log(LogSource::kOperator, format("first correction transferred from %s (%s): predicted %.2f deg RMS, feedback only %.2f deg",
+                                   o.sources.c_str(), o.method.c_str(), o.predicted_rms_deg, o.feedback_only_rms_deg));
+  set_status(format("iteration 0 runs with the transferred correction: predicted %.1f deg RMS", o.predicted_rms_deg));
+  transfer_offer_ = TransferOffer{};
+  return true;
+}
+
+}  // namespace bellows::ui

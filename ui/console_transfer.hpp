@@ -1,0 +1,45 @@
+// Learning transfer in the console (issue 13): when the operator selects a trajectory that has no
+// correction yet, what the earlier experiments of this console and the saved sessions taught is
+// turned into a first correction on a worker thread (engine/learning_transfer); the console offers
+// it with its prediction, and `T` takes it. The taught experiments are kept when the operator moves
+// on to another trajectory.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/configuration.hpp"
+#include "engine/learning_transfer.hpp"
+#include "ui/experiment.hpp"
+#include "ui/session_gateway.hpp"
+
+namespace bellows::ui {
+
+/// The key that takes the offered transfer.
+inline constexpr int kTransferKey = 'T';
+
+struct TransferOffer {
+  bool useful = false;
+  std::shared_ptr<const Trajectory> trajectory;  // what it was computed for
+  Eigen::VectorXd correction_bar;
+  std::string method;
+  std::string sources;     // "paper, steps (saved)"
+  int source_count = 0;
+  double predicted_rms_deg = 0.0;
+  double feedback_only_rms_deg = 0.0;
+  std::string why_not;     // when not useful
+  /// "T: start from what 2 sessions taught (inverse-fir): predicted 2.0 deg RMS, feedback only 12.6 deg"
+  std::string offer_line() const;
+};
+
+/// An experiment's trials as a transfer source; no trials when it has none with a record.
+TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config);
+
+/// Worker thread: the transfer from `taught` (this console's earlier experiments) and the `max_saved`
+/// newest saved sessions that fit this run (transfer_mismatch), for `target`. Never throws: a
+/// transfer that cannot be computed or would not help comes back with `why_not`.
+TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
+                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved = 4);
+
+}  // namespace bellows::ui
