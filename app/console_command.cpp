@@ -30,7 +30,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
     return resolve_trajectory(name_or_path, sample_s, limits);
   };
 
-  StoreSessionGateway sessions(options.device);
+  StoreSessionGateway sessions(options.device, options.data_dir);
   ui::ConsoleSetup setup;
   std::uint64_t seed = options.seed;
   if (!options.session_dir.empty()) {
@@ -43,6 +43,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
 
   SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
+  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP vent at once, from the handler
   RealtimeLoop loop(core, arm, speed);
   setup.core = &core;
   setup.loop = &loop;
@@ -74,7 +75,15 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
                 static_cast<unsigned long long>(report.frames),
                 report.seconds > 0 ? static_cast<double>(report.frames) / report.seconds : 0.0,
                 report.seconds > 0 ? 100.0 * report.ui_cpu_s / report.seconds : 0.0);
-  out << line << std::flush;
+  out << line;
+  if (!report.save_status.empty()) out << "session: " << report.save_status << " (saved as it went)\n";
+  if (!report.unsaved.empty()) out << "bellows: not saved: " << report.unsaved << "\n";
+  if (report.missed_warnings > 0) {
+    out << "loop: " << report.missed_warnings
+        << " deadlines missed, counted as warnings (the simulated arm's time follows the engine's ticks)\n";
+  }
+  if (report.dropped_events > 0) out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
+  out << std::flush;
   if (report.stopped_by_signal) return 128 + stop_signal();
   return 0;
 }

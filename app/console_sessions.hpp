@@ -1,5 +1,6 @@
-// The console's save and open on the session store (sessions/). The first save creates a session
-// in the data directory; later saves append the new iterations and log entries to it. Each saved
+// The console's save and open on the session store (sessions/). The console saves as it goes: the
+// first save creates a session in the data directory; later saves append the new iterations, black
+// boxes and log entries, and rewrite the last iteration's next correction when learning changed it. Each saved
 // iteration's "next correction" is what the following trial ran with; for the last one saved, the
 // correction the console had chosen for the next trial at the time of saving (learning after the
 // save shows in the next trial's own samples, u_ilc). Opening a
@@ -21,13 +22,15 @@ namespace bellows {
 class StoreSessionGateway final : public ui::SessionGateway {
  public:
   /// `device_name`: the console's device; a session recorded on another one is not opened.
-  explicit StoreSessionGateway(std::string device_name);
+  /// `data_dir`: where sessions live (--data-dir); empty: the default (XDG_DATA_HOME, HOME).
+  explicit StoreSessionGateway(std::string device_name, const std::string& data_dir = {});
 
   bool available() const override { return !data_dir_.empty(); }
   std::string unavailable_reason() const override { return reason_; }
   std::string save(const ui::SessionSnapshot& snapshot) override;
   std::vector<ui::SessionListing> list() override;
   ui::SessionSnapshot open(const std::string& location) override;
+  std::string rename(const std::string& name) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
 

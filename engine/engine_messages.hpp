@@ -31,6 +31,7 @@ struct EngineCommand {
   int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains
+  std::uint32_t stops_seen = 0;                 // set by EngineCore::send(): stops requested before it
 
   /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
   static EngineCommand of(CommandKind kind) {
@@ -61,6 +62,8 @@ enum class EventKind : std::uint8_t {
   kFault,
   kTrialComplete,
   kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
+  kWarning,       // something the operator should know that is not a fault (`fault` names it)
+  kTrajectorySelected,  // the engine holds `trajectory` now: earlier selections are handed back
 };
 
 struct EngineEvent {
@@ -72,7 +75,9 @@ struct EngineEvent {
   const char* refusal = "";                       // kCommandRefused: why (static text)
   FaultCode fault = FaultCode::kNone;
   TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
+  const Trajectory* trajectory = nullptr;         // kTrajectorySelected
   std::uint32_t trial_id = 0;
+  std::uint32_t count = 0;                        // kWarning: how many (e.g. deadlines missed in a row)
 };
 
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.

@@ -23,6 +23,7 @@ enum class CommandKind : std::uint8_t {
   kSelectTrajectory,// SAFE/ARMED: the trajectory to hold and run next
   kHeartbeat,       // the console is alive; no transition
   kSetGains,        // SAFE/ARMED: PID gains between trials
+  kGuard,           // not a command: the cause of a state change a safety guard made (FAULT)
 };
 
 struct Transition {

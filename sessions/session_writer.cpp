@@ -5,6 +5,7 @@
 
 #include "engine/errors.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/iteration_files.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
@@ -79,6 +80,18 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
   updated.resume = std::move(resume);
   write_manifest(directory_, updated);
   manifest_ = std::move(updated);  // only once it is on disk
+}
+
+void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar) {
+  if (manifest_.iterations.empty()) {
+    throw std::invalid_argument("SessionWriter::update_next_correction: no iteration saved yet");
+  }
+  if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
+      next_correction_bar.size() != manifest_.trajectory_samples) {
+    throw std::invalid_argument("SessionWriter::update_next_correction: the record does not match the session's trajectory");
+  }
+  write_file_atomic(directory_ / session_layout::samples_file(next_iteration() - 1),
+                    format_samples_csv(record, next_correction_bar));
 }
 
 void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {

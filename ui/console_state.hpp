@@ -27,6 +27,7 @@ enum class DialogKind {
   kEditValue,        // a number for the tuning field
   kConfirmQuit,      // s / q / Esc
   kConfirmDiscard,   // y/n: unsaved trials would be lost
+  kSessionName,      // a name for the session saved as the console goes
 };
 
 struct Dialog {
@@ -52,6 +53,7 @@ struct LoopHealth {
   std::string speed = "1";       // "1", "2", "5", "10", "max"
   double tick_hz = 200.0;
   std::uint64_t dropped_telemetry = 0;
+  std::uint64_t dropped_events = 0;   // engine events lost to a full event queue
   bool realtime = true;          // false on a simulated clock (no latency to show)
 };
 
