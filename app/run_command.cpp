@@ -111,7 +111,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
       failure = std::move(why);
       failure_name = "rig-unavailable";
-      status = stop_signal() != 0 ? 128 + stop_signal() : 3;
+      status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault
       progress << "bellows: " << failure << std::endl;
       recording.fault(failure);
     }

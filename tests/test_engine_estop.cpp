@@ -145,7 +145,10 @@ TEST(MissedDeadlines, OnTheSimulatedArmAreCountedWarningsNotAFault) {
   ASSERT_TRUE(f.core.send(EngineCommand::of(CommandKind::kArm)));
   f.clock.step(2);
   f.drain_events();
-  for (int i = 0; i < 20; ++i) f.core.tick(1.0 + i * 0.005, 1.0 + i * 0.005, 3);
+  for (int i = 0; i < 20; ++i) {
+    f.core.tick(1.0 + i * 0.005, 1.0 + i * 0.005, 3);
+    f.arm.advance(0.005);
+  }
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
   EXPECT_EQ(f.core.missed_deadline_warnings(), 60u);
   int warnings = 0;

@@ -60,6 +60,7 @@ TEST_P(GuardFault, ReachesTheLogAndTheSessionUnderItsOwnName) {
     case FaultCode::kMissedDeadlines:
       for (int i = 0; i < config.safety.missed_deadline_streak + 1; ++i) {
         f.core.tick(f.clock.now_s() + i * config.timing.tick_s, f.clock.now_s(), 1);
+        device.advance(config.timing.tick_s);
       }
       break;
     case FaultCode::kHeartbeatLost: f.clock.step(static_cast<long>(2.0 * config.safety.heartbeat_timeout_s / config.timing.tick_s)); break;
@@ -70,7 +71,9 @@ TEST_P(GuardFault, ReachesTheLogAndTheSessionUnderItsOwnName) {
   const std::string name = fault_name(code);
   EXPECT_TRUE(f.logged(std::string("FAULT ") + name)) << name;
   EXPECT_TRUE(f.logged(std::string("-> FAULT (") + name + ")")) << name;
-  if (code != FaultCode::kEmergencyStop) EXPECT_FALSE(f.logged("(emergency stop)")) << name;
+  if (code != FaultCode::kEmergencyStop) {
+    EXPECT_FALSE(f.logged("(emergency stop)")) << name;
+  }
 
   // Saved as it goes: the black box and the log lines, under the fault's name.
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled() && !f.state().experiment.faults.empty(); }, 5.0));
@@ -88,8 +91,8 @@ INSTANTIATE_TEST_SUITE_P(EveryGuard, GuardFault,
                                            FaultCode::kSupplyLow, FaultCode::kSensorNotANumber,
                                            FaultCode::kSensorOutOfRange, FaultCode::kSensorStale,
                                            FaultCode::kMissedDeadlines, FaultCode::kHeartbeatLost),
-                         [](const auto& info) {
-                           std::string n = fault_name(info.param);
+                         [](const ::testing::TestParamInfo<FaultCode>& param) {
+                           std::string n = fault_name(param.param);
                            for (char& ch : n) ch = ch == '-' ? '_' : ch;
                            return n;
                          });

@@ -43,6 +43,8 @@ void ConsoleController::start_save() {
   snapshot.experiment.trials.assign(e.trials.begin() + first, e.trials.end());
   snapshot.experiment.next_correction_bar = e.next_correction_bar;
   snapshot.experiment.next_unsaved = e.next_unsaved;
+  snapshot.experiment.next_origin = e.next_origin;
+  snapshot.experiment.next_tried = e.next_tried;
   snapshot.experiment.saved_trials = e.saved_trials;
   snapshot.experiment.session_location = e.session_location;
   snapshot.experiment.saved_events = e.saved_events;
