@@ -7,6 +7,12 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 data="$E2E_DIR/sessions"
 
+# Until the pane's shell printed the exit status (e2e_wait_exit expects it to be there soon).
+await_exit() {
+  for _ in $(seq 1 300); do e2e_history | grep -qE '^EXIT STATUS [0-9]+' && break; sleep 0.2; done
+  e2e_wait_exit
+}
+
 # Runs 3 iterations (N 3) in a fresh console on its own data directory $1.
 three_iterations() {
   e2e_start 120 40 -- console --speed max --rt off --data-dir "$1"
@@ -41,14 +47,15 @@ expect_three_saved() {
 
 # kill -9: nothing runs at exit, yet every completed iteration is on disk.
 three_iterations "$data/kill9"
-kill -KILL "$(e2e_pid)"
-e2e_wait_exit >/dev/null
+pid="$(e2e_pid)"
+kill -KILL "$pid"
+for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
 expect_three_saved "$data/kill9" "kill -9"
 
 # Ctrl-C: vent, save, restore the terminal, exit 130.
 three_iterations "$data/ctrl-c"
 e2e_keys C-c
-status="$(e2e_wait_exit)"
+status="$(await_exit)"
 [ "$status" = "130" ] || e2e_fail "exit status after Ctrl-C: $status"
 e2e_output_has 'valves vented'
 e2e_output_has 'session: .*saved as it went'
