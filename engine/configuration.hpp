@@ -23,6 +23,7 @@ struct Configuration {
   TrajectoryLimits trajectory;
   SafetyParameters safety;
   LcmParameters lcm;
+  T7Parameters t7;
 };
 
 /// What a parameter's value must satisfy.
