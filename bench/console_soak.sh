@@ -10,7 +10,7 @@ bellows="${1:-$root/build/app/bellows}"
 command -v tmux >/dev/null || { echo "tmux missing: run scripts/setup.sh" >&2; exit 1; }
 socket="bellows-soak-$$"
 work="$(mktemp -d)"
-trap 'tmux -L "$socket" kill-server 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'tmux -L "$socket" kill-server 2>/dev/null || true; sleep 1; rm -rf "$work"' EXIT
 export LC_ALL=C.UTF-8
 
 tmux -L "$socket" new-session -d -s keep "sleep 100000"
