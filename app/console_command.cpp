@@ -62,7 +62,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   std::uint64_t seed = options.seed;
   std::optional<ui::SessionSnapshot> opened_session;
   {
-    StoreSessionGateway reader(config.device.kind);
+    StoreSessionGateway reader(config.device.kind, nlohmann::ordered_json::object(), options.data_dir);
     if (!options.session_dir.empty()) {
       opened_session = reader.open(options.session_dir);  // InputError: missing, busy or damaged
       seed = opened_session->seed;
@@ -84,7 +84,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
     ~StopRig() { rig.stop(); }
   } stop_rig{*rig};
 
-  StoreSessionGateway sessions(config.device.kind, rig->session_info());
+  StoreSessionGateway sessions(config.device.kind, rig->session_info(), options.data_dir);
   ui::ConsoleSetup setup;
   if (opened_session) {
     setup.session = sessions.open(options.session_dir);  // this gateway saves into it from now on
@@ -95,6 +95,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
 
   Device& device = rig->device();
   EngineCore core(device, config.controller, config.timing, config.safety);
+  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP vent at once, from the handler
   RealtimeLoop loop(core, device, speed);
   setup.core = &core;
   setup.loop = &loop;
@@ -133,7 +134,15 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
                 static_cast<unsigned long long>(report.frames),
                 report.seconds > 0 ? static_cast<double>(report.frames) / report.seconds : 0.0,
                 report.seconds > 0 ? 100.0 * report.ui_cpu_s / report.seconds : 0.0);
-  out << line << std::flush;
+  out << line;
+  if (!report.save_status.empty()) out << "session: " << report.save_status << " (saved as it went)\n";
+  if (!report.unsaved.empty()) out << "bellows: not saved: " << report.unsaved << "\n";
+  if (report.missed_warnings > 0) {
+    out << "loop: " << report.missed_warnings
+        << " deadlines missed, counted as warnings (the simulated arm's time follows the engine's ticks)\n";
+  }
+  if (report.dropped_events > 0) out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
+  out << std::flush;
   if (report.stopped_by_signal) return 128 + stop_signal();
   return 0;
 }

@@ -16,6 +16,7 @@ struct ConsoleOptions {
   std::string config_path;
   std::string trajectory = "paper";  // library name or CSV file
   std::string session_dir;           // open this saved session at start
+  std::string data_dir;              // where sessions are saved; empty: the default (XDG_DATA_HOME, HOME)
   RealtimeMode rt = RealtimeMode::kTry;
   std::uint64_t seed = 1;
   int stop_after_rises = 3;          // a run of K iterations stops when the RMS rose this often in a row

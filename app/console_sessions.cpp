@@ -78,8 +78,13 @@ std::string local_date_of(const std::string& utc) {
   return text;
 }
 
-StoreSessionGateway::StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info)
+StoreSessionGateway::StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info,
+                                         const std::string& data_dir)
     : device_name_(std::move(device_name)), device_info_(std::move(device_info)) {
+  if (!data_dir.empty()) {
+    data_dir_ = data_dir;
+    return;
+  }
   try {
     data_dir_ = default_data_dir();
   } catch (const InputError& error) {
@@ -98,10 +103,15 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::size_t first_held = snapshot.events_total - held;
   const std::size_t first_new = continuing ? std::max(e.saved_events, first_held) - first_held : 0;
 
+  // The snapshot's trials are iterations first_trial..; the trial of iteration i is at i - first_trial.
+  const auto first = static_cast<std::size_t>(snapshot.first_trial);
+  const std::size_t end = first + e.trials.size();
+  const auto trial_at = [&](std::size_t iteration) -> const ui::Trial& { return e.trials[iteration - first]; };
   std::size_t first_trial = 0;
   if (continuing) {
     first_trial = writer_->manifest().iterations.size();
-    if (first_trial > e.trials.size()) throw InputError("the session on disk has more iterations than the console");
+    if (first_trial > end) throw InputError("the session on disk has more iterations than the console");
+    if (first_trial < first) throw std::logic_error("StoreSessionGateway::save: unsaved iterations missing from the snapshot");
     if (e.settings_changed) writer_->set_configuration(snapshot.config);
     std::string lines;
     for (std::size_t i = first_new; i < held; ++i) {
@@ -109,7 +119,12 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
       if (worth_saving(entry)) lines += entry.clock + " " + kind_of(entry) + ": " + entry.text + "\n";
     }
     if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
+    // Learned (or chosen) after the last saved trial: on disk before the next trial starts.
+    if (first_trial == end && first_trial > first && e.next_unsaved) {
+      writer_->update_next_correction(trial_at(end - 1).record, e.next_correction_bar);
+    }
   } else {
+    if (first != 0) throw std::logic_error("StoreSessionGateway::save: a new session needs every iteration");
     SessionManifest header;
     header.device = snapshot.device_name;
     header.device_info = device_info_;
@@ -121,16 +136,32 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     writer_.reset();  // the previous session's lock goes first
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
   }
-  for (std::size_t i = first_trial; i < e.trials.size(); ++i) {
-    const ui::Trial& trial = e.trials[i];
-    const Eigen::VectorXd& next = i + 1 < e.trials.size() ? e.trials[i + 1].correction_bar : e.next_correction_bar;
+  for (std::size_t i = first_trial; i < end; ++i) {
+    const Eigen::VectorXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
     // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
-    writer_->save_iteration(trial.record, trial.summary, next, ResumeState{});
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
   return writer_->directory().string();
+}
+
+std::string StoreSessionGateway::rename(const std::string& name) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  if (!writer_) throw InputError("nothing to name yet: the session is created with the first trial");
+  validate_session_name(name);
+  const std::filesystem::path from = writer_->directory();
+  const std::filesystem::path to = data_dir_ / name;
+  if (from == to) return to.string();
+  std::error_code error;
+  if (std::filesystem::exists(to, error)) throw InputError("a session named '" + name + "' exists already");
+  writer_.reset();  // its lock goes with it; taken again below
+  std::filesystem::rename(from, to, error);
+  Session loaded;
+  writer_.emplace(SessionWriter::open(error ? from : to, kPurpose, loaded));
+  if (error) throw InputError("cannot rename " + from.string() + " to '" + name + "': " + error.message());
+  return to.string();
 }
 
 std::vector<ui::SessionListing> StoreSessionGateway::list() {

@@ -1,5 +1,6 @@
-// The console's save and open on the session store (sessions/). The first save creates a session
-// in the data directory; later saves append the new iterations and log entries to it. Each saved
+// The console's save and open on the session store (sessions/). The console saves as it goes: the
+// first save creates a session in the data directory; later saves append the new iterations, black
+// boxes and log entries, and rewrite the last iteration's next correction when learning changed it. Each saved
 // iteration's "next correction" is what the following trial ran with; for the last one saved, the
 // correction the console had chosen for the next trial at the time of saving (learning after the
 // save shows in the next trial's own samples, u_ilc). Opening a
@@ -22,7 +23,9 @@ class StoreSessionGateway final : public ui::SessionGateway {
  public:
   /// `device_name`: the console's device; a session recorded on another one is not opened.
   /// `device_info`: what a new session records about it (seed, bus, address, rig profile).
-  explicit StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info = nlohmann::ordered_json::object());
+  /// `data_dir`: where sessions live (--data-dir); empty: the default (XDG_DATA_HOME, HOME).
+  explicit StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info = nlohmann::ordered_json::object(),
+                               const std::string& data_dir = {});
 
   bool available() const override { return !data_dir_.empty(); }
   std::string unavailable_reason() const override { return reason_; }
@@ -30,6 +33,7 @@ class StoreSessionGateway final : public ui::SessionGateway {
   std::vector<ui::SessionListing> list() override;
   ui::SessionSnapshot open(const std::string& location) override;
   ui::SessionSnapshot read_trials(const std::string& location) override;
+  std::string rename(const std::string& name) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
 

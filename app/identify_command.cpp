@@ -92,13 +92,13 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   const std::string temporary = path + ".tmp";
   {
     std::ofstream out(temporary, std::ios::trunc);
-    if (!out) throw InputError("cannot write " + temporary);
+    if (!out) throw EnvironmentError("cannot write " + temporary);
     out << text;
-    if (!out.flush()) throw InputError("cannot write " + temporary);
+    if (!out.flush()) throw EnvironmentError("cannot write " + temporary);
   }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError("cannot replace " + path + ": " + error.message());
+  if (error) throw EnvironmentError("cannot replace " + path + ": " + error.message());
 }
 
 }  // namespace

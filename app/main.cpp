@@ -168,6 +168,9 @@ int main(int argc, char** argv) {
   console_cmd->add_option("--trajectory", console.trajectory, "Library name (paper, steps, sine) or a CSV file")
       ->capture_default_str();
   console_cmd->add_option("--session", console.session_dir, "Open this saved session at start");
+  console_cmd->add_option("--data-dir", console.data_dir,
+                          "Where sessions are saved as the console goes (default $XDG_DATA_HOME/bellows/sessions or "
+                          "~/.local/share/bellows/sessions)");
   console_cmd->add_option("--rt", console.rt, "Real-time scheduling of the engine loop: enforce, try, off")
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");

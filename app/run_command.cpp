@@ -90,6 +90,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   Device& device = io.device();
   SimulatedArm* arm = io.simulated_arm();
   EngineCore core(device, config.controller, config.timing, config.safety);
+  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP latch the emergency stop at once
   io.add_telemetry_tap(core);
   const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;
@@ -136,7 +137,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
       failure = std::move(why);
       failure_name = "rig-unavailable";
-      status = stop_signal() != 0 ? 128 + stop_signal() : 3;
+      status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault
       progress << "bellows: " << failure << std::endl;
       recording.fault(failure);
     }
@@ -151,13 +152,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
       iterations.push_back(iteration);
     }
   } catch (const EngineFault& fault) {
-    failure = fault.what();
+    const bool interrupted = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0;
+    failure = interrupted ? std::string("interrupted by ") + stop_signal_name() + ": valves vented" : fault.what();
     failure_name = fault_name(core.fault());
     if (std::string why = io.explain_fault(fault.code()); !why.empty()) {
       failure = std::move(why);
       failure_name = "foreign-sender";
     }
-    status = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0 ? 128 + stop_signal() : 3;
+    status = interrupted ? 128 + stop_signal() : kExitFault;
     progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
     recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);
   } catch (const std::exception& error) {
@@ -174,6 +176,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
     progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
              << ": the correction keeps growing where the set points saturate (largest clamped excess "
              << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
+  }
+  if (core.dropped_events() > 0) {  // a loss like any other: said, and kept with the session
+    progress << "bellows: " << core.dropped_events() << " engine events dropped (the event queue was full)" << std::endl;
+    recording.note("dropped-events", std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
+  }
+  if (core.missed_deadline_warnings() > 0) {
+    progress << "bellows: " << core.missed_deadline_warnings()
+             << " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)" << std::endl;
   }
   if (status == 0) recording.finish(trials);
 
@@ -192,11 +202,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"iterations", iterations}};
     if (transfer) report["transfer"] = transfer_json(*transfer);
     if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
+    report["dropped_events"] = core.dropped_events();
+    report["dropped_telemetry"] = core.dropped_telemetry();
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
       report["loop"] = {{"ticks", core.ticks()},
                         {"missed", l.missed},
+                        {"missed_warnings", core.missed_deadline_warnings()},
                         {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
                         {"rt", loop->rt_description()},
                         {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},

@@ -112,6 +112,15 @@ void RunRecording::fault(const std::string& what, const EngineCore& core) noexce
   fault(what);
 }
 
+void RunRecording::note(const std::string& kind, const std::string& message) noexcept {
+  if (!writer_) return;
+  try {
+    writer_->record_event(kind, message);
+  } catch (...) {
+    // The report says it too.
+  }
+}
+
 void RunRecording::finish(int trials_run) {
   if (writer_) writer_->record_event("finish", std::string(kPurpose) + ": " + std::to_string(trials_run) + " trials done");
 }

@@ -49,6 +49,8 @@ class RunRecording {
   void fault(const std::string& what) noexcept;
   /// Records an engine fault and keeps its black box (the engine's frozen record, if any).
   void fault(const std::string& what, const EngineCore& core) noexcept;
+  /// Records an event of `kind` (e.g. "dropped-events"); never throws, like fault().
+  void note(const std::string& kind, const std::string& message) noexcept;
   void finish(int trials_run);
 
   /// The session directory; empty with --no-save.

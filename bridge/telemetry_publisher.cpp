@@ -48,7 +48,7 @@ TelemetryPublisher::TelemetryPublisher(TelemetryRing& ring, std::int64_t session
       throw InputError("the LCM log '" + log_path_ + "' exists already; nothing is overwritten, name a new file");
     }
     log_ = std::make_unique<lcm::LogFile>(log_path_, "w");
-    if (!log_->good()) throw InputError("cannot create the LCM log '" + log_path_ + "'");
+    if (!log_->good()) throw EnvironmentError("cannot create the LCM log '" + log_path_ + "'");
   }
   log_epoch_us_ = realtime_us();
   telemetry_.session_id = session_id_;

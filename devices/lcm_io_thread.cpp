@@ -55,13 +55,13 @@ void LcmIoThread::start(RealtimeMode mode, int priority) {
   while (!ready_.load(std::memory_order_acquire)) std::this_thread::yield();
   if (!start_error_.empty()) {
     thread_.join();
-    throw InputError(start_error_);
+    throw EnvironmentError(start_error_);  // the bus or the scheduler refused
   }
 }
 
 void LcmIoThread::run(const std::function<bool()>& should_stop, RealtimeMode mode, int priority) {
   serve(should_stop, mode, priority);
-  if (!start_error_.empty()) throw InputError(start_error_);
+  if (!start_error_.empty()) throw EnvironmentError(start_error_);
 }
 
 void LcmIoThread::stop() {

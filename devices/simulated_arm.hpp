@@ -55,6 +55,7 @@ class SimulatedArm final : public Device {
   void write_valves(const ValveCommand& command) override;
   void vent() override;
   void advance(double dt_s) override;
+  bool time_follows_ticks() const override { return true; }  // in-process: physics advances per tick
   const char* name() const override { return "sim"; }
 
   const PlantParameters& parameters() const { return params_; }

@@ -71,6 +71,10 @@ class Device {
   /// Let device time pass by `dt_s`. A simulated device integrates its physics here;
   /// a real rig ignores it (its time passes on its own).
   virtual void advance(double dt_s) = 0;
+  /// Whether the device's time passes only by advance(), once per engine tick (an in-process
+  /// simulation): then a late tick harms nothing physical and a missed deadline is a warning.
+  /// A real or remote rig keeps the default: its time passes on its own, a missed deadline faults.
+  virtual bool time_follows_ticks() const { return false; }
   /// A short human name, e.g. "sim" or "lcm".
   virtual const char* name() const = 0;
   /// The link's figures; any thread. In-process devices report nothing.

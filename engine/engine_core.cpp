@@ -1,5 +1,6 @@
 #include "engine/engine_core.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -19,7 +20,8 @@ EngineCore::EngineCore(Device& device, const ControllerParameters& controller, c
       control_(controller, timing),
       black_box_(static_cast<std::size_t>(std::lround(safety.black_box_s / timing.tick_s))),
       commands_(kCommandCapacity),
-      events_(kEventCapacity) {}
+      events_(kEventCapacity),
+      time_follows_ticks_(device.time_follows_ticks()) {}
 
 TelemetryRing& EngineCore::add_telemetry_tap(std::size_t capacity) {
   taps_.push_back(std::make_unique<TelemetryRing>(capacity));
@@ -30,7 +32,7 @@ void EngineCore::emit(const EngineEvent& event) {
   if (!events_.push(event)) dropped_events_.fetch_add(1, std::memory_order_relaxed);
 }
 
-void EngineCore::change_state(EngineState next, double now_s, CommandKind cause) {
+void EngineCore::change_state(EngineState next, double now_s, CommandKind cause, FaultCode fault_cause) {
   const EngineState from = state();
   if (from == next) return;
   state_.store(next, std::memory_order_release);
@@ -40,7 +42,7 @@ void EngineCore::change_state(EngineState next, double now_s, CommandKind cause)
   event.from = from;
   event.to = next;
   event.command = cause;
-  event.fault = fault();
+  event.fault = fault_cause != FaultCode::kNone ? fault_cause : fault();
   emit(event);
 }
 
@@ -58,12 +60,25 @@ void EngineCore::hand_back_trial(EventKind kind, double now_s) {
   if (control_.trial_running()) control_.abort_trial();
 }
 
+void EngineCore::hold_trajectory(const Trajectory* trajectory, double now_s) {
+  trajectory_ = trajectory;
+  // The sender may now free every trajectory it gave before this one.
+  EngineEvent event;
+  event.kind = EventKind::kTrajectorySelected;
+  event.time_s = now_s;
+  event.from = event.to = state();
+  event.trajectory = trajectory;
+  emit(event);
+}
+
 void EngineCore::enter_fault(FaultCode code, double now_s) {
   fault_.store(code, std::memory_order_release);
   manual_ = false;
   device_.vent();
   hand_back_trial(EventKind::kTrialAborted, now_s);
-  change_state(EngineState::kFault, now_s, CommandKind::kEmergencyStop);
+  // The state change names the guard that fired (event.fault); only an operator's stop is a command.
+  change_state(EngineState::kFault, now_s,
+               code == FaultCode::kEmergencyStop ? CommandKind::kEmergencyStop : CommandKind::kGuard, code);
   EngineEvent event;
   event.kind = EventKind::kFault;
   event.time_s = now_s;
@@ -92,11 +107,13 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
     case CommandKind::kHeartbeat:
       last_heartbeat_s_ = wall_s;
       return;
+    case CommandKind::kGuard:  // refused by transition(): a cause, never a command
+      return;
     case CommandKind::kEmergencyStop:
       enter_fault(FaultCode::kEmergencyStop, now_s);
       return;
     case CommandKind::kSelectTrajectory:
-      trajectory_ = command.trajectory;
+      hold_trajectory(command.trajectory, now_s);
       if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->angle_rad(0));
       return;
     case CommandKind::kSetGains: {
@@ -136,7 +153,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
         manual_ = false;
         control_.pid().reset();
       }
-      trajectory_ = command.trajectory;
+      hold_trajectory(command.trajectory, now_s);
       correction_ = command.correction;
       record_ = command.record;
       record_->complete = false;  // the engine owns the record from now on
@@ -151,6 +168,10 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       hand_back_trial(EventKind::kTrialAborted, now_s);
       break;
     case CommandKind::kReset:
+      if (command.stops_seen != stops_handled_.load(std::memory_order_relaxed)) {
+        refuse("an emergency stop came after this reset was sent");
+        return;
+      }
       fault_.store(FaultCode::kNone, std::memory_order_release);
       black_box_.clear();
       break;
@@ -158,7 +179,32 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
   change_state(t.next, now_s, command.kind);
 }
 
+void EngineCore::count_missed_deadlines(int missed, double now_s) {
+  missed_streak_ = missed > 0 ? missed_streak_ + missed : 0;
+  if (missed <= 0 || !time_follows_ticks_) return;
+  // The device's time advances per tick: a late tick harms nothing physical. Counted and reported
+  // (once per streak that would have faulted a real rig), never a fault.
+  missed_warnings_.fetch_add(static_cast<std::uint64_t>(missed), std::memory_order_relaxed);
+  if (missed_streak_ >= safety_.missed_deadline_streak && missed_streak_ - missed < safety_.missed_deadline_streak) {
+    EngineEvent event;
+    event.kind = EventKind::kWarning;
+    event.time_s = now_s;
+    event.from = event.to = state();
+    event.fault = FaultCode::kMissedDeadlines;
+    event.count = static_cast<std::uint32_t>(missed_streak_);
+    emit(event);
+  }
+  missed_streak_ = std::min(missed_streak_, safety_.missed_deadline_streak);  // a warning, never the guard
+}
+
 void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
+  // The stop latch before anything queued: a full command queue can never delay a stop.
+  const std::uint32_t stops = stop_requests_.load(std::memory_order_acquire);
+  if (stops != stops_handled_.load(std::memory_order_relaxed)) {
+    device_.vent();
+    if (state() != EngineState::kFault) enter_fault(FaultCode::kEmergencyStop, now_s);
+    stops_handled_.store(stops, std::memory_order_release);
+  }
   EngineCommand command;
   for (int i = 0; i < kMaxCommandsPerTick && commands_.pop(command); ++i) apply(command, now_s, wall_s);
 
@@ -166,13 +212,13 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   stale_count_ = reading.time_s > last_reading_time_s_ ? 0 : stale_count_ + 1;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
   if (std::isfinite(reading.angle_rad)) last_angle_rad_ = reading.angle_rad;
-  missed_streak_ = missed_deadlines > 0 ? missed_streak_ + missed_deadlines : 0;
+  count_missed_deadlines(missed_deadlines, now_s);
 
   if (valves_live(state())) {
     GuardInputs inputs;
     inputs.p_max_bar = controller_.p_max_bar;
     inputs.stale_count = stale_count_;
-    inputs.missed_streak = missed_streak_;
+    inputs.missed_streak = time_follows_ticks_ ? 0 : missed_streak_;
     inputs.heartbeat_age_s = monitor_heartbeat_.load(std::memory_order_relaxed) ? wall_s - last_heartbeat_s_ : 0.0;
     const FaultCode code = check_guards(reading, inputs, safety_);
     if (code != FaultCode::kNone) enter_fault(code, now_s);
@@ -255,6 +301,7 @@ void EngineCore::restore_armed(const ControlCore::State& state, double now_s) {
 void EngineCore::vent_now() {
   device_.vent();
   if (state() != EngineState::kFault) enter_fault(FaultCode::kEmergencyStop, 0.0);
+  stops_handled_.store(stop_requests_.load(std::memory_order_acquire), std::memory_order_release);
 }
 
 }  // namespace bellows

@@ -1,6 +1,7 @@
 // The engine: one tick of everything the loop does, whatever clock drives it.
 //
-// Per tick (tick()): take operator commands from the command queue, read the sensors, run the
+// Per tick (tick()): first the emergency-stop latch (an atomic any thread or a signal handler may
+// set: a stop never waits in a queue), then operator commands from the command queue, read the sensors, run the
 // guards, run the control scheme when the valves are live (else vent), write the valves, record the
 // tick in the black box, the telemetry taps and the latest-value snapshot, and emit events.
 // A clock driver calls tick(): SimulatedClock (as fast as possible, same thread, deterministic) or
@@ -33,8 +34,24 @@ class EngineCore {
              const SafetyParameters& safety);
 
   // ---- operator side (one producer thread for commands, one consumer thread for events) ----
-  /// Queue a command for the next tick. False when the queue is full (nothing is lost silently).
-  bool send(const EngineCommand& command) { return commands_.push(command); }
+  /// Queue a command for the next tick. False when the queue is full: the caller must handle it.
+  /// (An emergency stop is not queued: it sets the latch, see request_emergency_stop().)
+  [[nodiscard]] bool send(const EngineCommand& command) {
+    if (command.kind == CommandKind::kEmergencyStop) {
+      request_emergency_stop();
+      return true;
+    }
+    EngineCommand stamped = command;  // a reset queued before a stop must not undo it
+    stamped.stops_seen = stop_requests_.load(std::memory_order_acquire);
+    return commands_.push(stamped);
+  }
+  /// Latches an emergency stop: the next tick vents and faults (cause emergency-stop) before it
+  /// looks at any queued command. Any thread; async-signal-safe (one lock-free atomic add).
+  void request_emergency_stop() noexcept { stop_requests_.fetch_add(1, std::memory_order_acq_rel); }
+  /// Whether the engine has acted on every emergency stop requested so far (the valves vented).
+  bool emergency_stop_delivered() const noexcept {
+    return stops_handled_.load(std::memory_order_acquire) == stop_requests_.load(std::memory_order_acquire);
+  }
   bool poll_event(EngineEvent& event) { return events_.pop(event); }
   /// The latest tick (single reader).
   bool read_snapshot(TickRecord& out) { return snapshot_.read(out); }
@@ -49,6 +66,9 @@ class EngineCore {
   std::uint64_t ticks() const { return tick_count_.load(std::memory_order_relaxed); }
   std::uint64_t dropped_telemetry() const { return dropped_telemetry_.load(std::memory_order_relaxed); }
   std::uint64_t dropped_events() const { return dropped_events_.load(std::memory_order_relaxed); }
+  /// Missed deadlines the engine counted as warnings, not faults: on a device whose time follows
+  /// the ticks (Device::time_follows_ticks()) a late tick harms nothing physical.
+  std::uint64_t missed_deadline_warnings() const { return missed_warnings_.load(std::memory_order_relaxed); }
 
   // ---- loop side ----
   /// One tick. `now_s`: engine (device) time; `wall_s`: monotonic wall time, for the heartbeat;
@@ -68,8 +88,10 @@ class EngineCore {
 
  private:
   void apply(const EngineCommand& command, double now_s, double wall_s);
-  void change_state(EngineState next, double now_s, CommandKind cause);
+  void change_state(EngineState next, double now_s, CommandKind cause, FaultCode fault_cause = FaultCode::kNone);
   void enter_fault(FaultCode code, double now_s);
+  void count_missed_deadlines(int missed, double now_s);
+  void hold_trajectory(const Trajectory* trajectory, double now_s);
   void hand_back_trial(EventKind kind, double now_s);
   void emit(const EngineEvent& event);
 
@@ -87,6 +109,10 @@ class EngineCore {
   std::atomic<EngineState> state_{EngineState::kSafe};
   std::atomic<FaultCode> fault_{FaultCode::kNone};
   std::atomic<bool> monitor_heartbeat_{false};
+  std::atomic<std::uint32_t> stop_requests_{0};  // the latch: requests made ...
+  std::atomic<std::uint32_t> stops_handled_{0};  // ... and acted on by a tick
+  static_assert(std::atomic<std::uint32_t>::is_always_lock_free, "the stop latch is set from signal handlers");
+  std::atomic<std::uint64_t> missed_warnings_{0};
   std::atomic<std::uint64_t> tick_count_{0};
   std::atomic<std::uint64_t> dropped_telemetry_{0};
   std::atomic<std::uint64_t> dropped_events_{0};
@@ -101,6 +127,7 @@ class EngineCore {
   double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;
   int missed_streak_ = 0;
+  const bool time_follows_ticks_;  // the device's, read once: missed deadlines warn instead of fault
   double last_heartbeat_s_ = 0.0;
   // The operator's valves (kValvePulse): instead of the control scheme while `manual_` is set.
   bool manual_ = false;

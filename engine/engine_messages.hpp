@@ -41,6 +41,7 @@ struct EngineCommand {
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains
   ValvePulse pulse{};                           // kValvePulse
+  std::uint32_t stops_seen = 0;                 // set by EngineCore::send(): stops requested before it
 
   /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
   static EngineCommand of(CommandKind kind) {
@@ -77,6 +78,8 @@ enum class EventKind : std::uint8_t {
   kTrialComplete,
   kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
   kValvePulseDone,  // a valve pulse's `ticks` are over; `reading`: the first one after it; `trial_id`: its id
+  kWarning,       // something the operator should know that is not a fault (`fault` names it)
+  kTrajectorySelected,  // the engine holds `trajectory` now: earlier selections are handed back
 };
 
 struct EngineEvent {
@@ -88,8 +91,10 @@ struct EngineEvent {
   const char* refusal = "";                       // kCommandRefused: why (static text)
   FaultCode fault = FaultCode::kNone;
   TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
+  const Trajectory* trajectory = nullptr;         // kTrajectorySelected
   std::uint32_t trial_id = 0;
   SensorReading reading{};                        // kValvePulseDone: read after the pulse's last tick
+  std::uint32_t count = 0;                        // kWarning: how many (e.g. deadlines missed in a row)
 };
 
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.

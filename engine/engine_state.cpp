@@ -30,6 +30,8 @@ Transition transition(EngineState state, CommandKind command) {
     case CommandKind::kReset:
       if (state == S::kFault) return allow(S::kSafe);
       return refuse("no fault to reset");
+    case CommandKind::kGuard:
+      return refuse("a safety guard is not a command");
     case CommandKind::kSelectTrajectory:
     case CommandKind::kSetGains:
       if (state == S::kSafe || state == S::kArmed) return allow(state);
@@ -66,6 +68,7 @@ const char* to_string(CommandKind command) {
     case CommandKind::kHeartbeat: return "heartbeat";
     case CommandKind::kSetGains: return "set gains";
     case CommandKind::kValvePulse: return "valve pulse";
+    case CommandKind::kGuard: return "safety guard";
   }
   return "?";
 }

@@ -24,6 +24,7 @@ enum class CommandKind : std::uint8_t {
   kHeartbeat,       // the console is alive; no transition
   kSetGains,        // SAFE/ARMED: PID gains between trials
   kValvePulse,      // ARMED: the operator sets the valves for a while (the valve test); no transition
+  kGuard,           // not a command: the cause of a state change a safety guard made (FAULT)
 };
 
 struct Transition {

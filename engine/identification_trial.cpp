@@ -67,10 +67,11 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
   const Eigen::VectorXd no_correction = Eigen::VectorXd::Zero(excitation.learning_samples());
   record.prepare(excitation.learning_samples(), timing.ticks_per_sample);
-  core.send(EngineCommand::select_trajectory(excitation));
-  if (core.state() != EngineState::kArmed) core.send(EngineCommand::of(CommandKind::kArm));
-  core.send(EngineCommand::start_trial(excitation, no_correction, record,
-                                       static_cast<int>(std::lround(timing.settle_s / timing.tick_s)), 1));
+  const bool sent = core.send(EngineCommand::select_trajectory(excitation)) &&
+                    (core.state() == EngineState::kArmed || core.send(EngineCommand::of(CommandKind::kArm))) &&
+                    core.send(EngineCommand::start_trial(excitation, no_correction, record,
+                                                         static_cast<int>(std::lround(timing.settle_s / timing.tick_s)), 1));
+  if (!sent) throw std::runtime_error("identification: the engine's command queue is full");
   TickRecord tick;
   for (;;) {
     driver.await();
@@ -86,7 +87,7 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
     }
     core.read_snapshot(tick);
     if (std::abs(tick.reading.angle_rad) > bound_rad) {
-      core.send(EngineCommand::of(CommandKind::kEmergencyStop));
+      core.request_emergency_stop();  // a latch: the next tick vents
       while (core.state() != EngineState::kFault) driver.await();
       std::ostringstream message;
       message << "identification aborted, valves vented: angle " << tick.reading.angle_rad / kRadPerDeg

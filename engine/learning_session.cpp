@@ -6,6 +6,17 @@
 #include "engine/errors.hpp"
 
 namespace bellows {
+namespace {
+
+// The headless flow sends one command at a time into a queue of hundreds: a refusal means the
+// engine stopped taking commands, and the run cannot go on.
+void send_or_throw(EngineCore& core, const EngineCommand& command) {
+  if (!core.send(command)) {
+    throw std::runtime_error(std::string("the engine's command queue is full: ") + to_string(command.kind) + " not sent");
+  }
+}
+
+}  // namespace
 
 IterationSummary summarize_trial(int iteration, const TrialRecord& record, const Eigen::VectorXd& correction_bar,
                                  double ambient_bar, double p_max_bar) {
@@ -34,7 +45,7 @@ LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Traject
                      std::to_string(trajectory_.learning_samples()));
   }
   record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample);
-  driver_.core().send(EngineCommand::select_trajectory(trajectory_));
+  send_or_throw(driver_.core(), EngineCommand::select_trajectory(trajectory_));
 }
 
 void LearningSession::set_correction(const Eigen::VectorXd& correction_bar, int iteration) {
@@ -47,7 +58,7 @@ EngineEvent LearningSession::next_event() {
   EngineEvent event;
   while (!driver_.core().poll_event(event)) {
     if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
-      driver_.core().send(EngineCommand::of(CommandKind::kEmergencyStop));
+      driver_.core().request_emergency_stop();  // a latch: the next tick vents, whatever is queued
       while (driver_.core().state() != EngineState::kFault) driver_.await();
       throw EngineFault(FaultCode::kEmergencyStop, "interrupted: valves vented");
     }
@@ -59,7 +70,7 @@ EngineEvent LearningSession::next_event() {
 void LearningSession::ensure_armed() {
   EngineCore& core = driver_.core();
   if (core.state() == EngineState::kArmed) return;
-  core.send(EngineCommand::of(CommandKind::kArm));
+  send_or_throw(core, EngineCommand::of(CommandKind::kArm));
   for (;;) {
     const EngineEvent event = next_event();
     if (event.kind == EventKind::kStateChanged && event.to == EngineState::kArmed) return;
@@ -74,7 +85,7 @@ IterationSummary LearningSession::run_trial() {
   ensure_armed();
   const EngineCommand start = EngineCommand::start_trial(
       trajectory_, correction_, record_, static_cast<int>(std::lround(timing_.settle_s / timing_.tick_s)), next_trial_id_++);
-  driver_.core().send(start);
+  send_or_throw(driver_.core(), start);
   for (;;) {
     const EngineEvent event = next_event();
     if (event.kind == EventKind::kTrialComplete && event.trial_id == start.trial_id) break;

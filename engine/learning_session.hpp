@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/engine_driver.hpp"
+#include "engine/errors.hpp"
 #include "engine/learning_law.hpp"
 #include "engine/trajectory.hpp"
 #include "engine/trial_record.hpp"
@@ -28,9 +29,9 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record, const
                                  double ambient_bar, double p_max_bar);
 
 /// The engine faulted (or refused) while the session was running a trial. Carries the fault code.
-class EngineFault : public std::runtime_error {
+class EngineFault : public FaultError {  // exit status 3
  public:
-  EngineFault(FaultCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  EngineFault(FaultCode code, const std::string& message) : FaultError(message), code_(code) {}
   FaultCode code() const { return code_; }
 
  private:

@@ -86,7 +86,7 @@ void RealtimeLoop::start(RealtimeMode mode, int priority) {
   if (!start_error_.empty()) {
     thread_.join();
     running_.store(false);
-    throw InputError(start_error_);
+    throw EnvironmentError(start_error_);
   }
 }
 
@@ -160,10 +160,8 @@ void RealtimeLoop::run(int priority, RealtimeMode mode) {
     // Engine time is simulated time for a warped simulator: tick count times the tick.
     timespec wall{};
     clock_gettime(CLOCK_MONOTONIC, &wall);
-    // The missed-deadline guard protects a device living in real time; a time-warped simulator
-    // loses nothing when the wall clock hiccups (its physics advances per tick), so it is spared.
-    const int missed_for_guard = speed_ == 1.0 ? missed_since_last : 0;
-    core_.tick(static_cast<double>(tick) * tick_s, static_cast<double>(diff_ns(wall, start)) * 1e-9, missed_for_guard);
+    // The engine decides what a missed deadline means for its device (Device::time_follows_ticks()).
+    core_.tick(static_cast<double>(tick) * tick_s, static_cast<double>(diff_ns(wall, start)) * 1e-9, missed_since_last);
     device_.advance(tick_s);
     missed_since_last = 0;
     ++tick;

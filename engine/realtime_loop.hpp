@@ -43,7 +43,7 @@ class RealtimeLoop final : public EngineDriver {
   RealtimeLoop(EngineCore& core, Device& device, double speed);
   ~RealtimeLoop() override;
 
-  /// Starts the thread. With kEnforce, throws InputError if SCHED_FIFO or mlockall is refused;
+  /// Starts the thread. With kEnforce, throws EnvironmentError if SCHED_FIFO or mlockall is refused;
   /// with kTry it takes what it gets (see rt_granted()). Blocks all signals in the loop thread.
   void start(RealtimeMode mode, int priority = 80);
   /// Stops the thread and vents the device.

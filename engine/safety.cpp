@@ -31,7 +31,9 @@ const char* fault_message(FaultCode code) {
     case FaultCode::kSensorNotANumber: return "a sensor reading is not a number";
     case FaultCode::kSensorOutOfRange: return "a sensor reading is outside its plausible range";
     case FaultCode::kSensorStale: return "the sensors stopped updating";
-    case FaultCode::kMissedDeadlines: return "the control loop missed too many deadlines in a row";
+    case FaultCode::kMissedDeadlines:
+      return "the control loop missed [safety] missed_deadline_streak deadlines in a row: lighten the machine's "
+             "load, run with --rt enforce (real-time scheduling), or raise [safety] missed_deadline_streak";
     case FaultCode::kHeartbeatLost: return "the console stopped responding";
   }
   return "unknown fault";

@@ -4,6 +4,9 @@
 #include <stdexcept>
 
 #include "engine/errors.hpp"
+#include "sessions/file_access.hpp"
+#include "sessions/file_digest.hpp"
+#include "sessions/iteration_files.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
@@ -83,6 +86,24 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
   updated.resume = std::move(resume);
   write_manifest(directory_, updated);
   manifest_ = std::move(updated);  // only once it is on disk
+}
+
+void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar) {
+  if (manifest_.iterations.empty()) {
+    throw std::invalid_argument("SessionWriter::update_next_correction: no iteration saved yet");
+  }
+  if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
+      next_correction_bar.size() != manifest_.trajectory_samples) {
+    throw std::invalid_argument("SessionWriter::update_next_correction: the record does not match the session's trajectory");
+  }
+  // The rewritten samples file gets its new digest in the manifest, or a resume would refuse it.
+  const int iteration = next_iteration() - 1;
+  const std::string contents = format_samples_csv(record, next_correction_bar);
+  write_file_atomic_at(iterations_, session_layout::folder_and_name(session_layout::samples_file(iteration)).second, contents);
+  SessionManifest updated = manifest_;
+  updated.iterations.back().samples_sha256 = sha256_hex(contents);
+  write_manifest(directory_, updated);
+  manifest_ = std::move(updated);
 }
 
 void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {

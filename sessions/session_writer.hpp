@@ -34,6 +34,10 @@ class SessionWriter {
   /// the correction learned from it and the state to continue from.
   void save_iteration(const TrialRecord& record, const IterationSummary& summary,
                       const Eigen::VectorXd& next_correction_bar, ResumeState resume);
+  /// The correction learned from the last saved iteration changed (learning ran after the save, or
+  /// the operator chose another): rewrites that iteration's samples file (`record` is its record)
+  /// atomically, so the learned correction is on disk before the next trial starts.
+  void update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar);
   /// Keeps a fault's black box (`ticks` oldest first, ending with the fault tick): writes its file,
   /// then lists it in the manifest. Throws std::invalid_argument when `ticks` is empty.
   void save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks);

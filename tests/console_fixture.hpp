@@ -5,6 +5,8 @@
 #include <chrono>
 #include <functional>
 #include <map>
+#include <mutex>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <thread>
@@ -22,10 +24,30 @@ namespace bellows::testing {
 class MemorySessions final : public ui::SessionGateway {
  public:
   bool available() const override { return true; }
+  /// Like the store: a new session, or what was added to the session named by the snapshot.
   std::string save(const ui::SessionSnapshot& snapshot) override {
+    const std::lock_guard<std::mutex> guard(mutex);
     const std::string location =
         snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size()) : snapshot.experiment.session_location;
-    saved[location] = snapshot;
+    ui::SessionSnapshot merged = snapshot;
+    if (const auto old = saved.find(location); old != saved.end()) {
+      const auto& before = old->second.experiment.trials;
+      merged.experiment.trials.assign(before.begin(), before.begin() + snapshot.first_trial);
+      merged.experiment.trials.insert(merged.experiment.trials.end(), snapshot.experiment.trials.begin(),
+                                      snapshot.experiment.trials.end());
+      for (std::size_t i = 0; i < old->second.experiment.faults.size() && i < merged.experiment.faults.size(); ++i) {
+        merged.experiment.faults[i] = old->second.experiment.faults[i];  // the saved black boxes, with their ticks
+      }
+      merged.events = old->second.events;
+      const std::size_t first_new = snapshot.events_total - snapshot.events.size();
+      for (std::size_t i = snapshot.experiment.saved_events > first_new ? snapshot.experiment.saved_events - first_new : 0;
+           i < snapshot.events.size(); ++i) {
+        merged.events.push_back(snapshot.events[i]);
+      }
+    }
+    if (fail_saves) throw std::runtime_error("disk full (test)");
+    merged.first_trial = 0;
+    saved[location] = std::move(merged);
     ++saves;
     return location;
   }
@@ -45,15 +67,21 @@ class MemorySessions final : public ui::SessionGateway {
   ui::SessionSnapshot read_trials(const std::string& location) override { return open(location); }
   std::map<std::string, ui::SessionSnapshot> saved;
   int saves = 0;
+  bool fail_saves = false;
+  std::mutex mutex;
 };
 
 struct ConsoleFixture {
-  /// `gateway`: where sessions go (default: `sessions`, in memory).
-  /// `write_figures`: the figure key's writer (default: none, the key says so).
+  /// `gateway`: where sessions go (default: `sessions`, in memory). `device`: the engine drives it
+  /// instead of `arm` (a test's own device). `write_figures`: the figure key's writer (default:
+  /// none, the key says so).
   explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
-                          ui::SessionGateway* gateway = nullptr,
+                          ui::SessionGateway* gateway = nullptr, Device* device = nullptr,
                           std::function<std::string(const ui::SessionSnapshot&)> write_figures = {})
-      : config(c), arm(c.plant, 1), core(arm, c.controller, c.timing, c.safety), clock(core, arm) {
+      : config(c),
+        arm(c.plant, 1),
+        core(device != nullptr ? *device : arm, c.controller, c.timing, c.safety),
+        clock(core, device != nullptr ? *device : arm) {
     ui::ConsoleEnvironment env;
     env.core = &core;
     env.telemetry = &core.add_telemetry_tap(4096);

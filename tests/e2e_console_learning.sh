@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The operator's day in the real binary: arm, choose `paper`, run 5 iterations and read the falling
 # RMS off the screen, inspect the correction and move the cursor, emergency stop and see FAULT,
-# reset, re-arm, run again, save, quit with the valves vented; relaunch with --session and see the
+# reset, re-arm, run again (saved as it goes), quit with the valves vented; relaunch with --session and see the
 # same RMS history, find it in the browser, and continue learning into the same session.
 source "$(dirname "$0")/e2e_console_lib.sh"
 
@@ -72,20 +72,16 @@ e2e_keys n
 e2e_wait_for 'iteration 5: RMS' 120
 e2e_wait_for 'iteration 6  RMS'
 
-# Quit asks while work is unsaved; cancel, save, then quit: the valves are vented before the exit.
-e2e_keys q
-e2e_wait_for 'Quit\?'
-e2e_wait_for "6 iterations and 1 fault's black box"  # the emergency stop's, not saved yet either
-e2e_keys Escape
-e2e_keys s
-e2e_wait_for 'saved: /'
-session="$(e2e_screen | grep -oE 'saved: /[^ ]+' | head -1 | cut -c8-)"
-[ -f "$session/manifest.json" ] || e2e_fail "no session at '$session'"
+# Saved as it went: quit does not ask; the closing report names the session, with every iteration.
+for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
 history="$(e2e_rms_list)"
 e2e_keys q
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has 'bellows console: .* 6 iterations, best RMS .*valves vented'
+e2e_output_has 'session: /.* \(saved as it went\)'
+session="$(e2e_history | grep -oE '^session: /[^ ]+' | head -1 | cut -c10-)"
+[ -f "$session/manifest.json" ] || e2e_fail "no session at '$session'"
 
 # Relaunch on the saved session: the same RMS history, and learning goes on from it.
 e2e_start 120 40 -- console --speed max --session "$session"

@@ -3,6 +3,8 @@
 
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "devices/simulated_arm.hpp"
 #include "engine/configuration.hpp"
 #include "engine/engine_core.hpp"
@@ -14,7 +16,8 @@ struct EngineFixture {
   explicit EngineFixture(const Configuration& c = Configuration{}, std::uint64_t seed = 1)
       : config(c), arm(c.plant, seed), core(arm, c.controller, c.timing, c.safety), clock(core, arm) {}
 
-  void send(CommandKind kind) { core.send(EngineCommand::of(kind)); }
+  /// Sends `kind`; a full command queue fails the test (it never fills in these tests).
+  void send(CommandKind kind) { EXPECT_TRUE(core.send(EngineCommand::of(kind))) << to_string(kind); }
   std::vector<EngineEvent> drain_events() {
     std::vector<EngineEvent> events;
     EngineEvent e;

@@ -186,7 +186,8 @@ std::string read_all(int fd) {
 }
 
 TEST(CliRun, SigintVentsAndExitsCleanlyWithWhatFinished) {
-  for (int signal_number : {SIGINT, SIGTERM}) {
+  // SIGHUP (the terminal closed, an ssh session dropped) is handled like SIGINT and SIGTERM.
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
     setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-xdg").c_str(), 1);  // never the real home
     auto [pid, out] = spawn_bellows({"run", "--clock", "wall", "--speed", "5", "--iterations", "50", "--json"});
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // past the first trial (~1.8 s)
@@ -198,6 +199,9 @@ TEST(CliRun, SigintVentsAndExitsCleanlyWithWhatFinished) {
     EXPECT_EQ(WEXITSTATUS(status), 128 + signal_number);
     const nlohmann::json report = nlohmann::json::parse(text);
     EXPECT_EQ(report["fault"]["name"], "emergency-stop");
+    const std::string name = signal_number == SIGINT ? "SIGINT" : signal_number == SIGTERM ? "SIGTERM" : "SIGHUP";
+    EXPECT_EQ(report["fault"]["message"], "interrupted by " + name + ": valves vented");
+    EXPECT_EQ(report["dropped_events"], 0);
     EXPECT_GE(report["iterations"].size(), 1u);
     EXPECT_LT(report["iterations"].size(), 51u);
   }

@@ -51,7 +51,7 @@ TEST(EngineAllocations, TicksAllocateNothing) {
   Eigen::VectorXd correction = Eigen::VectorXd::Constant(paper.learning_samples(), 0.01);
   TrialRecord record;
   record.prepare(paper.learning_samples(), f.config.timing.ticks_per_sample);  // sized outside the loop
-  f.core.send(EngineCommand::select_trajectory(paper));
+  EXPECT_TRUE(f.core.send(EngineCommand::select_trajectory(paper)));
   f.send(CommandKind::kArm);
   f.clock.step(10);  // warm up outside the count
 
@@ -59,7 +59,7 @@ TEST(EngineAllocations, TicksAllocateNothing) {
   long allocations = 0;
   {
     CountAllocations counter;
-    f.core.send(start);
+    EXPECT_TRUE(f.core.send(start));
     f.clock.step(100 + 4 * 400 + 10);  // settle, the whole trial, back to holding
     f.send(CommandKind::kEmergencyStop);
     f.clock.step(10);

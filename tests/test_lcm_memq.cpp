@@ -299,7 +299,7 @@ void expect_stale_fault_after(int stale_ticks) {
   for (int i = 0; i < 5; ++i) tick(true);
   EngineCommand arm;
   arm.kind = CommandKind::kArm;
-  core.send(arm);
+  EXPECT_TRUE(core.send(arm));
   for (int i = 0; i < 20; ++i) tick(true);
   ASSERT_EQ(core.state(), EngineState::kArmed);
   EXPECT_TRUE(b.last_command().armed);
@@ -410,7 +410,7 @@ struct TelemetryRun {
     }
     EngineCommand stop;
     stop.kind = CommandKind::kEmergencyStop;
-    core.send(stop);
+    EXPECT_TRUE(core.send(stop));
     clock.step(5);
   }
 };

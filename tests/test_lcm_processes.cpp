@@ -12,6 +12,7 @@
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_device.hpp"
+#include "engine/errors.hpp"
 #include "engine/safety.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/process_runner.hpp"
@@ -368,9 +369,9 @@ TEST(LcmCli, OnTheSimulatedClockTheLogHoldsEveryTick) {
   EXPECT_EQ(nlohmann::json::parse(plain.out)["iterations"], report["iterations"]);
 }
 
-void expect_refused(const std::string& args, const std::string& fragment) {
+void expect_refused(const std::string& args, const std::string& fragment, int status = kExitBadInput) {
   const auto result = testing::run_process(kBellows + " " + args);
-  EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.err;
+  EXPECT_EQ(result.exit_code, status) << args << "\n" << result.err;
   EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
 }
 
@@ -380,8 +381,9 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   expect_refused("run --device lcm --clock sim", "--device lcm needs --clock wall");
   expect_refused("run --device lcm --clock wall --speed 2", "--speed must be 1");
   expect_refused("run --device rig", "--device");
-  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "cannot open the LCM bus");
-  expect_refused("io-sim --lcm nowhere://at-all", "cannot open the LCM bus");
+  // The environment refusing (a bus that cannot be opened) has its own status.
+  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "cannot open the LCM bus", kExitEnvironment);
+  expect_refused("io-sim --lcm nowhere://at-all", "cannot open the LCM bus", kExitEnvironment);
   const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
   expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
   expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
@@ -390,7 +392,7 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");
   const auto result = testing::run_process(kBellows + " run --device lcm --clock wall --lcm memq:// --json --config " +
                                            config.string());
-  EXPECT_EQ(result.exit_code, 3) << result.err;
+  EXPECT_EQ(result.exit_code, kExitEnvironment) << result.err;  // no rig: the environment, not a fault
   const nlohmann::json report = nlohmann::json::parse(result.out);
   EXPECT_EQ(report["fault"]["name"], "rig-unavailable");
   EXPECT_EQ(report["iterations"].size(), 0u);

@@ -16,7 +16,7 @@ TEST(PlotConsole, TheFigureKeyWritesFiguresWhileTheBatchGoesOn) {
   testing::TempDir dir;
   const fs::path root = dir / "figures";
   int calls = 0;
-  testing::ConsoleFixture f(Configuration{}, 3, nullptr, [&](const ui::SessionSnapshot& snapshot) {
+  testing::ConsoleFixture f(Configuration{}, 3, nullptr, nullptr, [&](const ui::SessionSnapshot& snapshot) {
     ++calls;
     return write_console_figures(snapshot, root);
   });

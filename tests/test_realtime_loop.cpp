@@ -9,6 +9,7 @@
 #include "engine/configuration.hpp"
 #include "engine/learning_session.hpp"
 #include "engine/noilc_dense.hpp"
+#include "engine/errors.hpp"
 #include "engine/realtime_loop.hpp"
 
 namespace bellows {
@@ -70,11 +71,11 @@ TEST(RealtimeLoop, HungConsoleTripsTheHeartbeatGuard) {
   core.monitor_heartbeat(true);
   RealtimeLoop loop(core, arm, 1.0);
   loop.start(RealtimeMode::kOff);
-  core.send(EngineCommand::of(CommandKind::kArm));
+  EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
   const auto start = std::chrono::steady_clock::now();
   const EngineCommand heartbeat = EngineCommand::of(CommandKind::kHeartbeat);
   while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(500)) {  // a live console
-    core.send(heartbeat);
+    EXPECT_TRUE(core.send(heartbeat));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_EQ(core.state(), EngineState::kArmed);
@@ -96,8 +97,9 @@ TEST(RealtimeLoop, EnforceRefusesClearlyWhenRealTimeIsNotAllowed) {
     EXPECT_TRUE(loop.rt_granted());  // allowed here (root): then it must really be FIFO
     EXPECT_EQ(loop.rt_description(), "fifo");
     loop.stop();
-  } catch (const std::exception& e) {
+  } catch (const EnvironmentError& e) {  // the environment refused: exit status 4
     EXPECT_NE(std::string(e.what()).find("--rt enforce"), std::string::npos) << e.what();
+    EXPECT_EQ(e.exit_status(), kExitEnvironment);
   }
 }
 

@@ -56,7 +56,10 @@ TEST(UiController, FiveIterationsLowerTheRms) {
   EXPECT_TRUE(f.logged("batch of 5 done"));
   // The law's convergence prediction is shown (for the paper's defaults it warns about model errors).
   EXPECT_NE(f.state().convergence.find("contraction"), std::string::npos) << f.state().convergence;
-  EXPECT_TRUE(f.state().experiment.unsaved());
+  // Saved as it went.
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  EXPECT_FALSE(f.state().experiment.unsaved());
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 5u);
 }
 
 TEST(UiController, RunRepeatsAndNextLearnsFirst) {
@@ -306,9 +309,9 @@ TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {
   f.key(key::kDown);
   ASSERT_TRUE(f.state().chooser.preview);
   EXPECT_EQ(f.state().chooser.preview->name, "steps");
-  f.key(key::kEnter);  // one unsaved trial: asks first
-  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmDiscard);
-  f.key('y');
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  f.key(key::kEnter);  // the trial is saved: nothing is lost, nothing to ask
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   EXPECT_EQ(f.state().experiment.trajectory->name, "steps");
   EXPECT_TRUE(f.state().experiment.trials.empty());
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
@@ -357,23 +360,26 @@ TEST(UiController, RefusalsAreExplainedAndSendNothing) {
   EXPECT_TRUE(f.state().experiment.trials.empty());
 }
 
-TEST(UiController, SaveAndOpenThroughTheGateway) {
+TEST(UiController, SavesAsItGoesAndOpensFromTheSession) {
   ConsoleFixture f;
   f.arm_valves();
   f.run_batch(3);
-  f.key('s');
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy; }));
-  ASSERT_EQ(f.sessions.saves, 1);
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  ASSERT_EQ(f.sessions.saved.size(), 1u);
   const SessionSnapshot& saved = f.sessions.saved.begin()->second;
   EXPECT_EQ(saved.experiment.trials.size(), 3u);
   EXPECT_FALSE(saved.events.empty());
   EXPECT_FALSE(f.state().experiment.unsaved());
   EXPECT_EQ(f.state().experiment.session_location, "mem://0");
-  const auto rms = f.state().experiment.rms_history_deg();
+  // The correction learned from the last trial of the batch is saved as its next correction.
+  EXPECT_TRUE(saved.experiment.next_correction_bar.isApprox(f.state().experiment.next_correction_bar));
 
-  // Another trial, then open the saved session: asks (unsaved), and needs the valves vented.
+  // Another trial: saved without asking, into the same session.
   f.key('r');
-  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 4u);
+  const auto rms = f.state().experiment.rms_history_deg();
+  // Open it (valves vented first): nothing to discard, it comes from what was saved.
   f.key('o');
   EXPECT_NE(f.state().status.find("disarm first"), std::string::npos) << f.state().status;
   f.key('d');
@@ -381,36 +387,69 @@ TEST(UiController, SaveAndOpenThroughTheGateway) {
   f.key('o');
   ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
   ASSERT_EQ(f.state().browser.sessions.size(), 1u);
-  EXPECT_EQ(f.state().browser.sessions[0].iterations, 3);
+  EXPECT_EQ(f.state().browser.sessions[0].iterations, 4);
   f.key(key::kEnter);
-  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmDiscard);
-  f.key('y');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy && f.state().law_ready; }));
   EXPECT_EQ(f.state().experiment.rms_history_deg(), rms);
   EXPECT_FALSE(f.state().experiment.unsaved());
   // Learning continues from the opened session.
   f.arm_valves();
   f.key('n');
-  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
-  EXPECT_EQ(f.state().experiment.trials.size(), 4u);
-  EXPECT_EQ(f.state().experiment.trials[3].origin, "learned from 2");
-  EXPECT_LT(f.state().experiment.trials[3].summary.rms_deg, rms[2]);
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 5u);
+  EXPECT_EQ(f.state().experiment.trials[4].origin, "learned from 3");
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 5u);
 }
 
-TEST(UiController, QuitAsksWhenWorkIsUnsavedAndDisarms) {
+TEST(UiController, ATrialWaitsForTheSaveAndAFailedSaveStopsTrials) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.sessions.fail_saves = true;
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  EXPECT_TRUE(f.logged("save failed: disk full (test)"));
+  EXPECT_TRUE(f.state().experiment.unsaved());
+  // No trial starts while the session cannot be saved: asking retries the save, which fails again.
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  EXPECT_EQ(f.state().experiment.trials.size(), 1u);
+  // Quit asks now (the work is not on disk); once saving works, it saves and quits.
+  f.key('q');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
+  f.sessions.fail_saves = false;
+  f.key('s');
+  ASSERT_TRUE(f.pump_until([&] { return f.console->quit_requested(); }));
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);
+}
+
+TEST(UiController, QuitFinishesTheSaveAndDisarmsWithoutAsking) {
   ConsoleFixture f;
   f.arm_valves();
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   f.key('q');
-  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
-  f.key(key::kEscape);
-  EXPECT_FALSE(f.console->quit_requested());
-  f.key('q');
-  f.key('s');  // save, then quit
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   ASSERT_TRUE(f.pump_until([&] { return f.console->quit_requested(); }));
-  EXPECT_EQ(f.sessions.saves, 1);
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);
   ASSERT_TRUE(f.pump_until([&] { return f.core.state() == EngineState::kSafe; }));
+}
+
+TEST(UiController, MemoryHoldsOnlyTheNewestTrialsAndTheEngineHandsTrajectoriesBack) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(Experiment::kTrialsKeptInMemory + 4);
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  const auto& trials = f.state().experiment.trials;
+  ASSERT_EQ(trials.size(), static_cast<std::size_t>(Experiment::kTrialsKeptInMemory + 4));
+  int in_memory = 0;
+  for (const Trial& t : trials) in_memory += t.in_memory() ? 1 : 0;
+  EXPECT_EQ(in_memory, Experiment::kTrialsKeptInMemory);
+  EXPECT_TRUE(trials.back().in_memory());
+  EXPECT_FALSE(trials.front().in_memory());
+  EXPECT_GT(trials.front().summary.rms_deg, 0.0);  // the RMS history stays whole
+  // The session on disk (here: in memory) has every record.
+  for (const Trial& t : f.sessions.saved.begin()->second.experiment.trials) EXPECT_TRUE(t.in_memory());
 }
 
 TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
@@ -434,15 +473,34 @@ TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
   EXPECT_EQ(e.unsaved_sentence(), "changed settings are not saved.");
 }
 
-TEST(UiController, QuitAsksWhenOnlyAFaultsBlackBoxIsUnsaved) {
+TEST(UiController, AFaultsBlackBoxIsSavedAtOnceAndAStopIsVentedOnlyWhenTheEngineActed) {
   ConsoleFixture f;
   f.arm_valves();
   f.key(' ');
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().experiment.faults.empty(); }));
+  // Requested, not yet acted on (no tick since): the console does not claim the valves vented.
+  EXPECT_EQ(f.state().status.find("valves vented"), std::string::npos) << f.state().status;
+  EXPECT_NE(f.state().status.find("EMERGENCY STOP requested"), std::string::npos) << f.state().status;
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().experiment.faults.empty() && f.console->saves_settled(); }));
+  EXPECT_TRUE(f.logged("emergency stop: valves vented"));
+  EXPECT_TRUE(f.logged("ARMED -> FAULT (emergency-stop)"));
+  ASSERT_EQ(f.sessions.saved.size(), 1u);  // the black box made the session
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.faults.size(), 1u);
   f.key('q');
-  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
-  ASSERT_FALSE(f.state().dialog.text.empty());
-  EXPECT_EQ(f.state().dialog.text[0], "1 fault's black box is not saved.");
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  EXPECT_TRUE(f.console->quit_requested());
+}
+
+TEST(UiController, AStopWithAFullCommandQueueStillVentsInTheNextTick) {
+  ConsoleFixture f;
+  f.arm_valves();
+  while (f.core.send(EngineCommand::of(CommandKind::kHeartbeat))) {
+  }
+  f.key(' ');
+  f.clock.step(1);
+  EXPECT_EQ(f.core.state(), EngineState::kFault);
+  EXPECT_EQ(f.core.fault(), FaultCode::kEmergencyStop);
+  f.console->update(f.clock.now_s());
+  EXPECT_TRUE(f.logged("emergency stop: valves vented"));
 }
 
 TEST(UiController, WithoutASessionStoreSaveSaysSo) {
@@ -458,6 +516,8 @@ TEST(UiController, WithoutASessionStoreSaveSaysSo) {
   console.start(0.0);
   console.handle_key('s', 0.0);
   EXPECT_NE(console.state().status.find("not part of this build"), std::string::npos) << console.state().status;
+  console.handle_key('q', 0.0);  // nothing can be saved: quit does not wait for a save
+  EXPECT_TRUE(console.quit_requested());
   console.handle_key('o', 0.0);
   EXPECT_EQ(console.state().screen, Screen::kMain);
 }

@@ -38,10 +38,10 @@ class UiSessions : public ::testing::Test {
   bool had_previous_ = false;
 };
 
+/// The console saves as it goes: waits until everything done so far is on disk.
 void save_and_wait(ConsoleFixture& f) {
-  f.key('s');
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy; }));
-  ASSERT_FALSE(f.state().status_important) << f.state().status;
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  ASSERT_FALSE(f.state().experiment.unsaved()) << f.state().status;
 }
 
 TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
@@ -111,12 +111,11 @@ TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
     change_logged = change_logged || e.message.find("k_p changed 0.3 -> 0.35") != std::string::npos;
   }
   EXPECT_TRUE(change_logged);
-  // Iteration 0's next correction is what iteration 1 ran with. Iteration 1 was saved before the
-  // console learned from it: its next correction is the one chosen then (its own); what iteration 2
-  // ran with is in iteration 2's samples.
+  // Each iteration's next correction is what the next one ran with: iteration 1 was saved with its
+  // own, and rewritten with the learned one before iteration 2 started.
   const auto applied = [&](std::size_t i) { return Eigen::VectorXd(loaded.iterations[i].record.samples.u_ilc_bar.head(400)); };
   EXPECT_TRUE(loaded.iterations[0].next_correction_bar.isApprox(applied(1)));
-  EXPECT_TRUE(loaded.iterations[1].next_correction_bar.isApprox(applied(1)));
+  EXPECT_TRUE(loaded.iterations[1].next_correction_bar.isApprox(applied(2)));
   EXPECT_FALSE(applied(2).isApprox(applied(1)));
 }
 
@@ -128,7 +127,6 @@ TEST_F(UiSessions, AFaultsBlackBoxIsSavedWithTheSessionAndReopened) {
   f.key(' ');  // emergency stop
   ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.black_box.empty(); }));
   ASSERT_EQ(f.state().experiment.faults.size(), 1u);
-  EXPECT_TRUE(f.state().experiment.unsaved());
   save_and_wait(f);
   EXPECT_EQ(f.state().experiment.saved_faults, 1);
   const std::string location = f.state().experiment.session_location;
@@ -213,6 +211,28 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("recorded on the device 'sim'"), std::string::npos) << error.what();
   }
+}
+
+TEST_F(UiSessions, NamingRenamesTheSessionAndSavingGoesOnThere) {
+  StoreSessionGateway gateway("sim", (data_home_ / "elsewhere").string());  // --data-dir
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  EXPECT_EQ(std::filesystem::path(f.state().experiment.session_location).parent_path(), data_home_ / "elsewhere");
+  f.key('s');
+  ASSERT_EQ(f.state().dialog.kind, ui::DialogKind::kSessionName);
+  for (int i = 0; i < 80; ++i) f.key(ui::key::kBackspace);
+  f.type("morning-run");
+  f.key(ui::key::kEnter);
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  EXPECT_EQ(f.state().experiment.session_location, (data_home_ / "elsewhere" / "morning-run").string()) << f.state().status;
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  f.console.reset();
+  EXPECT_EQ(load_manifest((data_home_ / "elsewhere" / "morning-run").string()).iterations.size(), 2u);
 }
 
 TEST(UiSessionDates, LocalDateOfUtc) {

@@ -13,6 +13,7 @@ namespace {
 
 constexpr int kKeyTimeoutMs = 33;
 constexpr double kDisarmWaitS = 1.0;          // on quit: how long the engine may take to disarm
+constexpr double kFinalSaveWaitS = 10.0;      // on exit: how long the last autosave may take
 constexpr std::size_t kTelemetryCapacity = 4096;  // ~20 s of ticks at 200 Hz between two frames
 
 double seconds_of(clockid_t clock) {
@@ -80,7 +81,8 @@ ConsoleReport run_console(ConsoleSetup setup) {
     const double now = monotonic_s();
     controller->update(now);
     if (setup.stop_flag != nullptr && setup.stop_flag->load(std::memory_order_relaxed)) {
-      controller->emergency_stop("signal: emergency stop and exit");
+      // The handler has latched the stop already (the valves vent in the next tick); this logs it.
+      controller->emergency_stop("signal: emergency stop, save and exit");
       report.stopped_by_signal = true;
       break;
     }
@@ -97,20 +99,31 @@ ConsoleReport run_console(ConsoleSetup setup) {
 
   // Vent: disarm through the engine (heartbeats continue meanwhile), then stop the loop.
   // (A quit from the keyboard has sent the disarm already; a signal has stopped the engine.)
-  if (report.exited_after_time && valves_live(setup.core->state())) {
-    setup.core->send(EngineCommand::of(CommandKind::kDisarm));
+  if (report.exited_after_time && valves_live(setup.core->state()) &&
+      !setup.core->send(EngineCommand::of(CommandKind::kDisarm))) {
+    setup.core->request_emergency_stop();  // the queue is full: vent through the latch
   }
   const double quit_s = monotonic_s();
   while (valves_live(setup.core->state()) && monotonic_s() - quit_s < kDisarmWaitS) {
     terminal->read_key(10);
     controller->update(monotonic_s());
   }
+  if (valves_live(setup.core->state())) setup.core->request_emergency_stop();  // never leave them live
+  // Vented; now what is not on disk yet (the last log lines, a black box) goes there.
+  while (!controller->saves_settled() && monotonic_s() - quit_s < kFinalSaveWaitS) {
+    terminal->read_key(10);
+    controller->update(monotonic_s());
+  }
+  report.save_status = controller->saves_settled() ? controller->state().experiment.session_location : std::string();
+  report.unsaved = controller->state().experiment.unsaved_sentence();
   report.seconds = monotonic_s() - start_s;
   report.ui_cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID) - cpu_start_s;
   loop->stop();
   terminal.reset();
   report.loop = loop->latency();
   report.ticks = setup.core->ticks();
+  report.dropped_events = setup.core->dropped_events();
+  report.missed_warnings = setup.core->missed_deadline_warnings();
   report.iterations = static_cast<int>(controller->state().experiment.trials.size());
   report.best_rms_deg = controller->state().experiment.best_rms_deg();
   return report;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include "engine/realtime_loop.hpp"
 #include "ui/console_controller.hpp"
@@ -19,7 +20,7 @@ struct ConsoleSetup {
   ConsoleEnvironment environment;    // core, telemetry and latency are filled in here
   Trajectory trajectory;
   std::optional<SessionSnapshot> session;  // open this saved session at start
-  const std::atomic<bool>* stop_flag = nullptr;  // set by SIGINT/SIGTERM
+  const std::atomic<bool>* stop_flag = nullptr;  // set by SIGINT/SIGTERM/SIGHUP
   double exit_after_s = 0.0;         // > 0: quit by itself after this long (benchmarks, tests)
   bool allow_colors = true;
 };
@@ -34,6 +35,10 @@ struct ConsoleReport {
   int iterations = 0;
   double best_rms_deg = -1.0;
   bool stopped_by_signal = false;
+  std::string save_status;           // the session saved as it went (empty: none)
+  std::string unsaved;               // what did not reach the disk (empty: nothing), a sentence
+  std::uint64_t dropped_events = 0;  // engine events lost to a full queue
+  std::uint64_t missed_warnings = 0; // missed deadlines counted as warnings (simulated arm)
   bool exited_after_time = false;
   bool unicode = false;
   bool colors = false;

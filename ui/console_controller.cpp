@@ -1,5 +1,6 @@
 #include "ui/console_controller.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <numbers>
@@ -16,6 +17,8 @@ constexpr double kHeartbeatPeriodS = 0.05;    // well inside the engine's timeou
 constexpr double kLoopStatsPeriodS = 0.25;    // the latency summary walks a histogram: not every frame
 constexpr double kStaleSnapshotS = 0.5;       // no fresh tick for this long: the device shows no data
 constexpr double kStripSeconds = 5.0;         // the live plot's window
+constexpr double kStopOverdueS = 0.5;         // an unacted stop this old is shown as overdue (100 ticks)
+constexpr const char* kStopOverdueText = "EMERGENCY STOP requested: the engine has not acted on it yet (is its loop stalled?)";
 
 std::string system_clock_text() {
   const std::time_t now = std::time(nullptr);
@@ -79,13 +82,13 @@ bool ConsoleController::send(const EngineCommand& command, const char* what) {
   return false;
 }
 
-void ConsoleController::send_simple(CommandKind kind, const char* what) { send(EngineCommand::of(kind), what); }
+bool ConsoleController::send_simple(CommandKind kind, const char* what) { return send(EngineCommand::of(kind), what); }
 
 void ConsoleController::send_gains() {
   const ControllerParameters& c = state_.config.controller;
   EngineCommand gains = EngineCommand::of(CommandKind::kSetGains);
   gains.gains = {c.k_ff, c.k_p, c.k_i_per_s, c.k_d_s};
-  send(gains, "set gains");
+  if (!send(gains, "set gains")) log(LogSource::kOperator, "the engine keeps its previous gains", true);
 }
 
 void ConsoleController::start(double now_s) {
@@ -104,7 +107,10 @@ void ConsoleController::start(double now_s) {
 
 void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> trajectory) {
   selected_trajectories_.push_back(trajectory);
-  send(EngineCommand::select_trajectory(*selected_trajectories_.back()), "select trajectory");
+  if (!send(EngineCommand::select_trajectory(*selected_trajectories_.back()), "select trajectory")) {
+    selected_trajectories_.pop_back();  // the engine never saw it
+    log(LogSource::kOperator, "the engine holds the previous trajectory until the next trial", true);
+  }
 }
 
 void ConsoleController::heartbeat(double now_s) {
@@ -151,6 +157,25 @@ void ConsoleController::update(double now_s) {
   }
   state_.loop.ticks = env_.core->ticks();
   state_.loop.dropped_telemetry = env_.core->dropped_telemetry();
+  if (const std::uint64_t dropped = env_.core->dropped_events(); dropped != state_.loop.dropped_events) {
+    log(LogSource::kEngine, format("%llu engine events dropped (the event queue was full)",
+                                   static_cast<unsigned long long>(dropped - state_.loop.dropped_events)), true);
+    state_.loop.dropped_events = dropped;
+  }
+  if (stop_pending_) {
+    if (env_.core->emergency_stop_delivered()) {
+      on_emergency_stop_delivered();
+    } else if (now_s - stop_requested_s_ > kStopOverdueS && state_.status != kStopOverdueText) {
+      set_status(kStopOverdueText, true);  // never "vented" for a stop the engine has not acted on
+    }
+  }
+  autosave();
+}
+
+void ConsoleController::on_emergency_stop_delivered() {
+  stop_pending_ = false;
+  log(LogSource::kEngine, "emergency stop: valves vented", true);
+  set_status("EMERGENCY STOP: valves vented. R resets.", true);
 }
 
 void ConsoleController::poll_engine(double /*now_s*/) {
@@ -173,7 +198,10 @@ void ConsoleController::on_event(const EngineEvent& event) {
       // A trial's own ARMED <-> RUNNING changes are routine: the trial's lines say it better.
       const bool routine = event.command == CommandKind::kStartTrial &&
                            (event.to == EngineState::kRunning || event.to == EngineState::kArmed);
-      log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), to_string(event.command)),
+      // Into FAULT: the fault's own name (a guard is not an emergency stop).
+      const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone ? fault_name(event.fault)
+                                                                                              : to_string(event.command);
+      log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
           event.to == EngineState::kFault, event.time_s, routine);
     }
       if (event.command == CommandKind::kArm && event.to == EngineState::kArmed) {
@@ -201,7 +229,26 @@ void ConsoleController::on_event(const EngineEvent& event) {
       set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);
       state_.dialog = {};
       state_.screen = Screen::kFault;
+      if (stop_pending_ && env_.core->emergency_stop_delivered()) on_emergency_stop_delivered();
       return;
+    case EventKind::kWarning:
+      if (event.fault == FaultCode::kMissedDeadlines) {
+        log(LogSource::kEngine,
+            format("warning: %u deadlines missed in a row (the machine is loaded); on the simulated arm time follows "
+                   "the engine's ticks, so nothing physical is harmed: counted, not a fault",
+                   event.count),
+            true, event.time_s);
+      } else {
+        log(LogSource::kEngine, format("warning: %s", fault_message(event.fault)), true, event.time_s);
+      }
+      return;
+    case EventKind::kTrajectorySelected: {
+      // The engine holds this one now: every trajectory given before it is handed back.
+      const auto held = std::find_if(selected_trajectories_.begin(), selected_trajectories_.end(),
+                                     [&](const auto& t) { return t.get() == event.trajectory; });
+      if (held != selected_trajectories_.end()) selected_trajectories_.erase(selected_trajectories_.begin(), held);
+      return;
+    }
     case EventKind::kTrialComplete:
       if (in_flight_ && event.trial_id == in_flight_->id) finish_trial(event.time_s);
       return;
@@ -276,21 +323,18 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
 }
 
 void ConsoleController::emergency_stop(const std::string& why) {
-  const EngineCommand stop = EngineCommand::of(CommandKind::kEmergencyStop);
-  bool sent = false;
-  for (int attempt = 0; attempt < 1000 && !(sent = env_.core->send(stop)); ++attempt) {
-    // The queue is drained every tick; a full queue empties within a few ticks.
-    struct timespec pause{0, 1'000'000};
-    nanosleep(&pause, nullptr);
-  }
+  // The latch, not the queue: however full the command queue, the next tick vents. No waiting here.
+  env_.core->request_emergency_stop();
+  stop_pending_ = true;
+  stop_requested_s_ = now_s_;
   if (state_.run.mode != RunProgress::Mode::kIdle) state_.run.stop_requested = true;
   if (valve_test_ && valve_test_->running()) {
     valve_test_->abandon("emergency stop");
     show_valve_verdicts();
   }
   state_.dialog = {};
-  log(LogSource::kOperator, why + (sent ? "" : " (NOT SENT: the command queue stayed full)"), true);
-  set_status("EMERGENCY STOP: valves vented", true);
+  log(LogSource::kOperator, why, true);
+  set_status("EMERGENCY STOP requested: venting", true);
 }
 
 void ConsoleController::resize(int width, int height) {

@@ -4,6 +4,10 @@
 //   - trials go through the engine's commands (kStartTrial with a record and a correction this
 //     controller owns until the engine hands them back), never through a blocking API;
 //   - learning updates, building the law, saving and opening run as background tasks;
+//   - it saves as it goes: every completed trial, black box and learned correction is on disk (a
+//     background save) before the next trial starts; only the newest trials stay in memory;
+//   - an emergency stop is the engine's latch (never queued) and is reported as done only once
+//     the engine has acted on it;
 //   - it sends the heartbeat every update (at least every 50 ms) unless a drill withholds it.
 // The UI thread is the single producer of engine commands and the single consumer of its events,
 // its snapshot and one telemetry tap. Tests drive it with a simulated clock.
@@ -68,8 +72,12 @@ class ConsoleController {
   /// Heartbeat, engine events, snapshot, telemetry, background tasks, loop statistics.
   void update(double now_s);
   void resize(int width, int height);
-  /// Vents at once (Space, a signal); stops any trials.
+  /// Latches the engine's emergency stop (vents in its next tick, whatever its queue holds) and
+  /// stops any trials. Never waits: the status says "vented" once the engine has acted.
   void emergency_stop(const std::string& why);
+  /// Nothing left to save and no save running (autosave caught up, or saving is not available or
+  /// failed: then `state().status` says why).
+  bool saves_settled() const;
 
   const ConsoleState& state() const { return state_; }
   bool quit_requested() const { return quit_requested_; }
@@ -89,8 +97,8 @@ class ConsoleController {
   };
 
   // Engine side (console_controller.cpp).
-  bool send(const EngineCommand& command, const char* what);
-  void send_simple(CommandKind kind, const char* what);
+  [[nodiscard]] bool send(const EngineCommand& command, const char* what);
+  [[nodiscard]] bool send_simple(CommandKind kind, const char* what);
   void send_gains();  // the current configuration's PID gains
   void poll_engine(double now_s);
   void on_event(const EngineEvent& event);
@@ -98,6 +106,8 @@ class ConsoleController {
   void poll_tasks();
   void heartbeat(double now_s);
   void begin_trial();
+  void begin_trial_when_saved();  // begin_trial() once everything done so far is on disk
+  void on_emergency_stop_delivered();
   void finish_trial(double time_s);
   void drop_trial(const std::string& why);
   void continue_run();
@@ -142,7 +152,9 @@ class ConsoleController {
   bool handle_transfer_key(int key);
 
   // Sessions (console_sessions.cpp).
+  void autosave();   // starts a save when something is unsaved and none is running
   void start_save();
+  void start_rename(const std::string& name);
   void start_listing();
   void start_open(const std::string& location);
   void start_figures();
@@ -156,7 +168,8 @@ class ConsoleController {
   bool quit_requested_ = false;
   bool quit_after_save_ = false;
 
-  // Trajectories ever given to the engine stay alive: it may hold a pointer to any of them.
+  // Trajectories given to the engine, in the order sent, alive until it hands them back (a
+  // kTrajectorySelected event for a later one): it may hold a pointer to any of them until then.
   std::vector<std::shared_ptr<const Trajectory>> selected_trajectories_;
   std::unique_ptr<InFlight> in_flight_;
   std::uint32_t last_trial_id_ = 0;
@@ -176,6 +189,10 @@ class ConsoleController {
   bellows::DeviceHealth link_{};  // the device's link, refreshed with the loop statistics
   std::unique_ptr<ValveTest> valve_test_;
   bool black_box_pending_ = false;
+  bool stop_pending_ = false;        // an emergency stop requested, not yet acted on by the engine
+  double stop_requested_s_ = 0.0;
+  bool begin_after_save_ = false;    // a trial waits for the autosave
+  bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
   std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate
   std::size_t strip_next_ = 0, strip_count_ = 0;
@@ -190,6 +207,7 @@ class ConsoleController {
   BackgroundTask<BuiltLaw> law_build_;
   BackgroundTask<Eigen::VectorXd> law_update_;
   BackgroundTask<std::string> save_task_;
+  BackgroundTask<std::string> rename_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;
   BackgroundTask<SessionSnapshot> open_task_;
   BackgroundTask<std::string> figure_task_;
@@ -201,6 +219,7 @@ class ConsoleController {
   int saving_faults_ = 0;
   std::size_t saving_events_ = 0;
   bool saving_settings_changed_ = false;
+  std::uint64_t saving_next_revision_ = 0;
 };
 
 }  // namespace bellows::ui

@@ -55,7 +55,7 @@ void ConsoleController::open_dialog(DialogKind kind, std::string title, std::vec
 bool ConsoleController::handle_dialog_key(int k) {
   Dialog& d = state_.dialog;
   const bool prompt = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
-                      d.kind == DialogKind::kEditValue;
+                      d.kind == DialogKind::kEditValue || d.kind == DialogKind::kSessionName;
   if (k == key::kEscape) {
     state_.dialog = {};
     pending_discard_action_ = nullptr;
@@ -84,8 +84,7 @@ bool ConsoleController::handle_dialog_key(int k) {
     case DialogKind::kConfirmArm:
       if (k == 'y' || k == 'Y') {
         state_.dialog = {};
-        send_simple(CommandKind::kArm, "arm");
-        log(LogSource::kOperator, "arm");
+        if (send_simple(CommandKind::kArm, "arm")) log(LogSource::kOperator, "arm");
       } else if (k == 'n' || k == 'N') {
         state_.dialog = {};
         set_status("not armed");
@@ -119,9 +118,10 @@ bool ConsoleController::handle_dialog_key(int k) {
       }
       return true;
     case DialogKind::kConfirmQuit:
-      if (k == 's' && state_.sessions_available) {
+      if (k == 's' && state_.sessions_available) {  // the autosave failed: try once more, then quit
         state_.dialog = {};
         quit_after_save_ = true;
+        autosave_failed_ = false;
         start_save();
       } else if (k == 'q' || k == 'y') {
         state_.dialog = {};
@@ -187,6 +187,16 @@ void ConsoleController::accept_input() {
       }
       return;
     }
+    case DialogKind::kSessionName: {
+      const std::string name = trim(d.input);
+      if (name.empty()) {
+        reject_input("type a name (letters, digits, - _ .), or Esc");
+        return;
+      }
+      state_.dialog = {};
+      start_rename(name);
+      return;
+    }
     case DialogKind::kEditValue: {
       const std::string why = apply_tuning(TuningForm::field_of(state_.tuning.selected), d.input);
       if (!why.empty()) {
@@ -230,11 +240,14 @@ void ConsoleController::perform(Action action) {
     }
     case Action::kDisarm:
       if (state_.run.mode != RunProgress::Mode::kIdle) state_.run.stop_requested = true;
-      send_simple(CommandKind::kDisarm, "disarm");
+      if (!send_simple(CommandKind::kDisarm, "disarm")) {
+        emergency_stop("disarm not sent (the command queue is full): emergency stop instead");
+        return;
+      }
       log(LogSource::kOperator, "disarm");
       return;
     case Action::kReset:
-      send_simple(CommandKind::kReset, "reset");
+      if (!send_simple(CommandKind::kReset, "reset")) return;  // said by send(); the fault stays latched
       log(LogSource::kOperator, format("reset the fault (%s)", fault_name(state_.fault)));
       set_status("fault reset: the valves stay vented (SAFE) until you arm (a)");
       if (state_.screen == Screen::kFault) state_.screen = Screen::kMain;
@@ -245,7 +258,7 @@ void ConsoleController::perform(Action action) {
     case Action::kRunTrial:
       state_.run = RunProgress{};
       state_.run.mode = RunProgress::Mode::kTrial;
-      begin_trial();
+      begin_trial_when_saved();
       return;
     case Action::kNextIteration:
       state_.run = RunProgress{};
@@ -260,7 +273,10 @@ void ConsoleController::perform(Action action) {
       return;
     case Action::kStopRun:
       state_.run.stop_requested = true;
-      if (state_.engine_state == EngineState::kRunning) send_simple(CommandKind::kAbortTrial, "abort trial");
+      if (state_.engine_state == EngineState::kRunning && !send_simple(CommandKind::kAbortTrial, "abort trial")) {
+        set_status("abort not sent (the command queue is full): the trial ends by itself, or Space stops", true);
+        return;
+      }
       log(LogSource::kOperator, "stop the trials");
       set_status("stopping the trials");
       return;
@@ -277,8 +293,15 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kLog;
       return;
     case Action::kFaultView: state_.screen = Screen::kFault; return;
+    case Action::kSave: {
+      const std::string& location = state_.experiment.session_location;
+      const std::string current = location.substr(location.find_last_of('/') + 1);
+      open_dialog(DialogKind::kSessionName, "Name this session",
+                  {"The session is saved as you go, in", location, "A name renames it in the data directory."},
+                  "Enter rename   Esc cancel", current);
+      return;
+    }
     case Action::kRig: state_.screen = Screen::kRig; return;
-    case Action::kSave: start_save(); return;
     case Action::kFigures: start_figures(); return;
     case Action::kOpen:
       state_.screen = Screen::kSessions;
@@ -286,6 +309,12 @@ void ConsoleController::perform(Action action) {
       return;
     case Action::kQuit: {
       const Experiment& e = state_.experiment;
+      if (!saves_settled()) {
+        quit_after_save_ = true;  // the autosave in progress (or about to start) first, then quit
+        set_status("finishing the save, then quitting");
+        autosave();
+        return;
+      }
       const int unsaved_faults = static_cast<int>(e.faults.size()) - e.saved_faults;
       if (e.unsaved() && (!e.trials.empty() || unsaved_faults > 0)) {
         std::vector<std::string> text = {e.unsaved_sentence()};
@@ -311,7 +340,9 @@ void ConsoleController::perform(Action action) {
 
 void ConsoleController::quit_now() {
   log(LogSource::kOperator, "quit: vent and exit");
-  if (valves_live(state_.engine_state)) send_simple(CommandKind::kDisarm, "disarm");
+  if (valves_live(state_.engine_state) && !send_simple(CommandKind::kDisarm, "disarm")) {
+    env_.core->request_emergency_stop();  // the queue is full: vent through the latch instead
+  }
   quit_requested_ = true;
 }
 

@@ -40,6 +40,11 @@ bool ConsoleController::handle_screen_key(int k) {
             set_status("not while trials run", true);
             return true;
           }
+          if (!t.in_memory()) {
+            set_status(format("iteration %d is on disk only (the console keeps the newest %d trials in memory)",
+                              t.iteration, Experiment::kTrialsKeptInMemory), true);
+            return true;
+          }
           state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration));
           log(LogSource::kOperator, format("go back to the correction of iteration %d for the next trial", t.iteration));
           set_status(format("the next trial applies the correction of iteration %d", t.iteration));

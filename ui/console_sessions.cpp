@@ -1,9 +1,29 @@
 // Saving and opening sessions through the SessionGateway, on background tasks.
+#include <algorithm>
+
 #include "engine/errors.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 
 namespace bellows::ui {
+
+bool ConsoleController::saves_settled() const {
+  if (save_task_.busy() || rename_task_.busy()) return false;
+  const Experiment& e = state_.experiment;
+  const bool worth_a_session = !e.trials.empty() || !e.faults.empty() || !e.session_location.empty();
+  return !state_.sessions_available || autosave_failed_ || !e.unsaved() || !worth_a_session;
+}
+
+void ConsoleController::autosave() {
+  const Experiment& e = state_.experiment;
+  // A session is created with the first trial or black box, not by merely looking around.
+  const bool worth_a_session = !e.trials.empty() || !e.faults.empty() || !e.session_location.empty();
+  if (!state_.sessions_available || save_task_.busy() || rename_task_.busy() || autosave_failed_ || !e.unsaved() ||
+      !worth_a_session) {
+    return;
+  }
+  start_save();
+}
 
 void ConsoleController::start_save() {
   if (!state_.sessions_available) {
@@ -11,24 +31,38 @@ void ConsoleController::start_save() {
     quit_after_save_ = false;
     return;
   }
-  if (save_task_.busy()) {
-    set_status("already saving");
-    return;
-  }
+  if (save_task_.busy()) return;  // the completion looks again
+  // Only what the save needs: the unsaved trials and the last saved one (its next correction may
+  // have changed), never the whole history.
+  const Experiment& e = state_.experiment;
+  const int trials = static_cast<int>(e.trials.size());
+  const int first = e.session_location.empty() ? 0 : std::max(0, std::min(e.saved_trials, trials) - 1);
   SessionSnapshot snapshot;
   snapshot.config = state_.config;
-  snapshot.experiment = state_.experiment;
-  snapshot.events.assign(state_.log.entries().begin(), state_.log.entries().end());
+  snapshot.experiment.trajectory = e.trajectory;
+  snapshot.experiment.trials.assign(e.trials.begin() + first, e.trials.end());
+  snapshot.experiment.next_correction_bar = e.next_correction_bar;
+  snapshot.experiment.next_unsaved = e.next_unsaved;
+  snapshot.experiment.next_origin = e.next_origin;
+  snapshot.experiment.next_tried = e.next_tried;
+  snapshot.experiment.saved_trials = e.saved_trials;
+  snapshot.experiment.session_location = e.session_location;
+  snapshot.experiment.saved_events = e.saved_events;
+  snapshot.experiment.settings_changed = e.settings_changed;
+  snapshot.experiment.faults = e.faults;  // saved ones hold no ticks (released)
+  snapshot.first_trial = first;
+  const std::size_t new_events = std::min(state_.log.entries().size(), state_.log.total() - std::min(e.saved_events, state_.log.total()));
+  const bool all_events = e.session_location.empty();
+  snapshot.events.assign(all_events ? state_.log.entries().begin() : state_.log.entries().end() - static_cast<long>(new_events),
+                         state_.log.entries().end());
   snapshot.events_total = state_.log.total();
   snapshot.device_name = env_.device_name;
   snapshot.seed = env_.seed;
-  saving_trials_ = static_cast<int>(state_.experiment.trials.size());
-  saving_faults_ = static_cast<int>(state_.experiment.faults.size());
+  saving_trials_ = trials;
+  saving_faults_ = static_cast<int>(e.faults.size());
   saving_events_ = state_.log.total();
-  saving_settings_changed_ = state_.experiment.settings_changed;
-  state_.learner_busy = true;
-  state_.learner_task = "saving";
-  log(LogSource::kSession, format("saving %d iterations", saving_trials_));
+  saving_settings_changed_ = e.settings_changed;
+  saving_next_revision_ = e.next_revision;
   save_task_.start([gateway = env_.sessions, snapshot = std::move(snapshot)] { return gateway->save(snapshot); });
 }
 
@@ -50,6 +84,15 @@ void ConsoleController::start_figures() {
   figure_task_.start([write = env_.write_figures, snapshot = std::move(snapshot)] { return write(snapshot); });
 }
 
+void ConsoleController::start_rename(const std::string& name) {
+  if (rename_task_.busy() || save_task_.busy()) {
+    set_status("saving: name the session again in a moment", true);
+    return;
+  }
+  log(LogSource::kSession, "name the session " + name);
+  rename_task_.start([gateway = env_.sessions, name] { return gateway->rename(name); });
+}
+
 void ConsoleController::start_listing() {
   if (list_task_.busy()) return;
   state_.browser.loading = true;
@@ -67,24 +110,55 @@ void ConsoleController::start_open(const std::string& location) {
 
 void ConsoleController::poll_session_tasks() {
   if (save_task_.ready()) {
-    state_.learner_busy = false;
     try {
       const std::string location = save_task_.take();
       Experiment& e = state_.experiment;
+      const bool first_save = e.session_location != location;
       e.session_location = location;
       e.saved_trials = saving_trials_;
       e.saved_faults = saving_faults_;
       e.saved_events = saving_events_;
-      // Settings changed while saving stay unsaved.
+      // Settings or a correction changed while saving stay unsaved (the next autosave takes them).
       if (saving_settings_changed_ == e.settings_changed) e.settings_changed = false;
-      log(LogSource::kSession, format("saved %d iterations to %s", saving_trials_, location.c_str()));
-      set_status("saved: " + location);
-      if (quit_after_save_) quit_now();
+      if (saving_next_revision_ == e.next_revision) e.next_unsaved = false;
+      e.release_saved_history();  // on disk now: memory keeps only the newest trials
+      if (first_save) {
+        log(LogSource::kSession, "saving as it goes to " + location);
+        set_status("this session is saved as it goes: " + location);
+      }
     } catch (const std::exception& error) {
+      autosave_failed_ = true;  // no retry loop: the operator decides (quit asks, s retries)
+      begin_after_save_ = false;
       log(LogSource::kSession, std::string("save failed: ") + error.what(), true);
-      set_status(std::string("save failed: ") + error.what(), true);
+      set_status(std::string("save failed: ") + error.what() + "; trials are not started until it is fixed", true);
+      if (state_.run.mode != RunProgress::Mode::kIdle) end_run("stopped: the session cannot be saved", true);
     }
-    quit_after_save_ = false;
+    ++revision_;
+    autosave();  // what changed meanwhile
+    if (!save_task_.busy() && !state_.experiment.unsaved()) {
+      if (begin_after_save_) {
+        begin_after_save_ = false;
+        begin_trial();
+      }
+      if (quit_after_save_) {
+        quit_after_save_ = false;
+        quit_now();
+      }
+    } else if (autosave_failed_ && quit_after_save_) {
+      quit_after_save_ = false;
+      perform(Action::kQuit);  // asks: quit without saving?
+    }
+  }
+  if (rename_task_.ready()) {
+    try {
+      const std::string location = rename_task_.take();
+      state_.experiment.session_location = location;
+      log(LogSource::kSession, "the session is now " + location);
+      set_status("named: " + location);
+    } catch (const std::exception& error) {
+      log(LogSource::kSession, std::string("naming failed: ") + error.what(), true);
+      set_status(std::string("naming failed: ") + error.what(), true);
+    }
     ++revision_;
   }
   if (figure_task_.ready()) {
@@ -149,6 +223,9 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.experiment.saved_faults = static_cast<int>(state_.experiment.faults.size());
   state_.experiment.settings_changed = false;
   state_.experiment.saved_events = state_.log.total();  // what came with the session is saved
+  state_.experiment.next_unsaved = false;
+  state_.experiment.release_saved_history();  // on disk: only the newest trials stay in memory
+  autosave_failed_ = false;
   state_.inspector = InspectorView{};
   state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
   const Experiment& adopted = state_.experiment;

@@ -28,6 +28,7 @@ enum class DialogKind {
   kConfirmQuit,      // s / q / Esc
   kConfirmDiscard,   // y/n: unsaved trials would be lost
   kConfirmValveTest, // y/n: the valves open one by one, the arm moves
+  kSessionName,      // a name for the session saved as the console goes
 };
 
 struct Dialog {
@@ -70,6 +71,7 @@ struct LoopHealth {
   std::string speed = "1";       // "1", "2", "5", "10", "max"
   double tick_hz = 200.0;
   std::uint64_t dropped_telemetry = 0;
+  std::uint64_t dropped_events = 0;   // engine events lost to a full event queue
   bool realtime = true;          // false on a simulated clock (no latency to show)
 };
 

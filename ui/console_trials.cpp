@@ -72,7 +72,7 @@ void ConsoleController::poll_tasks() {
       if (state_.run.stop_requested || state_.engine_state != EngineState::kArmed) {
         end_run(state_.run.stop_requested ? "stopped by the operator" : "stopped: the valves are not armed", false);
       } else {
-        begin_trial();
+        begin_trial_when_saved();  // the learned correction on disk first
       }
     } catch (const std::exception& error) {
       end_run(std::string("learning failed: ") + error.what(), true);
@@ -81,6 +81,20 @@ void ConsoleController::poll_tasks() {
   }
   if (rebuild_pending_ && !law_build_.busy() && !law_update_.busy()) rebuild_law();
   poll_session_tasks();
+}
+
+void ConsoleController::begin_trial_when_saved() {
+  if (autosave_failed_) {  // asking for a trial retries the failed save once
+    autosave_failed_ = false;
+    log(LogSource::kSession, "retrying the save before the trial");
+  }
+  if (saves_settled() && !autosave_failed_) {
+    begin_trial();
+    return;
+  }
+  begin_after_save_ = true;  // poll_session_tasks() begins it once the save is done
+  state_.run.phase = RunProgress::Phase::kNone;
+  autosave();
 }
 
 void ConsoleController::begin_trial() {
@@ -102,6 +116,7 @@ void ConsoleController::begin_trial() {
     return;
   }
   log(LogSource::kOperator, format("run iteration %d (%s)", e.next_iteration(), trial->origin.c_str()));
+  selected_trajectories_.push_back(trial->trajectory);  // the engine holds it until it selects another
   in_flight_ = std::move(trial);
   state_.run.phase = RunProgress::Phase::kSettling;
   state_.run.sample = -1;
@@ -176,7 +191,7 @@ void ConsoleController::continue_run() {
 void ConsoleController::step() {
   Experiment& e = state_.experiment;
   if (!e.next_tried || e.trials.empty()) {
-    begin_trial();
+    begin_trial_when_saved();
     return;
   }
   if (!state_.law_ready || !law_ || law_build_.busy()) {

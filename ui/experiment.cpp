@@ -22,6 +22,7 @@ std::string Experiment::unsaved_sentence() const {
     parts.push_back(std::to_string(black_boxes) + (black_boxes == 1 ? " fault's black box" : " faults' black boxes"));
   }
   if (settings_changed) parts.push_back("changed settings");
+  if (next_unsaved && !trials.empty() && iterations <= 0) parts.push_back("the next correction");
   if (parts.empty()) return {};
   std::string sentence = parts[0];
   for (std::size_t i = 1; i < parts.size(); ++i) sentence += (i + 1 == parts.size() ? " and " : ", ") + parts[i];
@@ -39,6 +40,21 @@ void Experiment::set_next(Eigen::VectorXd correction_bar, std::string origin) {
   next_correction_bar = std::move(correction_bar);
   next_origin = std::move(origin);
   next_tried = false;
+  next_unsaved = true;
+  ++next_revision;
+}
+
+void Experiment::release_saved_history() {
+  const int keep_from = std::min(saved_trials, static_cast<int>(trials.size()) - kTrialsKeptInMemory);
+  for (int i = 0; i < keep_from; ++i) {
+    Trial& t = trials[static_cast<std::size_t>(i)];
+    if (!t.in_memory()) continue;
+    t.record = TrialRecord{};
+    t.correction_bar = Eigen::VectorXd();
+  }
+  for (int i = 0; i < std::min(saved_faults, static_cast<int>(faults.size())); ++i) {
+    std::vector<TickRecord>().swap(faults[static_cast<std::size_t>(i)].ticks);
+  }
 }
 
 std::vector<double> Experiment::rms_history_deg() const {

@@ -19,20 +19,28 @@ namespace bellows::ui {
 
 struct Trial {
   int iteration = 0;
-  Eigen::VectorXd correction_bar;  // u_ilc(0..N-1) the trial applied
-  TrialRecord record;
+  Eigen::VectorXd correction_bar;  // u_ilc(0..N-1) the trial applied; empty once released
+  TrialRecord record;              // empty once released (saved, and older than the kept window)
   IterationSummary summary;
   std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
+
+  /// False once its record and correction were released: they are in the session on disk only.
+  bool in_memory() const { return record.learning_samples > 0; }
 };
 
 /// A fault's black box, kept with the experiment so that saving stores it in the session.
 struct FaultRecord {
   std::string fault;              // fault_name(), e.g. "overpressure"
   int iteration = 0;              // the iteration running or next when it fired
-  std::vector<TickRecord> ticks;  // oldest first, ending with the fault tick
+  std::vector<TickRecord> ticks;  // oldest first, ending with the fault tick; empty once released
 };
 
 struct Experiment {
+  /// Full records (tick-rate telemetry, hundreds of kB each) kept in memory for the newest trials
+  /// only: a lab day of thousands of iterations must not grow without bound; the session on disk
+  /// holds every one. Summaries (RMS history) stay for all.
+  static constexpr int kTrialsKeptInMemory = 8;
+
   std::shared_ptr<const Trajectory> trajectory;
   std::vector<Trial> trials;
   Eigen::VectorXd next_correction_bar;  // what the next trial applies
@@ -40,6 +48,8 @@ struct Experiment {
   bool next_tried = false;              // a trial already ran with it: a step learns first
   int saved_trials = 0;                 // trials already in the saved session
   bool settings_changed = false;        // gains or weights changed since the last save
+  bool next_unsaved = false;            // the next correction changed since the last trial was saved
+  std::uint64_t next_revision = 0;      // bumped by every set_next()
   std::string session_location;         // where it was saved or opened from; empty if never
   std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
   std::vector<FaultRecord> faults;      // black boxes, in the order the faults fired
@@ -52,8 +62,11 @@ struct Experiment {
   int next_iteration() const { return static_cast<int>(trials.size()); }
   bool unsaved() const {
     return static_cast<int>(trials.size()) > saved_trials || static_cast<int>(faults.size()) > saved_faults ||
-           settings_changed;
+           settings_changed || (next_unsaved && !trials.empty());
   }
+  /// Releases the records and corrections of saved trials older than the kept window, and the
+  /// ticks of saved black boxes (the session on disk has them).
+  void release_saved_history();
   /// What a save would add, as a sentence: "2 iterations, 1 fault's black box and changed settings
   /// are not saved."; empty when nothing is unsaved.
   std::string unsaved_sentence() const;

@@ -39,7 +39,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kTuning, 'w', key::kNone, "w", "Tune", "learning weights M, S, W and PID gains (between trials)"},
       {Action::kLog, 'l', key::kNone, "l", "Log", "event log: everything the operator and the engine did"},
       {Action::kFaultView, 'f', key::kNone, "f", "Fault", "the last fault: which guard fired and the black box"},
-      {Action::kSave, 's', key::kNone, "s", "Save", "save the session"},
+      {Action::kSave, 's', key::kNone, "s", "Name", "name the session (it is saved as you go)"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
       {Action::kFigures, 'g', key::kNone, "g", "Figures", "write figures of this session (PNG, SVG; the engine goes on)"},
       {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
@@ -110,8 +110,7 @@ Availability availability(Action action, const ConsoleState& s) {
       return {};
     case Action::kSave:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
-      if (!s.experiment.unsaved()) return no("nothing new to save");
-      if (s.learner_busy && s.learner_task == "saving") return no("already saving");
+      if (s.experiment.session_location.empty()) return no("nothing to name yet: the session is saved from the first trial on");
       return {};
     case Action::kFigures:
       if (s.experiment.trials.empty()) return no("no trial has run yet");

@@ -39,14 +39,15 @@ CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chose
     return i < 0 ? e.next_correction_bar : e.trials[static_cast<std::size_t>(i)].correction_bar;
   };
   const auto label_of = [&](int i) { return i < 0 ? std::string("next") : "it " + std::to_string(i); };
+  const auto in_memory = [&](int i) { return i < 0 || correction_of(i).size() >= n; };  // released: on disk only
   const int previous = primary < 0 ? trials - 1 : primary - 1;
-  if (previous >= 0) out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
-  if (chosen >= 0 && chosen < trials && chosen != primary && chosen != previous) {
+  if (previous >= 0 && in_memory(previous)) out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
+  if (chosen >= 0 && chosen < trials && chosen != primary && chosen != previous && in_memory(chosen)) {
     out.series.push_back({label_of(chosen), Role::kSeries3, 'o', to_vector(correction_of(chosen), 1.0, n)});
   }
-  if (primary < trials) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
+  if (primary < trials && in_memory(primary)) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
   // A transferred start stays in view beside what was learned from it.
-  if (trials > 0 && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 && previous != 0 && chosen != 0) {
+  if (trials > 0 && in_memory(0) && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 && previous != 0 && chosen != 0) {
     out.series.insert(out.series.begin(), {"transferred", Role::kSeries3, '+', to_vector(e.trials.front().correction_bar, 1.0, n)});
   }
   return out;

@@ -136,6 +136,9 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   if (level == 0) {
     out.push_back({2, format("M %g S %g W %g", s.config.ilc.m, s.config.ilc.s, s.config.ilc.w), Role::kDim, false});
   }
+  if (l.dropped_events > 0) {  // a loss, said like every other
+    out.push_back({2, format("%llu events dropped", static_cast<unsigned long long>(l.dropped_events)), Role::kWarning, false});
+  }
   if (s.experiment.unsaved() && !s.experiment.trials.empty()) out.push_back({2, "unsaved", Role::kWarning, false});
   return out;
 }
@@ -185,7 +188,7 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
   content_width = std::max({content_width, text_width(d.hint), text_width(d.error), 40});
   const int width = std::min(content_width + 4, c.width() - 4);
   const bool has_input = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
-                         d.kind == DialogKind::kEditValue;
+                         d.kind == DialogKind::kEditValue || d.kind == DialogKind::kSessionName;
   const std::vector<std::string> error = d.error.empty() ? std::vector<std::string>{} : wrap(d.error, width - 4);
   const int height = static_cast<int>(d.text.size() + error.size()) + (has_input ? 2 : 0) + 4;
   const Rect box{(c.width() - width) / 2, std::max(2, (c.height() - height) / 2), width, height};

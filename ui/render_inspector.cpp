@@ -26,6 +26,15 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
     return;
   }
   const Trial& t = e.trials[static_cast<std::size_t>(s.inspector.trial)];
+  if (!t.in_memory()) {
+    c.put(body.x + 1, body.y, format("Iteration %d", t.iteration), Role::kTitle, true);
+    c.put(body.x + 2, body.y + 1,
+          format("RMS %.3f deg. Its record is in the session on disk only: the console keeps the newest %d trials in "
+                 "memory (bellows sessions show / export).",
+                 t.summary.rms_deg, Experiment::kTrialsKeptInMemory),
+          Role::kDim, false, body.right());
+    return;
+  }
   const TrialSamples& samples = t.record.samples;
   const int k = std::clamp(s.inspector.sample, 0, static_cast<int>(samples.time_s.size()) - 1);
   const double cursor_s = samples.time_s(k);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/configuration.hpp"
+#include "engine/errors.hpp"
 #include "ui/event_log.hpp"
 #include "ui/experiment.hpp"
 
@@ -20,6 +21,8 @@ namespace bellows::ui {
 struct SessionSnapshot {
   Configuration config;
   Experiment experiment;          // trajectory, trials, next correction, where it is saved
+  int first_trial = 0;            // experiment.trials holds iterations first_trial.. (a save needs
+                                  // only the unsaved ones and the last saved one, not the history)
   std::vector<LogEntry> events;   // the operator's and the engine's log (the newest entries)
   std::size_t events_total = 0;   // entries ever logged (EventLog::total()), to tell new ones apart
   std::string device_name;        // e.g. "sim"
@@ -44,8 +47,9 @@ class SessionGateway {
   /// Why save and open are not available (shown to the operator).
   virtual std::string unavailable_reason() const { return "saving sessions is not available in this build"; }
   /// Saves `snapshot`: a new session, or, when `experiment.session_location` is the session this
-  /// gateway opened or saved last, the trials and log entries added since (`experiment.saved_trials`,
-  /// `experiment.saved_events`). Returns the session's location. Throws on failure.
+  /// gateway opened or saved last, what was added since: trials, black boxes, log entries
+  /// (`experiment.saved_events`), changed settings and a changed next correction. The console
+  /// calls it as it goes (autosave). Returns the session's location. Throws on failure.
   virtual std::string save(const SessionSnapshot& snapshot) = 0;
   /// Saved sessions, oldest first.
   virtual std::vector<SessionListing> list() = 0;
@@ -55,6 +59,9 @@ class SessionGateway {
   /// no lock is taken and the session the console saves into stays what it was. Throws when it
   /// cannot be read; the default says it is not available.
   virtual SessionSnapshot read_trials(const std::string& /*location*/) { throw std::runtime_error(unavailable_reason()); }
+  /// Names the session last saved or opened (renames its directory to `name` in the data
+  /// directory) and returns its new location. Throws InputError (bad or taken name).
+  virtual std::string rename(const std::string& name) { throw InputError("naming sessions is not available: " + name); }
 };
 
 /// The gateway when no session store is built in: everything says "not available".

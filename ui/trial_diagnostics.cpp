@@ -13,6 +13,7 @@ const IterationDiagnostics& TrialDiagnostics::observe_latest(const Experiment& e
     monitor_.emplace(input_limit_bar_, experiment.samples());
     trajectory_ = experiment.trajectory.get();
     for (std::size_t i = 0; i + 1 < experiment.trials.size(); ++i) {
+      if (!experiment.trials[i].in_memory()) continue;  // released: on disk only
       monitor_->observe(experiment.trials[i].iteration, experiment.trials[i].record);
     }
   }
