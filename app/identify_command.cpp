@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/signals.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
@@ -42,7 +43,7 @@ TrialFit record_trial(const Configuration& config, const std::string& signal, st
   SimulatedClock clock(core, arm);
   const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
   TrialRecord record;
-  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record);
+  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
   arm.vent();
   return {signal, identification_data(record, config.controller, config.timing.tick_s)};
 }
@@ -136,7 +137,7 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
   progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
            << config.identify.duration_s << " s)" << std::endl;
   const TrialFit estimation = record_trial(config, estimation_signal, options.seed);
-  const ArmModelFit fit = fit_arm_model(estimation.data, config.model);
+  const ArmModelFit fit = fit_arm_model(estimation.data, config.model, &stop_requested());
   progress << "validation trial (" << held_out_signal << ")" << std::endl;
   const TrialFit validation = record_trial(config, held_out_signal, options.seed + 1);
   const double validation_fit =
