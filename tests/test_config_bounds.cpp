@@ -165,7 +165,8 @@ TEST(ConfigBounds, CombinationsOverACostBudgetAreRefusedNamingTheKeys) {
   expect_refused("[timing]\ntick_s = 1e-4\n[safety]\nblack_box_s = 60.0\n", "black_box_s");
   expect_refused("[timing]\ntick_s = 1.0\n[plant]\npwm_period_s = 1.0\nintegration_step_s = 1e-6\n", "integration_step_s");
   expect_refused("[timing]\ntick_s = 1e-4\n[identify]\nduration_s = 600.0\n", "[identify] duration_s");
-  expect_refused("[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n", "settle_s");
+  expect_refused("[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n[identify]\nduration_s = 50.0\n",
+                 "[identify] duration_s");
   // A law whose Q-filter is at or above the Nyquist frequency is refused at load, naming the file.
   expect_refused("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n", "[ilc] pd_q_cutoff_hz");
   expect_refused("[ilc]\nlaw = \"p-type\"\n", "[ilc] law");
@@ -222,6 +223,7 @@ TEST(Cancellation, LongComputationsStopWhenTheirFlagIsSet) {
     const double t = k * data.sample_time_s;
     data.pressure_difference_bar(k) = 0.2 * std::sin(2.0 * M_PI * t) + 0.1 * std::sin(2.0 * M_PI * 3.1 * t);
   }
+  data.angle_rad = Eigen::VectorXd::Zero(400);
   data.angle_rad = simulate_arm_angle(config.model, data);
   EXPECT_THROW(fit_arm_model(data, config.model, &stop), Cancelled);
   EXPECT_NO_THROW(fit_arm_model(data, config.model, &go));
