@@ -65,6 +65,11 @@ void check_trial_cost(const Configuration& config, std::int64_t learning_samples
     over_budget("[ilc] law = 'noilc-dense': learning samples", learning_samples, kMaxDenseLawSamples,
                 "use law 'noilc' (the same optimum in O(N) memory) or a shorter trajectory");
   }
+  const std::int64_t admm_work = learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * config.ilc.admm_max_iterations;
+  if (config.ilc.law == "noilc-constrained" && admm_work > kMaxAdmmWork) {
+    over_budget("[ilc] admm_max_iterations x learning samples (" + std::to_string(learning_samples) + ")", admm_work,
+                kMaxAdmmWork, "lower admm_max_iterations or use a shorter trajectory");
+  }
 }
 
 }  // namespace bellows

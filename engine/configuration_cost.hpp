@@ -20,7 +20,10 @@ inline constexpr std::int64_t kMaxBlackBoxBytes = 64ll << 20;
 /// Steps of the simulated arm's integrator within one tick (tick_s / integration_step_s).
 inline constexpr std::int64_t kMaxIntegrationStepsPerTick = 10'000;
 /// Learning samples of a trial for the dense norm-optimal law, which holds several N x N matrices.
-inline constexpr std::int64_t kMaxDenseLawSamples = 3'000;
+inline constexpr std::int64_t kMaxDenseLawSamples = 4'000;  // ~0.5 GB, as bench/bench_ilc.cpp measures
+/// ADMM iterations times learning samples of one noilc-constrained update (each iteration is a
+/// Riccati sweep over the trial): the longest pause between trials.
+inline constexpr std::int64_t kMaxAdmmWork = 200'000'000;
 }  // namespace cost_budget
 
 /// Checks what the configuration alone implies (black box, integration steps, settling and
@@ -28,8 +31,8 @@ inline constexpr std::int64_t kMaxDenseLawSamples = 3'000;
 /// calls it, so the TOML loader and the session manifest reader both do.
 void check_configuration_cost(const Configuration& config);
 
-/// Checks a trial of `learning_samples` samples with this configuration (its ticks, and the learning
-/// law's matrices), before the law or the record is built. Throws InputError.
+/// Checks a trial of `learning_samples` samples with this configuration (its ticks, the learning
+/// law's matrices and update), before the law or the record is built. Throws InputError.
 void check_trial_cost(const Configuration& config, std::int64_t learning_samples);
 
 }  // namespace bellows

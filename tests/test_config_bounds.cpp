@@ -178,6 +178,11 @@ TEST(ConfigBounds, ATrialOverItsBudgetIsRefusedBeforeTheLawIsBuilt) {
   EXPECT_NO_THROW(check_trial_cost(config, 400));
   EXPECT_THROW(check_trial_cost(config, cost_budget::kMaxTicksPerTrial), InputError);
   EXPECT_THROW(check_trial_cost(config, 2'000'000'000), InputError);  // no overflow into a small count
+  config.ilc.law = "noilc-constrained";
+  config.ilc.admm_max_iterations = 100000;
+  EXPECT_NO_THROW(check_trial_cost(config, 400));
+  EXPECT_THROW(check_trial_cost(config, 10000), InputError);  // 10^9 ADMM sweeps per update
+  config = {};
   config.ilc.law = "noilc-dense";
   const DiscreteArmModel model = discretize_arm_model(config.model, config.timing.sample_s());
   try {
