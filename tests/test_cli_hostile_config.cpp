@@ -155,6 +155,12 @@ TEST(HostileManifest, BadValuesInASavedSessionAreRefusedByShowAndResumeWithoutHa
     expect_one_line_refusal(run({"sessions", "show", data + "/s"}), {"manifest.json", key});
     expect_one_line_refusal(run({"run", "--resume", data + "/s", "--iterations", "1"}), {"manifest.json", key});
   }
+  // A trial far longer than the configuration allows is refused before its files are read.
+  nlohmann::ordered_json json = nlohmann::ordered_json::parse(original);
+  json["trajectory"]["learning_samples"] = 50'000'000;
+  testing::write_text(manifest, json.dump(2));
+  expect_one_line_refusal(run({"sessions", "show", data + "/s"}), {"manifest.json", "learning_samples", "ticks per trial"});
+  expect_one_line_refusal(run({"run", "--resume", data + "/s", "--iterations", "1"}), {"learning_samples"});
   // The refusals held no lock: the repaired session resumes.
   testing::write_text(manifest, original);
   const ProcessResult resumed = run({"run", "--resume", data + "/s", "--iterations", "1"});
