@@ -212,6 +212,15 @@ void validate_configuration(const Configuration& config) {
   if (config.trajectory.max_abs_angle_deg >= config.safety.angle_limit_deg) {
     throw InputError("[trajectory] max_abs_angle_deg must be below [safety] angle_limit_deg");
   }
+  if (config.safety.sensor_min_bar >= config.safety.sensor_max_bar) {
+    throw InputError("[safety] sensor_min_bar must be below [safety] sensor_max_bar");
+  }
+  if (config.identify.chirp_start_hz >= config.identify.chirp_end_hz) {
+    throw InputError("[identify] chirp_start_hz must be below [identify] chirp_end_hz");
+  }
+  if (config.identify.amplitude_deg >= config.identify.max_abs_angle_deg) {
+    throw InputError("[identify] amplitude_deg must be below [identify] max_abs_angle_deg");
+  }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");
   }

@@ -170,6 +170,10 @@ TEST(ConfigBounds, CombinationsOverACostBudgetAreRefusedNamingTheKeys) {
   // A law whose Q-filter is at or above the Nyquist frequency is refused at load, naming the file.
   expect_refused("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n", "[ilc] pd_q_cutoff_hz");
   expect_refused("[ilc]\nlaw = \"p-type\"\n", "[ilc] law");
+  expect_refused("[safety]\nsensor_min_bar = 12.0\n", "[safety] sensor_min_bar");
+  expect_refused("[identify]\nchirp_start_hz = 5.0\n", "[identify] chirp_start_hz");
+  expect_refused("[identify]\namplitude_deg = 70.0\n", "[identify] amplitude_deg");
+  expect_refused("[ilc]\nlaw = \"noilc-dense\"\ns = 0.0\nw = 0.0\n", "[ilc] s, w");
   expect_refused("[identify]\nsignal = \"noise\"\n", "[identify] signal");
 }
 
