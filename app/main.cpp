@@ -12,6 +12,7 @@
 #include "app/io_sim_command.hpp"
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
+#include "app/t7_sim_command.hpp"
 #include "app/signals.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/cancellation.hpp"
@@ -20,7 +21,7 @@
 using bellows::kExitBadInput;
 
 namespace {
-// Longest --duration / --exit-after: a year, far beyond any run, far below a double's range.
+// Longest --duration / --exit-after / --silent-after: a year, far beyond any run, far below a double's range.
 constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
@@ -81,9 +82,12 @@ int main(int argc, char** argv) {
   }
   export_cmd->add_option("--format", sessions.format, "csv or mat")->capture_default_str()->check(CLI::IsMember({"csv", "mat"}));
   export_cmd->add_option("--output", sessions.output, "File to write (default: <session>.csv or .mat here)");
-  run_cmd->add_option("--device", run.device, "sim: the simulated arm in-process; lcm: a rig over LCM (--clock wall)")
+  run_cmd->add_option("--device", run.device,
+                      "sim: the simulated arm in-process; lcm: a rig over LCM; t7: a LabJack T7 over Modbus TCP (both --clock wall)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"sim", "lcm"}));
+      ->check(CLI::IsMember({"sim", "lcm", "t7"}));
+  run_cmd->add_option("--t7", run.t7_address, "--device t7: the T7's address HOST[:PORT] (port 502 by default)");
+  run_cmd->add_option("--rig-profile", run.rig_profile, "--device t7: the rig profile (default: the paper rig's)");
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find the rig there)");
   CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
                                              "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
@@ -104,6 +108,25 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
+
+  bellows::T7SimCommandOptions t7_sim;
+  CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
+  t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on")->capture_default_str();
+  t7_sim_cmd->add_option("--config", t7_sim.config_path, "TOML configuration file ([plant])");
+  t7_sim_cmd->add_option("--rig-profile", t7_sim.rig_profile, "Rig profile (default: the paper rig's)");
+  t7_sim_cmd->add_option("--seed", t7_sim.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
+  t7_sim_cmd->add_option("--duration", t7_sim.duration_s, "Stop after this many seconds (0: at SIGINT/SIGTERM)")
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--status", t7_sim.status_path, "Keep the valve lines' state in this JSON file (docs/labjack-t7.md)");
+  t7_sim_cmd->add_flag("--swapped-chambers", t7_sim.swapped_chambers, "Drill: chamber A's and B's transmitters swapped");
+  t7_sim_cmd->add_option("--dead-valve", t7_sim.dead_valve, "Drill: this valve pair never opens")
+      ->check(CLI::IsMember({"inlet_a", "inlet_b", "outlet_a", "outlet_b"}));
+  t7_sim_cmd->add_flag("--no-supply", t7_sim.no_supply, "Drill: the supply at ambient pressure");
+  t7_sim_cmd->add_option("--silent-after", t7_sim.silent_after_s, "Drill: the link falls silent this many seconds after the first request")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
@@ -163,6 +186,7 @@ int main(int argc, char** argv) {
     run.lcm_log = lcm_log->count() > 0;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
+    if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);
     if (config_cmd->parsed()) {
       const bellows::Configuration config =
           config_path.empty() ? bellows::Configuration{} : bellows::load_config_file(config_path);

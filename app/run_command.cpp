@@ -176,6 +176,12 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                         {"rt", loop->rt_description()},
                         {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
                         {"speed", options.speed}};
+      if (const DeviceHealth h = device.health(); h.has_link) {  // the link's figures, e.g. the T7's Modbus round trip
+        report["loop"]["link"] = {{"round_trip_ms", {{"p50", h.round_trip_p50_ms}, {"p99", h.round_trip_p99_ms}, {"max", h.round_trip_max_ms}}},
+                                  {"exchanges", h.exchanges},
+                                  {"errors", h.link_errors},
+                                  {"stale_readings", h.stale_readings}};
+      }
     }
     out << report.dump() << std::endl;
   }

@@ -24,10 +24,12 @@ struct RunOptions {
   std::string data_dir;      // empty: $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions
   std::string session_name;  // empty: start time and trajectory
   std::string resume_dir;    // continue this session (its configuration, trajectory and state)
-  std::string device = "sim";  // sim: the simulated arm in-process; lcm: a rig over LCM (wall clock only)
+  std::string device = "sim";  // sim: the simulated arm in-process; lcm: a rig over LCM; t7: a LabJack T7 (wall clock only)
   std::string lcm_url;         // --lcm URL: publish telemetry there (and find the rig there)
   bool lcm_log = false;        // --lcm-log [FILE]: an LCM event log of the telemetry,
   std::string lcm_log_file;    //   in FILE, or (no FILE) in the session directory
+  std::string t7_address;      // --t7 HOST[:PORT] with --device t7
+  std::string rig_profile;     // --rig-profile FILE with --device t7 ("": the paper rig's)
 };
 
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "app/t7_wiring.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/errors.hpp"
 
@@ -44,25 +45,36 @@ nlohmann::json receive_counts_json(const ReceiveCounts& c) {
 
 RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config)
     : options_(options), config_(config), telemetry_(!options.lcm_url.empty() || options.lcm_log) {
-  if (options.device != "sim" && options.device != "lcm") throw InputError("--device must be sim or lcm, not '" + options.device + "'");
+  if (options.device != "sim" && options.device != "lcm" && options.device != "t7") {
+    throw InputError("--device must be sim, lcm or t7, not '" + options.device + "'");
+  }
+  if (options.device != "t7" && (!options.t7_address.empty() || !options.rig_profile.empty())) {
+    throw InputError("--t7 and --rig-profile go with --device t7");
+  }
   if (options.lcm_log && options.lcm_log_file.empty() && options.no_save) {
     throw InputError("--lcm-log without a FILE writes into the session directory: name a FILE with --no-save");
   }
   if (options.lcm_log && !options.lcm_log_file.empty() && std::filesystem::exists(options.lcm_log_file)) {
     throw InputError("the LCM log '" + options.lcm_log_file + "' exists already; nothing is overwritten, name a new file");
   }
-  if (options.device == "lcm") {
+  if (options.device == "lcm" || options.device == "t7") {
+    const std::string flag = "--device " + options.device;
     if (options.clock != "wall") {
-      throw InputError("--device lcm needs --clock wall: a real rig's time passes on its own and cannot be simulated");
+      throw InputError(flag + " needs --clock wall: a real rig's time passes on its own and cannot be simulated");
     }
-    if (speed != 1.0) throw InputError("--device lcm runs in real time: --speed must be 1");
-    if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with --device lcm");
+    if (speed != 1.0) throw InputError(flag + " runs in real time: --speed must be 1");
+    if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with " + flag);
+  }
+  if (options.device == "t7") {
+    if (options.t7_address.empty()) throw InputError("--device t7 needs --t7 HOST[:PORT]");
+    t7_device_ = open_t7_device({options.t7_address, options.rig_profile, options.rt != RealtimeMode::kOff}, config);
   }
   if (options.device == "lcm" || telemetry_) session_id_ = LcmDevice::random_session_id();
   if (options.device == "sim") {
     arm_ = std::make_unique<SimulatedArm>(config.plant, seed);
     return;
   }
+  if (options.device == "t7") return;
   lcm_device_ = std::make_unique<LcmDevice>(session_id_);
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
   device_io_ = std::make_unique<LcmIoThread>(url, std::vector<LcmEndpoint*>{lcm_device_.get()});
@@ -72,6 +84,7 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
 RunIo::~RunIo() { stop(); }
 
 Device& RunIo::device() {
+  if (t7_device_) return *t7_device_;
   if (lcm_device_) return *lcm_device_;
   return *arm_;
 }

@@ -80,6 +80,7 @@ class RunIo {
   bool telemetry_ = false;
   std::unique_ptr<SimulatedArm> arm_;
   std::unique_ptr<LcmDevice> lcm_device_;
+  std::unique_ptr<Device> t7_device_;  // --device t7 (app/t7_wiring.hpp)
   std::unique_ptr<LcmIoThread> device_io_;
   TelemetryRing* tap_ = nullptr;
   std::string log_path_;

@@ -133,6 +133,10 @@ std::vector<ParameterBinding> make_bindings() {
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", pos(180.0), [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
       number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", pos(60.0), [](C& c) { return &c.lcm.rig_timeout_s; }),
       number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", pos(3600.0), [](C& c) { return &c.lcm.connect_timeout_s; }),
+      number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", pos(1.0), [](C& c) { return &c.t7.response_timeout_s; }),
+      number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", pos(3600.0), [](C& c) { return &c.t7.connect_timeout_s; }),
+      whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds)", count(3600), [](C& c) { return &c.t7.watchdog_timeout_s; }),
+      number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", pos(60.0), [](C& c) { return &c.t7.command_timeout_s; }),
   };
   const ParameterBinding fault = name("plant", "fault", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike",
                                       [](C& c) { return &c.plant.fault; });

@@ -23,6 +23,7 @@ struct Configuration {
   TrajectoryLimits trajectory;
   SafetyParameters safety;
   LcmParameters lcm;
+  T7Parameters t7;
 };
 
 /// The values a number may take: [min, max], either end open. Every key has one, documented in

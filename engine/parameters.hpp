@@ -131,4 +131,12 @@ struct LcmParameters {
   double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
 };
 
+/// A LabJack T7 over Modbus TCP (docs/labjack-t7.md); the engine itself knows no Modbus.
+struct T7Parameters {
+  double response_timeout_s = 0.004;  // one Modbus request waits this long for its answer (under a tick)
+  double connect_timeout_s = 2.0;     // opening the TCP connection and configuring the T7
+  int watchdog_timeout_s = 1;         // the T7 vents by itself after this much silence (whole s, >= 1)
+  double command_timeout_s = 0.05;    // the I/O thread vents when the engine sends no command this long
+};
+
 }  // namespace bellows

@@ -1,0 +1,115 @@
+// A LabJack T7 over Modbus TCP (`--device t7`, docs/labjack-t7.md).
+//
+// The constructor connects, checks that a T7 answers and configures it: the T7's own watchdog
+// (the backstop: it puts the valve lines in their safe state after watchdog_timeout_s of silence,
+// even when bellows was killed), the analog input ranges, the PWM clock and the four PWM lines,
+// vented. Then an I/O thread of its own does all Modbus traffic; the engine thread only touches
+// lock-free latest-value buffers:
+// - write_valves()/vent() leave the desired duty cycles in the outbox;
+// - each new command makes the I/O thread do one exchange: one write of the four duty cycles and
+//   one read of every analog input, then it hands the calibrated reading to read_sensors().
+// So the engine's tick costs no system call, and there is at most one write and one read per tick.
+// A failed or timed-out exchange hands nothing over: the engine sees stale readings and, after
+// [safety] stale_ticks of them, faults (sensor-stale) and vents. There is no reconnect: once the
+// link has failed it stays down until bellows is restarted (the I/O thread reports it on stderr).
+// Without commands (the engine not running) the I/O thread vents after [t7] command_timeout_s and
+// keeps reading every tick, which keeps the watchdog fed and raw_inputs() live.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "devices/modbus_client.hpp"
+#include "devices/rig_profile.hpp"
+#include "devices/t7_registers.hpp"
+#include "engine/device.hpp"
+#include "engine/latest_value.hpp"
+#include "engine/parameters.hpp"
+
+namespace bellows {
+
+struct T7DeviceOptions {
+  std::string host = "127.0.0.1";
+  int port = 502;
+  RigProfile profile;
+  T7Parameters link;
+  double tick_s = 1.0 / 200.0;  // the idle exchange period
+  bool realtime = true;         // ask for SCHED_FIFO for the I/O thread (ignored when refused)
+  int priority = 70;            // just below the engine loop
+};
+
+class T7Device final : public Device {
+ public:
+  /// Connects and configures. Throws EnvironmentError when the address cannot be reached, does not
+  /// answer as a T7, or refuses the configuration (the message names the address and the register).
+  explicit T7Device(T7DeviceOptions options);
+  /// Vents (one last write of the duty cycles) and closes the link.
+  ~T7Device() override;
+  /// Stops the I/O thread after its last exchange, which vents; the engine loop must have stopped.
+  /// Idempotent (the destructor calls it).
+  void stop();
+
+  // ---- Device: engine thread ----
+  SensorReading read_sensors() override;
+  void write_valves(const ValveCommand& command) override;
+  void vent() override;
+  void advance(double) override {}  // a real rig's time passes on its own
+  const char* name() const override { return "t7"; }
+
+  // ---- any thread ----
+  DeviceHealth health() const override;
+  RawInputs raw_inputs() const override;
+  /// "host:port".
+  const std::string& address() const { return address_; }
+  const RigProfile& profile() const { return options_.profile; }
+  /// Why the link failed ("" while it works). Set once, by the I/O thread.
+  std::string link_error() const;
+
+ private:
+  struct Outgoing {
+    ValveCommand valves = ValveCommand::vented();
+  };
+
+  void configure();
+  void configure_watchdog();
+  void require(bool ok, const char* what);
+  void serve();
+  bool exchange(const ValveCommand& valves);
+  void encode_duties(const ValveCommand& valves);
+  void record_round_trip(double ms);
+  void fail_link();
+
+  T7DeviceOptions options_;
+  std::string address_;
+  ModbusClient client_;
+  t7::PwmClock clock_;
+  int first_dio_ = 0, dio_span_ = 0;  // the CONFIG_A block written each exchange
+  int ain_registers_ = 0;             // AIN0.. up to the highest input used, two registers each
+
+  LatestValue<Outgoing> outbox_;        // engine -> I/O
+  LatestValue<SensorReading> inbox_;    // I/O -> engine
+  SensorReading reading_{};             // engine thread's copy
+
+  // I/O thread state (preallocated: the thread allocates nothing per exchange).
+  std::vector<std::uint16_t> duty_registers_;
+  std::vector<std::uint16_t> ain_buffer_;
+  std::vector<double> round_trips_ms_;  // ring of the latest exchanges
+  std::vector<double> scratch_ms_;
+  std::size_t round_trip_count_ = 0;
+  double origin_s_ = 0.0;
+  double last_time_s_ = 0.0;
+
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> link_up_{true};
+  std::atomic<bool> error_published_{false};
+  std::string link_error_;  // written once before error_published_
+  std::array<std::atomic<double>, kSensorRoleCount> volts_{};
+  std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
+  std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0};
+};
+
+}  // namespace bellows

@@ -1,0 +1,96 @@
+#include "devices/t7_sim_registers.hpp"
+
+#include <modbus/modbus.h>
+
+#include "devices/t7_registers.hpp"
+
+namespace bellows {
+namespace {
+constexpr std::uint8_t kUnknown = 0, kReadOnly = 1, kReadWrite = 2;
+}
+
+T7SimRegisters::T7SimRegisters() : registers_(kSize, 0), access_(kSize, kUnknown) {
+  using namespace t7;
+  allow(kAin(0), 2 * kAinCount, false);
+  allow(kAinRange(0), 2 * kAinCount, true);
+  for (int first : {kDioEfEnable(0), kDioEfIndex(0), kDioEfClockSource(0), kDioEfConfigA(0)}) allow(first, 2 * kDioCount, true);
+  allow(kClock0Enable, 6, true);    // ENABLE, DIVISOR, OPTIONS, ROLL_VALUE
+  allow(44908, 2, false);           // DIO_EF_CLOCK0_COUNT
+  allow(kDioState, 2, true);
+  allow(kDioDirection, 2, true);
+  allow(kProductId, 2, false);
+  allow(kFirmwareVersion, 2, false);
+  allow(kSerialNumber, 2, false);
+  for (int first : {kWatchdogEnable, kWatchdogAdvanced, kWatchdogTimeout_s, kWatchdogStartupDelay_s, kWatchdogStrictEnable,
+                    kWatchdogStrictKey, kWatchdogStrictClear, kWatchdogResetEnable, kWatchdogDioEnable, kWatchdogDioState,
+                    kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
+    allow(first, 2, true);
+  }
+  put_float(kT7ProductId, &registers_[kProductId]);
+  put_float(1.0299, &registers_[kFirmwareVersion]);
+  set_u32(kSerialNumber, 470000000u);
+  registers_[kClock0Divisor] = 1;
+}
+
+void T7SimRegisters::allow(int first, int count, bool writable) {
+  for (int a = first; a < first + count; ++a) access_[static_cast<std::size_t>(a)] = writable ? kReadWrite : kReadOnly;
+}
+
+int T7SimRegisters::check(int function, int address, int count) const {
+  const bool write = function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS;
+  if (!write && function != MODBUS_FC_READ_HOLDING_REGISTERS && function != MODBUS_FC_READ_INPUT_REGISTERS) {
+    return MODBUS_EXCEPTION_ILLEGAL_FUNCTION;
+  }
+  if (count < 1 || address < 0 || address + count > kSize) return t7::kExceptionIllegalDataAddress;
+  for (int a = address; a < address + count; ++a) {
+    const std::uint8_t access = access_[static_cast<std::size_t>(a)];
+    if (access == kUnknown || (write && access != kReadWrite)) return t7::kExceptionIllegalDataAddress;
+  }
+  return 0;
+}
+
+std::uint32_t T7SimRegisters::u32(int address) const { return t7::get_u32(&registers_[static_cast<std::size_t>(address)]); }
+void T7SimRegisters::set_u32(int address, std::uint32_t value) { t7::put_u32(value, &registers_[static_cast<std::size_t>(address)]); }
+
+void T7SimRegisters::set_ain(int ain, double volts) {
+  t7::put_float(volts, &registers_[static_cast<std::size_t>(t7::kAin(ain))]);
+}
+
+double T7SimRegisters::line_duty(int dio) const {
+  using namespace t7;
+  const bool clock_on = registers_[kClock0Enable] == 1;
+  if (u32(kDioEfEnable(dio)) == 1 && u32(kDioEfIndex(dio)) == kEfIndexPwmOut && clock_on) {
+    PwmClock clock{registers_[kClock0Divisor], u32(kClock0RollValue)};
+    return clock.duty(u32(kDioEfConfigA(dio)));
+  }
+  const std::uint32_t bit = 1u << dio;
+  if ((u32(kDioDirection) & bit) != 0) return (u32(kDioState) & bit) != 0 ? 1.0 : 0.0;
+  return 0.0;  // an input: the driver's pull-down holds the valve closed
+}
+
+bool T7SimRegisters::watchdog_enabled() const { return u32(t7::kWatchdogEnable) == 1; }
+std::uint32_t T7SimRegisters::watchdog_timeout_s() const { return u32(t7::kWatchdogTimeout_s); }
+
+bool T7SimRegisters::run_watchdog(double now_s) {
+  using namespace t7;
+  if (!watchdog_enabled()) return false;
+  const double timeout = static_cast<double>(std::max<std::uint32_t>(1, watchdog_timeout_s()));
+  if (now_s - last_answer_s_ < timeout) return false;
+  last_answer_s_ = now_s;  // it acts again after another timeout of silence
+  if (u32(kWatchdogAdvanced) == kWatchdogAdvancedIoConfigToDefault || u32(kWatchdogResetEnable) == 1) {
+    for (int dio = 0; dio < kDioCount; ++dio) set_u32(kDioEfEnable(dio), 0);  // power-up: no EF, all inputs
+    set_u32(kDioDirection, 0);
+    set_u32(kDioState, 0);
+  }
+  if (u32(kWatchdogDioEnable) == 1) {
+    const std::uint32_t direction = u32(kWatchdogDioDirection);
+    for (int dio = 0; dio < kDioCount; ++dio) {
+      if ((direction & (1u << dio)) != 0) set_u32(kDioEfEnable(dio), 0);  // a line the watchdog sets is a plain output
+    }
+    set_u32(kDioDirection, u32(kDioDirection) | direction);
+    set_u32(kDioState, (u32(kDioState) & ~direction) | (u32(kWatchdogDioState) & direction));
+  }
+  return true;
+}
+
+}  // namespace bellows

@@ -1,0 +1,54 @@
+// The register side of `bellows t7-sim`: the subset of a T7's Modbus map bellows uses, what the
+// lines output, and the T7's watchdog, as docs/labjack-t7.md describes the real one.
+// - Known addresses only: any other one, or a write to a read-only one, is answered with Modbus
+//   exception 2 (ILLEGAL DATA ADDRESS), as a T7 does; a function other than 3, 4, 6, 16 with 1.
+// - A line's output: PWM (EF enabled, index 0, clock 0 enabled) at CONFIG_A / roll; else an output
+//   at its DIO_STATE bit; else an input, which the valve driver's pull-down reads as closed.
+// - The watchdog counts from the last answered request; on timeout it resets the IO configuration
+//   to its power-up defaults (every EF off, every line an input) when WATCHDOG_ADVANCED_DEFAULT
+//   asks for it, then sets the lines WATCHDOG_DIO_DIRECTION/STATE_DEFAULT name, and starts over.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bellows {
+
+class T7SimRegisters {
+ public:
+  T7SimRegisters();
+
+  /// The whole 16-bit register space; the server's Modbus mapping points into it.
+  std::uint16_t* data() { return registers_.data(); }
+  static constexpr int kSize = 65536;
+
+  /// The Modbus exception for a request (function, first address, register count), or 0 to serve it.
+  int check(int function, int address, int count) const;
+
+  /// The duty cycle line `dio` outputs now, in [0, 1].
+  double line_duty(int dio) const;
+
+  /// Writes volts into AIN#.
+  void set_ain(int ain, double volts);
+
+  /// A request was answered at `now_s`: the watchdog starts over.
+  void answered(double now_s) { last_answer_s_ = now_s; }
+  /// Runs the watchdog; true when it acted at this call.
+  bool run_watchdog(double now_s);
+  bool watchdog_enabled() const;
+  std::uint32_t watchdog_timeout_s() const;
+  double last_answer_s() const { return last_answer_s_; }
+
+  std::uint32_t u32(int address) const;
+  void set_u32(int address, std::uint32_t value);
+
+ private:
+  void allow(int first, int count, bool writable);
+
+  std::vector<std::uint16_t> registers_;
+  std::vector<std::uint8_t> access_;  // 0 unknown, 1 read only, 2 read-write
+  double last_answer_s_ = 0.0;
+};
+
+}  // namespace bellows

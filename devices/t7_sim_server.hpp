@@ -1,0 +1,98 @@
+// `bellows t7-sim`: a Modbus TCP server that behaves as the subset of a LabJack T7 bellows uses
+// (devices/t7_sim_registers.hpp), with the simulated arm behind it in real time. The arm's sensor
+// values (noise included) become input voltages through the inverse of the rig profile's
+// calibration; the duty cycles the PWM lines output drive the arm's valves. Drills make it
+// misbehave: swapped chamber wiring, a dead valve, no supply, a silent link.
+//
+// Its valve state can be read by tests and scripts from a status file (JSON, rewritten atomically
+// at most every 10 ms and at every watchdog action; docs/labjack-t7.md has its fields), and each
+// watchdog action is also a line on stdout.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "devices/rig_profile.hpp"
+#include "devices/simulated_arm.hpp"
+#include "devices/t7_sim_registers.hpp"
+
+typedef struct _modbus modbus_t;
+
+namespace bellows {
+
+struct T7SimOptions {
+  std::string host = "127.0.0.1";
+  int port = 5020;                     // 0: any free port (port() tells which)
+  RigProfile profile;
+  PlantParameters plant;
+  std::uint64_t seed = 1;
+  bool swapped_chambers = false;       // chamber A's transmitter wired to chamber B's input and back
+  std::optional<ValveRole> dead_valve; // this valve pair never opens, whatever its line does
+  bool no_supply = false;              // the supply at ambient pressure
+  double silent_after_s = -1.0;        // >= 0: the link goes silent this long after the first request
+  std::string status_path;             // "": no status file
+};
+
+/// What the T7's lines output and what its watchdog did, for tests and scripts.
+struct T7SimStatus {
+  double time_s = 0.0;                          // since the server started
+  std::array<double, kValveRoleCount> duty{};   // by ValveRole: the duty cycle its line outputs
+  bool safe = true;                             // inlets closed, outlets open
+  double safe_since_s = 0.0;                    // when the lines last became safe (-1: not safe)
+  double last_request_s = -1.0;                 // when a request was last answered (-1: never)
+  bool watchdog_enabled = false;
+  std::uint32_t watchdog_timeout_s = 0;
+  int watchdog_actions = 0;
+  double last_watchdog_action_s = -1.0;
+  std::uint64_t requests = 0;                   // answered
+  std::uint64_t exceptions = 0;                 // answered with a Modbus exception
+  int clients = 0;                              // connected now
+  bool silent = false;
+};
+
+class T7SimServer {
+ public:
+  /// Listens on host:port. Throws EnvironmentError when it cannot.
+  explicit T7SimServer(T7SimOptions options);
+  ~T7SimServer();
+  T7SimServer(const T7SimServer&) = delete;
+  T7SimServer& operator=(const T7SimServer&) = delete;
+
+  int port() const { return port_; }
+  /// Serves until `should_stop()` (checked at least every millisecond). `events` gets one line per
+  /// watchdog action and per client that comes or goes.
+  void run(const std::function<bool()>& should_stop, const std::function<void(const std::string&)>& events);
+  T7SimStatus status() const;
+
+ private:
+  double now_s() const;
+  void advance_arm(double now);
+  void update_inputs();
+  void apply_lines(double now);
+  void serve_client(int fd, double now, const std::function<void(const std::string&)>& events);
+  void write_status(double now, bool force);
+
+  T7SimOptions options_;
+  modbus_t* context_ = nullptr;
+  int listen_fd_ = -1;
+  int port_ = 0;
+  std::vector<int> clients_;
+  T7SimRegisters registers_;
+  SimulatedArm arm_;
+  double start_s_ = 0.0;
+  double arm_time_s_ = 0.0;   // wall time the arm has been advanced to (since start)
+  double first_request_s_ = -1.0;
+  double last_status_write_s_ = -1.0;
+  T7SimStatus status_;                // the server thread's; published copies under the mutex
+  mutable std::mutex published_mutex_;
+  T7SimStatus published_;
+  std::vector<std::uint8_t> query_;
+};
+
+}  // namespace bellows

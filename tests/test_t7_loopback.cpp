@@ -1,0 +1,278 @@
+// The T7 device against t7-sim's server in the same process, on 127.0.0.1 (a free port): the
+// configuration it writes, duty cycles and calibrated readings both ways, health and raw inputs,
+// the exception for an unknown register, the watchdog, and a link that dies.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <thread>
+
+#include "app/rig_profile_file.hpp"
+#include "devices/modbus_client.hpp"
+#include "devices/t7_device.hpp"
+#include "devices/t7_sim_server.hpp"
+#include "engine/errors.hpp"
+#include "engine/safety.hpp"
+
+namespace bellows {
+namespace {
+
+/// t7-sim's server on its own thread, on a free loopback port.
+class SimThread {
+ public:
+  explicit SimThread(T7SimOptions options = {}) {
+    if (options.profile.name.empty()) options.profile = paper_rig_profile();
+    options.port = 0;
+    server_ = std::make_unique<T7SimServer>(std::move(options));
+    thread_ = std::thread([this] { server_->run([this] { return stop_.load(); }, [](const std::string&) {}); });
+  }
+  ~SimThread() { stop(); }
+  void stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  int port() const { return server_->port(); }
+  T7SimStatus status() const { return server_->status(); }
+
+ private:
+  std::unique_ptr<T7SimServer> server_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+T7DeviceOptions device_options(int port) {
+  T7DeviceOptions o;
+  o.port = port;
+  o.profile = paper_rig_profile();
+  o.realtime = false;
+  o.link.response_timeout_s = 0.05;  // a loaded test machine: the timeout is not what is tested here
+  return o;
+}
+
+/// Polls `done` for up to 10 s (a generous bound for a loaded machine; no timing is asserted).
+bool eventually(const std::function<bool()>& done) {
+  for (int i = 0; i < 1000; ++i) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return done();
+}
+
+TEST(T7Loopback, ConnectingConfiguresTheWatchdogAndLeavesTheValvesVented) {
+  SimThread sim;
+  T7Device device(device_options(sim.port()));
+  ASSERT_TRUE(eventually([&] { return sim.status().requests > 30 && sim.status().watchdog_enabled; }));
+  const T7SimStatus s = sim.status();
+  EXPECT_EQ(s.watchdog_timeout_s, 1u);
+  EXPECT_TRUE(s.safe);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kOutletA)], 1.0);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kInletA)], 0.0);
+  EXPECT_EQ(s.exceptions, 0u);  // every register bellows touches exists on a T7
+}
+
+TEST(T7Loopback, DutyCyclesReachTheLinesAndCalibratedReadingsComeBack) {
+  SimThread sim;
+  T7Device device(device_options(sim.port()));
+  ValveCommand command;
+  command.inlet_duty = {0.25, 0.0};
+  command.outlet_duty = {0.0, 0.5};
+  // The engine sends a command every tick; so does this loop, until the lines show it.
+  ASSERT_TRUE(eventually([&] {
+    device.write_valves(command);
+    const T7SimStatus s = sim.status();
+    return s.duty[0] == 0.25 && s.duty[1] == 0.0 && s.duty[2] == 0.0 && s.duty[3] == 0.5;
+  }));
+  EXPECT_FALSE(sim.status().safe);
+  device.vent();
+  ASSERT_TRUE(eventually([&] { return sim.status().safe; }));
+
+  SensorReading r;
+  ASSERT_TRUE(eventually([&] {
+    r = device.read_sensors();
+    return r.time_s > 0.0;
+  }));
+  const PlantParameters plant;
+  EXPECT_NEAR(r.supply_bar, plant.supply_bar, 0.05);            // through volts and back
+  EXPECT_NEAR(r.temperature_K, plant.gas.temperature_K, 0.5);
+  EXPECT_LT(std::abs(r.angle_rad), 0.2);
+  EXPECT_GT(r.chamber_bar[0], 0.9);
+
+  const RawInputs raw = device.raw_inputs();
+  ASSERT_EQ(raw.count, 5);
+  EXPECT_STREQ(raw.inputs[2].name, "supply");
+  EXPECT_STREQ(raw.inputs[2].unit, "bar");
+  EXPECT_NEAR(raw.inputs[2].volts, plant.supply_bar - plant.gas.ambient_bar, 0.05);  // 1 bar per volt above ambient
+  EXPECT_STREQ(raw.inputs[3].unit, "deg");
+
+  const DeviceHealth h = device.health();
+  EXPECT_TRUE(h.has_link);
+  EXPECT_TRUE(h.connected);
+  EXPECT_GT(h.exchanges, 0u);
+  EXPECT_EQ(h.link_errors, 0u);
+  EXPECT_GT(h.round_trip_max_ms, 0.0);
+  EXPECT_LE(h.round_trip_p50_ms, h.round_trip_max_ms);
+}
+
+TEST(T7Loopback, WhenTheEngineFallsSilentTheLinkVentsByItselfAndKeepsTheWatchdogFed) {
+  SimThread sim;
+  T7Device device(device_options(sim.port()));
+  ValveCommand open_inlet;
+  open_inlet.inlet_duty = {1.0, 0.0};
+  open_inlet.outlet_duty = {0.0, 1.0};
+  ASSERT_TRUE(eventually([&] {
+    device.write_valves(open_inlet);
+    return sim.status().duty[static_cast<int>(ValveRole::kInletA)] == 1.0;
+  }));
+  // No more commands (a hung engine loop): within [t7] command_timeout_s the I/O thread vents.
+  ASSERT_TRUE(eventually([&] { return sim.status().safe; }));
+  // It keeps exchanging, so the T7's watchdog never has to act while bellows lives.
+  const std::uint64_t exchanges = device.health().exchanges;
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > exchanges + 10; }));
+  EXPECT_EQ(sim.status().watchdog_actions, 0);
+}
+
+TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {
+  T7SimOptions options;
+  options.swapped_chambers = true;
+  SimThread sim(options);
+  T7Device device(device_options(sim.port()));
+  ValveCommand inflate_a;
+  inflate_a.inlet_duty = {1.0, 0.0};
+  inflate_a.outlet_duty = {0.0, 1.0};
+  SensorReading r;
+  ASSERT_TRUE(eventually([&] {
+    device.write_valves(inflate_a);
+    r = device.read_sensors();
+    return r.chamber_bar[1] > 1.5;  // chamber A fills, but its pressure shows on B's input
+  }));
+  EXPECT_LT(r.chamber_bar[0], r.chamber_bar[1] - 0.1);
+  device.vent();
+}
+
+TEST(T7Loopback, AVoltageOutsideItsValidRangeIsASensorRangeFault) {
+  SimThread sim;
+  T7DeviceOptions options = device_options(sim.port());
+  options.profile.input(SensorRole::kSupply).volts_max_V = 1.0;  // the simulated supply reads ~2 V
+  T7Device device(options);
+  SensorReading r;
+  ASSERT_TRUE(eventually([&] {
+    r = device.read_sensors();
+    return r.time_s > 0.0;
+  }));
+  EXPECT_EQ(r.supply_bar, kOutOfRangePressure_bar);
+  GuardInputs inputs;
+  inputs.p_max_bar = ControllerParameters{}.p_max_bar;
+  EXPECT_EQ(check_guards(r, inputs, SafetyParameters{}), FaultCode::kSensorOutOfRange);
+}
+
+/// Chamber B after its inlet line has been fully open (outlet shut) for 200 ms.
+double chamber_b_after_inflating(T7SimOptions options, double& supply_bar) {
+  SimThread sim(std::move(options));
+  T7Device device(device_options(sim.port()));
+  ValveCommand inflate_b;
+  inflate_b.inlet_duty = {0.0, 1.0};
+  inflate_b.outlet_duty = {1.0, 0.0};
+  EXPECT_TRUE(eventually([&] {
+    device.write_valves(inflate_b);
+    return sim.status().duty[static_cast<int>(ValveRole::kInletB)] == 1.0;
+  }));
+  for (int i = 0; i < 40; ++i) {  // 200 ms of ticks
+    device.write_valves(inflate_b);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const SensorReading r = device.read_sensors();
+  supply_bar = r.supply_bar;
+  device.vent();
+  return r.chamber_bar[1];
+}
+
+TEST(T7Loopback, DrillsADeadInletAndNoSupply) {
+  const PlantParameters plant;
+  double supply_bar = 0.0;
+  EXPECT_GT(chamber_b_after_inflating({}, supply_bar), plant.gas.ambient_bar + 0.3);  // a healthy rig inflates
+  EXPECT_NEAR(supply_bar, plant.supply_bar, 0.05);
+  T7SimOptions dead;
+  dead.dead_valve = ValveRole::kInletB;
+  EXPECT_LT(chamber_b_after_inflating(dead, supply_bar), plant.gas.ambient_bar + 0.1);  // its line opens, the valve not
+  T7SimOptions no_supply;
+  no_supply.no_supply = true;
+  EXPECT_LT(chamber_b_after_inflating(no_supply, supply_bar), plant.gas.ambient_bar + 0.1);
+  EXPECT_NEAR(supply_bar, plant.gas.ambient_bar, 0.05);
+}
+
+TEST(T7Loopback, AnUnknownRegisterGetsTheExceptionAT7Gives) {
+  SimThread sim;
+  ModbusClient client("127.0.0.1", sim.port());
+  ASSERT_EQ(client.connect(2.0), "");
+  client.set_response_timeout(1.0);
+  std::uint16_t registers[2];
+  EXPECT_FALSE(client.read(12345, 2, registers));
+  EXPECT_NE(client.last_error().find("Modbus exception 2"), std::string::npos) << client.last_error();
+  EXPECT_FALSE(client.write_float(t7::kAin(0), 1.0));  // AIN# is read only
+  EXPECT_NE(client.last_error().find("Modbus exception 2"), std::string::npos) << client.last_error();
+  double product = 0.0;
+  EXPECT_TRUE(client.read_float(t7::kProductId, product));
+  EXPECT_EQ(product, 7.0);
+  EXPECT_TRUE(eventually([&] { return sim.status().exceptions == 2u; })) << sim.status().exceptions;
+}
+
+TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
+  SimThread sim;
+  {
+    T7Device device(device_options(sim.port()));  // configures the watchdog and the PWM lines
+  }
+  // A client that opens an inlet and falls silent, as a killed bellows would.
+  ModbusClient client("127.0.0.1", sim.port());
+  ASSERT_EQ(client.connect(2.0), "");
+  client.set_response_timeout(1.0);
+  const int actions_before = sim.status().watchdog_actions;
+  ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(2), 400000));  // inlet_a fully open
+  ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(4), 0));       // outlet_a shut
+  ASSERT_TRUE(eventually([&] { return !sim.status().safe; }));  // the status is published every 10 ms
+  ASSERT_TRUE(eventually([&] { return sim.status().watchdog_actions > actions_before; }));
+  const T7SimStatus s = sim.status();
+  EXPECT_TRUE(s.safe);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kInletA)], 0.0);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kOutletA)], 1.0);
+  // It acted after one timeout of silence, and the lines were safe within a PWM period of it.
+  EXPECT_GE(s.last_watchdog_action_s - s.last_request_s, 1.0);
+  EXPECT_LE(s.safe_since_s - s.last_request_s, 1.0 + 1.0 / 200.0);
+}
+
+TEST(T7Loopback, ADeadLinkStopsTheReadingsAndSaysWhichLink) {
+  auto sim = std::make_unique<SimThread>();
+  T7Device device(device_options(sim->port()));
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > 5; }));
+  sim.reset();  // the server goes away mid-run
+  ASSERT_TRUE(eventually([&] { return !device.health().connected; }));
+  EXPECT_GT(device.health().link_errors, 0u);
+  EXPECT_FALSE(device.link_error().empty());
+  // No fresh reading from now on: the engine's stale guard sees the time stand still.
+  device.read_sensors();
+  const double frozen = device.read_sensors().time_s;
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(device.read_sensors().time_s, frozen);
+  EXPECT_GT(device.health().stale_readings, 0u);
+}
+
+TEST(T7Loopback, AnAddressWhereNothingListensIsAnEnvironmentError) {
+  int port = 0;
+  {
+    SimThread sim;  // a port that was free a moment ago, and is closed again
+    port = sim.port();
+  }
+  T7DeviceOptions options = device_options(port);
+  options.link.connect_timeout_s = 1.0;
+  try {
+    T7Device device(options);
+    FAIL() << "connected to nothing";
+  } catch (const EnvironmentError& error) {
+    EXPECT_NE(std::string(error.what()).find("t7 127.0.0.1:" + std::to_string(port) + ": cannot connect"), std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace bellows

@@ -1,0 +1,218 @@
+// `bellows t7-sim` and `bellows run --device t7` as separate processes on 127.0.0.1: learning on the
+// T7 path matches the in-process arm; a kill -9'd bellows leaves safe valves behind (the T7's
+// watchdog); SIGTERM vents at once; t7-sim stopped mid-trial faults the run naming the link; a bad
+// rig profile or an unreachable address is one line and no session.
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/lcm_test_support.hpp"
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::Child;
+
+const std::string kBellows = BELLOWS_BINARY;
+
+/// A loopback port that was free a moment ago.
+int free_port() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  socklen_t length = sizeof address;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  return ntohs(address.sin_port);
+}
+
+class T7Processes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::make_temp_dir("bellows-t7");
+    setenv("XDG_DATA_HOME", (dir_ / "xdg").c_str(), 1);
+    port_ = free_port();
+    address_ = "127.0.0.1:" + std::to_string(port_);
+    status_ = dir_ / "status.json";
+  }
+
+  std::unique_ptr<Child> start_sim(std::vector<std::string> drills = {}) {
+    std::vector<std::string> argv = {kBellows, "t7-sim", "--listen", address_, "--status", status_.string()};
+    argv.insert(argv.end(), drills.begin(), drills.end());
+    auto sim = std::make_unique<Child>(argv, dir_ / "sim.out", dir_ / "sim.err");
+    EXPECT_TRUE(wait_for([&] { return std::filesystem::exists(status_); })) << sim->err();
+    return sim;
+  }
+
+  /// The runs tolerate a loaded test machine's scheduling: a 50 ms answer, 40 stale ticks (the
+  /// link's timing is the benchmark's business, bench/t7_round_trip.sh; not these tests').
+  std::unique_ptr<Child> start_run(int iterations, const std::string& name) {
+    const std::filesystem::path config =
+        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.05\n[safety]\nstale_ticks = 40\n");
+    return std::make_unique<Child>(
+        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "try",
+                                 "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},
+        dir_ / (name + ".out"), dir_ / (name + ".err"));
+  }
+
+  /// Runs bellows with `args` to the end (sessions into this test's XDG_DATA_HOME).
+  testing::ProcessResult run_cli(const std::vector<std::string>& args) {
+    std::vector<std::string> argv = {kBellows};
+    argv.insert(argv.end(), args.begin(), args.end());
+    Child child(argv, dir_ / "cli.out", dir_ / "cli.err");
+    testing::ProcessResult r;
+    r.exit_code = child.wait(60.0).value_or(-1);
+    r.out = child.out();
+    r.err = child.err();
+    return r;
+  }
+
+  bool no_session_saved() const { return !std::filesystem::exists(dir_ / "xdg" / "bellows" / "sessions") ||
+                                         std::filesystem::is_empty(dir_ / "xdg" / "bellows" / "sessions"); }
+
+  nlohmann::json status() const {
+    std::ifstream in(status_);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str().empty() ? nlohmann::json::object() : nlohmann::json::parse(text.str());
+  }
+
+  /// Polls for up to 30 s: a generous bound for a loaded machine (no timing is asserted by it).
+  static bool wait_for(const std::function<bool()>& done) {
+    for (int i = 0; i < 3000; ++i) {
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return done();
+  }
+
+  /// Waits until a trial runs: t7-sim's lines show an inlet opening.
+  bool wait_for_trial() {
+    return wait_for([&] {
+      const nlohmann::json s = status();
+      return s.contains("valves") && (s["valves"]["inlet_a"].get<double>() > 0.0 || s["valves"]["inlet_b"].get<double>() > 0.0);
+    });
+  }
+
+  std::filesystem::path dir_, status_;
+  int port_ = 0;
+  std::string address_;
+};
+
+std::vector<double> rms_of(const nlohmann::json& report) {
+  std::vector<double> rms;
+  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
+  return rms;
+}
+
+TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
+  auto sim = start_sim();
+  auto run = start_run(1, "run");
+  ASSERT_EQ(run->wait(120.0), 0) << run->err();
+  const nlohmann::json t7 = nlohmann::json::parse(run->out());
+  const testing::ProcessResult local =
+      testing::run_process(kBellows + " run --iterations 1 --json --no-save --seed 1 --config " + (dir_ / "loaded.toml").string());
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const std::vector<double> remote_rms = rms_of(t7), local_rms = rms_of(nlohmann::json::parse(local.out));
+  ASSERT_EQ(remote_rms.size(), local_rms.size());
+  for (std::size_t i = 0; i < local_rms.size(); ++i) {
+    EXPECT_NEAR(remote_rms[i], local_rms[i], 0.15 * local_rms[i]) << "iteration " << i;
+  }
+  EXPECT_EQ(t7.at("device"), "t7");
+  const nlohmann::json link = t7.at("loop").at("link");
+  EXPECT_GT(link.at("exchanges").get<std::uint64_t>(), 1000u);
+  EXPECT_EQ(link.at("errors").get<std::uint64_t>(), 0u);
+  EXPECT_GT(link.at("round_trip_ms").at("max").get<double>(), 0.0);
+  // bellows vented on its way out: the lines were safe before the silence began.
+  const nlohmann::json s = status();
+  EXPECT_TRUE(s.at("safe").get<bool>());
+  EXPECT_LE(s.at("safe_since_s").get<double>(), s.at("last_request_s").get<double>());
+}
+
+TEST_F(T7Processes, AKilledBellowsLeavesSafeValvesWithinTheWatchdogTimeoutAndAPwmPeriod) {
+  auto sim = start_sim();
+  auto run = start_run(2, "run");
+  ASSERT_TRUE(wait_for_trial()) << run->err();
+  run->signal(SIGKILL);
+  ASSERT_EQ(run->wait(10.0), 128 + SIGKILL);
+  ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; })) << sim->out();
+  const nlohmann::json s = status();
+  EXPECT_TRUE(s.at("safe").get<bool>()) << s.dump();
+  const double silence_s = s.at("safe_since_s").get<double>() - s.at("last_request_s").get<double>();
+  const double limit_s = s.at("watchdog").at("timeout_s").get<double>() + s.at("pwm_period_s").get<double>();
+  EXPECT_GE(silence_s, s.at("watchdog").at("timeout_s").get<double>());  // it was the watchdog
+  EXPECT_LE(silence_s, limit_s) << s.dump();
+  EXPECT_NE(sim->out().find("watchdog"), std::string::npos);
+}
+
+TEST_F(T7Processes, SigtermVentsAtOnceByItself) {
+  auto sim = start_sim();
+  auto run = start_run(2, "run");
+  ASSERT_TRUE(wait_for_trial()) << run->err();
+  run->signal(SIGTERM);
+  ASSERT_EQ(run->wait(10.0), 128 + SIGTERM) << run->err();
+  const nlohmann::json s = status();
+  EXPECT_TRUE(s.at("safe").get<bool>());
+  // Safe through bellows' own last request, not through the watchdog after the silence.
+  EXPECT_LE(s.at("safe_since_s").get<double>(), s.at("last_request_s").get<double>()) << s.dump();
+}
+
+TEST_F(T7Processes, T7SimStoppedMidTrialFaultsTheRunNamingTheLink) {
+  auto sim = start_sim();
+  auto run = start_run(2, "run");
+  ASSERT_TRUE(wait_for_trial()) << run->err();
+  sim->signal(SIGKILL);
+  ASSERT_EQ(run->wait(30.0), 3) << run->err();
+  const std::string err = run->err();
+  EXPECT_NE(err.find("sensor-stale"), std::string::npos) << err;
+  EXPECT_NE(err.find("t7 link " + address_), std::string::npos) << err;
+  const nlohmann::json report = nlohmann::json::parse(run->out());
+  EXPECT_EQ(report.at("fault").at("name"), "sensor-stale");
+}
+
+TEST_F(T7Processes, ASilentLinkFaultsTheRunAndTheWatchdogVents) {
+  auto sim = start_sim({"--silent-after", "3"});
+  auto run = start_run(2, "run");
+  ASSERT_EQ(run->wait(60.0), 3) << run->err();
+  EXPECT_NE(run->err().find("sensor-stale"), std::string::npos) << run->err();
+  ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; }));
+  EXPECT_TRUE(status().at("safe").get<bool>());
+}
+
+TEST_F(T7Processes, ABadRigProfileIsOneLineNamingFileAndKeyAndNoSession) {
+  const std::filesystem::path profile = testing::write_file(dir_, "bad.toml", "name = \"x\"\n[inputs.humidity]\nain = 7\n");
+  const testing::ProcessResult r =
+      run_cli({"run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rig-profile", profile.string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "bellows: rig profile " + profile.string() + ": [inputs.humidity]: unknown input (chamber_a, chamber_b, supply, angle, temperature)\n");
+  EXPECT_TRUE(no_session_saved());
+}
+
+TEST_F(T7Processes, AnUnreachableAddressIsOneLineExitFourAndNoSession) {
+  const testing::ProcessResult r = run_cli({"run", "--device", "t7", "--t7", address_, "--clock", "wall"});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("bellows: t7 " + address_ + ": cannot connect"), std::string::npos) << r.err;
+  EXPECT_TRUE(no_session_saved());
+}
+
+TEST_F(T7Processes, AMalformedAddressIsBadInput) {
+  const testing::ProcessResult r = run_cli({"run", "--device", "t7", "--t7", "127.0.0.1:http", "--clock", "wall"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "bellows: --t7 '127.0.0.1:http': the port must be a number 1..65535\n");
+  const testing::ProcessResult missing = run_cli({"run", "--device", "t7", "--clock", "wall"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.err, "bellows: --device t7 needs --t7 HOST[:PORT]\n");
+}
+
+}  // namespace
+}  // namespace bellows

@@ -1,0 +1,139 @@
+// Rig profiles: the shipped paper rig loads, and every bad profile is one InputError naming the
+// file and the key. The T7's PWM clock arithmetic.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "app/rig_profile_file.hpp"
+#include "devices/t7_registers.hpp"
+#include "engine/errors.hpp"
+
+namespace bellows {
+namespace {
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+/// The message of the InputError that parsing `text` throws ("" if none).
+std::string error_of(const std::string& text) {
+  try {
+    parse_rig_profile(text, "bad.toml");
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(RigProfile, ThePaperRigLoadsWithItsWiring) {
+  const RigProfile p = paper_rig_profile();
+  EXPECT_EQ(p.name, "paper-rig");
+  EXPECT_DOUBLE_EQ(p.pwm_frequency_hz, 200.0);
+  EXPECT_EQ(p.input(SensorRole::kChamberA).ain, 0);
+  EXPECT_EQ(p.input(SensorRole::kTemperature).ain, 4);
+  EXPECT_EQ(p.dio(ValveRole::kInletA), 2);
+  EXPECT_EQ(p.dio(ValveRole::kOutletB), 5);
+  // Buerkert 8230: 0 V is ambient; LM35: 10 mV per degree C.
+  EXPECT_NEAR(p.input(SensorRole::kChamberA).value(0.0), 1.01325, 1e-12);
+  EXPECT_NEAR(p.input(SensorRole::kTemperature).value(0.25), 298.15, 1e-9);
+  // The P4500 reads zero mid-travel.
+  EXPECT_NEAR(p.input(SensorRole::kAngle).value(2.5), 0.0, 1e-3);
+  EXPECT_FALSE(p.model.has_value());
+}
+
+TEST(RigProfile, CalibrationInvertsExactly) {
+  const RigProfile profile = paper_rig_profile();
+  const SensorCalibration& c = profile.input(SensorRole::kAngle);
+  for (double volts : {0.1, 1.7, 4.9}) EXPECT_NEAR(c.volts(c.value(volts)), volts, 1e-12);
+  EXPECT_TRUE(c.valid(2.5));
+  EXPECT_FALSE(c.valid(0.0));  // the end of the track: a broken wiper
+}
+
+TEST(RigProfile, AnUnknownInputNamesFileAndKey) {
+  const std::string text = replaced(paper_rig_profile_text(), "[inputs.temperature]", "[inputs.humidity]");
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find("bad.toml"), std::string::npos) << message;
+  EXPECT_NE(message.find("[inputs.humidity]"), std::string::npos) << message;
+  EXPECT_NE(message.find("unknown input"), std::string::npos) << message;
+}
+
+TEST(RigProfile, ALineUsedTwiceIsRefused) {
+  const std::string message = error_of(replaced(paper_rig_profile_text(), "outlet_b = 5", "outlet_b = 3"));
+  EXPECT_NE(message.find("[valves] outlet_b"), std::string::npos) << message;
+  EXPECT_NE(message.find("already inlet_b's line"), std::string::npos) << message;
+}
+
+TEST(RigProfile, AnInputUsedTwiceIsRefused) {
+  const std::string text = replaced(paper_rig_profile_text(), "[inputs.chamber_b]\nain = 1", "[inputs.chamber_b]\nain = 0");
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find("[inputs.chamber_b] ain"), std::string::npos) << message;
+  EXPECT_NE(message.find("already chamber_a's input"), std::string::npos) << message;
+}
+
+TEST(RigProfile, ALineThatCannotCarryPwmIsRefused) {
+  const std::string message = error_of(replaced(paper_rig_profile_text(), "inlet_a = 2", "inlet_a = 1"));
+  EXPECT_NE(message.find("[valves] inlet_a: DIO1 cannot carry PWM"), std::string::npos) << message;
+}
+
+TEST(RigProfile, ACalibrationMappingTheValidRangeToNonsenseIsRefused) {
+  // A gain in mbar per volt: 9.9 V would read 9901 bar.
+  const std::string text = replaced(paper_rig_profile_text(), "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1.0",
+                                    "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1000.0");
+  const std::string message = error_of(text);
+  EXPECT_NE(message.find("bad.toml: [inputs.supply] gain_per_V"), std::string::npos) << message;
+  EXPECT_NE(message.find("outside anything a supply sensor can read"), std::string::npos) << message;
+}
+
+TEST(RigProfile, ValidVoltagesOutsideTheInputRangeAreRefused) {
+  const std::string text = replaced(paper_rig_profile_text(), "volts_max_V = 1.5", "volts_max_V = 11.0");
+  EXPECT_NE(error_of(text).find("[inputs.temperature] volts_max_V"), std::string::npos) << error_of(text);
+}
+
+TEST(RigProfile, UnknownKeysMissingValvesAndBadTypesAreRefused) {
+  EXPECT_NE(error_of("colour = \"red\"\n" + paper_rig_profile_text()).find("bad.toml: colour: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(paper_rig_profile_text() + "\ninlet_c = 0\n").find("[valves] inlet_c: unknown valve"), std::string::npos);
+  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "outlet_b = 5\n", "")).find("[valves] outlet_b: missing"), std::string::npos);
+  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "ain = 4", "ain = \"four\"")).find("[inputs.temperature] ain: expected a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = [").find("bad.toml:1"), std::string::npos) << error_of("name = [");
+}
+
+TEST(RigProfile, AMissingFileIsOneLine) {
+  try {
+    load_rig_profile("/nonexistent/rig.toml");
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "rig profile /nonexistent/rig.toml: cannot be read");
+  }
+}
+
+TEST(RigProfile, AnIdentifiedModelIsRead) {
+  const std::string text = paper_rig_profile_text() + "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
+  const RigProfile p = parse_rig_profile(text, "rig.toml");
+  ASSERT_TRUE(p.model.has_value());
+  EXPECT_DOUBLE_EQ(p.model->kappa_rad_per_bar, 6.5);
+  EXPECT_NE(error_of(paper_rig_profile_text() + "\n[model]\ndamping = -1\n").find("[model] damping"), std::string::npos);
+}
+
+TEST(T7Pwm, TheClockFor200HzAndItsDutyCycles) {
+  const t7::PwmClock clock = t7::pwm_clock_for(200.0);
+  EXPECT_EQ(clock.divisor, 1u);
+  EXPECT_EQ(clock.roll, 400000u);  // 80 MHz / 200 Hz
+  EXPECT_DOUBLE_EQ(clock.frequency_hz(), 200.0);
+  EXPECT_EQ(clock.config_a(0.25), 100000u);
+  EXPECT_EQ(clock.config_a(1.0), 400000u);
+  EXPECT_EQ(clock.config_a(-0.5), 0u);
+  EXPECT_EQ(clock.config_a(NAN), 0u);
+  EXPECT_DOUBLE_EQ(clock.duty(100000u), 0.25);
+  EXPECT_DOUBLE_EQ(clock.duty(500000u), 1.0);  // beyond the roll value: always high
+  // Slow enough to need a divisor: 80e6 / 0.01 Hz does not fit 32 bits at divisor 1.
+  const t7::PwmClock slow = t7::pwm_clock_for(0.01);
+  EXPECT_GT(slow.divisor, 1u);
+  EXPECT_NEAR(slow.frequency_hz(), 0.01, 1e-6);
+}
+
+}  // namespace
+}  // namespace bellows
