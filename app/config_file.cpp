@@ -1,6 +1,5 @@
 #include "app/config_file.hpp"
 
-#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -8,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include "engine/errors.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 namespace {
@@ -121,17 +121,8 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
 }
 
 Configuration load_config_file(const std::string& path) {
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (error || !std::filesystem::exists(status)) throw InputError("config " + path + ": cannot be read (no such file)");
-  // A directory would read as empty (the defaults), a FIFO or a device would block or never end.
-  if (!std::filesystem::is_regular_file(status)) throw InputError("config " + path + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("config " + path + ": cannot be read");
-  std::string text(kMaxConfigBytes + 1, '\0');  // one byte more than allowed: a longer file is refused
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (in.bad()) throw InputError("config " + path + ": cannot be read");
+  // A directory, FIFO or device is refused (never read as an empty file, never waited on).
+  const std::string text = read_regular_file(path, kMaxConfigBytes, "config");
   Configuration config;
   apply_config_toml(text, path, config);
   return config;

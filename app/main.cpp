@@ -14,9 +14,12 @@
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
 #include "app/signals.hpp"
+#include "app/standard_output.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/cancellation.hpp"
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
+#include "sessions/session_store.hpp"
 
 using bellows::kExitBadInput;
 
@@ -26,6 +29,7 @@ constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
 int main(int argc, char** argv) {
+  bellows::check_standard_output_at_exit();
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm"};
   app.require_subcommand(0, 1);
 
@@ -57,7 +61,17 @@ int main(int argc, char** argv) {
                       "Where sessions are saved (default $XDG_DATA_HOME/bellows/sessions or ~/.local/share/bellows/sessions)")
       ->excludes(no_save);
   CLI::Option* name = run_cmd->add_option("--name", run.session_name, "Session name (default: start time and trajectory)")
-                          ->excludes(no_save);
+                          ->excludes(no_save)
+                          ->check(CLI::Validator(
+                              [](const std::string& value) {
+                                try {
+                                  bellows::validate_session_name(value);  // '' too: never silently the default
+                                  return std::string();
+                                } catch (const bellows::InputError& error) {
+                                  return std::string(error.what());
+                                }
+                              },
+                              ""));
   run_cmd->add_option("--resume", run.resume_dir, "Continue a saved session (a directory, or a name in the data directory)")
       ->excludes(no_save)
       ->excludes(name)
@@ -178,7 +192,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& help) {
     return app.exit(help);
   } catch (const CLI::ParseError& error) {
-    std::cerr << "bellows: " << error.what() << " (see --help)" << std::endl;
+    std::cerr << "bellows: " << bellows::printable(error.what(), bellows::kPrintableLine) << " (see --help)" << std::endl;
     return kExitBadInput;
   }
 
@@ -205,10 +219,10 @@ int main(int argc, char** argv) {
     std::cerr << "bellows: " << stopped.what() << std::endl;
     return 128 + (bellows::stop_signal() != 0 ? bellows::stop_signal() : SIGINT);
   } catch (const bellows::BellowsError& error) {
-    std::cerr << "bellows: " << error.what() << std::endl;
+    std::cerr << "bellows: " << bellows::printable(error.what(), bellows::kPrintableLine) << std::endl;
     return error.exit_status();
   } catch (const std::exception& error) {
-    std::cerr << "bellows: internal error: " << error.what() << std::endl;
+    std::cerr << "bellows: internal error: " << bellows::printable(error.what(), bellows::kPrintableLine) << std::endl;
     return 1;
   }
 }

@@ -183,7 +183,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                                   {"stale_readings", h.stale_readings}};
       }
     }
-    out << report.dump() << std::endl;
+    out << report.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace) << std::endl;  // no raw text on a terminal
   }
   return status;
 }

@@ -9,6 +9,7 @@
 
 #include "engine/engine_state.hpp"
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 #include "engine/safety.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_export.hpp"
@@ -41,11 +42,27 @@ std::string format(const char* pattern, double value) {
   return text;
 }
 
+/// Text from a session's files as a terminal may show it (escaped, shortened).
+std::string shown(const std::string& text) { return printable(text); }
+
+/// JSON on stdout: every non-ASCII character as \uXXXX, so no control sequence reaches a terminal
+/// (C0 controls are escaped by JSON itself, C1 and bidirectional controls are not); invalid UTF-8
+/// replaced.
+std::string json_text(const Json& json) { return json.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace); }
+
 /// "2024-05-01T12:03:07.123Z" -> "2024-05-01 12:03:07"
 std::string short_time(const std::string& utc) {
-  std::string out = utc.substr(0, 19);
+  std::string out = printable(utc.substr(0, 19));
   if (out.size() > 10 && out[10] == 'T') out[10] = ' ';
   return out;
+}
+
+/// What the digests in the manifest say about the files just loaded (a mismatch never loads).
+std::string integrity_line(const SessionIntegrity& integrity) {
+  const std::string verified = std::to_string(integrity.verified_files);
+  if (integrity.unverified_files == 0) return "verified: the " + verified + " files match their SHA-256 digests";
+  return "unverified: " + std::to_string(integrity.unverified_files) +
+         " files have no digest (saved by a bellows that kept none); " + verified + " match theirs";
 }
 
 Json summary_json(const IterationEntry& entry) {
@@ -75,7 +92,7 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
   const fs::path data_dir = data_dir_of(options);
   const std::vector<SessionListing> listings = list_sessions(data_dir);
   for (const SessionListing& listing : listings) {
-    if (!listing.error.empty()) err << "bellows: warning: " << listing.error << std::endl;
+    if (!listing.error.empty()) err << "bellows: warning: " << printable(listing.error, kPrintableLine) << std::endl;
   }
   if (options.json) {
     Json all = Json::array();
@@ -86,11 +103,11 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
                                {"directory", listing.directory.string()},
                                {"error", listing.error}});
     }
-    out << all.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    out << json_text(all) << std::endl;
     return 0;
   }
   if (listings.empty()) {
-    out << "no sessions in " << data_dir.string() << std::endl;
+    out << "no sessions in " << shown(data_dir.string()) << std::endl;
     return 0;
   }
   char line[512];
@@ -98,14 +115,14 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
                 "TRAJECTORY", "ITERATIONS", "BEST RMS");
   out << line << "\n";
   for (const SessionListing& listing : listings) {
-    const std::string name = listing.directory.filename().string();
+    const std::string name = shown(listing.directory.filename().string());
     if (!listing.error.empty()) {
       std::snprintf(line, sizeof line, "%-40s  (unreadable: see the warning above)", name.c_str());
     } else {
       const SessionManifest& m = listing.manifest;
       const double best = best_rms_deg(m);
       std::snprintf(line, sizeof line, "%-40s  %-19s  %-6s  %-16s  %10zu  %12s", name.c_str(),
-                    short_time(m.started_utc).c_str(), m.device.c_str(), m.trajectory_name.c_str(), m.iterations.size(),
+                    short_time(m.started_utc).c_str(), shown(m.device).c_str(), shown(m.trajectory_name).c_str(), m.iterations.size(),
                     best < 0.0 ? "-" : format("%.3f deg", best).c_str());
     }
     out << line << "\n";
@@ -120,7 +137,7 @@ namespace {
 void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, const std::vector<TickRecord>& ticks,
                      double tick_s) {
   constexpr std::size_t kShown = 5;
-  out << "  " << index << ": " << entry.fault << " during iteration " << entry.iteration << ", saved "
+  out << "  " << index << ": " << shown(entry.fault) << " during iteration " << entry.iteration << ", saved "
       << short_time(entry.time_utc) << "; " << entry.ticks << " ticks (" << format("%.2f", entry.ticks * tick_s)
       << " s) in " << session_layout::black_box_file(index) << "\n";
   char line[200];
@@ -159,6 +176,8 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                              {"file", session_layout::black_box_file(static_cast<int>(i))}});
     }
     const Json report = {{"name", m.name},
+                         {"integrity", {{"verified_files", session.integrity.verified_files},
+                                        {"unverified_files", session.integrity.unverified_files}}},
                          {"directory", session.directory.string()},
                          {"schema_version", m.schema_version},
                          {"program_version", m.program_version},
@@ -175,18 +194,19 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                          {"iterations", iterations},
                          {"events", events},
                          {"black_boxes", black_boxes}};
-    out << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    out << json_text(report) << std::endl;
     return 0;
   }
-  out << "session      " << session.directory.string() << "\n"
-      << "name         " << m.name << "\n"
-      << "written by   bellows " << m.program_version << " (session schema " << m.schema_version << ")\n"
-      << "device       " << m.device << " " << m.device_info.dump() << "\n"
-      << "started      " << m.started_utc << "\n"
-      << "updated      " << m.updated_utc << "\n"
-      << "trajectory   " << m.trajectory_name << ": " << m.trajectory_samples << " samples every " << c.timing.sample_s()
+  out << "session      " << shown(session.directory.string()) << "\n"
+      << "name         " << shown(m.name) << "\n"
+      << "written by   bellows " << shown(m.program_version) << " (session schema " << m.schema_version << ")\n"
+      << "device       " << shown(m.device) << " " << shown(json_text(m.device_info)) << "\n"
+      << "started      " << shown(m.started_utc) << "\n"
+      << "updated      " << shown(m.updated_utc) << "\n"
+      << "integrity    " << integrity_line(session.integrity) << "\n"
+      << "trajectory   " << shown(m.trajectory_name) << ": " << m.trajectory_samples << " samples every " << c.timing.sample_s()
       << " s (" << m.trajectory_samples * c.timing.sample_s() << " s)\n"
-      << "learning     " << c.ilc.law << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
+      << "learning     " << shown(c.ilc.law) << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
       << "iterations   " << m.iterations.size();
   if (best >= 0.0) out << ", best RMS " << format("%.3f", best) << " deg";
   out << "\n\n";
@@ -202,7 +222,8 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   }
   if (!m.events.empty()) out << "\nevents\n";
   for (const SessionEvent& e : m.events) {
-    out << "  " << short_time(e.time_utc) << "  iteration " << e.iteration << "  " << e.kind << ": " << e.message << "\n";
+    out << "  " << short_time(e.time_utc) << "  iteration " << e.iteration << "  " << shown(e.kind) << ": "
+        << printable(e.message, kPrintableLine) << "\n";
   }
   if (!m.black_boxes.empty()) out << "\nblack boxes (the last ticks before each fault; every tick in the file)\n";
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {

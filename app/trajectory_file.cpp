@@ -2,14 +2,21 @@
 
 #include <charconv>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 namespace {
+
+// 64 MiB: about a million samples (six hours at 50 Hz), far beyond any trial, yet a bound that
+// keeps a wrong file (a disk image, /dev/zero behind a link) from being read whole.
+constexpr std::size_t kMostTrajectoryBytes = std::size_t{64} << 20;
+// Spreadsheets on Windows start UTF-8 files with it.
+constexpr std::string_view kUtf8ByteOrderMark = "\xef\xbb\xbf";
 
 std::string trim(const std::string& s) {
   const auto first = s.find_first_not_of(" \t\r");
@@ -22,7 +29,7 @@ double parse_number(const std::string& field, const std::string& where) {
   double value = 0.0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
-    throw InputError(where + ": '" + text + "' is not a number");
+    throw InputError(where + ": '" + printable(text) + "' is not a number");
   }
   return value;
 }
@@ -31,18 +38,20 @@ double parse_number(const std::string& field, const std::string& where) {
 
 Trajectory parse_trajectory_csv(const std::string& text, const std::string& source_name, double sample_time_s,
                                 const TrajectoryLimits& limits) {
-  std::istringstream in(text);
+  const bool byte_order_mark = std::string_view(text).substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark;
+  std::istringstream in(byte_order_mark ? text.substr(kUtf8ByteOrderMark.size()) : text);
+  const std::string source = printable(source_name);
   std::string line;
   if (!std::getline(in, line) || trim(line) != "time_s,angle_deg") {
-    throw InputError("trajectory " + source_name + ": line 1: the header must be 'time_s,angle_deg', found '" +
-                     trim(line) + "'");
+    throw InputError("trajectory " + source + ": line 1: the header must be 'time_s,angle_deg', found '" +
+                     printable(trim(line)) + "'");
   }
   std::vector<double> times, angles;
   int line_number = 1;
   while (std::getline(in, line)) {
     ++line_number;
     if (trim(line).empty()) continue;
-    const std::string where = "trajectory " + source_name + ": line " + std::to_string(line_number);
+    const std::string where = "trajectory " + source + ": line " + std::to_string(line_number);
     const auto comma = line.find(',');
     if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos) {
       throw InputError(where + ": expected two fields 'time_s,angle_deg'");
@@ -54,16 +63,13 @@ Trajectory parse_trajectory_csv(const std::string& text, const std::string& sour
   try {
     return trajectory_from_samples(name, times, angles, sample_time_s, limits);
   } catch (const InputError& error) {
-    throw InputError("trajectory " + source_name + ": " + error.what());
+    throw InputError("trajectory " + source + ": " + error.what());
   }
 }
 
 Trajectory load_trajectory_file(const std::string& path, double sample_time_s, const TrajectoryLimits& limits) {
-  std::ifstream in(path);
-  if (!in) throw InputError("trajectory " + path + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_trajectory_csv(text.str(), path, sample_time_s, limits);
+  // A FIFO, a device or a directory is refused without blocking; a link the operator names is followed.
+  return parse_trajectory_csv(read_regular_file(path, kMostTrajectoryBytes, "trajectory"), path, sample_time_s, limits);
 }
 
 Trajectory resolve_trajectory(const std::string& name_or_path, double sample_time_s, const TrajectoryLimits& limits) {

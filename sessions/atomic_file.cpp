@@ -19,22 +19,6 @@ constexpr std::string_view kTemporaryMarker = ".tmp-";
   throw InputError("cannot " + what + " " + path.string() + ": " + std::strerror(error_number));
 }
 
-/// Closes a descriptor on every path out of a scope.
-class FileDescriptor {
- public:
-  explicit FileDescriptor(int fd) : fd_(fd) {}
-  ~FileDescriptor() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FileDescriptor(const FileDescriptor&) = delete;
-  FileDescriptor& operator=(const FileDescriptor&) = delete;
-  int get() const { return fd_; }
-  int release() { return std::exchange(fd_, -1); }
-
- private:
-  int fd_;
-};
-
 }  // namespace
 
 std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
@@ -83,33 +67,12 @@ void sync_directory(const std::filesystem::path& directory) {
 }
 
 std::string read_file(const std::filesystem::path& path) {
-  FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
-  if (fd.get() < 0) fail("read", path, errno);
-  std::string contents;
-  struct stat info {};
-  if (::fstat(fd.get(), &info) == 0 && info.st_size > 0) contents.reserve(static_cast<std::size_t>(info.st_size));
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t got = ::read(fd.get(), buffer, sizeof buffer);
-    if (got < 0) {
-      if (errno == EINTR) continue;
-      fail("read", path, errno);
-    }
-    if (got == 0) break;
-    contents.append(buffer, static_cast<std::size_t>(got));
-  }
-  return contents;
+  constexpr std::size_t kLargest = std::size_t{1} << 30;
+  return read_regular_file(path, kLargest, "file");
 }
 
 bool is_temporary_file_name(const std::string& file_name) {
   return !file_name.empty() && file_name.front() == '.' && file_name.find(kTemporaryMarker) != std::string::npos;
-}
-
-void remove_temporary_files(const std::filesystem::path& directory) {
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator(directory, error)) {
-    if (is_temporary_file_name(entry.path().filename().string())) std::filesystem::remove(entry.path(), error);
-  }
 }
 
 }  // namespace bellows

@@ -1,16 +1,17 @@
-// Durable file writes for sessions: a file is written under a temporary name in its own directory,
-// flushed to disk (fsync), renamed over its final name, and the directory is flushed, so that a
-// crash or power cut at any moment leaves either the old file or the new one, never a mix.
-// Errors throw InputError naming the path and the system's reason.
+// Durable file writes by path (exports; a session's own files go through file_access.hpp): a file
+// is written under a temporary name in its own directory, flushed to disk (fsync), renamed over its
+// final name, and the directory is flushed, so that a crash or power cut at any moment leaves
+// either the old file or the new one, never a mix. Errors throw InputError naming the path and the
+// system's reason.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <string_view>
 
-namespace bellows {
+#include "sessions/file_access.hpp"
 
-enum class DirectorySync { kNow, kLater /* the caller calls sync_directory() once for a batch */ };
+namespace bellows {
 
 /// Replaces `path` by `contents` atomically and durably.
 void write_file_atomic(const std::filesystem::path& path, std::string_view contents,
@@ -22,13 +23,10 @@ std::filesystem::path temporary_path_for(const std::filesystem::path& path);
 /// Flushes a directory's entries (new names, renames) to disk.
 void sync_directory(const std::filesystem::path& directory);
 
-/// The whole file; throws InputError if it cannot be read.
+/// The whole regular file (at most 1 GiB); throws InputError if it cannot be read.
 std::string read_file(const std::filesystem::path& path);
 
 /// True for the names write_file_atomic() uses for its temporary files (left behind by a crash).
 bool is_temporary_file_name(const std::string& file_name);
-
-/// Removes temporary files a crashed writer left in `directory` (not recursive).
-void remove_temporary_files(const std::filesystem::path& directory);
 
 }  // namespace bellows

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 
 namespace bellows {
 namespace {
@@ -16,14 +17,12 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-std::string excerpt(std::string_view s) {
-  constexpr std::size_t kLongest = 80;
-  std::string out(s.substr(0, kLongest));
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
-  }
-  return s.size() > kLongest ? out + "..." : out;
-}
+constexpr std::size_t kExcerpt = 80;
+std::string excerpt(std::string_view s) { return printable(s, kExcerpt); }
+
+// The widest number append_csv() writes is 24 characters; a hand-edited file may pad fields.
+constexpr std::size_t kMostFieldBytes = 40;
+constexpr std::string_view kUtf8ByteOrderMark = "\xef\xbb\xbf";
 
 std::string joined(const std::vector<std::string_view>& names) {
   std::string out;
@@ -60,8 +59,17 @@ void append_csv(std::string& out, const std::vector<CsvColumn>& columns) {
   out.resize(static_cast<std::size_t>(cursor - out.data()));
 }
 
+std::size_t csv_size_limit(const std::vector<std::string_view>& header, std::size_t rows) {
+  std::size_t header_bytes = kUtf8ByteOrderMark.size() + 2;
+  for (std::string_view name : header) header_bytes += name.size() + 1 + kMostFieldBytes;
+  return header_bytes + rows * (header.size() * kMostFieldBytes + 2);
+}
+
 std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,
                                        const std::string& source, NonFinite non_finite) {
+  // Spreadsheets on Windows start UTF-8 with a byte order mark and end lines with CR LF: both are
+  // accepted (trim() drops the CR).
+  if (text.substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark) text.remove_prefix(kUtf8ByteOrderMark.size());
   if (text.empty()) throw InputError(source + ": the file is empty (expected the header '" + joined(header) + "')");
   if (text.back() != '\n') {
     const auto lines = std::count(text.begin(), text.end(), '\n') + 1;

@@ -2,6 +2,7 @@
 // comma-separated numbers in the shortest form that reads back to the same double. Plain enough for
 // spreadsheets, pandas, MATLAB readtable and PlotJuggler; strict on reading: the exact header, the
 // same field count on every line, finite numbers only, a final end of line (else: truncated).
+// Text from the file that an error quotes is escaped and shortened (engine/printable_text.hpp).
 #pragma once
 
 #include <string>
@@ -23,7 +24,12 @@ void append_csv(std::string& out, const std::vector<CsvColumn>& columns);
 /// Whether `nan` and `inf` are values (a black box keeps the bad reading that caused its fault).
 enum class NonFinite { kRefuse, kAccept };
 
-/// Parses `text` whose header must be exactly `header`; one vector per column. Throws InputError
+/// The most bytes a file of `rows` rows under `header` can take (numbers padded with spaces, CR LF
+/// line ends and a byte order mark included): a bigger file is refused before it is read.
+std::size_t csv_size_limit(const std::vector<std::string_view>& header, std::size_t rows);
+
+/// Parses `text` whose header must be exactly `header` (a UTF-8 byte order mark and CR LF line
+/// ends are accepted); one vector per column. Throws InputError
 /// that starts with `source` and names the line (and column) at fault.
 std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<std::string_view>& header,
                                        const std::string& source, NonFinite non_finite = NonFinite::kRefuse);

@@ -5,6 +5,7 @@
 #include "engine/arm_model.hpp"
 #include "engine/configuration_cost.hpp"
 #include "engine/errors.hpp"
+#include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
 
 namespace bellows {
@@ -42,16 +43,32 @@ PressureController::State pressure_state_from_json(const JsonReader& r, int filt
   return s;
 }
 
+/// A file's digest: optional (sessions saved before digests have none), else 64 hex digits.
+std::string digest_from_json(const JsonReader& r, const char* key) {
+  if (!r.has(key)) return "";
+  const std::string digest = r[key].text();
+  if (!is_sha256_hex(digest)) r[key].fail("expected a SHA-256 digest: 64 lowercase hex digits");
+  return digest;
+}
+
+/// Adds `"key": digest` unless the digest is unknown.
+void put_digest(Json& object, const char* key, const std::string& digest) {
+  if (!digest.empty()) object[key] = digest;
+}
+
 Json summary_to_json(const IterationEntry& entry) {
   const IterationSummary& s = entry.summary;
-  return {{"iteration", s.iteration},
-          {"completed_utc", entry.completed_utc},
-          {"rms_deg", s.rms_deg},
-          {"max_abs_error_deg", s.max_abs_error_deg},
-          {"max_abs_correction_bar", s.max_abs_correction_bar},
-          {"saturated_samples", s.saturated_samples},
-          {"samples_file", session_layout::samples_file(s.iteration)},
-          {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
+  Json out = {{"iteration", s.iteration},
+              {"completed_utc", entry.completed_utc},
+              {"rms_deg", s.rms_deg},
+              {"max_abs_error_deg", s.max_abs_error_deg},
+              {"max_abs_correction_bar", s.max_abs_correction_bar},
+              {"saturated_samples", s.saturated_samples},
+              {"samples_file", session_layout::samples_file(s.iteration)},
+              {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
+  put_digest(out, "samples_sha256", entry.samples_sha256);
+  put_digest(out, "telemetry_sha256", entry.telemetry_sha256);
+  return out;
 }
 
 double non_negative(const JsonReader& r) {
@@ -77,6 +94,8 @@ IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
                                       std::pair{"telemetry_file", session_layout::telemetry_file(index)}}) {
     if (r[key].text() != expected) r[key].fail("expected \"" + expected + "\"");
   }
+  entry.samples_sha256 = digest_from_json(r, "samples_sha256");
+  entry.telemetry_sha256 = digest_from_json(r, "telemetry_sha256");
   return entry;
 }
 
@@ -89,17 +108,19 @@ SessionEvent event_from_json(const JsonReader& r) {
 }
 
 Json black_box_to_json(const BlackBoxEntry& b, int index) {
-  return {{"time_utc", b.time_utc},
-          {"iteration", b.iteration},
-          {"fault", b.fault},
-          {"ticks", b.ticks},
-          {"file", session_layout::black_box_file(index)}};
+  Json out = {{"time_utc", b.time_utc},
+              {"iteration", b.iteration},
+              {"fault", b.fault},
+              {"ticks", b.ticks},
+              {"file", session_layout::black_box_file(index)}};
+  put_digest(out, "sha256", b.sha256);
+  return out;
 }
 
 BlackBoxEntry black_box_from_json(const JsonReader& r) {
   constexpr int kMostTicks = 100000000;
   return {r["time_utc"].text(), r["iteration"].integer(0, kMostIterations), r["fault"].text(),
-          r["ticks"].integer(1, kMostTicks)};
+          r["ticks"].integer(1, kMostTicks), digest_from_json(r, "sha256")};
 }
 
 }  // namespace
@@ -193,6 +214,12 @@ Json manifest_to_json(const SessionManifest& m) {
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
     black_boxes.push_back(black_box_to_json(m.black_boxes[i], static_cast<int>(i)));
   }
+  Json trajectory = {{"name", m.trajectory_name},
+                     {"file", session_layout::kTrajectory},
+                     {"learning_samples", m.trajectory_samples},
+                     {"sample_time_s", sample_s},
+                     {"duration_s", m.trajectory_samples * sample_s}};
+  put_digest(trajectory, "sha256", m.trajectory_sha256);
   Json out = {
       {"format", kFormat},
       {"schema_version", m.schema_version},
@@ -202,12 +229,7 @@ Json manifest_to_json(const SessionManifest& m) {
       {"device_info", m.device_info},
       {"started_utc", m.started_utc},
       {"updated_utc", m.updated_utc},
-      {"trajectory",
-       {{"name", m.trajectory_name},
-        {"file", session_layout::kTrajectory},
-        {"learning_samples", m.trajectory_samples},
-        {"sample_time_s", sample_s},
-        {"duration_s", m.trajectory_samples * sample_s}}},
+      {"trajectory", trajectory},
       // Derived from the configuration, written for readers; ignored when loading.
       {"model",
        {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
@@ -267,6 +289,7 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   } catch (const InputError& error) {
     trajectory["learning_samples"].fail(error.what());
   }
+  m.trajectory_sha256 = digest_from_json(trajectory, "sha256");
   const JsonReader iterations = r["iterations"];
   for (std::size_t i = 0; i < iterations.size(); ++i) {
     m.iterations.push_back(summary_from_json(iterations[i], static_cast<int>(i), m.trajectory_samples));

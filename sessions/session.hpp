@@ -41,12 +41,15 @@ struct BlackBoxEntry {
   int iteration = 0;     // the iteration running or next to run when the fault fired
   std::string fault;     // fault_name(), e.g. "overpressure"
   int ticks = 0;         // rows in the file: the ticks before the fault and the fault tick
+  std::string sha256 = {};  // the file's digest as saved; empty in sessions saved before digests
 };
 
 /// One completed iteration as the manifest lists it.
 struct IterationEntry {
   IterationSummary summary;
   std::string completed_utc;
+  std::string samples_sha256 = {};    // the files' digests; empty in sessions saved before digests
+  std::string telemetry_sha256 = {};  // were kept
 };
 
 /// What continuing the run exactly needs beyond the correction: the controllers' state, the
@@ -71,6 +74,7 @@ struct SessionManifest {
   Configuration configuration;
   std::string trajectory_name;
   int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
+  std::string trajectory_sha256;  // empty in sessions saved before digests were kept
   std::vector<IterationEntry> iterations;
   std::vector<SessionEvent> events;
   std::vector<BlackBoxEntry> black_boxes;  // numbered 0, 1, ... in the order the faults fired
@@ -83,8 +87,17 @@ struct IterationData {
   Eigen::VectorXd next_correction_bar;  // N values
 };
 
+/// How many of a loaded session's files the manifest's digests vouch for. A file whose digest does
+/// not match is refused while loading; a file without a digest (saved by an older bellows) is
+/// loaded and counted as unverified.
+struct SessionIntegrity {
+  int verified_files = 0;
+  int unverified_files = 0;
+};
+
 struct Session {
   std::filesystem::path directory;
+  SessionIntegrity integrity;
   SessionManifest manifest;
   Trajectory trajectory;
   std::vector<IterationData> iterations;  // in the order of manifest.iterations

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdio>
+#include <cstddef>
 #include <string>
+#include <utility>
 
 namespace bellows::session_layout {
 
@@ -11,6 +13,10 @@ inline constexpr const char* kManifest = "manifest.json";
 inline constexpr const char* kTrajectory = "trajectory.csv";
 inline constexpr const char* kIterations = "iterations";
 inline constexpr const char* kFaults = "faults";
+
+/// The largest manifest read: about 150 000 iterations (a paper session's is about 50 KB). Parsing
+/// JSON takes several times its size in memory, so this bound keeps a bad file from exhausting it.
+inline constexpr std::size_t kMostManifestBytes = std::size_t{64} << 20;
 
 inline std::string numbered(const char* stem, int iteration, const char* folder = kIterations) {
   char name[48];
@@ -23,5 +29,13 @@ inline std::string samples_file(int iteration) { return numbered("iteration", it
 inline std::string telemetry_file(int iteration) { return numbered("telemetry", iteration); }
 /// The black box of the session's fault number `index` (0, 1, ...), relative to the session directory.
 inline std::string black_box_file(int index) { return numbered("blackbox", index, kFaults); }
+
+/// "iterations/iteration_0001.csv" -> {"iterations", "iteration_0001.csv"}; a top-level name
+/// gets an empty folder.
+inline std::pair<std::string, std::string> folder_and_name(const std::string& relative) {
+  const std::size_t slash = relative.find('/');
+  if (slash == std::string::npos) return {"", relative};
+  return {relative.substr(0, slash), relative.substr(slash + 1)};
+}
 
 }  // namespace bellows::session_layout

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 
 namespace bellows {
 namespace {
@@ -31,25 +32,27 @@ std::string read_holder(int fd) {
   const ssize_t got = ::pread(fd, buffer, sizeof buffer - 1, 0);
   std::string holder(buffer, got > 0 ? static_cast<std::size_t>(got) : 0);
   while (!holder.empty() && (holder.back() == '\n' || holder.back() == '\r')) holder.pop_back();
-  return holder.empty() ? "another process" : holder;
+  return holder.empty() ? "another process" : printable(holder);  // anyone may have written it
 }
 
 }  // namespace
 
-SessionLock::SessionLock(const std::filesystem::path& directory, const std::string& purpose) {
-  const std::filesystem::path path = directory / kFileName;
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw InputError("session " + directory.string() + ": cannot open " + path.string() + ": " + std::strerror(errno));
+SessionLock::SessionLock(const DirectoryHandle& directory, const std::string& purpose) {
+  const std::string session = "session " + printable(directory.path().string());
+  try {
+    fd_ = open_regular_file_at(directory, kFileName, O_RDWR | O_CREAT, /*single_link=*/true)->release();
+  } catch (const InputError& error) {
+    throw InputError(session + ": " + error.what());
+  }
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int error_number = errno;
     const std::string holder = error_number == EWOULDBLOCK ? read_holder(fd_) : std::string();
     ::close(fd_);
     fd_ = -1;
     if (error_number == EWOULDBLOCK) {
-      throw InputError("session " + directory.string() + " is in use by " + holder +
-                       "; two processes never write the same session");
+      throw InputError(session + " is in use by " + holder + "; two processes never write the same session");
     }
-    throw InputError("session " + directory.string() + ": cannot lock " + path.string() + ": " + std::strerror(error_number));
+    throw InputError(session + ": cannot lock " + kFileName + ": " + std::strerror(error_number));
   }
   // Best effort: the line only serves the message another process prints.
   const std::string line = holder_line(purpose);
@@ -58,15 +61,27 @@ SessionLock::SessionLock(const std::filesystem::path& directory, const std::stri
   }
 }
 
-std::optional<std::string> SessionLock::holder(const std::filesystem::path& directory) {
-  const int fd = ::open((directory / kFileName).c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return std::nullopt;
-  std::optional<std::string> holder;
-  if (::flock(fd, LOCK_SH | LOCK_NB) != 0) {
-    if (errno == EWOULDBLOCK) holder = read_holder(fd);
+std::optional<std::string> SessionLock::holder(const DirectoryHandle& directory) {
+  std::optional<FileDescriptor> fd;
+  try {
+    fd = open_regular_file_at(directory, kFileName, O_RDONLY);
+  } catch (const InputError&) {
+    return std::nullopt;  // not a lock file: nobody holds it (taking the lock says what is wrong)
   }
-  ::close(fd);  // also drops the shared lock, if it was granted
-  return holder;
+  if (!fd) return std::nullopt;
+  std::optional<std::string> holder;
+  if (::flock(fd->get(), LOCK_SH | LOCK_NB) != 0) {
+    if (errno == EWOULDBLOCK) holder = read_holder(fd->get());
+  }
+  return holder;  // closing the descriptor drops the shared lock, if it was granted
+}
+
+std::optional<std::string> SessionLock::holder(const std::filesystem::path& directory) {
+  try {
+    return holder(DirectoryHandle::open(directory));
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
 }
 
 SessionLock::~SessionLock() {

@@ -1,11 +1,15 @@
 // One writer per session: an exclusive advisory lock (flock) on the session's `lock` file, held
 // for the writer's lifetime. The kernel releases it when the process ends, even by kill -9, so a
 // crashed writer never blocks a resume. The file names its holder, for the refusal message.
+// The lock file is opened inside the session's directory without following a link, and must be a
+// regular file of its own (one hard link): it is the one file written in place.
 #pragma once
 
 #include <filesystem>
 #include <optional>
 #include <string>
+
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 
@@ -13,7 +17,9 @@ class SessionLock {
  public:
   /// Takes the lock of the session in `directory`; throws InputError naming the current holder
   /// when another process has it. `purpose` (e.g. "bellows run") goes into the holder's line.
-  SessionLock(const std::filesystem::path& directory, const std::string& purpose);
+  SessionLock(const DirectoryHandle& directory, const std::string& purpose);
+  SessionLock(const std::filesystem::path& directory, const std::string& purpose)
+      : SessionLock(DirectoryHandle::open(directory), purpose) {}
   ~SessionLock();
   SessionLock(SessionLock&& other) noexcept;
   SessionLock& operator=(SessionLock&& other) noexcept;
@@ -22,6 +28,7 @@ class SessionLock {
 
   /// The holder's line when another process holds the lock of the session in `directory`.
   /// Creates nothing: a directory without a lock file has no holder.
+  static std::optional<std::string> holder(const DirectoryHandle& directory);
   static std::optional<std::string> holder(const std::filesystem::path& directory);
 
   static constexpr const char* kFileName = "lock";

@@ -3,12 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <exception>
-#include <thread>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -16,8 +12,10 @@
 #include <tuple>
 
 #include "engine/errors.hpp"
-#include "sessions/atomic_file.hpp"
+#include "engine/printable_text.hpp"
 #include "sessions/black_box_file.hpp"
+#include "sessions/csv_table.hpp"
+#include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_directory.hpp"
@@ -27,42 +25,53 @@ namespace bellows {
 namespace fs = std::filesystem;
 namespace {
 
-std::string describe(const fs::path& directory) { return "session " + directory.string(); }
+std::string describe(const fs::path& directory) { return "session " + printable(directory.string()); }
 
-std::string read_session_file(const fs::path& directory, const std::string& relative) {
-  const fs::path path = directory / relative;
-  std::error_code error;
-  if (!fs::exists(path, error)) throw InputError(describe(directory) + ": " + relative + " is missing");
+/// A loaded session's folders: `iterations` and `faults` are opened only if they exist, and are
+/// refused when they are links or not directories.
+struct SessionFolders {
+  const DirectoryHandle& root;
+  std::optional<DirectoryHandle> iterations, faults;
+
+  const DirectoryHandle* folder(const std::string& name) const {
+    if (name.empty()) return &root;
+    if (name == session_layout::kIterations) return iterations ? &*iterations : nullptr;
+    if (name == session_layout::kFaults) return faults ? &*faults : nullptr;
+    return nullptr;
+  }
+};
+
+/// The file `relative` (a layout name) of the session, at most `max_bytes`, checked against its
+/// digest in the manifest when there is one.
+std::string read_session_file(const SessionFolders& folders, const std::string& relative, std::size_t max_bytes,
+                              const std::string& digest, SessionIntegrity& integrity) {
+  const std::string where = describe(folders.root.path());
+  const auto [folder_name, name] = session_layout::folder_and_name(relative);
+  const DirectoryHandle* folder = folders.folder(folder_name);
+  std::optional<std::string> text;
   try {
-    return read_file(path);
-  } catch (const InputError& read_error) {
-    throw InputError(describe(directory) + ": " + relative + ": " + read_error.what());
+    if (folder != nullptr) text = read_regular_file_at(*folder, name, max_bytes);
+  } catch (const InputError& error) {
+    throw InputError(where + ": " + (folder_name.empty() ? "" : folder_name + "/") + error.what());
   }
+  if (!text) throw InputError(where + ": " + relative + " is missing");
+  if (digest.empty()) {
+    ++integrity.unverified_files;
+  } else if (sha256_hex(*text) != digest) {
+    throw InputError(where + ": " + relative +
+                     " was changed after it was saved: its SHA-256 digest differs from the one the manifest records");
+  } else {
+    ++integrity.verified_files;
+  }
+  return std::move(*text);
 }
 
-void check_finite(const Eigen::VectorXd& values, int index, const char* what) {
-  for (Eigen::Index k = 0; k < values.size(); ++k) {
-    if (!std::isfinite(values(k))) {
-      throw InputError("iteration " + std::to_string(index) + ": " + what + " at index " + std::to_string(k) +
-                       " is not a finite number; it cannot be saved");
-    }
-  }
-}
-
-void check_record(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar, int index) {
-  const TrialSamples& s = record.samples;
-  for (const auto& [values, what] :
-       {std::pair{&s.time_s, "time"}, {&s.setpoint_rad, "angle set point"}, {&s.angle_rad, "angle"},
-        {&s.error_rad, "error"}, {&s.u_pid_bar, "u_pid"}, {&s.u_ilc_bar, "u_ilc"}, {&s.u_total_bar, "u_tot"},
-        {&s.pressure_a_bar, "pressure A"}, {&s.pressure_b_bar, "pressure B"}, {&s.setpoint_a_bar, "pressure A set point"},
-        {&s.setpoint_b_bar, "pressure B set point"}, {&next_correction_bar, "next correction"}}) {
-    check_finite(*values, index, what);
-  }
-  const TrialTicks& t = record.ticks;
-  for (const Eigen::VectorXd* values : {&t.time_s, &t.angle_rad, &t.pressure_a_bar, &t.pressure_b_bar, &t.supply_bar,
-                                        &t.setpoint_a_bar, &t.setpoint_b_bar, &t.inlet_a, &t.outlet_a, &t.inlet_b,
-                                        &t.outlet_b}) {
-    check_finite(*values, index, "telemetry");
+/// A folder of the session, refused when it is a link or not a directory.
+std::optional<DirectoryHandle> session_folder(const DirectoryHandle& root, const char* name) {
+  try {
+    return root.subdirectory(name);
+  } catch (const InputError& error) {
+    throw InputError(describe(root.path()) + ": " + error.what());
   }
 }
 
@@ -91,14 +100,13 @@ std::string default_session_name(std::time_t start, const std::string& trajector
 }
 
 void validate_session_name(const std::string& name) {
-  const std::string what = "session name '" + name + "'";
+  const std::string what = "session name '" + printable(name) + "'";
   if (name.empty()) throw InputError("the session name must not be empty");
   if (name.size() > 200) throw InputError(what + " is longer than 200 characters");
   if (name.front() == '.') throw InputError(what + " must not start with '.'");
-  for (char c : name) {
-    if (c == '/' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      throw InputError(what + " must be a plain directory name (no '/', no control characters)");
-    }
+  // Printable UTF-8 only: a name is echoed in listings, messages and the console.
+  if (name.find('/') != std::string::npos || printable(name, name.size() * 8) != name) {
+    throw InputError(what + " must be a plain directory name (no '/', no control characters)");
   }
 }
 
@@ -111,153 +119,67 @@ fs::path resolve_session_dir(const std::string& path_or_name, const fs::path& da
   if (path.find('/') == std::string::npos && !data_dir.empty() && fs::is_directory(data_dir / path, error)) {
     return data_dir / path;
   }
-  throw InputError("session " + path_or_name + ": no such directory" +
-                   (data_dir.empty() ? std::string() : " (nor a session of that name in " + data_dir.string() + ")"));
+  throw InputError("session " + printable(path_or_name) + ": no such directory" +
+                   (data_dir.empty() ? std::string() : " (nor a session of that name in " + printable(data_dir.string()) + ")"));
 }
 
-SessionManifest load_manifest(const fs::path& directory) {
-  std::error_code error;
-  if (!fs::is_directory(directory, error)) throw InputError(describe(directory) + ": no such directory");
-  const std::string text = read_session_file(directory, session_layout::kManifest);
-  return parse_manifest(text, describe(directory) + ": " + session_layout::kManifest);
+SessionManifest load_manifest(const fs::path& directory) { return load_manifest(open_session_directory(directory)); }
+
+SessionManifest load_manifest(const DirectoryHandle& directory) {
+  SessionIntegrity ignored;
+  const std::string text = read_session_file({directory, {}, {}}, session_layout::kManifest,
+                                             session_layout::kMostManifestBytes, "", ignored);
+  return parse_manifest(text, describe(directory.path()) + ": " + session_layout::kManifest);
 }
 
-Session load_session(const fs::path& directory) {
+Session load_session(const fs::path& directory) { return load_session(open_session_directory(directory)); }
+
+Session load_session(const DirectoryHandle& directory) {
   Session session;
-  session.directory = directory;
+  session.directory = directory.path();
   session.manifest = load_manifest(directory);
+  const SessionFolders folders{directory, session_folder(directory, session_layout::kIterations),
+                               session_folder(directory, session_layout::kFaults)};
   const SessionManifest& m = session.manifest;
   const Configuration& config = m.configuration;
   const int samples = m.trajectory_samples;
-  session.trajectory = parse_trajectory_csv_file(read_session_file(directory, session_layout::kTrajectory),
-                                                 describe(directory) + ": " + session_layout::kTrajectory,
-                                                 m.trajectory_name, samples, config.timing.sample_s(), config.trajectory);
+  const auto rows = static_cast<std::size_t>(samples);
+  const std::string where = describe(directory.path()) + ": ";
+  SessionIntegrity& integrity = session.integrity;
+  session.trajectory = parse_trajectory_csv_file(
+      read_session_file(folders, session_layout::kTrajectory, csv_size_limit(trajectory_columns(), rows + 1),
+                        m.trajectory_sha256, integrity),
+      where + session_layout::kTrajectory, m.trajectory_name, samples, config.timing.sample_s(), config.trajectory);
   session.iterations.resize(m.iterations.size());
   for (std::size_t i = 0; i < m.iterations.size(); ++i) {
     const int index = static_cast<int>(i);
     IterationData& data = session.iterations[i];
+    const IterationEntry& entry = m.iterations[i];
     const std::string samples_file = session_layout::samples_file(index);
     const std::string telemetry_file = session_layout::telemetry_file(index);
-    parse_samples_csv(read_session_file(directory, samples_file), describe(directory) + ": " + samples_file, samples,
-                      config.timing.sample_s(), data);
-    parse_telemetry_csv(read_session_file(directory, telemetry_file), describe(directory) + ": " + telemetry_file,
-                        samples, config.timing.ticks_per_sample, config.timing.tick_s, data);
+    const std::size_t ticks = rows * static_cast<std::size_t>(config.timing.ticks_per_sample);
+    parse_samples_csv(read_session_file(folders, samples_file, csv_size_limit(samples_columns(), rows + 1),
+                                        entry.samples_sha256, integrity),
+                      where + samples_file, samples, config.timing.sample_s(), data);
+    parse_telemetry_csv(read_session_file(folders, telemetry_file, csv_size_limit(telemetry_columns(), ticks),
+                                          entry.telemetry_sha256, integrity),
+                        where + telemetry_file, samples, config.timing.ticks_per_sample, config.timing.tick_s, data);
     // The files and the manifest must tell the same story.
     const double rms = data.record.rms_error_deg();
-    const double listed = m.iterations[i].summary.rms_deg;
+    const double listed = entry.summary.rms_deg;
     if (std::abs(rms - listed) > 1e-9 * std::max(1.0, listed)) {
-      throw InputError(describe(directory) + ": " + samples_file + ": its RMS error " + std::to_string(rms) +
+      throw InputError(where + samples_file + ": its RMS error " + std::to_string(rms) +
                        " deg differs from the manifest's " + std::to_string(listed) + " deg");
     }
   }
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+    const BlackBoxEntry& entry = m.black_boxes[i];
     const std::string file = session_layout::black_box_file(static_cast<int>(i));
+    const std::size_t limit = csv_size_limit(black_box_columns(), static_cast<std::size_t>(entry.ticks));
     session.black_boxes.push_back(
-        parse_black_box_csv(read_session_file(directory, file), describe(directory) + ": " + file, m.black_boxes[i].ticks));
+        parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity), where + file, entry.ticks));
   }
   return session;
-}
-
-void write_black_box_file(const fs::path& directory, int index, const std::vector<TickRecord>& ticks) {
-  const fs::path faults = directory / session_layout::kFaults;
-  std::error_code error;
-  const bool created = fs::create_directories(faults, error);
-  if (error) throw InputError("cannot create " + faults.string() + ": " + error.message());
-  if (created) sync_directory(directory);  // the new directory's entry is durable too
-  write_file_atomic(directory / session_layout::black_box_file(index), format_black_box_csv(ticks), DirectorySync::kNow);
-}
-
-void write_iteration_files(const fs::path& directory, int index, const TrialRecord& record,
-                           const Eigen::VectorXd& next_correction_bar) {
-  check_record(record, next_correction_bar, index);
-  write_file_atomic(directory / session_layout::samples_file(index), format_samples_csv(record, next_correction_bar),
-                    DirectorySync::kLater);
-  write_file_atomic(directory / session_layout::telemetry_file(index), format_telemetry_csv(record),
-                    DirectorySync::kLater);
-}
-
-void write_manifest(const fs::path& directory, SessionManifest& manifest) {
-  manifest.updated_utc = utc_now();
-  write_file_atomic(directory / session_layout::kManifest, format_manifest(manifest));
-}
-
-namespace {
-
-/// Writes many iterations' files with two workers, so that one formats while the other waits for
-/// the disk: a whole paper session saves in about half the time of a single thread.
-void write_all_iteration_files(const fs::path& directory, const std::vector<IterationData>& iterations) {
-  constexpr std::size_t kWorkers = 2;
-  std::atomic<std::size_t> next{0};
-  std::array<std::exception_ptr, kWorkers> errors{};
-  const auto work = [&](std::size_t worker) {
-    try {
-      for (std::size_t i = next++; i < iterations.size(); i = next++) {
-        write_iteration_files(directory, static_cast<int>(i), iterations[i].record, iterations[i].next_correction_bar);
-      }
-    } catch (...) {
-      errors[worker] = std::current_exception();
-      next = iterations.size();  // the others stop too
-    }
-  };
-  {
-    std::jthread helper(work, 1);
-    work(0);
-  }
-  for (const std::exception_ptr& error : errors) {
-    if (error) std::rethrow_exception(error);
-  }
-}
-
-}  // namespace
-
-SessionLock create_session_directory(const fs::path& directory, const SessionManifest& manifest,
-                                     const Trajectory& trajectory, const std::vector<IterationData>& iterations,
-                                     const std::string& purpose,
-                                     const std::vector<std::vector<TickRecord>>& black_boxes) {
-  if (iterations.size() != manifest.iterations.size()) {
-    throw std::invalid_argument("create_session_directory: the manifest lists a different number of iterations");
-  }
-  if (black_boxes.size() != manifest.black_boxes.size()) {
-    throw std::invalid_argument("create_session_directory: the manifest lists a different number of black boxes");
-  }
-  const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
-  std::error_code error;
-  fs::create_directories(parent, error);
-  if (error) throw InputError("cannot create the data directory " + parent.string() + ": " + error.message());
-  const auto refuse_existing = [&] {
-    if (const auto holder = SessionLock::holder(directory)) {
-      throw InputError(describe(directory) + " is in use by " + *holder + "; two processes never write the same session");
-    }
-    throw InputError(describe(directory) + " exists already; continue it with --resume " + directory.string() +
-                     " or choose another --name");
-  };
-  if (fs::exists(directory, error)) refuse_existing();
-
-  std::string building_name = ".";  // by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
-  building_name.append(directory.filename().string()).append(".creating-").append(std::to_string(::getpid()));
-  const fs::path building = parent / building_name;
-  fs::remove_all(building, error);
-  fs::create_directories(building / session_layout::kIterations, error);
-  if (error) throw InputError("cannot create " + building.string() + ": " + error.message());
-  try {
-    SessionLock lock(building, purpose);
-    write_file_atomic(building / session_layout::kTrajectory, format_trajectory_csv(trajectory), DirectorySync::kLater);
-    write_all_iteration_files(building, iterations);
-    sync_directory(building / session_layout::kIterations);
-    for (std::size_t i = 0; i < black_boxes.size(); ++i) write_black_box_file(building, static_cast<int>(i), black_boxes[i]);
-    SessionManifest copy = manifest;
-    write_manifest(building, copy);
-    if (::rename(building.c_str(), directory.c_str()) != 0) {
-      const int rename_error = errno;
-      if (rename_error == EEXIST || rename_error == ENOTEMPTY) refuse_existing();
-      throw InputError("cannot create " + directory.string() + ": " + std::strerror(rename_error));
-    }
-    sync_directory(parent);
-    return lock;
-  } catch (...) {
-    fs::remove_all(building, error);
-    throw;
-  }
 }
 
 void save_session(const Session& session, const fs::path& directory) {
@@ -265,19 +187,34 @@ void save_session(const Session& session, const fs::path& directory) {
                            session.black_boxes);
 }
 
+DirectoryHandle open_session_directory(const fs::path& directory) {
+  try {
+    return DirectoryHandle::open(directory);
+  } catch (const InputError& error) {
+    throw InputError("session " + std::string(error.what()));
+  }
+}
+
 std::vector<SessionListing> list_sessions(const fs::path& data_dir) {
   std::vector<SessionListing> listings;
   std::error_code error;
   if (!fs::is_directory(data_dir, error)) return listings;
+  const DirectoryHandle data = DirectoryHandle::open(data_dir);
   for (const auto& entry : fs::directory_iterator(data_dir, error)) {
     const std::string name = entry.path().filename().string();
-    if (name.empty() || name.front() == '.' || !entry.is_directory(error)) continue;
+    // A link is listed (and refused): it may point at a session, but the session's files are not inside it.
+    if (name.empty() || name.front() == '.' || !(entry.is_symlink(error) || entry.is_directory(error))) continue;
     SessionListing listing;
     listing.directory = entry.path();
     try {
-      listing.manifest = load_manifest(entry.path());
+      const std::optional<DirectoryHandle> session = data.subdirectory(name);
+      if (!session) continue;  // gone meanwhile
+      listing.manifest = load_manifest(*session);
     } catch (const InputError& load_error) {
-      listing.error = load_error.what();
+      const std::string what = load_error.what();
+      listing.error = what.rfind("session ", 0) == 0 ? what : describe(entry.path()) + ": " + what;
+    } catch (const std::exception& load_error) {  // e.g. out of memory: this session only
+      listing.error = describe(entry.path()) + ": cannot be read: " + load_error.what();
     }
     listings.push_back(std::move(listing));
   }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "sessions/file_access.hpp"
 #include "sessions/session.hpp"
 
 namespace bellows {
@@ -23,11 +24,18 @@ void validate_session_name(const std::string& name);
 /// A session given as a directory path, or as the name of one inside `data_dir`.
 std::filesystem::path resolve_session_dir(const std::string& path_or_name, const std::filesystem::path& data_dir);
 
+/// Opens a session's directory; InputError "session DIR: no such directory" and the like.
+DirectoryHandle open_session_directory(const std::filesystem::path& directory);
+
 /// The manifest alone (fast, for listings). Throws InputError for anything missing or malformed.
 SessionManifest load_manifest(const std::filesystem::path& directory);
+SessionManifest load_manifest(const DirectoryHandle& directory);
 /// Everything: manifest, trajectory, every listed iteration's samples and telemetry, each checked
-/// (lengths, sampling, finite values, RMS against the manifest). Throws InputError.
+/// (lengths, sampling, finite values, RMS against the manifest, the file's SHA-256 digest against
+/// the manifest's). Every file is opened inside the session without following a link; a link,
+/// a special file or a file larger than its format allows is refused. Throws InputError.
 Session load_session(const std::filesystem::path& directory);
+Session load_session(const DirectoryHandle& directory);
 
 /// Writes `session` as a new directory `directory` (which must not exist yet), atomically: the
 /// directory appears complete or not at all.
@@ -38,8 +46,9 @@ struct SessionListing {
   SessionManifest manifest;  // valid when `error` is empty
   std::string error;
 };
-/// Every session directory in `data_dir` (hidden entries skipped), oldest first. A missing data
-/// directory has no sessions.
+/// Every session directory in `data_dir` (hidden entries and plain files skipped), oldest first.
+/// A session that cannot be read (a link, a bad manifest, anything) is listed with its error and
+/// never hides the others. A missing data directory has no sessions.
 std::vector<SessionListing> list_sessions(const std::filesystem::path& data_dir);
 
 /// The lowest RMS of the listed iterations, or a negative value if there are none.

@@ -4,7 +4,6 @@
 #include <stdexcept>
 
 #include "engine/errors.hpp"
-#include "sessions/atomic_file.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
@@ -12,8 +11,11 @@
 namespace bellows {
 namespace fs = std::filesystem;
 
-SessionWriter::SessionWriter(fs::path directory, SessionManifest manifest, SessionLock lock)
-    : directory_(std::move(directory)), manifest_(std::move(manifest)), lock_(std::move(lock)) {}
+SessionWriter::SessionWriter(DirectoryHandle directory, SessionManifest manifest, SessionLock lock)
+    : directory_(std::move(directory)),
+      iterations_(directory_.make_subdirectory(session_layout::kIterations)),
+      manifest_(std::move(manifest)),
+      lock_(std::move(lock)) {}
 
 SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string& name, SessionManifest header,
                                     const Trajectory& trajectory, const std::string& purpose) {
@@ -26,9 +28,8 @@ SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string&
   if (!name.empty()) {
     validate_session_name(name);
     header.name = name;
-    fs::path directory = data_dir / name;
-    SessionLock lock = create_session_directory(directory, header, trajectory, {}, purpose);
-    return SessionWriter(std::move(directory), std::move(header), std::move(lock));
+    CreatedSession created = create_session_directory(data_dir / name, header, trajectory, {}, purpose);
+    return SessionWriter(std::move(created.directory), std::move(created.manifest), std::move(created.lock));
   }
   // Two runs started in the same second with the same trajectory: the second gets a suffix.
   const std::string stem = default_session_name(std::time(nullptr), trajectory.name);
@@ -36,30 +37,33 @@ SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string&
     header.name = attempt == 1 ? stem : stem + "_" + std::to_string(attempt);
     fs::path directory = data_dir / header.name;
     std::error_code error;
-    if (attempt < 100 && fs::exists(directory, error)) continue;
-    SessionLock lock = create_session_directory(directory, header, trajectory, {}, purpose);
-    return SessionWriter(std::move(directory), std::move(header), std::move(lock));
+    if (attempt < 100 && fs::symlink_status(directory, error).type() != fs::file_type::not_found) continue;
+    CreatedSession created = create_session_directory(directory, header, trajectory, {}, purpose);
+    return SessionWriter(std::move(created.directory), std::move(created.manifest), std::move(created.lock));
   }
 }
 
 SessionWriter SessionWriter::open(const fs::path& directory, const std::string& purpose, Session& loaded) {
-  std::error_code error;
-  if (!fs::is_directory(directory, error)) throw InputError("session " + directory.string() + ": no such directory");
-  SessionLock lock(directory, purpose);  // before loading: nobody changes it under us
-  loaded = load_session(directory);
-  remove_temporary_files(directory);
-  remove_temporary_files(directory / session_layout::kIterations);
+  DirectoryHandle session = open_session_directory(directory);
+  SessionLock lock(session, purpose);  // before loading: nobody changes it under us
+  loaded = load_session(session);
+  remove_temporary_files(session);
+  SessionWriter writer(std::move(session), loaded.manifest, std::move(lock));
   // Files of an iteration whose manifest update a crash prevented: not part of the session.
+  const auto name_in_folder = [](const std::string& relative) { return session_layout::folder_and_name(relative).second; };
+  remove_temporary_files(writer.iterations_);
   for (int i = static_cast<int>(loaded.iterations.size());; ++i) {
-    const bool samples = fs::remove(directory / session_layout::samples_file(i), error);
-    const bool telemetry = fs::remove(directory / session_layout::telemetry_file(i), error);
+    const bool samples = remove_file_at(writer.iterations_, name_in_folder(session_layout::samples_file(i)));
+    const bool telemetry = remove_file_at(writer.iterations_, name_in_folder(session_layout::telemetry_file(i)));
     if (!samples && !telemetry) break;
   }
-  remove_temporary_files(directory / session_layout::kFaults);
-  for (int i = static_cast<int>(loaded.black_boxes.size());; ++i) {  // likewise for a black box
-    if (!fs::remove(directory / session_layout::black_box_file(i), error)) break;
+  if (const std::optional<DirectoryHandle> faults = writer.directory_.subdirectory(session_layout::kFaults)) {
+    remove_temporary_files(*faults);
+    for (int i = static_cast<int>(loaded.black_boxes.size());; ++i) {  // likewise for a black box
+      if (!remove_file_at(*faults, name_in_folder(session_layout::black_box_file(i)))) break;
+    }
   }
-  return SessionWriter(directory, loaded.manifest, std::move(lock));
+  return writer;
 }
 
 void SessionWriter::save_iteration(const TrialRecord& record, const IterationSummary& summary,
@@ -72,10 +76,10 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
       next_correction_bar.size() != manifest_.trajectory_samples) {
     throw std::invalid_argument("SessionWriter::save_iteration: the record does not match the session's trajectory");
   }
-  write_iteration_files(directory_, summary.iteration, record, next_correction_bar);
-  sync_directory(directory_ / session_layout::kIterations);
+  const IterationDigests digests = write_iteration_files(iterations_, summary.iteration, record, next_correction_bar);
+  sync(iterations_);
   SessionManifest updated = manifest_;
-  updated.iterations.push_back({summary, utc_now()});
+  updated.iterations.push_back({summary, utc_now(), digests.samples_sha256, digests.telemetry_sha256});
   updated.resume = std::move(resume);
   write_manifest(directory_, updated);
   manifest_ = std::move(updated);  // only once it is on disk
@@ -84,9 +88,9 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
 void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {
   if (ticks.empty()) throw std::invalid_argument("SessionWriter::save_black_box: no ticks");
   const auto index = static_cast<int>(manifest_.black_boxes.size());
-  write_black_box_file(directory_, index, ticks);
+  const std::string digest = write_black_box_file(directory_, index, ticks);
   SessionManifest updated = manifest_;
-  updated.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size())});
+  updated.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size()), digest});
   write_manifest(directory_, updated);
   manifest_ = std::move(updated);
 }

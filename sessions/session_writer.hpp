@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "sessions/file_access.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_lock.hpp"
 
@@ -20,12 +21,13 @@ class SessionWriter {
   /// Throws InputError when the name is taken or the directory cannot be written.
   static SessionWriter create(const std::filesystem::path& data_dir, const std::string& name, SessionManifest header,
                               const Trajectory& trajectory, const std::string& purpose);
-  /// Reopens a session to continue it: takes its lock, loads and checks everything into `loaded`,
-  /// and removes leftovers of an interrupted write (temporary files, files of an
-  /// iteration the manifest does not list). Throws InputError (busy, bad session).
+  /// Reopens a session to continue it: takes its lock, loads and checks everything into `loaded`
+  /// (digests included), and removes leftovers of an interrupted write (temporary files, files of
+  /// an iteration the manifest does not list). Throws InputError (busy, bad session, a link or a
+  /// special file where a file or folder of the session should be).
   static SessionWriter open(const std::filesystem::path& directory, const std::string& purpose, Session& loaded);
 
-  const std::filesystem::path& directory() const { return directory_; }
+  const std::filesystem::path& directory() const { return directory_.path(); }
   const SessionManifest& manifest() const { return manifest_; }
 
   /// Autosave after iteration `summary.iteration` (which must be the next one) completed, with
@@ -41,10 +43,11 @@ class SessionWriter {
   void set_configuration(const Configuration& config);
 
  private:
-  SessionWriter(std::filesystem::path directory, SessionManifest manifest, SessionLock lock);
+  SessionWriter(DirectoryHandle directory, SessionManifest manifest, SessionLock lock);
   int next_iteration() const { return static_cast<int>(manifest_.iterations.size()); }
 
-  std::filesystem::path directory_;
+  DirectoryHandle directory_;  // every file is written relative to it, never through a link
+  DirectoryHandle iterations_;
   SessionManifest manifest_;
   SessionLock lock_;
 };

@@ -4,9 +4,11 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -60,7 +62,12 @@ inline std::string read_text(const std::filesystem::path& path) {
 struct ProcessResult {
   int exit_code = -1;
   std::string out, err;
+  bool hung = false;  // killed by run_bellows()'s guard: a regression that blocks fails, never hangs the suite
 };
+
+/// How long run_bellows() waits before it kills the process and reports it hung. A hang guard,
+/// not a speed check: every command it runs takes well under a second on an idle machine.
+inline constexpr int kHangGuard_ms = 120000;
 
 /// A bellows process running in the background, its stdout and stderr on pipes.
 struct Spawned {
@@ -90,8 +97,10 @@ inline Spawned spawn_bellows(const std::vector<std::string>& args, const std::ve
   return {pid, out_pipe[0], err_pipe[0]};
 }
 
-/// Runs the bellows binary to completion, collecting its output.
-inline ProcessResult run_bellows(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+/// Runs the bellows binary to completion, collecting its output; kills it (and sets `hung`) if it
+/// has not finished after `guard_ms`.
+inline ProcessResult run_bellows(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+                                 int guard_ms = kHangGuard_ms) {
   const Spawned spawned = spawn_bellows(args, env);
   const pid_t pid = spawned.pid;
   int out_pipe[2] = {spawned.out, -1}, err_pipe[2] = {spawned.err, -1};
@@ -99,8 +108,14 @@ inline ProcessResult run_bellows(const std::vector<std::string>& args, const std
   pollfd fds[2] = {{out_pipe[0], POLLIN, 0}, {err_pipe[0], POLLIN, 0}};
   int open_pipes = 2;
   char buffer[4096];
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(guard_ms);
   while (open_pipes > 0) {
-    if (::poll(fds, 2, -1) < 0) continue;
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 && !result.hung) {
+      result.hung = true;
+      ::kill(pid, SIGKILL);  // its pipes close: the loop ends
+    }
+    if (::poll(fds, 2, result.hung ? -1 : static_cast<int>(left.count()) + 1) < 0) continue;
     for (int i = 0; i < 2; ++i) {
       if (fds[i].fd < 0 || fds[i].revents == 0) continue;
       const ssize_t got = ::read(fds[i].fd, buffer, sizeof buffer);

@@ -1,11 +1,13 @@
 // A fault's black box in a session: written by the writer, listed by the manifest, loaded back
 // tick for tick (including the bad reading that caused the fault), checked when damaged.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 
 #include "engine/errors.hpp"
 #include "sessions/black_box_file.hpp"
+#include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
 #include "sessions/session_writer.hpp"
@@ -132,6 +134,10 @@ TEST(SessionBlackBox, DamageIsReportedWithTheFileAndLine) {
   const std::string good = testing::read_text(file);
   const auto damaged = [&](const std::string& text) {
     testing::write_text(file, text);
+    // With its digest updated, so the damage reaches the parser's checks (not the digest's).
+    auto manifest = nlohmann::ordered_json::parse(testing::read_text(dir / "s" / "manifest.json"));
+    manifest["black_boxes"][0]["sha256"] = sha256_hex(text);
+    testing::write_text(dir / "s" / "manifest.json", manifest.dump(2));
     return load_error(dir / "s");
   };
   const std::size_t second_line = good.find('\n') + 1;
@@ -151,8 +157,7 @@ TEST(SessionBlackBox, DamageIsReportedWithTheFileAndLine) {
   EXPECT_NE(damaged(swapped).find("line 3: tick"), std::string::npos) << damaged(swapped);
   fs::remove(file);
   EXPECT_NE(load_error(dir / "s").find(session_layout::black_box_file(0)), std::string::npos);
-  testing::write_text(file, good);
-  EXPECT_EQ(load_error(dir / "s"), "");
+  EXPECT_EQ(damaged(good), "");
 }
 
 TEST(SessionBlackBox, ReopeningRemovesABlackBoxTheManifestDoesNotList) {

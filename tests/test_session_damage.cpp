@@ -10,6 +10,7 @@
 
 #include "engine/errors.hpp"
 #include "session_test_support.hpp"
+#include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
 
@@ -46,6 +47,34 @@ void replace_in(const fs::path& file, const std::string& from, const std::string
   ASSERT_NE(at, std::string::npos) << from;
   text.replace(at, from.size(), to);
   testing::write_text(file, text);
+}
+
+/// Digests that match the damaged files, as in a session damaged before it was saved (or saved
+/// before digests were kept): so each damage reaches the check it is about, not the digest check
+/// (tests/test_session_hostile.cpp tests that one).
+void refresh_digests(const fs::path& dir) {
+  nlohmann::ordered_json json;
+  try {
+    json = nlohmann::ordered_json::parse(testing::read_text(dir / "manifest.json"));
+  } catch (const nlohmann::json::exception&) {
+    return;
+  }
+  bool changed = false;
+  const auto refresh = [&](nlohmann::ordered_json& object, const char* key, const std::string& relative) {
+    if (!object.is_object() || !object.contains(key) || !fs::is_regular_file(dir / relative)) return;
+    const std::string digest = sha256_hex(testing::read_text(dir / relative));
+    changed = changed || object[key] != digest;
+    object[key] = digest;
+  };
+  if (!json.is_object()) return;
+  refresh(json["trajectory"], "sha256", "trajectory.csv");
+  if (json.contains("iterations") && json["iterations"].is_array()) {
+    for (std::size_t i = 0; i < json["iterations"].size(); ++i) {
+      refresh(json["iterations"][i], "samples_sha256", session_layout::samples_file(static_cast<int>(i)));
+      refresh(json["iterations"][i], "telemetry_sha256", session_layout::telemetry_file(static_cast<int>(i)));
+    }
+  }
+  if (changed) testing::write_text(dir / "manifest.json", json.dump(2));
 }
 
 std::vector<Damage> damages() {
@@ -131,7 +160,7 @@ std::vector<Damage> damages() {
          fs::remove(d / "manifest.json");
          fs::create_directory(d / "manifest.json");
        },
-       "manifest.json: cannot read"},
+       "manifest.json is a directory, not a regular file"},
   };
 }
 
@@ -141,6 +170,7 @@ TEST_P(BadSession, IsRefusedWithAClearError) {
   TempDir dir;
   save_session(testing::simulate_session(3), dir / "s");
   GetParam().apply(dir / "s");
+  refresh_digests(dir / "s");
   const std::string error = error_of([&] { load_session(dir / "s"); });
   EXPECT_NE(error.find(GetParam().expected), std::string::npos) << error;
   EXPECT_EQ(error.rfind("session " + (dir / "s").string(), 0), 0u) << error;  // names the session first

@@ -155,7 +155,7 @@ TEST(AtomicFile, RemovesLeftoversOfACrashedWriter) {
   TempDir dir;
   testing::write_text(dir / ".manifest.json.tmp-99999", "partial");
   testing::write_text(dir / "keep.csv", "x\n");
-  remove_temporary_files(dir.path());
+  remove_temporary_files(DirectoryHandle::open(dir.path()));
   EXPECT_FALSE(std::filesystem::exists(dir / ".manifest.json.tmp-99999"));
   EXPECT_TRUE(std::filesystem::exists(dir / "keep.csv"));
 }

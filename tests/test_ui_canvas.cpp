@@ -33,6 +33,12 @@ TEST(UiCanvas, WritesClipsAndReadsBackAsText) {
   EXPECT_EQ(c.text(), "  hello wo\ncdef\n\n");
 }
 
+TEST(UiCanvas, ControlsFromFilesOrTheBusNeverReachTheTerminal) {
+  Canvas canvas(24, 1);
+  canvas.put(0, 0, "a\x1b[2J\nb\xc2\x9b\xe2\x80\xae" "c", Role::kNormal);
+  EXPECT_EQ(canvas.line(0), "a?[2J?b??c");
+}
+
 TEST(UiCanvas, Utf8RoundTripsAndCountsCodePoints) {
   const std::string text = "a\u2800\u2500\u00b0z";
   EXPECT_EQ(text_width(text), 5);

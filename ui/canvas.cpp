@@ -4,6 +4,8 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "engine/printable_text.hpp"
+
 namespace bellows::ui {
 
 Glyphs Glyphs::for_unicode(bool unicode) {
@@ -21,6 +23,8 @@ int Canvas::put(int x, int y, std::string_view text, Role role, bool bold, int c
   if (y < 0 || y >= height_) return x;
   for (char32_t glyph : decode_utf8(text)) {
     if (x >= right) break;
+    // Text from files and the bus may hold controls: a cell never sends one to the terminal.
+    if (is_terminal_control(glyph)) glyph = U'?';
     if (x >= 0) cell(x, y) = Cell{glyph, role, bold};
     ++x;
   }

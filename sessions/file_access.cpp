@@ -1,0 +1,227 @@
+#include "sessions/file_access.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
+#include "sessions/atomic_file.hpp"
+
+namespace bellows {
+namespace fs = std::filesystem;
+namespace {
+
+std::string shown(const fs::path& path) { return printable(path.string(), kPrintableField); }
+
+/// Why opening `name` failed, in words an operator can act on.
+std::string open_failure(int error_number) {
+  if (error_number == ELOOP) return "is a symbolic link; a session's files must be inside it, so links are never followed";
+  if (error_number == ENOTDIR) return "is not a directory";
+  return std::strerror(error_number);
+}
+
+/// Reads the whole descriptor, refusing more than `max_bytes` (the size may change while reading).
+std::string read_bounded(int fd, std::size_t max_bytes, const std::string& what) {
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) throw InputError(what + ": " + std::strerror(errno));
+  if (!S_ISREG(info.st_mode)) throw InputError(what + " is " + file_type_name(info.st_mode) + ", not a regular file");
+  const auto too_large = [&](std::size_t size) {
+    return InputError(what + " is " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) +
+                      " its format allows");
+  };
+  if (static_cast<std::uintmax_t>(info.st_size) > max_bytes) throw too_large(static_cast<std::size_t>(info.st_size));
+  std::string contents;
+  contents.reserve(static_cast<std::size_t>(info.st_size));
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t got = ::read(fd, buffer, sizeof buffer);
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(what + ": " + std::strerror(errno));
+    }
+    if (got == 0) break;
+    contents.append(buffer, static_cast<std::size_t>(got));
+    if (contents.size() > max_bytes) throw too_large(contents.size());
+  }
+  return contents;
+}
+
+}  // namespace
+
+FileDescriptor::~FileDescriptor() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+FileDescriptor::FileDescriptor(FileDescriptor&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+
+FileDescriptor& FileDescriptor::operator=(FileDescriptor&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
+}
+
+int FileDescriptor::release() { return std::exchange(fd_, -1); }
+
+std::string file_type_name(unsigned mode) {
+  switch (mode & S_IFMT) {
+    case S_IFREG: return "a regular file";
+    case S_IFDIR: return "a directory";
+    case S_IFLNK: return "a symbolic link";
+    case S_IFIFO: return "a FIFO";
+    case S_IFSOCK: return "a socket";
+    case S_IFCHR: return "a character device";
+    case S_IFBLK: return "a block device";
+    default: return "a special file";
+  }
+}
+
+DirectoryHandle DirectoryHandle::open(const fs::path& path) {
+  FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_NONBLOCK | O_CLOEXEC));
+  if (fd.get() < 0) {
+    const int error_number = errno;
+    throw InputError(shown(path) + ": " + (error_number == ENOENT ? "no such directory" : open_failure(error_number)));
+  }
+  return DirectoryHandle(std::move(fd), path);
+}
+
+std::optional<DirectoryHandle> DirectoryHandle::subdirectory(const std::string& name) const {
+  FileDescriptor fd(::openat(fd_.get(), name.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (fd.get() < 0) {
+    const int error_number = errno;
+    if (error_number == ENOENT) return std::nullopt;
+    // ENOTDIR for a file, ELOOP for a link: say which.
+    struct stat info {};
+    const std::string what = ::fstatat(fd_.get(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISDIR(info.st_mode)
+                                 ? "is " + file_type_name(info.st_mode) + ", not a directory" +
+                                       (S_ISLNK(info.st_mode) ? " (links are never followed)" : "")
+                                 : open_failure(error_number);
+    throw InputError(name + " " + what);
+  }
+  return DirectoryHandle(std::move(fd), path_ / name);
+}
+
+DirectoryHandle DirectoryHandle::make_subdirectory(const std::string& name) const {
+  if (::mkdirat(fd_.get(), name.c_str(), 0755) == 0) {
+    sync(*this);  // the new directory's entry is durable too
+  } else if (errno != EEXIST) {
+    throw InputError("cannot create " + shown(path_ / name) + ": " + std::strerror(errno));
+  }
+  std::optional<DirectoryHandle> made = subdirectory(name);
+  if (!made) throw InputError("cannot create " + shown(path_ / name) + ": it vanished");
+  return std::move(*made);
+}
+
+std::optional<FileDescriptor> open_regular_file_at(const DirectoryHandle& directory, const std::string& name, int flags,
+                                                   bool single_link) {
+  // Refused before it is opened: opening some devices acts (a tape rewinds, a modem hangs up).
+  struct stat before {};
+  if (::fstatat(directory.fd(), name.c_str(), &before, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISREG(before.st_mode)) {
+    throw InputError(name + (S_ISLNK(before.st_mode) ? " " + open_failure(ELOOP)
+                                                     : " is " + file_type_name(before.st_mode) + ", not a regular file"));
+  }
+  // O_NONBLOCK: should a FIFO take its place meanwhile, opening it must not wait for a writer.
+  FileDescriptor fd(::openat(directory.fd(), name.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644));
+  if (fd.get() < 0) {
+    const int error_number = errno;
+    if (error_number == ENOENT && (flags & O_CREAT) == 0) return std::nullopt;
+    throw InputError(name + " " + open_failure(error_number));
+  }
+  struct stat info {};
+  if (::fstat(fd.get(), &info) != 0) throw InputError(name + ": " + std::strerror(errno));
+  if (!S_ISREG(info.st_mode)) throw InputError(name + " is " + file_type_name(info.st_mode) + ", not a regular file");
+  if (single_link && info.st_nlink > 1) {
+    throw InputError(name + " has " + std::to_string(info.st_nlink) +
+                     " hard links; it is written in place, so it must be the session's own file");
+  }
+  return fd;
+}
+
+std::optional<std::string> read_regular_file_at(const DirectoryHandle& directory, const std::string& name,
+                                                std::size_t max_bytes) {
+  std::optional<FileDescriptor> fd = open_regular_file_at(directory, name, O_RDONLY);
+  if (!fd) return std::nullopt;
+  return read_bounded(fd->get(), max_bytes, name);
+}
+
+std::string read_regular_file(const fs::path& path, std::size_t max_bytes, const std::string& what) {
+  const std::string where = what + " " + shown(path);
+  struct stat before {};
+  if (::stat(path.c_str(), &before) == 0 && !S_ISREG(before.st_mode)) {  // before opening, as above
+    throw InputError(where + " is " + file_type_name(before.st_mode) + ", not a regular file");
+  }
+  FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
+  if (fd.get() < 0) throw InputError(where + ": cannot be read: " + std::strerror(errno));
+  return read_bounded(fd.get(), max_bytes, where);
+}
+
+void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
+                          DirectorySync directory_sync) {
+  const std::string temporary = temporary_path_for(name).filename().string();
+  const auto fail = [&](const std::string& what, int error_number) {
+    ::unlinkat(directory.fd(), temporary.c_str(), 0);
+    throw InputError("cannot " + what + " " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
+  };
+  ::unlinkat(directory.fd(), temporary.c_str(), 0);  // a leftover of this pid: a link is removed, not followed
+  // O_EXCL: created here and now, never opened through whatever a name might already be.
+  FileDescriptor fd(::openat(directory.fd(), temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
+  if (fd.get() < 0) {
+    const int error_number = errno;
+    throw InputError("cannot create " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
+  }
+  const char* data = contents.data();
+  std::size_t left = contents.size();
+  while (left > 0) {
+    const ssize_t written = ::write(fd.get(), data, left);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      fail("write", errno);
+    }
+    data += written;
+    left -= static_cast<std::size_t>(written);
+  }
+  if (::fsync(fd.get()) != 0) fail("flush", errno);
+  if (::close(fd.release()) != 0) fail("close", errno);
+  if (::renameat(directory.fd(), temporary.c_str(), directory.fd(), name.c_str()) != 0) fail("rename", errno);
+  if (directory_sync == DirectorySync::kNow) sync(directory);
+}
+
+void sync(const DirectoryHandle& directory) {
+  if (::fsync(directory.fd()) != 0) {
+    throw InputError("cannot flush directory " + shown(directory.path()) + ": " + std::strerror(errno));
+  }
+}
+
+bool remove_file_at(const DirectoryHandle& directory, const std::string& name) {
+  if (::unlinkat(directory.fd(), name.c_str(), 0) == 0) return true;
+  if (errno == ENOENT) return false;
+  throw InputError("cannot remove " + shown(directory.path() / name) + ": " + std::strerror(errno));
+}
+
+void remove_temporary_files(const DirectoryHandle& directory) {
+  // fdopendir takes over its descriptor: give it a duplicate.
+  const int duplicate = ::fcntl(directory.fd(), F_DUPFD_CLOEXEC, 0);
+  if (duplicate < 0) return;
+  DIR* stream = ::fdopendir(duplicate);
+  if (stream == nullptr) {
+    ::close(duplicate);
+    return;
+  }
+  ::rewinddir(stream);  // the duplicate shares the position of earlier scans
+  std::vector<std::string> leftovers;
+  while (const dirent* entry = ::readdir(stream)) {
+    if (is_temporary_file_name(entry->d_name)) leftovers.emplace_back(entry->d_name);
+  }
+  ::closedir(stream);
+  for (const std::string& name : leftovers) ::unlinkat(directory.fd(), name.c_str(), 0);
+}
+
+}  // namespace bellows

@@ -1,0 +1,94 @@
+// Files inside a session, reached only through the session's own directory: every name is opened
+// relative to a directory descriptor (openat) without following a symbolic link (O_NOFOLLOW), only
+// regular files and real directories are accepted, special files are opened without blocking
+// (O_NONBLOCK) and refused, and every read is bounded by the size its format allows. So a session
+// cannot make bellows read or write outside it, hang on a FIFO or read /dev/zero for ever.
+// Errors throw InputError naming the file and what is wrong with it.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace bellows {
+
+/// Closes a descriptor on every path out of a scope.
+class FileDescriptor {
+ public:
+  FileDescriptor() = default;
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor();
+  FileDescriptor(FileDescriptor&& other) noexcept;
+  FileDescriptor& operator=(FileDescriptor&& other) noexcept;
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  int get() const { return fd_; }
+  int release();
+
+ private:
+  int fd_ = -1;
+};
+
+/// An open directory: its descriptor and, for messages only, the path it was opened by.
+class DirectoryHandle {
+ public:
+  /// Opens the directory the caller names (a symbolic link the operator gives is followed: it is
+  /// the operator's choice). Throws InputError when it is not a directory.
+  static DirectoryHandle open(const std::filesystem::path& path);
+  /// The subdirectory `name` of this one, which must be a real directory, not a symbolic link.
+  /// nullopt when it does not exist.
+  std::optional<DirectoryHandle> subdirectory(const std::string& name) const;
+  /// As subdirectory(), creating it (and syncing this directory) when it does not exist.
+  DirectoryHandle make_subdirectory(const std::string& name) const;
+
+  /// The same directory after it was renamed to `path` (the descriptor follows the directory).
+  DirectoryHandle moved_to(const std::filesystem::path& path) && { return DirectoryHandle(std::move(fd_), path); }
+
+  int fd() const { return fd_.get(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  DirectoryHandle(FileDescriptor fd, std::filesystem::path path) : fd_(std::move(fd)), path_(std::move(path)) {}
+  FileDescriptor fd_;
+  std::filesystem::path path_;
+};
+
+/// Opens `name` in `directory` as a regular file without following a symbolic link and without
+/// blocking on a FIFO; `flags` are open(2)'s (O_RDONLY, O_RDWR | O_CREAT, ...). Refuses anything
+/// but a regular file, and a file with other hard links when `single_link` (it is written in place).
+/// nullopt when it does not exist (and O_CREAT is not in `flags`).
+std::optional<FileDescriptor> open_regular_file_at(const DirectoryHandle& directory, const std::string& name, int flags,
+                                                   bool single_link = false);
+
+/// The whole regular file `name` in `directory`, at most `max_bytes` long; nullopt when it does
+/// not exist. Throws InputError ("trajectory.csv is a symbolic link", "is a FIFO", "is larger
+/// than ...").
+std::optional<std::string> read_regular_file_at(const DirectoryHandle& directory, const std::string& name,
+                                                std::size_t max_bytes);
+
+/// A file the operator names (--config, --trajectory): a symbolic link is followed, but anything
+/// that is not a regular file is refused without blocking, and more than `max_bytes` is refused.
+/// Errors: InputError "<what> <path>: ...".
+std::string read_regular_file(const std::filesystem::path& path, std::size_t max_bytes, const std::string& what);
+
+/// What a file type is called in a message: "a directory", "a FIFO", "a character device", ...
+std::string file_type_name(unsigned mode);
+
+/// Writes `name` in `directory` atomically: a hidden temporary file created exclusively (so never
+/// through a link), written, flushed, renamed over `name` (which replaces a link, never follows it).
+enum class DirectorySync { kNow, kLater /* the caller calls sync() once for a batch */ };
+void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
+                          DirectorySync directory_sync = DirectorySync::kNow);
+
+/// Flushes a directory's entries (new names, renames) to disk.
+void sync(const DirectoryHandle& directory);
+
+/// Removes `name` from `directory` (a link itself, never what it points to). False if absent.
+bool remove_file_at(const DirectoryHandle& directory, const std::string& name);
+
+/// Removes temporary files a crashed writer left in `directory` (not recursive).
+void remove_temporary_files(const DirectoryHandle& directory);
+
+}  // namespace bellows

@@ -1,0 +1,185 @@
+#include "sessions/session_directory.hpp"
+
+#include <fcntl.h>
+#include <linux/fs.h>  // RENAME_NOREPLACE
+#include <stdio.h>     // renameat2
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <stdexcept>
+#include <thread>
+
+#include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
+#include "sessions/black_box_file.hpp"
+#include "sessions/file_digest.hpp"
+#include "sessions/iteration_files.hpp"
+#include "sessions/manifest_json.hpp"
+#include "sessions/session_layout.hpp"
+
+namespace bellows {
+namespace fs = std::filesystem;
+namespace {
+
+std::string describe(const fs::path& directory) { return "session " + printable(directory.string()); }
+
+void check_finite(const Eigen::VectorXd& values, int index, const char* what) {
+  for (Eigen::Index k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values(k))) {
+      throw InputError("iteration " + std::to_string(index) + ": " + what + " at index " + std::to_string(k) +
+                       " is not a finite number; it cannot be saved");
+    }
+  }
+}
+
+void check_record(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar, int index) {
+  const TrialSamples& s = record.samples;
+  for (const auto& [values, what] :
+       {std::pair{&s.time_s, "time"}, {&s.setpoint_rad, "angle set point"}, {&s.angle_rad, "angle"},
+        {&s.error_rad, "error"}, {&s.u_pid_bar, "u_pid"}, {&s.u_ilc_bar, "u_ilc"}, {&s.u_total_bar, "u_tot"},
+        {&s.pressure_a_bar, "pressure A"}, {&s.pressure_b_bar, "pressure B"}, {&s.setpoint_a_bar, "pressure A set point"},
+        {&s.setpoint_b_bar, "pressure B set point"}, {&next_correction_bar, "next correction"}}) {
+    check_finite(*values, index, what);
+  }
+  const TrialTicks& t = record.ticks;
+  for (const Eigen::VectorXd* values : {&t.time_s, &t.angle_rad, &t.pressure_a_bar, &t.pressure_b_bar, &t.supply_bar,
+                                        &t.setpoint_a_bar, &t.setpoint_b_bar, &t.inlet_a, &t.outlet_a, &t.inlet_b,
+                                        &t.outlet_b}) {
+    check_finite(*values, index, "telemetry");
+  }
+}
+
+/// `contents` written as `relative` (a layout name) in `folder`; returns its digest.
+std::string write_layout_file(const DirectoryHandle& folder, const std::string& relative, const std::string& contents,
+                              DirectorySync directory_sync) {
+  write_file_atomic_at(folder, session_layout::folder_and_name(relative).second, contents, directory_sync);
+  return sha256_hex(contents);
+}
+
+/// Writes many iterations' files with two workers, so that one formats while the other waits for
+/// the disk: a whole paper session saves in about half the time of a single thread.
+void write_all_iteration_files(const DirectoryHandle& folder, const std::vector<IterationData>& iterations,
+                               std::vector<IterationEntry>& entries) {
+  constexpr std::size_t kWorkers = 2;
+  std::atomic<std::size_t> next{0};
+  std::array<std::exception_ptr, kWorkers> errors{};
+  const auto work = [&](std::size_t worker) {
+    try {
+      for (std::size_t i = next++; i < iterations.size(); i = next++) {
+        const IterationDigests digests = write_iteration_files(folder, static_cast<int>(i), iterations[i].record,
+                                                               iterations[i].next_correction_bar);
+        entries[i].samples_sha256 = digests.samples_sha256;
+        entries[i].telemetry_sha256 = digests.telemetry_sha256;
+      }
+    } catch (...) {
+      errors[worker] = std::current_exception();
+      next = iterations.size();  // the others stop too
+    }
+  };
+  {
+    std::jthread helper(work, 1);
+    work(0);
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+}
+
+/// Renames `from` to `to` in `parent` unless `to` exists (whatever it is: a link, an empty directory).
+int rename_no_replace(const DirectoryHandle& parent, const std::string& from, const std::string& to) {
+  if (::renameat2(parent.fd(), from.c_str(), parent.fd(), to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  // A file system without RENAME_NOREPLACE: rename(2) still never replaces a non-empty directory.
+  struct stat info {};
+  if (::fstatat(parent.fd(), to.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0) return EEXIST;
+  return ::renameat(parent.fd(), from.c_str(), parent.fd(), to.c_str()) == 0 ? 0 : errno;
+}
+
+}  // namespace
+
+std::string write_black_box_file(const DirectoryHandle& session, int index, const std::vector<TickRecord>& ticks) {
+  const DirectoryHandle faults = session.make_subdirectory(session_layout::kFaults);
+  return write_layout_file(faults, session_layout::black_box_file(index), format_black_box_csv(ticks), DirectorySync::kNow);
+}
+
+IterationDigests write_iteration_files(const DirectoryHandle& iterations, int index, const TrialRecord& record,
+                                       const Eigen::VectorXd& next_correction_bar) {
+  check_record(record, next_correction_bar, index);
+  IterationDigests digests;
+  digests.samples_sha256 = write_layout_file(iterations, session_layout::samples_file(index),
+                                             format_samples_csv(record, next_correction_bar), DirectorySync::kLater);
+  digests.telemetry_sha256 = write_layout_file(iterations, session_layout::telemetry_file(index),
+                                               format_telemetry_csv(record), DirectorySync::kLater);
+  return digests;
+}
+
+void write_manifest(const DirectoryHandle& session, SessionManifest& manifest) {
+  manifest.updated_utc = utc_now();
+  write_file_atomic_at(session, session_layout::kManifest, format_manifest(manifest));
+}
+
+CreatedSession create_session_directory(const fs::path& directory, const SessionManifest& manifest,
+                                        const Trajectory& trajectory, const std::vector<IterationData>& iterations,
+                                        const std::string& purpose,
+                                        const std::vector<std::vector<TickRecord>>& black_boxes) {
+  if (iterations.size() != manifest.iterations.size()) {
+    throw std::invalid_argument("create_session_directory: the manifest lists a different number of iterations");
+  }
+  if (black_boxes.size() != manifest.black_boxes.size()) {
+    throw std::invalid_argument("create_session_directory: the manifest lists a different number of black boxes");
+  }
+  const fs::path parent_path = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
+  const std::string name = directory.filename().string();
+  std::error_code error;
+  fs::create_directories(parent_path, error);
+  if (error) throw InputError("cannot create the data directory " + printable(parent_path.string()) + ": " + error.message());
+  const DirectoryHandle parent = DirectoryHandle::open(parent_path);
+  const auto refuse_existing = [&] {
+    if (const auto holder = SessionLock::holder(directory)) {
+      throw InputError(describe(directory) + " is in use by " + *holder + "; two processes never write the same session");
+    }
+    throw InputError(describe(directory) + " exists already; continue it with --resume " + printable(directory.string()) +
+                     " or choose another --name");
+  };
+  struct stat existing {};
+  if (::fstatat(parent.fd(), name.c_str(), &existing, AT_SYMLINK_NOFOLLOW) == 0) refuse_existing();
+
+  std::string building_name = ".";  // by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
+  building_name.append(name).append(".creating-").append(std::to_string(::getpid()));
+  fs::remove_all(parent_path / building_name, error);  // a leftover of this pid (a link is removed, not followed)
+  if (::mkdirat(parent.fd(), building_name.c_str(), 0755) != 0) {
+    throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": " + std::strerror(errno));
+  }
+  try {
+    std::optional<DirectoryHandle> building = parent.subdirectory(building_name);
+    if (!building) throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": it vanished");
+    SessionLock lock(*building, purpose);
+    SessionManifest written = manifest;
+    const DirectoryHandle iterations_folder = building->make_subdirectory(session_layout::kIterations);
+    written.trajectory_sha256 =
+        write_layout_file(*building, session_layout::kTrajectory, format_trajectory_csv(trajectory), DirectorySync::kLater);
+    write_all_iteration_files(iterations_folder, iterations, written.iterations);
+    sync(iterations_folder);
+    for (std::size_t i = 0; i < black_boxes.size(); ++i) {
+      written.black_boxes[i].sha256 = write_black_box_file(*building, static_cast<int>(i), black_boxes[i]);
+    }
+    write_manifest(*building, written);
+    if (const int rename_error = rename_no_replace(parent, building_name, name); rename_error != 0) {
+      if (rename_error == EEXIST || rename_error == ENOTEMPTY) refuse_existing();
+      throw InputError("cannot create " + printable(directory.string()) + ": " + std::strerror(rename_error));
+    }
+    sync(parent);
+    return {std::move(*building).moved_to(directory), std::move(lock), std::move(written)};
+  } catch (...) {
+    fs::remove_all(parent_path / building_name, error);
+    throw;
+  }
+}
+
+}  // namespace bellows
