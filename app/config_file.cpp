@@ -10,8 +10,61 @@
 #include "sessions/file_access.hpp"
 
 namespace bellows {
+namespace {
+
+// A lab's configuration is a few kilobytes of `[section] key = value`. These bounds are checked
+// before toml++ sees the text: its parser recurses once per nesting level, and a file nested tens
+// of thousands of levels deep (`[a.a.a...]`, `x = [[[[...`) overflows the stack.
+constexpr std::size_t kMaxConfigBytes = 256 * 1024;
+constexpr int kMaxTomlNesting = 16;
+
+// The deepest nesting in TOML text: open arrays and inline tables plus the dots of a dotted key or
+// table header. Strings and comments are skipped; a value's decimal point counts as a dot, which
+// only makes the estimate a little high.
+void check_toml_nesting(const std::string& text, const std::string& source_name) {
+  int brackets = 0, dots = 0, line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '#') {
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+    } else if (c == '"' || c == '\'') {
+      const bool multiline = text.compare(i, 3, std::string(3, c)) == 0;
+      const std::string close = multiline ? std::string(3, c) : std::string(1, c);
+      for (i += close.size(); i < text.size() && text.compare(i, close.size(), close) != 0; ++i) {
+        if (c == '"' && text[i] == '\\') ++i;  // an escaped character, perhaps a quote
+        if (i < text.size() && text[i] == '\n') {
+          if (!multiline) break;  // unterminated: toml++ reports it
+          ++line;
+        }
+      }
+      if (multiline) i += 2;
+    } else if (c == '[' || c == '{') {
+      ++brackets;
+      dots = 0;
+    } else if (c == ']' || c == '}') {
+      if (brackets > 0) --brackets;
+      dots = 0;
+    } else if (c == '.') {
+      ++dots;
+    } else if (c == '=' || c == ',' || c == '\n') {
+      dots = 0;
+      if (c == '\n') ++line;
+    }
+    if (brackets + dots > kMaxTomlNesting) {
+      throw InputError("config " + source_name + ":" + std::to_string(line) + ": nested deeper than " +
+                       std::to_string(kMaxTomlNesting) + " levels (a configuration is [section] key = value)");
+    }
+  }
+}
+
+}  // namespace
 
 void apply_config_toml(const std::string& toml_text, const std::string& source_name, Configuration& config) {
+  if (toml_text.size() > kMaxConfigBytes) {
+    throw InputError("config " + source_name + ": larger than " + std::to_string(kMaxConfigBytes) +
+                     " bytes (a configuration is a few kilobytes)");
+  }
+  check_toml_nesting(toml_text, source_name);
   toml::table root;
   try {
     root = toml::parse(toml_text, source_name);
@@ -34,21 +87,27 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
     if (table == nullptr) throw InputError("config " + source_name + ": [" + section + "] must be a table");
     for (const auto& [key_node, value] : *table) {
       const std::string key(key_node.str());
-      const ParameterBinding* binding = nullptr;
-      for (const ParameterBinding& b : bindings) {
-        if (b.section == section && b.key == key) binding = &b;
-      }
+      const ParameterBinding* binding = find_parameter(section, key);
       const std::string where = "config " + source_name + ": [" + section + "] " + key;
       if (binding == nullptr) throw InputError(where + ": unknown key");
-      if (binding->text) {
-        if (!value.is_string()) throw InputError(where + ": expected a string");
-        *binding->text(config) = *value.value<std::string>();
-      } else if (binding->integer) {
-        if (!value.is_integer()) throw InputError(where + ": expected a whole number");
-        *binding->integer(config) = static_cast<int>(*value.value<std::int64_t>());
-      } else {
-        if (!value.is_number()) throw InputError(where + ": expected a number");
-        *binding->real(config) = *value.value<double>();
+      try {
+        if (binding->text) {
+          if (!value.is_string()) throw InputError(where + ": expected a string");
+          *binding->text(config) = *value.value<std::string>();
+        } else if (binding->integer) {
+          if (!value.is_integer()) throw InputError(where + ": expected a whole number in " + binding->range.text());
+          const std::int64_t whole = *value.value<std::int64_t>();
+          check_parameter_value(*binding, static_cast<double>(whole));  // before the int: nothing wraps
+          *binding->integer(config) = static_cast<int>(whole);
+        } else {
+          if (!value.is_number()) throw InputError(where + ": expected a number in " + binding->range.text());
+          const double number = *value.value<double>();
+          check_parameter_value(*binding, number);
+          *binding->real(config) = number;
+        }
+      } catch (const InputError& error) {
+        const std::string what = error.what();
+        throw InputError(what.rfind("config ", 0) == 0 ? what : "config " + source_name + ": " + what);
       }
     }
   }
@@ -63,8 +122,7 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
 
 Configuration load_config_file(const std::string& path) {
   // A directory, FIFO or device is refused (never read as an empty file, never waited on).
-  constexpr std::size_t kMostConfigBytes = std::size_t{1} << 20;
-  const std::string text = read_regular_file(path, kMostConfigBytes, "config");
+  const std::string text = read_regular_file(path, kMaxConfigBytes, "config");
   Configuration config;
   apply_config_toml(text, path, config);
   return config;
@@ -92,13 +150,13 @@ std::string config_to_markdown(const Configuration& config) {
   for (const ParameterBinding& b : parameter_bindings()) {
     if (b.section != section) {
       section = b.section;
-      out << "\n## [" << section << "]\n\n| key | default | unit | meaning |\n|---|---|---|---|\n";
+      out << "\n## [" << section << "]\n\n| key | default | range | unit | meaning |\n|---|---|---|---|---|\n";
     }
     out << "| `" << b.key << "` | ";
     if (b.text) out << '"' << *b.text(copy) << '"';
     else if (b.integer) out << *b.integer(copy);
     else out << *b.real(copy);
-    out << " | " << b.unit << " | " << b.description << " |\n";
+    out << " | " << (b.text ? "" : b.range.text()) << " | " << b.unit << " | " << b.description << " |\n";
   }
   return out.str();
 }

@@ -44,7 +44,7 @@ struct TrialFit {
 TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal) {
   const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
   TrialRecord record;
-  run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record);
+  run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
   return {signal, identification_data(record, config.controller, config.timing.tick_s)};
 }
 
@@ -181,7 +181,7 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
   } else {
     std::tie(estimation, validation) = record_rig_trials(config, device, options, estimation_signal, held_out_signal, progress);
   }
-  const ArmModelFit fit = fit_arm_model(estimation.data, config.model);
+  const ArmModelFit fit = fit_arm_model(estimation.data, config.model, &stop_requested());
   const double validation_fit =
       normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
   const double nominal_validation_fit =

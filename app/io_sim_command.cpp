@@ -1,11 +1,13 @@
 #include "app/io_sim_command.hpp"
 
 #include <filesystem>
+#include <cmath>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/lcm_url.hpp"
 #include "app/run_io.hpp"
 #include "app/signals.hpp"
 #include "devices/lcm_channels.hpp"
@@ -20,9 +22,12 @@ constexpr int kRigPriority = 70;
 }  // namespace
 
 int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream& progress) {
-  if (options.duration_s < 0.0) throw InputError("--duration must not be negative");
+  if (!std::isfinite(options.duration_s) || options.duration_s < 0.0) {
+    throw InputError("--duration must be a finite number of seconds >= 0");
+  }
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
+  check_lcm_url(url, "--lcm");
 
   SimulatedArm arm(config.plant, options.seed);
   RigServerParameters params;

@@ -1,9 +1,11 @@
 // bellows: the lab console and its headless commands.
+#include <csignal>
 #include <iostream>
 #include <map>
 
 #include <CLI/CLI.hpp>
 
+#include "app/cli_checks.hpp"
 #include "app/config_file.hpp"
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
@@ -16,11 +18,17 @@
 #include "app/signals.hpp"
 #include "app/standard_output.hpp"
 #include "devices/lcm_channels.hpp"
+#include "engine/cancellation.hpp"
 #include "engine/errors.hpp"
 #include "engine/printable_text.hpp"
 #include "sessions/session_store.hpp"
 
 using bellows::kExitBadInput;
+
+namespace {
+// Longest --duration / --exit-after / --silent-after: a year, far beyond any run, far below a double's range.
+constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
+}  // namespace
 
 int main(int argc, char** argv) {
   bellows::check_standard_output_at_exit();
@@ -35,7 +43,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");
-  run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
   run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
       ->capture_default_str()
@@ -133,13 +143,16 @@ int main(int argc, char** argv) {
   bellows::IoSimOptions io_sim;
   CLI::App* io_sim_cmd = app.add_subcommand("io-sim", "Serve the simulated arm over LCM in real time, as a rig would");
   io_sim_cmd->add_option("--config", io_sim.config_path, "TOML configuration file ([plant], [timing], [lcm])");
-  io_sim_cmd->add_option("--seed", io_sim.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  io_sim_cmd->add_option("--seed", io_sim.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
   io_sim_cmd->add_option("--lcm", io_sim.lcm_url, "LCM bus URL")->default_str(bellows::kDefaultLcmUrl);
   io_sim_cmd->add_option("--rt", io_sim.rt, "Real-time scheduling: enforce (refuse without), try, off")
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");
   io_sim_cmd->add_option("--duration", io_sim.duration_s, "Stop after this many seconds (0: at SIGINT/SIGTERM)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
 
   bellows::T7SimCommandOptions t7_sim;
@@ -147,16 +160,19 @@ int main(int argc, char** argv) {
   t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on")->capture_default_str();
   t7_sim_cmd->add_option("--config", t7_sim.config_path, "TOML configuration file ([plant])");
   t7_sim_cmd->add_option("--rig-profile", t7_sim.rig_profile, "Rig profile (default: the paper rig's)");
-  t7_sim_cmd->add_option("--seed", t7_sim.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  t7_sim_cmd->add_option("--seed", t7_sim.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
   t7_sim_cmd->add_option("--duration", t7_sim.duration_s, "Stop after this many seconds (0: at SIGINT/SIGTERM)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
   t7_sim_cmd->add_option("--status", t7_sim.status_path, "Keep the valve lines' state in this JSON file (docs/labjack-t7.md)");
   t7_sim_cmd->add_flag("--swapped-chambers", t7_sim.swapped_chambers, "Drill: chamber A's and B's transmitters swapped");
   t7_sim_cmd->add_option("--dead-valve", t7_sim.dead_valve, "Drill: this valve pair never opens")
       ->check(CLI::IsMember({"inlet_a", "inlet_b", "outlet_a", "outlet_b"}));
   t7_sim_cmd->add_flag("--no-supply", t7_sim.no_supply, "Drill: the supply at ambient pressure");
   t7_sim_cmd->add_option("--silent-after", t7_sim.silent_after_s, "Drill: the link falls silent this many seconds after the first request")
-      ->check(CLI::NonNegativeNumber);
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
@@ -174,13 +190,15 @@ int main(int argc, char** argv) {
   console_cmd->add_option("--rt", console.rt, "Real-time scheduling of the engine loop: enforce, try, off")
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");
-  console_cmd->add_option("--seed", console.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  console_cmd->add_option("--seed", console.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
   console_cmd->add_option("--stop-after-rises", console.stop_after_rises,
                           "A run of K iterations stops when the RMS rose this many times in a row")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   console_cmd->add_option("--exit-after", console.exit_after_s, "Close by itself after this many seconds (benchmarks)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
   console_cmd->add_flag("--no-color", console.no_color, "Attributes only, no colours (also: NO_COLOR set)");
 
   std::string config_path;
@@ -200,7 +218,9 @@ int main(int argc, char** argv) {
       ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
       ->default_str("try");
   identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
-  identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")->capture_default_str();
+  identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
+      ->capture_default_str()
+      ->check(bellows::unsigned_whole_number());
   identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
 
@@ -253,6 +273,9 @@ int main(int argc, char** argv) {
     if (plot_cmd->parsed()) return bellows::sessions_plot_command(plot, std::cout);
     // No subcommand (or `console`): the operator console.
     return bellows::console_command(console, std::cout);
+  } catch (const bellows::Cancelled& stopped) {  // a long computation honoured SIGINT or SIGTERM
+    std::cerr << "bellows: " << stopped.what() << std::endl;
+    return 128 + (bellows::stop_signal() != 0 ? bellows::stop_signal() : SIGINT);
   } catch (const bellows::BellowsError& error) {
     std::cerr << "bellows: " << bellows::printable(error.what(), bellows::kPrintableLine) << std::endl;
     return error.exit_status();

@@ -9,6 +9,7 @@
 
 #include "app/config_file.hpp"
 #include "app/cpu_idle_hold.hpp"
+#include "app/lcm_url.hpp"
 #include "app/learning_report.hpp"
 #include "app/run_io.hpp"
 #include "app/run_recording.hpp"
@@ -72,6 +73,7 @@ double parse_speed(const std::string& speed) {
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
   if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+  if (!options.lcm_url.empty()) check_lcm_url(options.lcm_url, "--lcm");  // before a session exists
   const double speed = parse_speed(options.speed);
   RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
   const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
@@ -116,7 +118,12 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   if (transfer) progress << transfer_line(*transfer) << std::endl;
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
   io.start_telemetry(recording.directory());  // its LCM log goes into the session
-  const ConvergencePrediction prediction = predict_convergence(*law, config, trajectory.learning_samples());
+  ConvergencePrediction prediction;
+  try {
+    prediction = predict_convergence(*law, config, trajectory.learning_samples(), &stop_requested());
+  } catch (const Cancelled&) {
+    // Stopped by a signal: the first trial sees the flag too, vents and records why.
+  }
   if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
   if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume

@@ -2,160 +2,167 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <tuple>
 
+#include "engine/configuration_cost.hpp"
 #include "engine/errors.hpp"
+#include "engine/identification_trial.hpp"
+#include "engine/learning_law_factory.hpp"
+#include "engine/pressure_controller.hpp"
 
 namespace bellows {
 namespace {
 
+// Ranges. They are physical bounds wide enough for any lab's arm, and narrow enough that no value
+// inside them makes a run allocate or compute without limit (the costs that depend on several keys
+// together are checked by engine/configuration_cost).
+Range pos(double max) { return {0.0, max, true, false}; }         // (0, max]
+Range upto(double max) { return {0.0, max, false, false}; }       // [0, max]
+Range between(double min, double max) { return {min, max, false, false}; }
+Range fraction() { return {0.0, 1.0, false, true}; }              // [0, 1)
+Range count(int max) { return {1.0, static_cast<double>(max), false, false}; }  // whole numbers 1..max
+
 template <typename Member>
 ParameterBinding number(std::string section, std::string key, std::string unit, std::string description,
-                        Constraint constraint, Member member) {
-  ParameterBinding b{std::move(section), std::move(key), std::move(unit), std::move(description), constraint, {}, {}, {}};
+                        Range range, Member member) {
+  ParameterBinding b{std::move(section), std::move(key), std::move(unit), std::move(description), range, {}, {}, {}};
   b.real = member;
   return b;
 }
 
 template <typename Member>
-ParameterBinding whole(std::string section, std::string key, std::string description, Member member) {
-  ParameterBinding b{std::move(section), std::move(key), "", std::move(description), Constraint::kPositive, {}, {}, {}};
+ParameterBinding whole(std::string section, std::string key, std::string description, Range range, Member member) {
+  ParameterBinding b{std::move(section), std::move(key), "", std::move(description), range, {}, {}, {}};
   b.integer = member;
+  return b;
+}
+
+// Strings have no range; the law, signal and fault names are checked where they are used.
+template <typename Member>
+ParameterBinding name(std::string section, std::string key, std::string description, Member member) {
+  ParameterBinding b{std::move(section), std::move(key), "", std::move(description), {}, {}, {}, {}};
+  b.text = member;
   return b;
 }
 
 std::vector<ParameterBinding> make_bindings() {
   using C = Configuration;
-  constexpr Constraint kPos = Constraint::kPositive, kNonNeg = Constraint::kNonNegative, kAny = Constraint::kAny;
   std::vector<ParameterBinding> b = {
       // [plant]: the simulated arm's truth
-      number("plant", "kappa", "rad/bar", "static gain from pressure difference to angle", kPos, [](C& c) { return &c.plant.kappa_rad_per_bar; }),
-      number("plant", "omega0", "rad/s", "natural frequency", kPos, [](C& c) { return &c.plant.omega0_rad_per_s; }),
-      number("plant", "damping", "", "damping ratio delta", kPos, [](C& c) { return &c.plant.damping; }),
-      number("plant", "volume_l", "L", "average volume of one bellows", kPos, [](C& c) { return &c.plant.volume_l; }),
-      number("plant", "volume_gain", "1/rad", "beta: V = V0 (1 +- beta alpha)", kNonNeg, [](C& c) { return &c.plant.volume_gain_per_rad; }),
-      number("plant", "valve_conductance", "m^3/(s Pa)", "ISO 6358 sonic conductance of one valve", kPos, [](C& c) { return &c.plant.valve_conductance_m3_per_sPa; }),
-      number("plant", "valve_critical_ratio", "", "ISO 6358 critical pressure ratio b", Constraint::kFraction, [](C& c) { return &c.plant.valve_critical_ratio; }),
-      whole("plant", "valves_per_port", "valves per inlet and per outlet of one actuator", [](C& c) { return &c.plant.valves_per_port; }),
-      number("plant", "creep_gain", "", "c_z of the viscoelastic creep", kNonNeg, [](C& c) { return &c.plant.creep_gain; }),
-      number("plant", "creep_tau_s", "s", "time constant of the creep", kPos, [](C& c) { return &c.plant.creep_tau_s; }),
-      number("plant", "supply_bar", "bar", "absolute supply pressure", kPos, [](C& c) { return &c.plant.supply_bar; }),
-      number("plant", "encoder_resolution_deg", "deg", "encoder quantization step", kNonNeg, [](C& c) { return &c.plant.encoder_resolution_deg; }),
-      number("plant", "pressure_noise_bar", "bar", "sigma of the pressure-sensor noise", kNonNeg, [](C& c) { return &c.plant.pressure_noise_bar; }),
-      number("plant", "hard_stop_deg", "deg", "angle of the hard stops", kPos, [](C& c) { return &c.plant.hard_stop_deg; }),
-      number("plant", "hard_stop_stiffness", "1/s^2", "stiffness of the hard stops", kPos, [](C& c) { return &c.plant.hard_stop_stiffness_per_s2; }),
-      number("plant", "hard_stop_damping", "1/s", "damping of the hard stops", kNonNeg, [](C& c) { return &c.plant.hard_stop_damping_per_s; }),
-      number("plant", "integration_step_s", "s", "fixed internal integration step", kPos, [](C& c) { return &c.plant.integration_step_s; }),
-      number("plant", "pwm_period_s", "s", "PWM period of the switching valves", kPos, [](C& c) { return &c.plant.pwm_period_s; }),
-      number("plant", "fault_at_s", "s", "device time of the injected fault", kNonNeg, [](C& c) { return &c.plant.fault_at_s; }),
-      number("plant", "spike_bar", "bar", "size of an injected pressure-sensor spike", kNonNeg, [](C& c) { return &c.plant.spike_bar; }),
-      number("plant", "spike_s", "s", "duration of an injected pressure-sensor spike", kPos, [](C& c) { return &c.plant.spike_s; }),
-      number("plant", "temperature_K", "K", "air temperature", kPos, [](C& c) { return &c.plant.gas.temperature_K; }),
+      number("plant", "kappa", "rad/bar", "static gain from pressure difference to angle", pos(100.0), [](C& c) { return &c.plant.kappa_rad_per_bar; }),
+      number("plant", "omega0", "rad/s", "natural frequency", pos(1000.0), [](C& c) { return &c.plant.omega0_rad_per_s; }),
+      number("plant", "damping", "", "damping ratio delta", pos(10.0), [](C& c) { return &c.plant.damping; }),
+      number("plant", "volume_l", "L", "average volume of one bellows", pos(10.0), [](C& c) { return &c.plant.volume_l; }),
+      number("plant", "volume_gain", "1/rad", "beta: V = V0 (1 +- beta alpha)", upto(10.0), [](C& c) { return &c.plant.volume_gain_per_rad; }),
+      number("plant", "valve_conductance", "m^3/(s Pa)", "ISO 6358 sonic conductance of one valve", pos(1e-6), [](C& c) { return &c.plant.valve_conductance_m3_per_sPa; }),
+      number("plant", "valve_critical_ratio", "", "ISO 6358 critical pressure ratio b", fraction(), [](C& c) { return &c.plant.valve_critical_ratio; }),
+      whole("plant", "valves_per_port", "valves per inlet and per outlet of one actuator", count(16), [](C& c) { return &c.plant.valves_per_port; }),
+      number("plant", "creep_gain", "", "c_z of the viscoelastic creep", upto(10.0), [](C& c) { return &c.plant.creep_gain; }),
+      number("plant", "creep_tau_s", "s", "time constant of the creep", pos(1000.0), [](C& c) { return &c.plant.creep_tau_s; }),
+      number("plant", "supply_bar", "bar", "absolute supply pressure", pos(20.0), [](C& c) { return &c.plant.supply_bar; }),
+      number("plant", "encoder_resolution_deg", "deg", "encoder quantization step", upto(10.0), [](C& c) { return &c.plant.encoder_resolution_deg; }),
+      number("plant", "pressure_noise_bar", "bar", "sigma of the pressure-sensor noise", upto(1.0), [](C& c) { return &c.plant.pressure_noise_bar; }),
+      number("plant", "hard_stop_deg", "deg", "angle of the hard stops", pos(180.0), [](C& c) { return &c.plant.hard_stop_deg; }),
+      number("plant", "hard_stop_stiffness", "1/s^2", "stiffness of the hard stops", pos(1e8), [](C& c) { return &c.plant.hard_stop_stiffness_per_s2; }),
+      number("plant", "hard_stop_damping", "1/s", "damping of the hard stops", upto(1e6), [](C& c) { return &c.plant.hard_stop_damping_per_s; }),
+      number("plant", "integration_step_s", "s", "fixed internal integration step", between(1e-6, 1e-2), [](C& c) { return &c.plant.integration_step_s; }),
+      number("plant", "pwm_period_s", "s", "PWM period of the switching valves", between(1e-4, 1.0), [](C& c) { return &c.plant.pwm_period_s; }),
+      number("plant", "fault_at_s", "s", "device time of the injected fault", upto(1e6), [](C& c) { return &c.plant.fault_at_s; }),
+      number("plant", "spike_bar", "bar", "size of an injected pressure-sensor spike", upto(10.0), [](C& c) { return &c.plant.spike_bar; }),
+      number("plant", "spike_s", "s", "duration of an injected pressure-sensor spike", pos(60.0), [](C& c) { return &c.plant.spike_s; }),
+      number("plant", "temperature_K", "K", "air temperature", between(200.0, 400.0), [](C& c) { return &c.plant.gas.temperature_K; }),
       // [model]: the nominal model the learning uses
-      number("model", "kappa", "rad/bar", "nominal static gain", kPos, [](C& c) { return &c.model.kappa_rad_per_bar; }),
-      number("model", "omega0", "rad/s", "nominal natural frequency", kPos, [](C& c) { return &c.model.omega0_rad_per_s; }),
-      number("model", "damping", "", "nominal damping ratio", kPos, [](C& c) { return &c.model.damping; }),
-      number("model", "volume_gain", "1/rad", "beta of V = V0 (1 +- beta alpha) the convergence prediction assumes", kNonNeg, [](C& c) { return &c.model.volume_gain_per_rad; }),
+      number("model", "kappa", "rad/bar", "nominal static gain", pos(100.0), [](C& c) { return &c.model.kappa_rad_per_bar; }),
+      number("model", "omega0", "rad/s", "nominal natural frequency", pos(1000.0), [](C& c) { return &c.model.omega0_rad_per_s; }),
+      number("model", "damping", "", "nominal damping ratio", pos(10.0), [](C& c) { return &c.model.damping; }),
+      number("model", "volume_gain", "1/rad", "beta of V = V0 (1 +- beta alpha) the convergence prediction assumes", upto(10.0), [](C& c) { return &c.model.volume_gain_per_rad; }),
       // [controller]
-      number("controller", "k_ff", "", "feed-forward gain (normalized)", kAny, [](C& c) { return &c.controller.k_ff; }),
-      number("controller", "k_p", "", "proportional gain (normalized)", kNonNeg, [](C& c) { return &c.controller.k_p; }),
-      number("controller", "k_i", "1/s", "integral gain (normalized)", kNonNeg, [](C& c) { return &c.controller.k_i_per_s; }),
-      number("controller", "k_d", "s", "derivative gain (normalized)", kNonNeg, [](C& c) { return &c.controller.k_d_s; }),
-      number("controller", "integrator_limit_bar", "bar", "bound on the integral term", kNonNeg, [](C& c) { return &c.controller.integrator_limit_bar; }),
-      number("controller", "tau_p_s", "s", "desired time constant of the pressure response", kPos, [](C& c) { return &c.controller.tau_p_s; }),
-      number("controller", "p_max_bar", "bar", "highest absolute pressure set point", kPos, [](C& c) { return &c.controller.p_max_bar; }),
-      whole("controller", "filter_samples", "moving-average length on measured pressure", [](C& c) { return &c.controller.filter_samples; }),
-      number("controller", "valve_conductance", "m^3/(s Pa)", "nominal conductance the inversion uses", kPos, [](C& c) { return &c.controller.valve_conductance_m3_per_sPa; }),
-      number("controller", "valve_critical_ratio", "", "nominal critical ratio the inversion uses", Constraint::kFraction, [](C& c) { return &c.controller.valve_critical_ratio; }),
-      whole("controller", "valves_per_port", "nominal valves per port the inversion uses", [](C& c) { return &c.controller.valves_per_port; }),
-      number("controller", "volume_l", "L", "nominal bellows volume the inversion uses", kPos, [](C& c) { return &c.controller.volume_l; }),
+      number("controller", "k_ff", "", "feed-forward gain (normalized)", between(-100.0, 100.0), [](C& c) { return &c.controller.k_ff; }),
+      number("controller", "k_p", "", "proportional gain (normalized)", upto(100.0), [](C& c) { return &c.controller.k_p; }),
+      number("controller", "k_i", "1/s", "integral gain (normalized)", upto(1000.0), [](C& c) { return &c.controller.k_i_per_s; }),
+      number("controller", "k_d", "s", "derivative gain (normalized)", upto(10.0), [](C& c) { return &c.controller.k_d_s; }),
+      number("controller", "integrator_limit_bar", "bar", "bound on the integral term", upto(20.0), [](C& c) { return &c.controller.integrator_limit_bar; }),
+      number("controller", "tau_p_s", "s", "desired time constant of the pressure response", pos(10.0), [](C& c) { return &c.controller.tau_p_s; }),
+      number("controller", "p_max_bar", "bar", "highest absolute pressure set point", pos(20.0), [](C& c) { return &c.controller.p_max_bar; }),
+      whole("controller", "filter_samples", "moving-average length on measured pressure", count(PressureController::kMaxFilterSamples), [](C& c) { return &c.controller.filter_samples; }),
+      number("controller", "valve_conductance", "m^3/(s Pa)", "nominal conductance the inversion uses", pos(1e-6), [](C& c) { return &c.controller.valve_conductance_m3_per_sPa; }),
+      number("controller", "valve_critical_ratio", "", "nominal critical ratio the inversion uses", fraction(), [](C& c) { return &c.controller.valve_critical_ratio; }),
+      whole("controller", "valves_per_port", "nominal valves per port the inversion uses", count(16), [](C& c) { return &c.controller.valves_per_port; }),
+      number("controller", "volume_l", "L", "nominal bellows volume the inversion uses", pos(10.0), [](C& c) { return &c.controller.volume_l; }),
       // [ilc]
-      number("ilc", "m", "", "weight M = m I on the predicted error", kNonNeg, [](C& c) { return &c.ilc.m; }),
-      number("ilc", "s", "", "weight S = s I on the change of correction", kNonNeg, [](C& c) { return &c.ilc.s; }),
-      number("ilc", "w", "", "weight W = w I on the correction's rate", kNonNeg, [](C& c) { return &c.ilc.w; }),
-      number("ilc", "admm_rho", "", "noilc-constrained: ADMM penalty", kPos, [](C& c) { return &c.ilc.admm_rho; }),
-      whole("ilc", "admm_max_iterations", "noilc-constrained: ADMM iteration limit per update", [](C& c) { return &c.ilc.admm_max_iterations; }),
-      number("ilc", "admm_tolerance", "bar", "noilc-constrained: ADMM residual tolerance", kPos, [](C& c) { return &c.ilc.admm_tolerance; }),
-      number("ilc", "limit_margin_bar", "bar", "noilc-constrained: keep u_pid + u_ilc this far inside the pressure limits", kNonNeg, [](C& c) { return &c.ilc.limit_margin_bar; }),
-      number("ilc", "limit_recovery_s", "s", "noilc-constrained: errors this long after a set point on the pressure limit are not learned from", kNonNeg, [](C& c) { return &c.ilc.limit_recovery_s; }),
-      number("ilc", "pd_kp", "", "pd: proportional learning gain", kAny, [](C& c) { return &c.ilc.pd_kp; }),
-      number("ilc", "pd_kd_s", "s", "pd: derivative learning gain", kAny, [](C& c) { return &c.ilc.pd_kd_s; }),
-      number("ilc", "pd_q_cutoff_hz", "Hz", "pd: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.pd_q_cutoff_hz; }),
-      number("ilc", "gradient_step", "", "gradient: step as a fraction of 1/||P||^2, in (0, 2)", kPos, [](C& c) { return &c.ilc.gradient_step; }),
-      number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", kPos, [](C& c) { return &c.ilc.inverse_gain; }),
-      number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", kPos, [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
-      number("ilc", "prediction_model_error", "", "convergence prediction: relative error of kappa and omega0 on the grid", Constraint::kFraction, [](C& c) { return &c.ilc.prediction_model_error; }),
-      whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", [](C& c) { return &c.ilc.prediction_grid_points; }),
+      number("ilc", "m", "", "weight M = m I on the predicted error", upto(1e6), [](C& c) { return &c.ilc.m; }),
+      number("ilc", "s", "", "weight S = s I on the change of correction", upto(1e6), [](C& c) { return &c.ilc.s; }),
+      number("ilc", "w", "", "weight W = w I on the correction's rate", upto(1e6), [](C& c) { return &c.ilc.w; }),
+      number("ilc", "admm_rho", "", "noilc-constrained: ADMM penalty", pos(1e6), [](C& c) { return &c.ilc.admm_rho; }),
+      whole("ilc", "admm_max_iterations", "noilc-constrained: ADMM iteration limit per update", count(100000), [](C& c) { return &c.ilc.admm_max_iterations; }),
+      number("ilc", "admm_tolerance", "bar", "noilc-constrained: ADMM residual tolerance", pos(1.0), [](C& c) { return &c.ilc.admm_tolerance; }),
+      number("ilc", "limit_margin_bar", "bar", "noilc-constrained: keep u_pid + u_ilc this far inside the pressure limits", upto(10.0), [](C& c) { return &c.ilc.limit_margin_bar; }),
+      number("ilc", "limit_recovery_s", "s", "noilc-constrained: errors this long after a set point on the pressure limit are not learned from", upto(60.0), [](C& c) { return &c.ilc.limit_recovery_s; }),
+      number("ilc", "pd_kp", "", "pd: proportional learning gain", between(-100.0, 100.0), [](C& c) { return &c.ilc.pd_kp; }),
+      number("ilc", "pd_kd_s", "s", "pd: derivative learning gain", between(-10.0, 10.0), [](C& c) { return &c.ilc.pd_kd_s; }),
+      number("ilc", "pd_q_cutoff_hz", "Hz", "pd: cutoff of the zero-phase Q-filter", pos(1e4), [](C& c) { return &c.ilc.pd_q_cutoff_hz; }),
+      number("ilc", "gradient_step", "", "gradient: step as a fraction of 1/||P||^2, in (0, 2)", Range{0.0, 2.0, true, true}, [](C& c) { return &c.ilc.gradient_step; }),
+      number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", pos(1.0), [](C& c) { return &c.ilc.inverse_gain; }),
+      number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", pos(1e4), [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
+      number("ilc", "prediction_model_error", "", "convergence prediction: relative error of kappa and omega0 on the grid", fraction(), [](C& c) { return &c.ilc.prediction_model_error; }),
+      whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", count(21), [](C& c) { return &c.ilc.prediction_grid_points; }),
       // [identify]
-      number("identify", "amplitude_deg", "deg", "excitation amplitude of the reference angle", kPos, [](C& c) { return &c.identify.amplitude_deg; }),
-      number("identify", "max_abs_angle_deg", "deg", "abort the identification trial beyond this angle", kPos, [](C& c) { return &c.identify.max_abs_angle_deg; }),
-      number("identify", "duration_s", "s", "length of each identification trial", kPos, [](C& c) { return &c.identify.duration_s; }),
-      number("identify", "chirp_start_hz", "Hz", "chirp: start frequency", kPos, [](C& c) { return &c.identify.chirp_start_hz; }),
-      number("identify", "chirp_end_hz", "Hz", "chirp: end frequency", kPos, [](C& c) { return &c.identify.chirp_end_hz; }),
-      number("identify", "step_hold_s", "s", "steps: time between steps", kPos, [](C& c) { return &c.identify.step_hold_s; }),
+      number("identify", "amplitude_deg", "deg", "excitation amplitude of the reference angle", pos(90.0), [](C& c) { return &c.identify.amplitude_deg; }),
+      number("identify", "max_abs_angle_deg", "deg", "abort the identification trial beyond this angle", pos(180.0), [](C& c) { return &c.identify.max_abs_angle_deg; }),
+      number("identify", "duration_s", "s", "length of each identification trial", between(3.0, 600.0), [](C& c) { return &c.identify.duration_s; }),
+      number("identify", "chirp_start_hz", "Hz", "chirp: start frequency", pos(1000.0), [](C& c) { return &c.identify.chirp_start_hz; }),
+      number("identify", "chirp_end_hz", "Hz", "chirp: end frequency", pos(1000.0), [](C& c) { return &c.identify.chirp_end_hz; }),
+      number("identify", "step_hold_s", "s", "steps: time between steps", pos(600.0), [](C& c) { return &c.identify.step_hold_s; }),
       // [timing]
-      number("timing", "tick_s", "s", "loop period (pressure controllers, PWM)", kPos, [](C& c) { return &c.timing.tick_s; }),
-      whole("timing", "ticks_per_sample", "loop ticks per ILC sample", [](C& c) { return &c.timing.ticks_per_sample; }),
-      number("timing", "settle_s", "s", "hold at the start before each trial", kNonNeg, [](C& c) { return &c.timing.settle_s; }),
+      number("timing", "tick_s", "s", "loop period (pressure controllers, PWM)", between(1e-4, 1.0), [](C& c) { return &c.timing.tick_s; }),
+      whole("timing", "ticks_per_sample", "loop ticks per ILC sample", count(1000), [](C& c) { return &c.timing.ticks_per_sample; }),
+      number("timing", "settle_s", "s", "hold at the start before each trial", upto(60.0), [](C& c) { return &c.timing.settle_s; }),
       // [trajectory]
       // [safety]: the guards' limits
-      number("safety", "angle_limit_deg", "deg", "fault beyond this angle", kPos, [](C& c) { return &c.safety.angle_limit_deg; }),
-      number("safety", "pressure_margin_bar", "bar", "fault when a chamber exceeds p_max plus this", kNonNeg, [](C& c) { return &c.safety.pressure_margin_bar; }),
-      number("safety", "supply_min_bar", "bar", "fault below this absolute supply pressure", kPos, [](C& c) { return &c.safety.supply_min_bar; }),
-      number("safety", "sensor_min_bar", "bar", "lowest plausible pressure reading", kNonNeg, [](C& c) { return &c.safety.sensor_min_bar; }),
-      number("safety", "sensor_max_bar", "bar", "highest plausible pressure reading", kPos, [](C& c) { return &c.safety.sensor_max_bar; }),
-      number("safety", "sensor_max_angle_deg", "deg", "largest plausible encoder reading", kPos, [](C& c) { return &c.safety.sensor_max_angle_deg; }),
-      whole("safety", "stale_ticks", "ticks without a fresh reading before a stale-sensor fault", [](C& c) { return &c.safety.stale_ticks; }),
-      whole("safety", "missed_deadline_streak", "consecutive missed deadlines before a fault", [](C& c) { return &c.safety.missed_deadline_streak; }),
-      number("safety", "heartbeat_timeout_s", "s", "console silent this long: fault", kPos, [](C& c) { return &c.safety.heartbeat_timeout_s; }),
-      number("safety", "black_box_s", "s", "ticks kept before a fault", kPos, [](C& c) { return &c.safety.black_box_s; }),
-      number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", kPos, [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
-      number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", kPos, [](C& c) { return &c.lcm.rig_timeout_s; }),
-      number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", kPos, [](C& c) { return &c.lcm.connect_timeout_s; }),
-      whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers, at most 1000000", [](C& c) { return &c.lcm.seq_window; }),
-      number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", kNonNeg, [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
-      number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", kPos, [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
+      number("safety", "angle_limit_deg", "deg", "fault beyond this angle", pos(180.0), [](C& c) { return &c.safety.angle_limit_deg; }),
+      number("safety", "pressure_margin_bar", "bar", "fault when a chamber exceeds p_max plus this", upto(10.0), [](C& c) { return &c.safety.pressure_margin_bar; }),
+      number("safety", "supply_min_bar", "bar", "fault below this absolute supply pressure", pos(20.0), [](C& c) { return &c.safety.supply_min_bar; }),
+      number("safety", "sensor_min_bar", "bar", "lowest plausible pressure reading", upto(20.0), [](C& c) { return &c.safety.sensor_min_bar; }),
+      number("safety", "sensor_max_bar", "bar", "highest plausible pressure reading", pos(100.0), [](C& c) { return &c.safety.sensor_max_bar; }),
+      number("safety", "sensor_max_angle_deg", "deg", "largest plausible encoder reading", pos(360.0), [](C& c) { return &c.safety.sensor_max_angle_deg; }),
+      whole("safety", "stale_ticks", "ticks without a fresh reading before a stale-sensor fault", count(100000), [](C& c) { return &c.safety.stale_ticks; }),
+      whole("safety", "missed_deadline_streak", "consecutive missed deadlines before a fault", count(1000000), [](C& c) { return &c.safety.missed_deadline_streak; }),
+      number("safety", "heartbeat_timeout_s", "s", "console silent this long: fault", pos(3600.0), [](C& c) { return &c.safety.heartbeat_timeout_s; }),
+      number("safety", "black_box_s", "s", "ticks kept before a fault", pos(60.0), [](C& c) { return &c.safety.black_box_s; }),
+      number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", pos(180.0), [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
+      number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", pos(60.0), [](C& c) { return &c.lcm.rig_timeout_s; }),
+      number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", pos(3600.0), [](C& c) { return &c.lcm.connect_timeout_s; }),
+      whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers", count(1000000), [](C& c) { return &c.lcm.seq_window; }),
+      number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", upto(10.0), [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
+      number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", pos(180.0), [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
+      name("lcm", "key_file", "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and states; empty: none", [](C& c) { return &c.lcm.key_file; }),
+      // [device]: which rig
+      name("device", "kind", "the rig: sim (the simulated arm), lcm (a rig over LCM) or t7 (a LabJack T7 over Modbus TCP)", [](C& c) { return &c.device.kind; }),
+      name("device", "lcm", "lcm: the rig's LCM bus URL (empty: udpm://239.255.76.67:7667?ttl=0)", [](C& c) { return &c.device.lcm_url; }),
+      name("device", "t7", "t7: the T7's address HOST[:PORT] (port 502 by default)", [](C& c) { return &c.device.t7_address; }),
+      name("device", "rig_profile", "t7: the rig profile file (empty: the paper's rig)", [](C& c) { return &c.device.rig_profile; }),
       // [rig_check]: the valve test of the first day (docs/rig-bring-up.md)
-      number("rig_check", "vent_s", "s", "both outlets open before each valve's test (back to ambient)", kPos, [](C& c) { return &c.rig_check.vent_s; }),
-      number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", kPos, [](C& c) { return &c.rig_check.fill_s; }),
-      number("rig_check", "valve_pulse_s", "s", "how long the valve under test opens, alone", kPos, [](C& c) { return &c.rig_check.valve_pulse_s; }),
-      number("rig_check", "min_change_bar", "bar", "a chamber moved: by at least this, and this much more than the other", kPos, [](C& c) { return &c.rig_check.min_change_bar; }),
-      number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", kPos, [](C& c) { return &c.t7.response_timeout_s; }),
-      number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", kPos, [](C& c) { return &c.t7.connect_timeout_s; }),
-      whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds, at least 1)", [](C& c) { return &c.t7.watchdog_timeout_s; }),
-      number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", kPos, [](C& c) { return &c.t7.command_timeout_s; }),
+      number("rig_check", "vent_s", "s", "both outlets open before each valve's test (back to ambient)", pos(60.0), [](C& c) { return &c.rig_check.vent_s; }),
+      number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", pos(10.0), [](C& c) { return &c.rig_check.fill_s; }),
+      number("rig_check", "valve_pulse_s", "s", "how long the valve under test opens, alone", pos(10.0), [](C& c) { return &c.rig_check.valve_pulse_s; }),
+      number("rig_check", "min_change_bar", "bar", "a chamber moved: by at least this, and this much more than the other", pos(10.0), [](C& c) { return &c.rig_check.min_change_bar; }),
+      number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", pos(1.0), [](C& c) { return &c.t7.response_timeout_s; }),
+      number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", pos(3600.0), [](C& c) { return &c.t7.connect_timeout_s; }),
+      whole("t7", "watchdog_timeout_s", "the T7's own watchdog vents after this much silence (whole seconds)", count(3600), [](C& c) { return &c.t7.watchdog_timeout_s; }),
+      number("t7", "command_timeout_s", "s", "the T7 link vents when the engine sends no command this long", pos(60.0), [](C& c) { return &c.t7.command_timeout_s; }),
   };
-  ParameterBinding key_file{"lcm", "key_file", "", "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and states; empty: none",
-                            Constraint::kAny, {}, {}, {}};
-  key_file.text = [](C& c) { return &c.lcm.key_file; };
-  const auto after_rig_angle = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "rig_angle_limit_deg"; });
-  b.insert(after_rig_angle + 1, key_file);
-  // [device]: which rig (names, so text rows), after [lcm]
-  const std::vector<std::tuple<const char*, const char*, std::function<std::string*(C&)>>> device_rows = {
-      {"kind", "the rig: sim (the simulated arm), lcm (a rig over LCM) or t7 (a LabJack T7 over Modbus TCP)", [](C& c) { return &c.device.kind; }},
-      {"lcm", "lcm: the rig's LCM bus URL (empty: udpm://239.255.76.67:7667?ttl=0)", [](C& c) { return &c.device.lcm_url; }},
-      {"t7", "t7: the T7's address HOST[:PORT] (port 502 by default)", [](C& c) { return &c.device.t7_address; }},
-      {"rig_profile", "t7: the rig profile file (empty: the paper's rig)", [](C& c) { return &c.device.rig_profile; }},
-  };
-  auto after_lcm = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "rig_check"; });
-  for (const auto& [key, description, member] : device_rows) {
-    ParameterBinding row{"device", key, "", description, Constraint::kAny, {}, {}, {}};
-    row.text = member;
-    after_lcm = std::next(b.insert(after_lcm, row));
-  }
-  ParameterBinding fault{"plant", "fault", "", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet", Constraint::kAny, {}, {}, {}};
-  fault.text = [](C& c) { return &c.plant.fault; };
+  const ParameterBinding fault = name("plant", "fault", "injected fault: none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet",
+                                      [](C& c) { return &c.plant.fault; });
   const auto after_plant = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
   b.insert(after_plant, fault);
-  ParameterBinding law{"ilc", "law", "", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
-                       Constraint::kAny, {}, {}, {}};
-  law.text = [](C& c) { return &c.ilc.law; };
+  const ParameterBinding law = name("ilc", "law", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
+                                    [](C& c) { return &c.ilc.law; });
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
   b.insert(first_ilc, law);
-  ParameterBinding signal{"identify", "signal", "", "excitation of the identification trial: chirp or steps",
-                          Constraint::kAny, {}, {}, {}};
-  signal.text = [](C& c) { return &c.identify.signal; };
+  const ParameterBinding signal = name("identify", "signal", "excitation of the identification trial: chirp or steps",
+                                       [](C& c) { return &c.identify.signal; });
   const auto first_identify = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "identify"; });
   b.insert(first_identify, signal);
   return b;
@@ -165,37 +172,48 @@ std::string describe(const ParameterBinding& b) { return "[" + b.section + "] " 
 
 std::string format_number(double value) {
   std::ostringstream out;
-  out << value;
+  out << std::setprecision(12) << value;
   return out.str();
 }
 
+void check_below_nyquist(const char* key, double cutoff_hz, const TimingParameters& timing) {
+  const double nyquist_hz = 0.5 / timing.sample_s();
+  if (cutoff_hz >= nyquist_hz) {
+    throw InputError(std::string("[ilc] ") + key + " = " + format_number(cutoff_hz) +
+                     ": must be below the Nyquist frequency " + format_number(nyquist_hz) + " Hz of the ILC sample time");
+  }
+}
+
 }  // namespace
+
+std::string Range::text() const {
+  return std::string(min_open ? "(" : "[") + format_number(min) + ", " + format_number(max) + (max_open ? ")" : "]");
+}
 
 const std::vector<ParameterBinding>& parameter_bindings() {
   static const std::vector<ParameterBinding> bindings = make_bindings();
   return bindings;
 }
 
+const ParameterBinding* find_parameter(const std::string& section, const std::string& key) {
+  for (const ParameterBinding& b : parameter_bindings()) {
+    if (b.section == section && b.key == key) return &b;
+  }
+  return nullptr;
+}
+
+void check_parameter_value(const ParameterBinding& b, double value) {
+  const std::string where = describe(b) + " = " + format_number(value);
+  if (!std::isfinite(value)) throw InputError(where + ": must be a finite number in " + b.range.text());
+  if (b.integer && value != std::floor(value)) throw InputError(where + ": must be a whole number in " + b.range.text());
+  if (!b.range.contains(value)) throw InputError(where + ": must be in " + b.range.text());
+}
+
 void validate_configuration(const Configuration& config) {
   Configuration copy = config;  // the bindings hand out pointers into a mutable configuration
   for (const ParameterBinding& b : parameter_bindings()) {
     if (b.text) continue;
-    const double value = b.real ? *b.real(copy) : static_cast<double>(*b.integer(copy));
-    const std::string where = describe(b) + " = " + format_number(value);
-    if (!std::isfinite(value)) throw InputError(where + ": must be a finite number");
-    switch (b.constraint) {
-      case Constraint::kPositive:
-        if (!(value > 0.0)) throw InputError(where + ": must be positive");
-        break;
-      case Constraint::kNonNegative:
-        if (value < 0.0) throw InputError(where + ": must not be negative");
-        break;
-      case Constraint::kFraction:
-        if (value < 0.0 || value >= 1.0) throw InputError(where + ": must be in [0, 1)");
-        break;
-      case Constraint::kAny:
-        break;
-    }
+    check_parameter_value(b, b.real ? *b.real(copy) : static_cast<double>(*b.integer(copy)));
   }
   const double ambient = config.controller.gas.ambient_bar;
   if (config.controller.p_max_bar <= ambient) {
@@ -226,13 +244,42 @@ void validate_configuration(const Configuration& config) {
     throw InputError("[lcm] rig_angle_limit_deg = " + format_number(config.lcm.rig_angle_limit_deg) +
                      ": must be in [[safety] angle_limit_deg, 180]: the engine's guard acts first");
   }
+  if (config.safety.sensor_min_bar >= config.safety.sensor_max_bar) {
+    throw InputError("[safety] sensor_min_bar must be below [safety] sensor_max_bar");
+  }
+  if (config.identify.chirp_start_hz >= config.identify.chirp_end_hz) {
+    throw InputError("[identify] chirp_start_hz must be below [identify] chirp_end_hz");
+  }
+  if (config.identify.amplitude_deg >= config.identify.max_abs_angle_deg) {
+    throw InputError("[identify] amplitude_deg must be below [identify] max_abs_angle_deg");
+  }
   if (config.plant.integration_step_s > config.plant.pwm_period_s) {
     throw InputError("[plant] integration_step_s must not exceed [plant] pwm_period_s");
   }
-  if (config.t7.watchdog_timeout_s < 1) {
-    throw InputError("[t7] watchdog_timeout_s = " + std::to_string(config.t7.watchdog_timeout_s) +
-                     ": the T7's watchdog counts whole seconds, 1 at least");
+  const std::vector<std::string> laws = learning_law_names();
+  if (std::find(laws.begin(), laws.end(), config.ilc.law) == laws.end()) {
+    std::string known;
+    for (const std::string& law : laws) known += (known.empty() ? "" : ", ") + law;
+    throw InputError("[ilc] law = '" + config.ilc.law + "': unknown learning law (known: " + known + ")");
   }
+  validation_signal(config.identify.signal);  // throws for anything but chirp and steps
+  // The Q-filters of the law in use; the other laws' keys may hold anything in range.
+  if (config.ilc.law == "pd") check_below_nyquist("pd_q_cutoff_hz", config.ilc.pd_q_cutoff_hz, config.timing);
+  if (config.ilc.law == "inverse") check_below_nyquist("inverse_q_cutoff_hz", config.ilc.inverse_q_cutoff_hz, config.timing);
+  // The norm-optimal cost must be positive definite: the dense form factors P'MP + S + D'WD, the
+  // Riccati forms also accept S = W = 0 with M > 0 (the plain inverse).
+  const IlcParameters& ilc = config.ilc;
+  const bool dense = ilc.law == "noilc-dense", riccati = ilc.law == "noilc" || ilc.law == "noilc-constrained";
+  if ((dense && !(ilc.s + ilc.w > 0.0)) || (riccati && !(ilc.s + ilc.w > 0.0) && !(ilc.m > 0.0))) {
+    throw InputError(std::string("[ilc] s, w") + (dense ? "" : " and m") + " are all 0: law '" + ilc.law +
+                     "' needs a positive definite cost");
+  }
+  if (config.ilc.law == "noilc-constrained" &&
+      !(config.ilc.limit_margin_bar < config.controller.p_max_bar - ambient)) {
+    throw InputError("[ilc] limit_margin_bar = " + format_number(config.ilc.limit_margin_bar) +
+                     ": leaves no room below [controller] p_max_bar");
+  }
+  check_configuration_cost(config);
 }
 
 }  // namespace bellows

@@ -82,7 +82,8 @@ constexpr double kDivergenceTolerance = 1e-3;
 
 }  // namespace
 
-ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples) {
+ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples,
+                                          StopFlag stop) {
   ConvergencePrediction p;
   if (samples < 2 || !law.frequency_response(std::numbers::pi / 2.0)) return p;
   p.available = true;
@@ -96,6 +97,7 @@ ConvergencePrediction predict_convergence(const LearningLaw& law, const Configur
   p.worst = p.nominal;
   for (int i = 0; i < n; ++i) {
     for (int k = 0; k < n; ++k) {
+      if (stop_is_requested(stop)) throw Cancelled("convergence prediction stopped by a signal");
       const double a = n == 1 ? 0.0 : -1.0 + 2.0 * i / (n - 1);
       const double b = n == 1 ? 0.0 : -1.0 + 2.0 * k / (n - 1);
       const ContractionEstimate e =

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/cancellation.hpp"
 #include "engine/configuration.hpp"
 #include "engine/learning_law.hpp"
 
@@ -39,6 +40,8 @@ struct ConvergencePrediction {
 };
 
 /// The prediction for `law` on trials of `samples` samples, with the grid of [ilc] prediction_*.
-ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples);
+/// Throws Cancelled when `stop` is set (looked at between grid points).
+ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples,
+                                          StopFlag stop = nullptr);
 
 }  // namespace bellows

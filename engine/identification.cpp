@@ -133,7 +133,7 @@ double normalized_fit_percent(const Eigen::VectorXd& measured, const Eigen::Vect
   return 100.0 * (1.0 - (measured - predicted).norm() / spread);
 }
 
-ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters& fallback) {
+ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters& fallback, StopFlag stop) {
   const Eigen::Index n = data.angle_rad.size();
   if (n < 50 || data.pressure_difference_bar.size() != n || !(data.sample_time_s > 0.0)) {
     throw InputError("identification: need at least 50 samples of angle and pressure difference, got " +
@@ -152,6 +152,7 @@ ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters&
   fit.initial = arx_estimate(data).value_or(fallback);
   Eigen::Vector3d p = to_log_parameters(fit.initial);
   auto residual = [&](const Eigen::Vector3d& q) -> Eigen::VectorXd {
+    if (stop_is_requested(stop)) throw Cancelled("identification stopped by a signal");
     return simulate_arm_angle(from_log_parameters(q), data) - data.angle_rad;
   };
   Eigen::VectorXd r = residual(p);

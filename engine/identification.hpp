@@ -16,6 +16,7 @@
 
 #include <Eigen/Dense>
 
+#include "engine/cancellation.hpp"
 #include "engine/parameters.hpp"
 #include "engine/trial_record.hpp"
 
@@ -51,7 +52,8 @@ struct ArmModelFit {
 };
 
 /// Least-squares fit. `fallback` is the start when the ARX estimate is not a stable oscillator.
-/// Throws InputError when the data are too short or carry no excitation.
-ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters& fallback);
+/// Throws InputError when the data are too short or carry no excitation, Cancelled when `stop` is set
+/// (looked at before each model simulation).
+ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters& fallback, StopFlag stop = nullptr);
 
 }  // namespace bellows

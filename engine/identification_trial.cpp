@@ -61,7 +61,7 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
 }
 
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
-                              double max_abs_angle_deg, TrialRecord& record) {
+                              double max_abs_angle_deg, TrialRecord& record, StopFlag stop) {
   // Through the engine like any trial: armed, guarded, the record prepared outside the loop.
   EngineCore& core = driver.core();
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
@@ -84,6 +84,11 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       if (event.kind == EventKind::kTrialAborted || event.kind == EventKind::kFault) {
         throw EngineFault(core.fault(), std::string("identification aborted: ") + fault_message(core.fault()));
       }
+    }
+    if (stop_is_requested(stop)) {
+      core.send(EngineCommand::of(CommandKind::kEmergencyStop));
+      while (core.state() != EngineState::kFault) driver.await();
+      throw Cancelled("identification stopped by a signal, valves vented");
     }
     core.read_snapshot(tick);
     if (std::abs(tick.reading.angle_rad) > bound_rad) {

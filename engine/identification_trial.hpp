@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "engine/cancellation.hpp"
 #include "engine/engine_driver.hpp"
 #include "engine/parameters.hpp"
 #include "engine/trajectory.hpp"
@@ -24,8 +25,9 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
 
 /// Runs the excitation as a trial through the engine (arming it if needed; its guards apply):
 /// settles at the start, then tracks it with the PID alone. Throws InputError, after an emergency
-/// stop that vents, when the angle leaves +-max_abs_angle_deg; EngineFault if the engine faults.
+/// stop that vents, when the angle leaves +-max_abs_angle_deg; EngineFault if the engine faults;
+/// Cancelled, after an emergency stop that vents, when `stop` is set (looked at every tick).
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
-                              double max_abs_angle_deg, TrialRecord& record);
+                              double max_abs_angle_deg, TrialRecord& record, StopFlag stop = nullptr);
 
 }  // namespace bellows

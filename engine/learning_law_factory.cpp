@@ -1,5 +1,6 @@
 #include "engine/learning_law_factory.hpp"
 
+#include "engine/configuration_cost.hpp"
 #include "engine/errors.hpp"
 #include "engine/gradient_ilc.hpp"
 #include "engine/inverse_ilc.hpp"
@@ -26,6 +27,7 @@ std::string learning_law_description(const std::string& name) {
 
 std::unique_ptr<LearningLaw> make_learning_law(const Configuration& config, const DiscreteArmModel& model, int samples) {
   const std::string& law = config.ilc.law;
+  check_trial_cost(config, samples);  // before any matrix of the law is allocated
   try {
     if (law == "noilc") return std::make_unique<NormOptimalRiccati>(model, config.ilc, samples);
     if (law == "noilc-dense") return std::make_unique<NormOptimalDense>(model, config.ilc, samples);

@@ -3,6 +3,7 @@
 #include <set>
 
 #include "engine/arm_model.hpp"
+#include "engine/configuration_cost.hpp"
 #include "engine/errors.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
@@ -284,6 +285,11 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   const JsonReader trajectory = r["trajectory"];
   m.trajectory_name = trajectory["name"].text();
   m.trajectory_samples = trajectory["learning_samples"].integer(m.configuration.trajectory.min_learning_samples, kMostSamples);
+  try {  // the ticks and the law's matrices such a trial implies, before anything reads or allocates them
+    check_trial_cost(m.configuration, m.trajectory_samples);
+  } catch (const InputError& error) {
+    trajectory["learning_samples"].fail(error.what());
+  }
   m.trajectory_sha256 = digest_from_json(trajectory, "sha256");
   const JsonReader iterations = r["iterations"];
   for (std::size_t i = 0; i < iterations.size(); ++i) {

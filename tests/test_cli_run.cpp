@@ -132,8 +132,8 @@ TEST(CliRun, BadInputGetsOneLineAndExitStatusTwo) {
   expect_bad_input("--trajectory loops", "unknown trajectory");
   expect_bad_input("--config " + write_file(dir, "key.toml", "[plant]\nkapa = 1.0\n").string(), "unknown key");
   expect_bad_input("--config " + write_file(dir, "type.toml", "[ilc]\ns = \"big\"\n").string(), "expected a number");
-  expect_bad_input("--config " + write_file(dir, "tau.toml", "[plant]\ncreep_tau_s = 0\n").string(), "must be positive");
-  expect_bad_input("--config " + write_file(dir, "taup.toml", "[controller]\ntau_p_s = -1\n").string(), "must be positive");
+  expect_bad_input("--config " + write_file(dir, "tau.toml", "[plant]\ncreep_tau_s = 0\n").string(), "must be in (0, ");
+  expect_bad_input("--config " + write_file(dir, "taup.toml", "[controller]\ntau_p_s = -1\n").string(), "must be in (0, ");
   expect_bad_input("--config " + (dir / "none.toml").string(), "cannot be read");
   expect_bad_input("--iterations -3", "iterations");
   expect_bad_input("--iterations many", "iterations");

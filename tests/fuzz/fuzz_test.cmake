@@ -16,3 +16,9 @@ add_test(NAME fuzz_rig_commands
                  -DCLANGXX=${BELLOWS_CLANGXX} -DTARGET=fuzz_rig_commands -DSECONDS=${BELLOWS_FUZZ_SECONDS}
                  -P ${CMAKE_CURRENT_LIST_DIR}/run_fuzz.cmake)
 set_tests_properties(fuzz_rig_commands PROPERTIES TIMEOUT 1800 LABELS fuzz SKIP_REGULAR_EXPRESSION "SKIPPED:")
+add_test(NAME fuzz_config_loader
+         COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DBUILD_DIR=${CMAKE_BINARY_DIR}/fuzz
+                 -DCLANGXX=${BELLOWS_CLANGXX} -DTARGET=fuzz_config_loader -DSECONDS=${BELLOWS_FUZZ_SECONDS}
+                 -DSEEDS=${PROJECT_SOURCE_DIR}/tests/fuzz/seeds_config -DDICT=${PROJECT_SOURCE_DIR}/tests/fuzz/config.dict
+                 -P ${CMAKE_CURRENT_LIST_DIR}/run_fuzz.cmake)
+set_tests_properties(fuzz_config_loader PROPERTIES TIMEOUT 1800 LABELS fuzz SKIP_REGULAR_EXPRESSION "SKIPPED:")

@@ -1,6 +1,13 @@
-# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DCLANGXX=... -DTARGET=... -DSECONDS=... -P run_fuzz.cmake
+# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DCLANGXX=... -DTARGET=... -DSECONDS=... [-DSEEDS=dir -DDICT=file]
+#       -P run_fuzz.cmake
 # Configures and builds the clang + libFuzzer + ASan/UBSan build, then fuzzes TARGET for SECONDS,
-# starting from the seeds in tests/fuzz/seeds and the corpus grown by earlier runs.
+# starting from the seeds in SEEDS (default tests/fuzz/seeds) and the corpus grown by earlier runs.
+if(NOT SEEDS)
+  set(SEEDS ${SOURCE_DIR}/tests/fuzz/seeds)
+endif()
+if(NOT DICT)
+  set(DICT ${SOURCE_DIR}/tests/fuzz/session.dict)
+endif()
 if(NOT CLANGXX OR NOT EXISTS "${CLANGXX}")
   message("SKIPPED: clang++ not found; scripts/setup.sh installs it")
   return()
@@ -20,8 +27,8 @@ endif()
 file(MAKE_DIRECTORY ${BUILD_DIR}/corpus/${TARGET})
 set(binary ${BUILD_DIR}/tests/fuzz/${TARGET})
 execute_process(
-  COMMAND ${binary} ${BUILD_DIR}/corpus/${TARGET} ${SOURCE_DIR}/tests/fuzz/seeds
-          -dict=${SOURCE_DIR}/tests/fuzz/session.dict -max_total_time=${SECONDS} -max_len=16384 -timeout=10
+  COMMAND ${binary} ${BUILD_DIR}/corpus/${TARGET} ${SEEDS}
+          -dict=${DICT} -max_total_time=${SECONDS} -max_len=16384 -timeout=10
           -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=${BUILD_DIR}/
   RESULT_VARIABLE fuzzed)
 if(fuzzed)
