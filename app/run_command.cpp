@@ -56,7 +56,8 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
   } catch (const InputError&) {
     // Without a data directory the sources must be paths; resolve_session_dir() says so.
   }
-  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config, options.device);
+  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config,
+                                                              resolve_device(options.device, config.device).kind);
   return compute_transfer(sessions, config, trajectory, method);
 }
 

@@ -119,8 +119,13 @@ nlohmann::json RunIo::report() const {
   return lcm;
 }
 
+const LcmDevice* RunIo::lcm_device() const {
+  return device_ ? dynamic_cast<const LcmDevice*>(&device_->device()) : nullptr;
+}
+
 std::string RunIo::explain_fault(FaultCode code) const {
   // No fresh state is what a rig taken over by another sender looks like from here: say so.
+  const LcmDevice* lcm_device_ = lcm_device();
   if (!lcm_device_ || code != FaultCode::kSensorStale) return "";
   const LcmDeviceStats s = lcm_device_->stats();
   if (s.commands_not_ours == 0 && s.states.unauthenticated == 0) return "";
@@ -128,7 +133,7 @@ std::string RunIo::explain_fault(FaultCode code) const {
 }
 
 std::string RunIo::warning() const {
-  if (lcm_device_) {
+  if (const LcmDevice* lcm_device_ = lcm_device()) {
     if (std::string why = lcm_device_->diagnosis(); !why.empty()) return why;
   }
   if (!publisher_) return "";

@@ -81,6 +81,8 @@ class RunIo {
   /// A better account of an engine fault than its name, or "": a sensor-stale fault while another
   /// sender commands the rig (or forges its states) is that sender's doing.
   std::string explain_fault(FaultCode code) const;
+  /// The LCM device when the run drives a rig over LCM, else null.
+  const LcmDevice* lcm_device() const;
 
  private:
   const RunOptions& options_;

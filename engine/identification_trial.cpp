@@ -86,7 +86,7 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       }
     }
     if (stop_is_requested(stop)) {
-      core.send(EngineCommand::of(CommandKind::kEmergencyStop));
+      core.request_emergency_stop();  // a latch: the next tick vents
       while (core.state() != EngineState::kFault) driver.await();
       throw Cancelled("identification stopped by a signal, valves vented");
     }

@@ -220,17 +220,25 @@ ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& c
   EngineEvent event;
   while (core.poll_event(event)) {
   }  // what happened before the test is not its business
-  for (const EngineCommand& c : test.begin(core.state(), latest.reading)) core.send(c);
+  // A command the engine's queue refused would leave the test waiting for ever: stop instead.
+  bool refused = false;
+  const auto send_all = [&](const std::vector<EngineCommand>& commands) {
+    for (const EngineCommand& c : commands) refused = refused || !core.send(c);
+  };
+  send_all(test.begin(core.state(), latest.reading));
   while (test.running()) {
+    if (refused) {
+      core.request_emergency_stop();
+      test.abandon("the engine's command queue refused a command (emergency stop)");
+      break;
+    }
     if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
-      core.send(EngineCommand::of(CommandKind::kEmergencyStop));
+      core.request_emergency_stop();
       test.abandon("stopped by the operator (emergency stop)");
       break;
     }
     driver.await();
-    while (core.poll_event(event)) {
-      for (const EngineCommand& c : test.on_event(event)) core.send(c);
-    }
+    while (core.poll_event(event)) send_all(test.on_event(event));
   }
   // Until the final disarm (or stop) has taken effect: the valves are vented when this returns.
   while (valves_live(core.state())) driver.await();

@@ -129,7 +129,7 @@ TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
   pulse.valves.inlet_duty = {1.0, 0.0};
   pulse.ticks = 3;
   pulse.id = 7;
-  f.core.send(EngineCommand::valve_pulse(pulse));
+  ASSERT_TRUE(f.core.send(EngineCommand::valve_pulse(pulse)));
   for (int i = 0; i < 3; ++i) {
     f.clock.step(1);
     EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 1.0) << "tick " << i;
@@ -157,7 +157,7 @@ TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
 
 TEST(ValveTest, ThePulseCommandNeedsArmedValves) {
   EngineFixture f;
-  f.core.send(EngineCommand::valve_pulse({ValveCommand{}, ValveCommand{}, 10, 1}));
+  ASSERT_TRUE(f.core.send(EngineCommand::valve_pulse({ValveCommand{}, ValveCommand{}, 10, 1})));
   f.clock.step(2);
   bool refused = false;
   for (const EngineEvent& e : f.drain_events()) refused |= e.kind == EventKind::kCommandRefused && e.command == CommandKind::kValvePulse;

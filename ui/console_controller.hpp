@@ -142,6 +142,7 @@ class ConsoleController {
   bool handle_rig_key(int key);
   void start_valve_test();
   void forward_to_valve_test(const EngineEvent& event);
+  bool send_valve_test_commands(const std::vector<EngineCommand>& commands);  // false: refused, stopped
   void show_valve_verdicts();
   void refresh_rig(double now_s);
   void add_link_health(DeviceHealth& health);

@@ -37,16 +37,28 @@ void ConsoleController::start_valve_test() {
   valve_test_ = std::make_unique<ValveTest>(env_.config.rig_check, env_.config.safety, env_.config.controller.gas.ambient_bar,
                                             env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad);
   const SensorReading latest = state_.live_valid ? state_.live.reading : SensorReading{};
-  for (const EngineCommand& c : valve_test_->begin(state_.engine_state, latest)) send(c, "valve test");
   state_.rig.verdicts_logged = false;
+  if (!send_valve_test_commands(valve_test_->begin(state_.engine_state, latest))) return;
   log(LogSource::kOperator, format("valve test started (%.3f s per valve)", env_.config.rig_check.valve_pulse_s));
   show_valve_verdicts();
 }
 
 void ConsoleController::forward_to_valve_test(const EngineEvent& event) {
   if (!valve_test_ || !valve_test_->running()) return;
-  for (const EngineCommand& c : valve_test_->on_event(event)) send(c, "valve test");
+  if (!send_valve_test_commands(valve_test_->on_event(event))) return;
   show_valve_verdicts();
+}
+
+bool ConsoleController::send_valve_test_commands(const std::vector<EngineCommand>& commands) {
+  for (const EngineCommand& c : commands) {
+    if (send(c, "valve test")) continue;
+    // The test would wait for ever for a pulse the engine never took: stop it, valves vented.
+    valve_test_->abandon("the engine refused a valve test command");
+    emergency_stop("valve test command refused");
+    show_valve_verdicts();
+    return false;
+  }
+  return true;
 }
 
 void ConsoleController::show_valve_verdicts() {
