@@ -497,7 +497,7 @@ TEST(LcmTelemetry, TheEventLogHoldsEveryMessageInLcmsFormat) {
   // An existing log is never overwritten.
   TelemetryRun again;
   EXPECT_THROW(TelemetryPublisher(again.tap, 43, path), InputError);
-  EXPECT_THROW(TelemetryPublisher(again.tap, 43, (dir / "missing-dir" / "x.lcmlog").string()), InputError);
+  EXPECT_THROW(TelemetryPublisher(again.tap, 43, (dir / "missing-dir" / "x.lcmlog").string()), EnvironmentError);
 }
 
 }  // namespace

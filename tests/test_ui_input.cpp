@@ -81,10 +81,15 @@ TEST(UiInput, EmergencyStopFromEveryScreenAndEveryDialog) {
                      f.key(key::kEnter);
                      ASSERT_EQ(f.state().dialog.kind, DialogKind::kEditValue);
                    }));
+  // Quit asks only when the work is not on disk: a save that failed.
   expect_stop_from(f, "quit dialog", armed([&] {
+                     f.sessions.fail_saves = true;
+                     f.key('r');
+                     ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
                      f.key('q');
                      ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
                    }));
+  f.sessions.fail_saves = false;
   expect_stop_from(f, "session browser (SAFE)", [&] {
     f.key('o');
     ASSERT_EQ(f.state().screen, Screen::kSessions);
