@@ -222,6 +222,7 @@ ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& c
   }  // what happened before the test is not its business
   // A command the engine's queue refused would leave the test waiting for ever: stop instead.
   bool refused = false;
+  bool stopped = false;
   const auto send_all = [&](const std::vector<EngineCommand>& commands) {
     for (const EngineCommand& c : commands) refused = refused || !core.send(c);
   };
@@ -230,17 +231,23 @@ ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& c
     if (refused) {
       core.request_emergency_stop();
       test.abandon("the engine's command queue refused a command (emergency stop)");
+      stopped = true;
       break;
     }
     if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
       core.request_emergency_stop();
       test.abandon("stopped by the operator (emergency stop)");
+      stopped = true;
       break;
     }
     driver.await();
     while (core.poll_event(event)) send_all(test.on_event(event));
   }
   // Until the final disarm (or stop) has taken effect: the valves are vented when this returns.
+  // After a stop, until the engine has acted on the latch (FAULT, vented).
+  if (stopped) {
+    while (core.state() != EngineState::kFault) driver.await();
+  }
   while (valves_live(core.state())) driver.await();
   return test.report();
 }

@@ -382,8 +382,12 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   expect_refused("run --device lcm --clock wall --speed 2", "--speed must be 1");
   expect_refused("run --device rig", "--device");
   // The environment refusing (a bus that cannot be opened) has its own status.
-  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "cannot open the LCM bus", kExitEnvironment);
-  expect_refused("io-sim --lcm nowhere://at-all", "cannot open the LCM bus", kExitEnvironment);
+  // A URL that is no LCM URL is bad input; a well-formed one that LCM cannot open is the environment.
+  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "unknown provider 'nowhere'");
+  expect_refused("io-sim --lcm nowhere://at-all", "unknown provider 'nowhere'");
+  const std::string unopenable = "file://" + (dir / "no-such-folder" / "bus.lcmlog").string() + "?mode=r";
+  expect_refused("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
+  expect_refused("io-sim --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
   const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
   expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
   expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");

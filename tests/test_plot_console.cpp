@@ -45,7 +45,11 @@ TEST(PlotConsole, TheFigureKeyWritesFiguresWhileTheBatchGoesOn) {
   }
   // Again after the batch: a second folder, nothing replaced.
   f.key('g');
-  ASSERT_TRUE(f.pump_until([&] { return f.logged("console_iteration_0002"); }, 1e6));
+  ASSERT_TRUE(f.pump_until([&] { return f.logged("_iteration_0002"); }, 1e6)) << f.state().status << "\n" << [&] {
+    std::string all;
+    for (const ui::LogEntry& e : f.state().log.entries()) all += e.text + "\n";
+    return all;
+  }();
   EXPECT_EQ(calls, 2);
   EXPECT_EQ(std::distance(fs::directory_iterator(root), fs::directory_iterator()), 2);
 }

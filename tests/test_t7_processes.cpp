@@ -53,11 +53,12 @@ class T7Processes : public ::testing::Test {
     return sim;
   }
 
-  /// The runs tolerate a loaded test machine's scheduling: a 50 ms answer, 40 stale ticks (the
-  /// link's timing is the benchmark's business, bench/t7_round_trip.sh; not these tests').
+  /// The runs tolerate a loaded test machine's scheduling (CI runs tests two at a time beside
+  /// builds): a 0.5 s answer, 400 stale ticks, long missed-deadline streaks. The guards have their
+  /// own tests; the link's timing is the benchmark's business (bench/t7_round_trip.sh).
   std::unique_ptr<Child> start_run(int iterations, const std::string& name) {
     const std::filesystem::path config =
-        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.05\n[safety]\nstale_ticks = 40\n");
+        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
     return std::make_unique<Child>(
         std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "try",
                                  "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},

@@ -214,7 +214,7 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
 }
 
 TEST_F(UiSessions, NamingRenamesTheSessionAndSavingGoesOnThere) {
-  StoreSessionGateway gateway("sim", (data_home_ / "elsewhere").string());  // --data-dir
+  StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(), (data_home_ / "elsewhere").string());  // --data-dir
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
   f.key('r');

@@ -29,7 +29,8 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 }
 
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved) {
+                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved,
+                                     const std::vector<std::string>& taught_locations) {
   TransferOffer offer;
   offer.trajectory = target;
   try {
@@ -44,6 +45,7 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
       for (const SessionListing& listing : listed) {
         if (used >= max_saved) break;
         if (!listing.error.empty() || listing.iterations == 0) continue;
+        if (std::find(taught_locations.begin(), taught_locations.end(), listing.location) != taught_locations.end()) continue;
         try {
           const SessionSnapshot snapshot = sessions->read_trials(listing.location);
           if (!transfer_mismatch(snapshot.config, snapshot.device_name, config, device).empty()) continue;
@@ -85,7 +87,9 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
 
 void ConsoleController::remember_taught() {
   TransferSource source = transfer_source_of(state_.experiment, env_.config);
-  if (!source.trials.empty()) taught_.push_back(std::move(source));
+  if (source.trials.empty()) return;
+  taught_.push_back(std::move(source));
+  if (!state_.experiment.session_location.empty()) taught_locations_.push_back(state_.experiment.session_location);
 }
 
 void ConsoleController::offer_transfer() {
@@ -96,9 +100,9 @@ void ConsoleController::offer_transfer() {
     return;
   }
   transfer_wanted_ = false;
-  transfer_task_.start([taught = taught_, sessions = env_.sessions, config = env_.config, device = env_.device_name,
-                        target = state_.experiment.trajectory] {
-    return compute_transfer_offer(taught, sessions, config, device, target);
+  transfer_task_.start([taught = taught_, locations = taught_locations_, sessions = env_.sessions, config = env_.config,
+                        device = env_.device_name, target = state_.experiment.trajectory] {
+    return compute_transfer_offer(taught, sessions, config, device, target, 4, locations);
   });
 }
 

@@ -38,8 +38,10 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 
 /// Worker thread: the transfer from `taught` (this console's earlier experiments) and the `max_saved`
 /// newest saved sessions that fit this run (transfer_mismatch), for `target`. Never throws: a
-/// transfer that cannot be computed or would not help comes back with `why_not`.
+/// transfer that cannot be computed or would not help comes back with `why_not`. `taught_locations`:
+/// where `taught` is saved (the console saves as it goes), so the same trials are not used twice.
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved = 4);
+                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved = 4,
+                                     const std::vector<std::string>& taught_locations = {});
 
 }  // namespace bellows::ui
