@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include "engine/errors.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 
@@ -132,11 +133,9 @@ RigProfile parse_rig_profile(const std::string& toml_text, const std::string& so
 }
 
 RigProfile load_rig_profile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("rig profile " + path + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_rig_profile(text.str(), path);
+  // Like a config file: a FIFO or a device is refused without blocking, and the size is bounded.
+  constexpr std::size_t kMaxRigProfileBytes = 256 * 1024;
+  return parse_rig_profile(read_regular_file(path, kMaxRigProfileBytes, "rig profile"), path);
 }
 
 const std::string& paper_rig_profile_text() {

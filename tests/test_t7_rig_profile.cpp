@@ -4,6 +4,9 @@
 
 #include <string>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "app/rig_profile_file.hpp"
 #include "devices/t7_registers.hpp"
 #include "engine/errors.hpp"
@@ -106,8 +109,21 @@ TEST(RigProfile, AMissingFileIsOneLine) {
     load_rig_profile("/nonexistent/rig.toml");
     FAIL() << "no error";
   } catch (const InputError& error) {
-    EXPECT_STREQ(error.what(), "rig profile /nonexistent/rig.toml: cannot be read");
+    EXPECT_EQ(std::string(error.what()).rfind("rig profile /nonexistent/rig.toml: ", 0), 0u) << error.what();
   }
+}
+
+TEST(RigProfile, AFifoIsRefusedWithoutWaiting) {
+  const std::string fifo = "/tmp/bellows-rig-profile-fifo-" + std::to_string(::getpid());
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    load_rig_profile(fifo);  // nobody writes: a blocking open would hang here
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("FIFO"), std::string::npos) << error.what();
+  }
+  ::unlink(fifo.c_str());
 }
 
 TEST(RigProfile, AnIdentifiedModelIsRead) {
