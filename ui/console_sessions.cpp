@@ -124,7 +124,8 @@ void ConsoleController::poll_session_tasks() {
       e.release_saved_history();  // on disk now: memory keeps only the newest trials
       if (first_save) {
         log(LogSource::kSession, "saving as it goes to " + location);
-        set_status("this session is saved as it goes: " + location);
+        // A background note: it must not hide a warning the operator has not read yet.
+        if (!state_.status_important) set_status("this session is saved as it goes: " + location);
       }
     } catch (const std::exception& error) {
       autosave_failed_ = true;  // no retry loop: the operator decides (quit asks, s retries)
