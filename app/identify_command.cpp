@@ -19,16 +19,11 @@
 #include "engine/errors.hpp"
 #include "engine/identification.hpp"
 #include "engine/identification_trial.hpp"
+#include "engine/printable_text.hpp"
 #include "engine/realtime_loop.hpp"
 
 namespace bellows {
 namespace {
-
-std::string trim(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r") - begin + 1);
-}
 
 std::string format_value(double value) {
   char text[64];
@@ -114,7 +109,7 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
   bool in_model = false;
   long header = -1, section_end = -1;
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::string t = trim(lines[i]);
+    const std::string t(trim(lines[i]));
     if (!t.empty() && t.front() == '[') {
       if (in_model) section_end = static_cast<long>(i);
       in_model = t.rfind("[model]", 0) == 0 && (t.size() == 7 || trim(t.substr(7)).rfind('#', 0) == 0);
@@ -124,7 +119,7 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
     if (!in_model) continue;
     const auto equals = t.find('=');
     if (equals == std::string::npos) continue;
-    const std::string key = trim(t.substr(0, equals));
+    const std::string key(trim(t.substr(0, equals)));
     for (std::size_t v = 0; v < values.size(); ++v) {
       if (key == values[v].first) {
         lines[i] = values[v].first + " = " + format_value(values[v].second) + "  # fitted by bellows identify";

@@ -18,14 +18,8 @@ constexpr std::size_t kMostTrajectoryBytes = std::size_t{64} << 20;
 // Spreadsheets on Windows start UTF-8 files with it.
 constexpr std::string_view kUtf8ByteOrderMark = "\xef\xbb\xbf";
 
-std::string trim(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
-}
-
 double parse_number(const std::string& field, const std::string& where) {
-  const std::string text = trim(field);
+  const std::string text(trim(field));
   double value = 0.0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (text.empty() || error != std::errc() || end != text.data() + text.size()) {

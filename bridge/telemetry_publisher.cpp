@@ -1,4 +1,5 @@
 #include "bridge/telemetry_publisher.hpp"
+#include "engine/single_writer_counter.hpp"
 
 #include <time.h>
 
@@ -14,10 +15,6 @@ namespace {
 // How often the ring is drained: 40 ticks at 200 Hz, far below what a person watching notices,
 // far above what fills the ring.
 constexpr double kDrainPeriod_s = 0.02;
-
-void bump(std::atomic<std::uint64_t>& n, std::uint64_t by = 1) {
-  n.store(n.load(std::memory_order_relaxed) + by, std::memory_order_relaxed);
-}
 
 std::int64_t realtime_us() {
   timespec now{};

@@ -20,6 +20,7 @@
 #include <bellows_v1/io_state_t.hpp>
 
 #include "devices/lcm_auth.hpp"
+#include "engine/single_writer_counter.hpp"
 
 #include "engine/device.hpp"
 
@@ -65,7 +66,6 @@ class ReceiveCounters {
   ReceiveCounts snapshot() const;
 
  private:
-  static void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
   std::atomic<std::uint64_t> accepted_{0}, truncated_{0}, wrong_type_{0}, too_large_{0}, malformed_{0};
   std::atomic<std::uint64_t> invalid_{0}, foreign_{0}, out_of_order_{0}, old_version_{0}, unauthenticated_{0};
 };

@@ -1,4 +1,5 @@
 #include "devices/lcm_device.hpp"
+#include "engine/single_writer_counter.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,6 @@ constexpr double kOutboxPoll_s = 0.001;
 // health(): the link counts as up while a valid state arrived this recently (20 ticks at 200 Hz).
 constexpr double kLinkAlive_s = 0.1;
 
-void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
 }  // namespace
 

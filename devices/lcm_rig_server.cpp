@@ -1,4 +1,5 @@
 #include "devices/lcm_rig_server.hpp"
+#include "engine/single_writer_counter.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 
 namespace bellows {
 namespace {
-void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
 }  // namespace
 

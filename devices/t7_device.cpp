@@ -1,4 +1,5 @@
 #include "devices/t7_device.hpp"
+#include "engine/single_writer_counter.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -34,7 +35,6 @@ void sleep_s(double seconds) {
   nanosleep(&t, nullptr);
 }
 
-void bump(std::atomic<std::uint64_t>& n) { n.store(n.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 
 ValveCommand clamped(const ValveCommand& command) {
   ValveCommand c;  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet

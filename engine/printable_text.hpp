@@ -26,4 +26,11 @@ std::string printable(std::string_view text, std::size_t max_bytes = kPrintableF
 /// C1 controls, DEL, bidirectional marks and overrides, line separators, the byte order mark.
 bool is_terminal_control(char32_t code_point);
 
+/// `text` without leading and trailing blanks (spaces, tabs, a CRLF file's carriage return).
+constexpr std::string_view trim(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
 }  // namespace bellows

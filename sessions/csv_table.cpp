@@ -11,12 +11,6 @@
 namespace bellows {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 constexpr std::size_t kExcerpt = 80;
 std::string excerpt(std::string_view s) { return printable(s, kExcerpt); }
 

@@ -25,9 +25,10 @@
 
 namespace bellows {
 namespace fs = std::filesystem;
-namespace {
 
-std::string describe(const fs::path& directory) { return "session " + printable(directory.string()); }
+std::string describe_session(const fs::path& directory) { return "session " + printable(directory.string()); }
+
+namespace {
 
 void check_finite(const Eigen::VectorXd& values, int index, const char* what) {
   for (Eigen::Index k = 0; k < values.size(); ++k) {
@@ -142,9 +143,10 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
   const DirectoryHandle parent = DirectoryHandle::open(parent_path);
   const auto refuse_existing = [&] {
     if (const auto holder = SessionLock::holder(directory)) {
-      throw InputError(describe(directory) + " is in use by " + *holder + "; two processes never write the same session");
+      throw SessionExistsError(describe_session(directory) + " is in use by " + *holder +
+                               "; two processes never write the same session");
     }
-    throw InputError(describe(directory) + " exists already; continue it with --resume " + printable(directory.string()) +
+    throw SessionExistsError(describe_session(directory) + " exists already; continue it with --resume " + printable(directory.string()) +
                      " or choose another --name");
   };
   struct stat existing {};

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/errors.hpp"
 #include "sessions/file_access.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_lock.hpp"
@@ -16,6 +17,12 @@
 namespace bellows {
 
 /// A session directory just created, locked for its creator.
+/// The session directory to create exists already (or another process created it first).
+class SessionExistsError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 struct CreatedSession {
   DirectoryHandle directory;
   SessionLock lock;
@@ -25,6 +32,9 @@ struct CreatedSession {
 /// Creates `directory` holding the manifest, the trajectory and `iterations` (as listed by the
 /// manifest), locked for the caller. Throws InputError if it exists already, naming the process
 /// that uses it, if any.
+/// "session <directory>", escaped, for messages about one session.
+std::string describe_session(const std::filesystem::path& directory);
+
 CreatedSession create_session_directory(const std::filesystem::path& directory, const SessionManifest& manifest,
                                         const Trajectory& trajectory, const std::vector<IterationData>& iterations,
                                         const std::string& purpose,

@@ -25,8 +25,6 @@ namespace bellows {
 namespace fs = std::filesystem;
 namespace {
 
-std::string describe(const fs::path& directory) { return "session " + printable(directory.string()); }
-
 /// A loaded session's folders: `iterations` and `faults` are opened only if they exist, and are
 /// refused when they are links or not directories.
 struct SessionFolders {
@@ -45,7 +43,7 @@ struct SessionFolders {
 /// digest in the manifest when there is one.
 std::string read_session_file(const SessionFolders& folders, const std::string& relative, std::size_t max_bytes,
                               const std::string& digest, SessionIntegrity& integrity) {
-  const std::string where = describe(folders.root.path());
+  const std::string where = describe_session(folders.root.path());
   const auto [folder_name, name] = session_layout::folder_and_name(relative);
   const DirectoryHandle* folder = folders.folder(folder_name);
   std::optional<std::string> text;
@@ -71,7 +69,7 @@ std::optional<DirectoryHandle> session_folder(const DirectoryHandle& root, const
   try {
     return root.subdirectory(name);
   } catch (const InputError& error) {
-    throw InputError(describe(root.path()) + ": " + error.what());
+    throw InputError(describe_session(root.path()) + ": " + error.what());
   }
 }
 
@@ -129,7 +127,7 @@ SessionManifest load_manifest(const DirectoryHandle& directory) {
   SessionIntegrity ignored;
   const std::string text = read_session_file({directory, {}, {}}, session_layout::kManifest,
                                              session_layout::kMostManifestBytes, "", ignored);
-  return parse_manifest(text, describe(directory.path()) + ": " + session_layout::kManifest);
+  return parse_manifest(text, describe_session(directory.path()) + ": " + session_layout::kManifest);
 }
 
 Session load_session(const fs::path& directory) { return load_session(open_session_directory(directory)); }
@@ -144,7 +142,7 @@ Session load_session(const DirectoryHandle& directory) {
   const Configuration& config = m.configuration;
   const int samples = m.trajectory_samples;
   const auto rows = static_cast<std::size_t>(samples);
-  const std::string where = describe(directory.path()) + ": ";
+  const std::string where = describe_session(directory.path()) + ": ";
   SessionIntegrity& integrity = session.integrity;
   session.trajectory = parse_trajectory_csv_file(
       read_session_file(folders, session_layout::kTrajectory, csv_size_limit(trajectory_columns(), rows + 1),
@@ -212,9 +210,9 @@ std::vector<SessionListing> list_sessions(const fs::path& data_dir) {
       listing.manifest = load_manifest(*session);
     } catch (const InputError& load_error) {
       const std::string what = load_error.what();
-      listing.error = what.rfind("session ", 0) == 0 ? what : describe(entry.path()) + ": " + what;
+      listing.error = what.rfind("session ", 0) == 0 ? what : describe_session(entry.path()) + ": " + what;
     } catch (const std::exception& load_error) {  // e.g. out of memory: this session only
-      listing.error = describe(entry.path()) + ": cannot be read: " + load_error.what();
+      listing.error = describe_session(entry.path()) + ": cannot be read: " + load_error.what();
     }
     listings.push_back(std::move(listing));
   }

@@ -188,7 +188,7 @@ void ConsoleController::accept_input() {
       return;
     }
     case DialogKind::kSessionName: {
-      const std::string name = trim(d.input);
+      const std::string name(trim(d.input));
       if (name.empty()) {
         reject_input("type a name (letters, digits, - _ .), or Esc");
         return;

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "engine/printable_text.hpp"
+
 namespace bellows::ui {
 
 /// Removes the last UTF-8 code point (Backspace).
@@ -16,22 +18,17 @@ inline void pop_last_code_point(std::string& text) {
   }
 }
 
-/// Without leading and trailing blanks.
-inline std::string trim(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t");
-  if (first == std::string::npos) return {};
-  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
-}
-
 /// "~/x" as $HOME/x, as a shell would (the path prompt is not a shell).
-inline std::string expand_home(const std::string& path) {
+inline std::string expand_home(std::string_view path_text) {
+  const std::string path(path_text);
   if (path.rfind("~/", 0) != 0) return path;
   const char* home = std::getenv("HOME");
   return home != nullptr && *home != '\0' ? std::string(home) + path.substr(1) : path;
 }
 
 /// A whole finite number ("0.45", "2e-5"): false for anything else, trailing text included.
-inline bool parse_number(const std::string& text, double& value) {
+inline bool parse_number(std::string_view text_view, double& value) {
+  const std::string text(text_view);
   if (text.empty()) return false;
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
