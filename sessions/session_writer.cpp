@@ -34,15 +34,19 @@ SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string&
     CreatedSession created = create_session_directory(data_dir / name, header, trajectory, {}, purpose);
     return SessionWriter(std::move(created.directory), std::move(created.manifest), std::move(created.lock));
   }
-  // Two runs started in the same second with the same trajectory: the second gets a suffix.
+  // Two runs started in the same second with the same trajectory: the second gets a suffix, also
+  // when both looked before either created its directory (the creation itself is exclusive).
+  constexpr int kMostSuffixes = 100;
   const std::string stem = default_session_name(std::time(nullptr), trajectory.name);
   for (int attempt = 1;; ++attempt) {
     header.name = attempt == 1 ? stem : stem + "_" + std::to_string(attempt);
     fs::path directory = data_dir / header.name;
-    std::error_code error;
-    if (attempt < 100 && fs::symlink_status(directory, error).type() != fs::file_type::not_found) continue;
-    CreatedSession created = create_session_directory(directory, header, trajectory, {}, purpose);
-    return SessionWriter(std::move(created.directory), std::move(created.manifest), std::move(created.lock));
+    try {
+      CreatedSession created = create_session_directory(directory, header, trajectory, {}, purpose);
+      return SessionWriter(std::move(created.directory), std::move(created.manifest), std::move(created.lock));
+    } catch (const SessionExistsError&) {
+      if (attempt >= kMostSuffixes) throw;
+    }
   }
 }
 

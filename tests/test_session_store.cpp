@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -262,6 +264,33 @@ TEST(SessionWriter, NamesSessionsByStartTimeAndTrajectory) {
   EXPECT_EQ(name.substr(name.size() - 6), "_short");
   EXPECT_NE(first.directory(), second.directory());
   EXPECT_EQ(first.manifest().name, name);
+}
+
+TEST(SessionWriter, RunsStartedTogetherGetSessionsOfTheirOwn) {
+  // Several runs in the same second look for a free name before any of them has created it: each
+  // must still get a session of its own, never "in use by" another (a CI run of tests met this).
+  TempDir dir;
+  const Session simulated = testing::simulate_session(0);
+  constexpr int kRuns = 6;
+  std::vector<std::string> names(kRuns), errors(kRuns);
+  std::atomic<int> waiting{kRuns};
+  std::vector<std::thread> runs;
+  for (int i = 0; i < kRuns; ++i) {
+    runs.emplace_back([&, i] {
+      waiting.fetch_sub(1);
+      while (waiting.load() > 0) std::this_thread::yield();
+      try {
+        SessionWriter writer = SessionWriter::create(dir.path(), "", simulated.manifest, simulated.trajectory, "test");
+        names[i] = writer.directory().filename().string();
+      } catch (const std::exception& error) {
+        errors[i] = error.what();
+      }
+    });
+  }
+  for (auto& run : runs) run.join();
+  for (int i = 0; i < kRuns; ++i) EXPECT_EQ(errors[i], "") << "run " << i;
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(std::unique(names.begin(), names.end()), names.end());
 }
 
 TEST(SessionWriter, RefusesNonFiniteValuesAndKeepsWhatWasSaved) {
