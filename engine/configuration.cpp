@@ -187,7 +187,13 @@ void check_below_nyquist(const char* key, double cutoff_hz, const TimingParamete
 }  // namespace
 
 std::string Range::text() const {
-  return std::string(min_open ? "(" : "[") + format_number(min) + ", " + format_number(max) + (max_open ? ")" : "]");
+  // Appended in place: GCC 12 warns falsely (-Wrestrict, its bug 105651) on a chain of rvalue +.
+  std::string out(min_open ? "(" : "[");
+  out += format_number(min);
+  out += ", ";
+  out += format_number(max);
+  out += max_open ? ")" : "]";
+  return out;
 }
 
 const std::vector<ParameterBinding>& parameter_bindings() {
