@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -40,6 +41,17 @@ inline CLI::Validator finite_seconds(double max_s) {
         return "";
       },
       "SECONDS");
+}
+
+/// A word mapped to a value (--rt enforce|try|off): help shows the words, never the mapped codes
+/// (CLI11's own description would read "value in {enforce->0,...}").
+template <typename Value>
+CLI::Validator named_choice(const std::map<std::string, Value>& choices) {
+  std::string words;
+  for (const auto& [word, value] : choices) words += (words.empty() ? "" : "|") + word;
+  CLI::Validator checked = CLI::CheckedTransformer(choices, CLI::ignore_case);
+  checked.description(words);
+  return checked;
 }
 
 }  // namespace bellows

@@ -21,6 +21,7 @@
 #include "engine/cancellation.hpp"
 #include "engine/errors.hpp"
 #include "engine/printable_text.hpp"
+#include "sessions/session.hpp"
 #include "sessions/session_store.hpp"
 
 using bellows::kExitBadInput;
@@ -32,8 +33,9 @@ constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 
 int main(int argc, char** argv) {
   bellows::check_standard_output_at_exit();
-  CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm"};
+  CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm", "bellows"};  // not argv[0]: no build path
   app.require_subcommand(0, 1);
+  app.set_version_flag("--version", "bellows " + bellows::program_version());  // as sessions record it
 
   bellows::RunOptions run;
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless on simulated time, learning between them");
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
   const std::map<std::string, bellows::RealtimeMode> rt_modes = {
       {"enforce", bellows::RealtimeMode::kEnforce}, {"try", bellows::RealtimeMode::kTry}, {"off", bellows::RealtimeMode::kOff}};
   run_cmd->add_option("--rt", run.rt, "Real-time scheduling: enforce (refuse without), try, off")
-      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->transform(bellows::named_choice(rt_modes))->type_name("MODE")
       ->default_str("try");
   CLI::Option* no_save = run_cmd->add_flag("--no-save", run.no_save, "Do not save the session");
   run_cmd->add_option("--data-dir", run.data_dir,
@@ -148,7 +150,7 @@ int main(int argc, char** argv) {
       ->check(bellows::unsigned_whole_number());
   io_sim_cmd->add_option("--lcm", io_sim.lcm_url, "LCM bus URL")->default_str(bellows::kDefaultLcmUrl);
   io_sim_cmd->add_option("--rt", io_sim.rt, "Real-time scheduling: enforce (refuse without), try, off")
-      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->transform(bellows::named_choice(rt_modes))->type_name("MODE")
       ->default_str("try");
   io_sim_cmd->add_option("--duration", io_sim.duration_s, "Stop after this many seconds (0: at SIGINT/SIGTERM)")
       ->capture_default_str()
@@ -188,7 +190,7 @@ int main(int argc, char** argv) {
                           "Where sessions are saved as the console goes (default $XDG_DATA_HOME/bellows/sessions or "
                           "~/.local/share/bellows/sessions)");
   console_cmd->add_option("--rt", console.rt, "Real-time scheduling of the engine loop: enforce, try, off")
-      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->transform(bellows::named_choice(rt_modes))->type_name("MODE")
       ->default_str("try");
   console_cmd->add_option("--seed", console.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
@@ -215,7 +217,7 @@ int main(int argc, char** argv) {
   identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
   bellows::add_device_options(*identify_cmd, identify.device);
   identify_cmd->add_option("--rt", identify.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
-      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->transform(bellows::named_choice(rt_modes))->type_name("MODE")
       ->default_str("try");
   identify_cmd->add_option("--signal", identify.signal, "Excitation: chirp or steps (default: [identify] signal)");
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
@@ -233,7 +235,7 @@ int main(int argc, char** argv) {
   bellows::add_device_options(*rig_check_cmd, rig_check.device);
   rig_check_cmd->add_option("--seed", rig_check.seed, "Seed of the simulated arm's noise")->capture_default_str();
   rig_check_cmd->add_option("--rt", rig_check.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
-      ->transform(CLI::CheckedTransformer(rt_modes, CLI::ignore_case))
+      ->transform(bellows::named_choice(rt_modes))->type_name("MODE")
       ->default_str("try");
   rig_check_cmd->add_flag("--yes", rig_check.yes, "Pulse the valves without asking (the operator has cleared the arm)");
   rig_check_cmd->add_flag("--inputs-only", rig_check.inputs_only, "Only show the inputs; open no valve");
@@ -241,8 +243,8 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& help) {
-    return app.exit(help);
+  } catch (const CLI::Success& help_or_version) {  // --help, --version: printed, exit 0
+    return app.exit(help_or_version);
   } catch (const CLI::ParseError& error) {
     std::cerr << "bellows: " << bellows::printable(error.what(), bellows::kPrintableLine) << " (see --help)" << std::endl;
     return kExitBadInput;
@@ -250,6 +252,7 @@ int main(int argc, char** argv) {
 
   try {
     run.lcm_log = lcm_log->count() > 0;
+    run.speed_given = run_cmd->get_option("--speed")->count() > 0;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);

@@ -69,9 +69,9 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
 
 int sessions_plot_command(const PlotOptions& options, std::ostream& out) {
   if (options.no_paper && !options.paper.empty()) throw InputError("--paper and --no-paper exclude each other");
-  fs::path data_dir;
+  fs::path data_dir = options.data_dir.empty() ? fs::path() : given_data_dir(options.data_dir);  // a typo: refused
   try {
-    data_dir = options.data_dir.empty() ? default_data_dir() : fs::path(options.data_dir);
+    if (data_dir.empty()) data_dir = default_data_dir();
   } catch (const InputError&) {
     // Then only a path can name the session; resolve_session_dir() says so if it is not one.
   }

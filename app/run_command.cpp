@@ -74,6 +74,9 @@ double parse_speed(const std::string& speed) {
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
   if (options.iterations < 0) throw InputError("--iterations must not be negative");
   if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+  if (options.speed_given && options.clock != "wall") {  // never ignored in silence
+    throw InputError("--speed is for --clock wall: the simulated clock runs as fast as it can");
+  }
   if (!options.lcm_url.empty()) check_lcm_url(options.lcm_url, "--lcm");  // before a session exists
   const double speed = parse_speed(options.speed);
   RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state

@@ -20,6 +20,7 @@ struct RunOptions {
   bool json = false;
   std::string clock = "sim";   // sim: as fast as possible, deterministic; wall: the real-time loop
   std::string speed = "1";     // wall clock with the simulated arm: 1, 2, 5, 10 or max
+  bool speed_given = false;    // --speed on the command line: refused with the simulated clock
   RealtimeMode rt = RealtimeMode::kTry;
   // Sessions: saved as the run goes into data_dir/session_name unless no_save.
   bool no_save = false;

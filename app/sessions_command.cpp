@@ -28,11 +28,10 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-fs::path data_dir_of(const SessionsOptions& options) {
-  return options.data_dir.empty() ? default_data_dir() : fs::path(options.data_dir);
-}
+fs::path data_dir_of(const SessionsOptions& options) { return given_data_dir(options.data_dir); }
 
 fs::path session_dir_of(const SessionsOptions& options) {
+  if (!options.data_dir.empty()) return resolve_session_dir(options.session, given_data_dir(options.data_dir));
   fs::path data_dir;
   try {
     data_dir = data_dir_of(options);

@@ -84,6 +84,17 @@ fs::path default_data_dir() {
   throw InputError("no data directory: neither XDG_DATA_HOME nor HOME is an absolute path; pass --data-dir");
 }
 
+fs::path given_data_dir(const std::string& option_value) {
+  if (option_value.empty()) return default_data_dir();
+  const fs::path dir(option_value);
+  std::error_code error;
+  const fs::file_status status = fs::status(dir, error);
+  if (status.type() == fs::file_type::not_found) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": no such directory");
+  if (error) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": " + error.message());
+  if (status.type() != fs::file_type::directory) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": not a directory");
+  return dir;
+}
+
 std::string default_session_name(std::time_t start, const std::string& trajectory_name) {
   std::tm local{};
   ::localtime_r(&start, &local);

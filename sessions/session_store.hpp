@@ -16,6 +16,10 @@ namespace bellows {
 /// variable gives an absolute path.
 std::filesystem::path default_data_dir();
 
+/// The data directory an operator named (--data-dir), which must exist: a typo is refused with
+/// InputError rather than answered "no sessions". Empty: default_data_dir(), which may not exist yet.
+std::filesystem::path given_data_dir(const std::string& option_value);
+
 /// "2024-05-01_14-03-07_paper": the local start time, then the trajectory's name (made safe).
 std::string default_session_name(std::time_t start, const std::string& trajectory_name);
 /// Throws InputError unless `name` is a plain directory name (no '/', not hidden, printable).

@@ -1,0 +1,76 @@
+// The command line keeps the conventions people know: --version, help without internal codes or
+// build paths, and options that would do nothing refused with one line (exit 2), never ignored.
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "sessions/session.hpp"
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::run_process;
+
+testing::ProcessResult bellows(const std::string& args) { return run_process(std::string(BELLOWS_BINARY) + " " + args + " < /dev/null"); }
+
+void expect_refused(const std::string& args, const std::string& fragment) {
+  const auto result = bellows(args);
+  EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.err;
+  EXPECT_TRUE(result.out.empty()) << args << ": " << result.out;
+  EXPECT_NE(result.err.find(fragment), std::string::npos) << args << ": " << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << args << ": " << result.err;
+}
+
+TEST(CliConventions, VersionIsTheOneSessionsRecord) {
+  const auto result = bellows("--version");
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.out, "bellows " + program_version() + "\n");
+  EXPECT_FALSE(program_version().empty());
+}
+
+const char* const kCommands[] = {"",           "run",          "sessions",     "sessions list", "sessions show",
+                                 "sessions export", "sessions rm", "sessions rename", "sessions plot", "io-sim",
+                                 "t7-sim",     "console",      "config",       "identify",      "rig",
+                                 "rig check"};
+
+TEST(CliConventions, HelpShowsWordsNotCodesOrBuildPaths) {
+  for (const std::string command : kCommands) {
+    const auto result = bellows(command + " --help");
+    EXPECT_EQ(result.exit_code, 0) << command << ": " << result.err;
+    EXPECT_NE(result.out.find("Usage"), std::string::npos) << command;
+    EXPECT_EQ(result.out.find("->"), std::string::npos) << command << ":\n" << result.out;
+    EXPECT_EQ(result.out.find("ENUM"), std::string::npos) << command << ":\n" << result.out;
+    EXPECT_EQ(result.out.find(BELLOWS_SOURCE_DIR), std::string::npos) << command << ":\n" << result.out;
+  }
+  for (const std::string command : {"run", "io-sim", "console", "identify", "rig check"}) {
+    EXPECT_NE(bellows(command + " --help").out.find("enforce|off|try"), std::string::npos) << command;
+  }
+}
+
+TEST(CliConventions, TheWordsStillChooseTheMode) {
+  expect_refused("run --rt sometimes", "--rt");
+  EXPECT_EQ(bellows("run --rt OFF --iterations 0 --no-save --trajectory steps").exit_code, 0);
+}
+
+TEST(CliConventions, SpeedOnTheSimulatedClockIsRefused) {
+  expect_refused("run --speed 10 --no-save", "--speed is for --clock wall");
+  expect_refused("run --clock sim --speed max --no-save", "--speed is for --clock wall");
+}
+
+TEST(CliConventions, AMissingDataDirectoryIsRefusedNotEmpty) {
+  const auto dir = testing::make_temp_dir("bellows-cli-conventions");
+  const std::string missing = (dir / "typo").string();
+  for (const std::string command : {"sessions list", "sessions show x", "sessions export x", "sessions rm --yes x",
+                                    "sessions rename x y", "sessions plot x"}) {
+    expect_refused(command + " --data-dir " + missing, "no such directory");
+  }
+  const auto file = testing::write_file(dir, "a-file", "text");
+  expect_refused("sessions list --data-dir " + file.string(), "not a directory");
+  const auto empty = bellows("sessions list --data-dir " + dir.string());
+  EXPECT_EQ(empty.exit_code, 0) << empty.err;
+  EXPECT_NE(empty.out.find("no sessions"), std::string::npos) << empty.out;
+}
+
+}  // namespace
+}  // namespace bellows
