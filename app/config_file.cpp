@@ -1,6 +1,10 @@
 #include "app/config_file.hpp"
 
+#include <algorithm>
+#include <array>
+#include <charconv>
 #include <fstream>
+#include <vector>
 #include <set>
 #include <sstream>
 
@@ -55,6 +59,15 @@ void check_toml_nesting(const std::string& text, const std::string& source_name)
                        std::to_string(kMaxTomlNesting) + " levels (a configuration is [section] key = value)");
     }
   }
+}
+
+// The shortest decimal that reads back as exactly `value`, always a TOML float ("2.0", "1e-06").
+std::string shortest_exact(double value) {
+  std::array<char, 32> digits{};
+  const auto [end, error] = std::to_chars(digits.data(), digits.data() + digits.size(), value);
+  std::string text(digits.data(), error == std::errc() ? end : digits.data());
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // n: nan, inf (never valid here)
+  return text;
 }
 
 }  // namespace
@@ -130,16 +143,28 @@ Configuration load_config_file(const std::string& path) {
 
 std::string config_to_toml(const Configuration& config) {
   Configuration copy = config;
-  toml::table root;
+  // Sections in the table's order (the order of docs/configuration.md), each key under a comment
+  // with its meaning, unit and range; numbers in their shortest exact form (0.4, not 0.40000000000000002).
+  std::vector<std::string> sections;
   for (const ParameterBinding& b : parameter_bindings()) {
-    if (!root.contains(b.section)) root.insert(b.section, toml::table{});
-    toml::table& section = *root[b.section].as_table();
-    if (b.text) section.insert(b.key, *b.text(copy));
-    else if (b.integer) section.insert(b.key, static_cast<std::int64_t>(*b.integer(copy)));
-    else section.insert(b.key, *b.real(copy));
+    if (std::find(sections.begin(), sections.end(), b.section) == sections.end()) sections.push_back(b.section);
   }
   std::ostringstream out;
-  out << root << "\n";
+  out << "# bellows configuration: every key with its value. Keep only the keys you change.\n";
+  for (const std::string& section : sections) {
+    out << "\n[" << section << "]\n";
+    for (const ParameterBinding& b : parameter_bindings()) {
+      if (b.section != section) continue;
+      out << "# " << b.description;
+      if (!b.unit.empty()) out << " [" << b.unit << "]";
+      if (!b.text) out << ", " << (b.integer ? "whole number in " : "in ") << b.range.text();
+      out << "\n" << b.key << " = ";
+      if (b.text) out << toml::value<std::string>(*b.text(copy));
+      else if (b.integer) out << *b.integer(copy);
+      else out << shortest_exact(*b.real(copy));
+      out << "\n";
+    }
+  }
   return out.str();
 }
 

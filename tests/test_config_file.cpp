@@ -125,3 +125,52 @@ TEST(ConfigFile, EveryKeyIsDocumented) {
 
 }  // namespace
 }  // namespace bellows
+
+namespace bellows {
+namespace {
+
+// `bellows config` is a file a person starts from: every value reads back exactly, in its shortest
+// form, sections in the documented order, each key under its meaning and unit.
+TEST(ConfigFile, PrintedConfigurationIsExactShortAndCommented) {
+  Configuration c;
+  c.plant.kappa_rad_per_bar = 0.4;
+  c.ilc.s = 0.1 + 0.2;  // 0.30000000000000004: needs all its digits to read back exactly
+  c.device.t7_address = "10.0.0.2:502 \"quoted\"";
+  const std::string toml = config_to_toml(c);
+  Configuration back;
+  apply_config_toml(toml, "printed", back);
+  Configuration original = c, reread = back;
+  for (const ParameterBinding& b : parameter_bindings()) {
+    if (b.text) {
+      EXPECT_EQ(*b.text(reread), *b.text(original)) << b.section << " " << b.key;
+    } else if (b.integer) {
+      EXPECT_EQ(*b.integer(reread), *b.integer(original)) << b.section << " " << b.key;
+    } else {
+      EXPECT_EQ(*b.real(reread), *b.real(original)) << b.section << " " << b.key;  // exactly, not nearly
+    }
+    EXPECT_NE(toml.find(b.description), std::string::npos) << b.key;
+    if (!b.unit.empty()) {
+      EXPECT_NE(toml.find("[" + b.unit + "]"), std::string::npos) << b.key;
+    }
+  }
+  EXPECT_NE(toml.find("\nkappa = 0.4\n"), std::string::npos) << toml;
+  EXPECT_NE(toml.find("0.30000000000000004"), std::string::npos);
+  // No 17-digit noise on the defaults.
+  const std::string defaults = config_to_toml(Configuration{});
+  EXPECT_EQ(defaults.find("0000000000"), std::string::npos) << defaults;
+  EXPECT_EQ(defaults.find("9999999999"), std::string::npos) << defaults;
+  // Sections in the table's order.
+  std::size_t last = 0;
+  std::string previous;
+  for (const ParameterBinding& b : parameter_bindings()) {
+    if (b.section == previous) continue;
+    previous = b.section;
+    const std::size_t at = defaults.find("\n[" + b.section + "]\n");
+    ASSERT_NE(at, std::string::npos) << b.section;
+    EXPECT_GE(at, last) << b.section;
+    last = at;
+  }
+}
+
+}  // namespace
+}  // namespace bellows
