@@ -19,7 +19,7 @@ namespace {
 // A lab's configuration is a few kilobytes of `[section] key = value`. These bounds are checked
 // before toml++ sees the text: its parser recurses once per nesting level, and a file nested tens
 // of thousands of levels deep (`[a.a.a...]`, `x = [[[[...`) overflows the stack.
-constexpr std::size_t kMaxConfigBytes = 256 * 1024;
+constexpr std::size_t kMaxConfigBytes = kMaxConfigFileBytes;
 constexpr int kMaxTomlNesting = 16;
 
 // The deepest nesting in TOML text: open arrays and inline tables plus the dots of a dotted key or

@@ -2,11 +2,15 @@
 // anything else is an InputError naming the file, the key and what is wrong.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "engine/configuration.hpp"
 
 namespace bellows {
+
+/// The largest configuration file read (a lab's is a few kilobytes).
+inline constexpr std::size_t kMaxConfigFileBytes = 256 * 1024;
 
 /// Applies the TOML text on top of `config` (keys not given keep their values).
 void apply_config_toml(const std::string& toml_text, const std::string& source_name, Configuration& config);

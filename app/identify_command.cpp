@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <toml++/toml.h>
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
@@ -21,6 +22,7 @@
 #include "engine/identification_trial.hpp"
 #include "engine/printable_text.hpp"
 #include "engine/realtime_loop.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 namespace {
@@ -151,23 +153,27 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  std::string plant_source = options.config_path.empty() ? "the default plant" : "the plant of " + options.config_path;
+  std::string existing_text;
+  if (!options.write_model_path.empty() && std::filesystem::exists(options.write_model_path)) {
+    // A directory, FIFO or device is refused, and the read is bounded, as for --config.
+    existing_text = read_regular_file(options.write_model_path, kMaxConfigFileBytes, "config");
+    Configuration written;
+    apply_config_toml(existing_text, options.write_model_path, written);  // fail before any trial runs
+    // The file whose model is fitted describes the arm: without --config, its [plant] is the one fitted.
+    if (options.config_path.empty() && toml::parse(existing_text).contains("plant")) {
+      config = written;
+      plant_source = "the plant of " + options.write_model_path;
+    }
+  }
   if (!options.signal.empty()) config.identify.signal = options.signal;
   const std::string estimation_signal = config.identify.signal;
   const std::string held_out_signal = validation_signal(estimation_signal);
-  std::string existing_text;
-  if (!options.write_model_path.empty() && std::filesystem::exists(options.write_model_path)) {
-    std::ifstream in(options.write_model_path);
-    if (!in) throw InputError("config " + options.write_model_path + ": cannot be read");
-    std::ostringstream text;
-    text << in.rdbuf();
-    existing_text = text.str();
-    Configuration check;
-    apply_config_toml(existing_text, options.write_model_path, check);  // fail before any trial runs
-  }
 
   const DeviceParameters device = resolve_device(options.device, config.device);
   TrialFit estimation, validation;
   if (device.kind == "sim") {
+    progress << "fitting " << plant_source << std::endl;
     progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
              << config.identify.duration_s << " s)" << std::endl;
     estimation = record_simulated_trial(config, estimation_signal, options.seed);

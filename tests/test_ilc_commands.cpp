@@ -132,4 +132,24 @@ TEST_F(IlcCommands, IdentifyLeavesAnInvalidConfigUntouched) {
   EXPECT_EQ(bellows("identify --signal noise").status, 2);
 }
 
+TEST_F(IlcCommands, IdentifyFitsThePlantOfTheFileItWritesAndSaysWhich) {
+  // A lab's file describes its arm: a stiffer gain than the default plant's 7.91 rad/bar.
+  const auto lab = write("rig2.toml", "[plant]\nkappa = 5.0\ncreep_gain = 0.0\n");
+  const Result r = bellows("identify --json --write-model " + lab.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("fitting the plant of " + lab.string()), std::string::npos) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(report["model"]["kappa"].get<double>(), 5.0, 0.05 * 5.0);
+  const Result defaults = bellows("identify --json --signal steps");
+  EXPECT_NE(defaults.err.find("fitting the default plant"), std::string::npos) << defaults.err;
+}
+
+TEST_F(IlcCommands, IdentifyRefusesAModelFileThatIsNotAFile) {
+  const auto dir = write("x.toml", "").parent_path() / "a-directory";
+  std::filesystem::create_directories(dir);
+  const Result r = bellows("identify --write-model " + dir.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("is a directory"), std::string::npos) << r.err;
+}
+
 }  // namespace
