@@ -72,5 +72,17 @@ TEST(CliConventions, AMissingDataDirectoryIsRefusedNotEmpty) {
   EXPECT_NE(empty.out.find("no sessions"), std::string::npos) << empty.out;
 }
 
+TEST(CliConventions, ConfigErrorsNameTheFileAndSayWhyItCannotBeRead) {
+  const auto dir = testing::make_temp_dir("bellows-cli-config-errors");
+  for (const std::string& text : {std::string("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n"),
+                                  std::string("[ilc]\nlaw = \"noilc-dense\"\ns = 0.0\nw = 0.0\n"),
+                                  std::string("[ilc]\nlaw = \"bogus\"\n"), std::string("[ilc]\nm = -1.0\n")}) {
+    const auto file = testing::write_file(dir, "ilc.toml", text);
+    expect_refused("run --no-save --config " + file.string(), "config " + file.string() + ": [ilc]");
+  }
+  expect_refused("config --config " + (dir / "missing.toml").string(), "missing.toml: cannot be read: No such file");
+  expect_refused("config --config " + dir.string(), "is a directory");
+}
+
 }  // namespace
 }  // namespace bellows
