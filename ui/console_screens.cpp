@@ -8,6 +8,7 @@
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"
+#include "ui/render_parts.hpp"
 #include "ui/text_input.hpp"
 #include "ui/tuning.hpp"
 
@@ -133,8 +134,21 @@ bool ConsoleController::handle_screen_key(int k) {
     }
     case Screen::kRig:
       return handle_rig_key(k);
+    case Screen::kHelp: {
+      const int page = std::max(1, state_.height - 6);  // the help's inner height
+      const int last = std::max(0, detail::help_line_count(state_) - page);
+      int& top = state_.help_scroll;
+      if (k == key::kUp) top -= 1;
+      else if (k == key::kDown) top += 1;
+      else if (k == key::kPageUp) top -= page;
+      else if (k == key::kPageDown) top += page;
+      else if (k == key::kHome) top = 0;
+      else if (k == key::kEnd) top = last;
+      else return false;
+      top = std::clamp(top, 0, last);
+      return true;
+    }
     case Screen::kMain:
-    case Screen::kHelp:
     case Screen::kFault:
       return false;
   }

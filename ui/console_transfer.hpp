@@ -12,12 +12,10 @@
 #include "engine/configuration.hpp"
 #include "engine/learning_transfer.hpp"
 #include "ui/experiment.hpp"
+#include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
 
 namespace bellows::ui {
-
-/// The key that takes the offered transfer.
-inline constexpr int kTransferKey = 'T';
 
 struct TransferOffer {
   bool useful = false;

@@ -11,29 +11,61 @@
 
 namespace bellows::ui::detail {
 
+namespace {
+
+/// A line of the help as drawn: a section title, or a key (on the first line of its entry only)
+/// and a piece of its wrapped description.
+struct HelpLine {
+  bool section = false;
+  bool available = true;
+  std::string keys;
+  std::string text;
+};
+
+constexpr int kHelpKeyColumn = 20;
+
+std::vector<HelpLine> help_layout(const ConsoleState& s, int inner_width) {
+  std::vector<HelpLine> lines;
+  const int text_columns = std::max(20, inner_width - kHelpKeyColumn - 3);
+  for (const HelpEntry& e : help_entries(s)) {
+    if (e.section) {
+      if (!lines.empty()) lines.push_back({});
+      lines.push_back({true, true, "", e.what});
+      continue;
+    }
+    std::string text = e.what;
+    if (!e.availability.available && !e.availability.reason.empty()) text += "  (" + e.availability.reason + ")";
+    bool first = true;
+    for (const std::string& piece : wrap(text, text_columns)) {
+      lines.push_back({false, e.availability.available, first ? e.keys : "", piece});
+      first = false;
+    }
+  }
+  return lines;
+}
+
+}  // namespace
+
+int help_line_count(const ConsoleState& s) { return static_cast<int>(help_layout(s, s.width - 2).size()); }
+
 void render_help(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  c.frame(body, g, "Keys (greyed: not available now)");
   const Rect in = inner(body);
-  int y = in.y;
-  for (const KeyBinding& b : key_bindings()) {
-    if (y >= in.bottom()) break;
-    const Availability a = availability(b.action, s);
-    const Role role = a.available ? Role::kNormal : Role::kDim;
-    c.put(in.x + 1, y, fit(b.key_label, 7), a.available ? Role::kKey : Role::kDim, a.available);
-    int x = c.put(in.x + 9, y, b.description, role, false, in.right());
-    if (!a.available && !a.reason.empty()) c.put(x, y, "  (" + a.reason + ")", Role::kDim, false, in.right());
-    ++y;
-  }
-  const auto extra = screen_keys(s.previous_screen);
-  if (!extra.empty() && y + 2 < in.bottom()) {
-    ++y;
-    c.put(in.x + 1, y++, "On the screen you came from:", Role::kTitle, true);
-    for (const auto& [keys, what] : extra) {
-      if (y >= in.bottom()) break;
-      c.put(in.x + 1, y, fit(keys, 20), Role::kKey);
-      c.put(in.x + 22, y++, what, Role::kNormal, false, in.right());
+  const std::vector<HelpLine> lines = help_layout(s, in.width);
+  const int total = static_cast<int>(lines.size());
+  const int top = std::clamp(s.help_scroll, 0, std::max(0, total - in.height));
+  const int shown_last = std::min(total, top + in.height);
+  std::string title = "Keys";
+  if (total > in.height) title += format(" (lines %d-%d of %d; Up/Down, PgUp/PgDn scroll)", top + 1, shown_last, total);
+  c.frame(body, g, title);
+  for (int i = top, y = in.y; i < shown_last; ++i, ++y) {
+    const HelpLine& l = lines[static_cast<std::size_t>(i)];
+    if (l.section) {
+      c.put(in.x + 1, y, l.text, Role::kTitle, true, in.right());
+      continue;
     }
+    if (!l.keys.empty()) c.put(in.x + 1, y, fit(l.keys, kHelpKeyColumn), l.available ? Role::kKey : Role::kDim, l.available);
+    c.put(in.x + 2 + kHelpKeyColumn, y, l.text, l.available ? Role::kNormal : Role::kDim, false, in.right());
   }
 }
 
