@@ -130,5 +130,53 @@ TEST(UiRenderFit, NoNegativeZeroInTheReadouts) {
   EXPECT_EQ(screen.find("-0.00"), std::string::npos) << screen;
 }
 
+TEST(UiRenderFit, TheFunctionBarKeepsStopBackHelpAndQuitAt80Columns) {
+  for (EngineState state : {EngineState::kSafe, EngineState::kArmed, EngineState::kFault}) {
+    for (Screen screen : {Screen::kMain, Screen::kTuning, Screen::kRig, Screen::kLog}) {
+      ConsoleState s = small_state(state);
+      s.fault_view.code = state == EngineState::kFault ? FaultCode::kHeartbeatLost : FaultCode::kNone;
+      s.screen = screen;
+      const std::string bar = render_lines(s).back();
+      SCOPED_TRACE(bar);
+      if (state == EngineState::kArmed) {
+        EXPECT_NE(bar.find("Space E-STOP"), std::string::npos);
+      }
+      if (screen != Screen::kMain) {
+        EXPECT_NE(bar.find("Esc Back"), std::string::npos);
+      }
+      EXPECT_NE(bar.find("?/F1 Help"), std::string::npos);
+      EXPECT_NE(bar.find("q Quit"), std::string::npos);
+      EXPECT_LE(static_cast<int>(bar.find_last_not_of(' ')), kMinWidth - 1);
+    }
+  }
+}
+
+TEST(UiRenderFit, TheStatusLineWrapsAtAWordAndNeverCutsOne) {
+  ConsoleState s = small_state(EngineState::kArmed);
+  s.unicode = false;
+  s.status = "Run: arm the valves first (a); the learning law is rebuilt after every change of the weights, "
+             "which takes a moment on a slow machine ENDWORD";
+  std::vector<std::string> lines = render_lines(s);
+  const std::string two = lines[lines.size() - 3] + "\n" + lines[lines.size() - 2];
+  EXPECT_NE(two.find("Run: arm the valves first (a);"), std::string::npos) << two;
+  EXPECT_NE(two.find("ENDWORD"), std::string::npos) << two;  // all of it, on two lines
+  for (const char* word : {"rebuilt", "weights,", "machine"}) EXPECT_NE(two.find(word), std::string::npos) << word;
+
+  std::string very_long;
+  for (int i = 0; i < 60; ++i) very_long += "word" + std::to_string(i) + " ";
+  s.status = very_long;
+  lines = render_lines(s);
+  const std::string last = lines[lines.size() - 2];
+  SCOPED_TRACE(last);
+  const auto end = last.find_last_not_of(' ');
+  ASSERT_NE(end, std::string::npos);
+  EXPECT_EQ(last.substr(end - 3, 4), " ...");  // abbreviated after a whole word
+  const std::string before = last.substr(0, end - 3);
+  const std::string tail = before.substr(before.find_last_of(' ') + 1);
+  EXPECT_NE(very_long.find(" " + tail + " "), std::string::npos) << tail;  // a whole word, not a piece of one
+  // The function bar stays below it.
+  EXPECT_NE(lines.back().find("Space E-STOP"), std::string::npos) << lines.back();
+}
+
 }  // namespace
 }  // namespace bellows::ui
