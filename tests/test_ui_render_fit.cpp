@@ -178,5 +178,25 @@ TEST(UiRenderFit, TheStatusLineWrapsAtAWordAndNeverCutsOne) {
   EXPECT_NE(lines.back().find("Space E-STOP"), std::string::npos) << lines.back();
 }
 
+TEST(UiRenderFit, TheTuningScreenSaysHowToEditAValueAt80x24) {
+  ConsoleState s = small_state(EngineState::kArmed);
+  s.screen = Screen::kTuning;
+  s.run.mode = RunProgress::Mode::kIdle;
+  s.tuning.selected = 1;
+  std::string screen = all(render_lines(s));
+  EXPECT_NE(screen.find("Up/Down choose   Enter edit: type the value, Enter applies, Esc cancels"), std::string::npos)
+      << screen;
+  s.tuning.selected = TuningForm::kLawRow;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("Enter or Right: next law   Left: the one before"), std::string::npos) << screen;
+  s.run.mode = RunProgress::Mode::kBatch;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("changes wait: trials are running (x stops them)"), std::string::npos) << screen;
+  s = small_state(EngineState::kFault);
+  s.screen = Screen::kTuning;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("changes wait: a fault is latched (R resets)"), std::string::npos) << screen;
+}
+
 }  // namespace
 }  // namespace bellows::ui

@@ -130,6 +130,20 @@ std::string law_summary(const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+/// How to edit the selected row, and why not now when it cannot change.
+std::string tuning_hint(const ConsoleState& s) {
+  if (s.run.mode != RunProgress::Mode::kIdle || s.engine_state == EngineState::kRunning) {
+    return "Up/Down choose   changes wait: trials are running (x stops them)";
+  }
+  if (s.engine_state == EngineState::kFault) return "Up/Down choose   changes wait: a fault is latched (R resets)";
+  if (s.tuning.selected == TuningForm::kLawRow) return "Up/Down choose   Enter or Right: next law   Left: the one before";
+  return "Up/Down choose   Enter edit: type the value, Enter applies, Esc cancels";
+}
+
+}  // namespace
+
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
   const int form_height = std::min(body.height, 15);
@@ -167,7 +181,10 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
     if (y >= in.bottom()) break;
     c.put(in.x + 1, y++, line, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning, in.right());
   }
-  const Rect changes{body.x, form.bottom(), body.width, body.height - form_height};
+  if (form_height < body.height) {  // how to edit, under the form
+    c.put(body.x + 2, form.bottom(), tuning_hint(s), Role::kKey, false, body.right() - 1);
+  }
+  const Rect changes{body.x, form.bottom() + 1, body.width, body.height - form_height - 1};
   if (changes.height < 3) return;
   c.frame(changes, g, "Changes recorded in the log");
   const Rect cin = inner(changes);
