@@ -198,5 +198,28 @@ TEST(UiRenderFit, TheTuningScreenSaysHowToEditAValueAt80x24) {
   EXPECT_NE(screen.find("changes wait: a fault is latched (R resets)"), std::string::npos) << screen;
 }
 
+TEST(UiRenderFit, VentedTheLivePanelShowsNoSetPointAndNoTrackingError) {
+  // After an emergency stop in the middle of `paper`: the engine still knows its last set point
+  // (40 deg), the arm has sagged to 3 deg.
+  ConsoleState s = small_state(EngineState::kFault);
+  s.live.state = EngineState::kFault;
+  s.live.desired_angle_rad = 40.0 * testing::kDeg;
+  s.live.reading.angle_rad = 3.0 * testing::kDeg;
+  std::string screen = all(render_lines(s));
+  EXPECT_NE(screen.find("angle         3.00 deg"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("set point  none: vented"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
+  EXPECT_EQ(screen.find("40.00"), std::string::npos) << screen;
+  EXPECT_EQ(screen.find("37.00"), std::string::npos) << screen;
+  // Armed, the engine holds a set point, still no trial; running, the tracking error is shown.
+  s.engine_state = s.live.state = EngineState::kArmed;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("set point    40.00 deg hold"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
+  s.engine_state = s.live.state = EngineState::kRunning;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("error        37.00 deg"), std::string::npos) << screen;
+}
+
 }  // namespace
 }  // namespace bellows::ui
