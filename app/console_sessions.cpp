@@ -177,6 +177,7 @@ std::vector<ui::SessionListing> StoreSessionGateway::list() {
       l.trajectory = s.manifest.trajectory_name;
       l.iterations = static_cast<int>(s.manifest.iterations.size());
       l.best_rms_deg = best_rms_deg(s.manifest);
+      l.device = s.manifest.device;
     }
     out.push_back(std::move(l));
   }

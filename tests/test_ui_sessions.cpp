@@ -169,6 +169,8 @@ TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
   EXPECT_EQ(l.iterations, 2);
   EXPECT_NEAR(l.best_rms_deg, 9.38, 0.3);
   EXPECT_EQ(l.date.size(), 16u) << l.date;
+  EXPECT_EQ(l.device, "sim");  // from its manifest
+  EXPECT_TRUE(l.refusal.empty()) << l.refusal;
   f.key(ui::key::kEnter);
   ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy && f.state().law_ready; }));
   ASSERT_EQ(f.state().experiment.trials.size(), 2u);
@@ -205,6 +207,11 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
     location = f.state().experiment.session_location;
   }
   StoreSessionGateway lcm("lcm");
+  const auto listing = lcm.list();  // the browser knows before the operator picks it
+  ASSERT_EQ(listing.size(), 1u);
+  EXPECT_EQ(listing[0].device, "sim");
+  EXPECT_EQ(ui::drive_refusal(listing[0], "lcm"), "recorded on the device 'sim'; this console drives 'lcm'");
+  EXPECT_EQ(ui::drive_refusal(listing[0], "sim"), "");
   try {
     lcm.open(location);
     FAIL() << "opened a sim session on an lcm console";

@@ -109,6 +109,10 @@ bool ConsoleController::handle_screen_key(int k) {
         const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];
         if (!l.error.empty()) {
           set_status(l.name + " cannot be opened: " + l.error, true);
+        } else if (!l.refusal.empty()) {
+          set_status(l.name + " cannot be opened here: " + l.refusal + " (bellows console --device " + l.device + " --session " +
+                         l.location + ")",
+                     true);
         } else if (!availability(Action::kOpen, state_).available) {
           set_status("cannot open now: " + availability(Action::kOpen, state_).reason, true);
         } else {

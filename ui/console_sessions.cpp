@@ -179,6 +179,7 @@ void ConsoleController::poll_session_tasks() {
       state_.browser.sessions = list_task_.take();
       // Newest first is what an operator looks for.
       std::reverse(state_.browser.sessions.begin(), state_.browser.sessions.end());
+      for (SessionListing& l : state_.browser.sessions) l.refusal = drive_refusal(l, env_.device_name);
       state_.browser.selected = 0;
     } catch (const std::exception& error) {
       state_.browser.sessions.clear();

@@ -254,8 +254,8 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(in.x + 1, in.y, "No saved session yet: s saves the current one.", Role::kDim);
     return;
   }
-  c.put(in.x + 1, in.y, "  started           trajectory   iterations   best RMS  name", Role::kDim);
-  const int rows = in.height - 2;
+  c.put(in.x + 1, in.y, "  started           device trajectory  iterations   best RMS  name", Role::kDim);
+  const int rows = in.height - 3;  // the last line tells why the chosen one cannot be opened
   const int count = static_cast<int>(b.sessions.size());
   const int first = std::clamp(b.selected - rows + 1, 0, std::max(0, count - rows));
   for (int i = first, y = in.y + 1; i < count && y < in.y + 1 + rows; ++i, ++y) {
@@ -263,13 +263,21 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
     const bool selected = i == b.selected;
     std::string row;
     if (l.error.empty()) {
-      row = format("%s %-17s %-12s %10d   %s  %s", selected ? ">" : " ", l.date.c_str(), l.trajectory.c_str(), l.iterations,
-                   l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str());
+      row = format("%s %-17s %-6s %-12s %9d   %s  %s%s", selected ? ">" : " ", l.date.c_str(), l.device.c_str(),
+                   l.trajectory.c_str(), l.iterations,
+                   l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str(),
+                   l.refusal.empty() ? "" : "  (other device)");
     } else {
       row = format("%s %s: cannot be read: %s", selected ? ">" : " ", l.name.c_str(), l.error.c_str());
     }
-    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (l.error.empty() ? Role::kNormal : Role::kDim),
-          selected);
+    const bool openable = l.error.empty() && l.refusal.empty();
+    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (openable ? Role::kNormal : Role::kDim), selected);
+  }
+  if (b.selected >= 0 && b.selected < count) {
+    const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];
+    if (!l.refusal.empty() && b.error.empty()) {
+      c.put(in.x + 1, in.bottom() - 1, "cannot open it here: " + l.refusal, Role::kWarning, true, in.right());
+    }
   }
 }
 
