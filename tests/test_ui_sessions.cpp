@@ -265,5 +265,49 @@ TEST(UiSessionGateway, WithoutADataDirectoryItSaysWhy) {
   else unsetenv("HOME");
 }
 
+TEST_F(UiSessions, ASessionStartedFromATransferRecordsWhereItsFirstCorrectionCameFrom) {
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(6);
+  save_and_wait(f);
+  const std::string taught = f.state().experiment.session_location;
+  f.key('t');
+  f.key(ui::key::kDown);  // steps
+  f.key(ui::key::kEnter);
+  ASSERT_EQ(f.state().experiment.trajectory->name, "steps");
+  ASSERT_TRUE(f.pump_until([&] { return f.state().status.find("T: start from what") != std::string::npos; }, 50.0))
+      << f.state().status;
+  f.key('T');
+  ASSERT_NE(f.state().experiment.first_correction, nullptr);
+  const double predicted = f.state().experiment.first_correction->result.predicted_rms_deg;
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  const std::string started = f.state().experiment.session_location;
+  ASSERT_NE(started, taught);
+  f.console.reset();
+
+  const nlohmann::ordered_json first = load_manifest(started).first_correction;
+  ASSERT_TRUE(first.is_object()) << first.dump();
+  EXPECT_EQ(first["status"], "transferred");
+  EXPECT_EQ(first["by"], "console");
+  EXPECT_FALSE(first["method"].get<std::string>().empty());
+  EXPECT_NEAR(first["prediction"]["rms_deg"].get<double>(), predicted, 1e-9);
+  EXPECT_GT(first["prediction"]["feedback_only_rms_deg"].get<double>(), predicted);
+  ASSERT_EQ(first["sources"].size(), 1u) << first.dump();
+  EXPECT_EQ(first["sources"][0]["trajectory"], "paper");
+  EXPECT_EQ(first["sources"][0]["directory"], taught);  // the taught trajectory's own session
+  EXPECT_EQ(first["sources"][0]["trials"], 6);
+  EXPECT_GT(first["sources"][0]["last_rms_deg"].get<double>(), 0.0);
+  // The same keys as bellows run --transfer-from records.
+  for (const char* key : {"sources", "method", "status", "reason", "prediction", "validation_ratio", "clamped_samples",
+                          "max_abs_correction_bar"}) {
+    EXPECT_TRUE(first.contains(key)) << key;
+  }
+  // A session that started with feedback only records none.
+  EXPECT_TRUE(load_manifest(taught).first_correction.is_null());
+}
+
 }  // namespace
 }  // namespace bellows
