@@ -534,6 +534,8 @@ TEST(UiController, AfterAnEmergencyStopTheLivePanelShowsTheRealState) {
   f.key(' ');
   ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }));
   f.pump_for(3.0);  // vented, the arm sags
+  f.key(ui::key::kEscape);  // from the fault screen the stop opened, back to the main one
+  ASSERT_EQ(f.state().screen, Screen::kMain);
   const TickRecord& live = f.state().live;
   ASSERT_EQ(live.state, EngineState::kFault);
   const std::string screen = testing::all(render_lines(f.state()));
