@@ -224,6 +224,7 @@ void ConsoleController::perform(Action action) {
         state_.screen = state_.previous_screen;
       } else {
         state_.previous_screen = state_.screen;
+        state_.help_scroll = 0;
         state_.screen = Screen::kHelp;
       }
       return;

@@ -142,6 +142,7 @@ struct ConsoleState {
   std::string status;          // the latest message for the operator
   bool status_important = false;
   int log_scroll = 0;          // log screen: entries scrolled back from the newest
+  int help_scroll = 0;         // help screen: its first line shown
 
   // The engine and the rig.
   EngineState engine_state = EngineState::kSafe;
