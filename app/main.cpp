@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
-  t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on")->capture_default_str();
+  t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on (port 0: any free one, named on the first line)")->capture_default_str();
   t7_sim_cmd->add_option("--config", t7_sim.config_path, "TOML configuration file ([plant])");
   t7_sim_cmd->add_option("--rig-profile", t7_sim.rig_profile, "Rig profile (default: the paper rig's)");
   t7_sim_cmd->add_option("--seed", t7_sim.seed, "Seed of the simulated arm's noise")

@@ -24,7 +24,7 @@ constexpr int kSimPriority = 70;
 int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (options.duration_s < 0.0) throw InputError("--duration must not be negative");
   T7SimOptions sim;
-  parse_host_port(options.listen, kDefaultT7SimPort, sim.host, sim.port);
+  parse_host_port(options.listen, kDefaultT7SimPort, sim.host, sim.port, "--listen", 0);  // port 0: any free one
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   sim.plant = config.plant;
   sim.profile = rig_profile_or_default(options.rig_profile);
