@@ -31,6 +31,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   sim.plant.pwm_period_s = 1.0 / sim.profile.pwm_frequency_hz;  // the arm's valves follow the profile's PWM
   sim.seed = options.seed;
   sim.status_path = options.status_path;
+  sim.limits = RigLimits::from(config);  // the rig's own limits, as io-sim's
   sim.swapped_chambers = options.swapped_chambers;
   sim.no_supply = options.no_supply;
   sim.silent_after_s = options.silent_after_s;
