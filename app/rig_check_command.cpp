@@ -115,7 +115,7 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   }
   const ValveTestReport result =
       run_valve_test(*driver, check, config.safety, config.controller.gas.ambient_bar,
-                     config.model.volume_gain_per_rad, &stop_requested());
+                     config.model.volume_gain_per_rad, &stop_requested(), link_lag_s(rig->device().health()));
   report["valves"] = nlohmann::json::array();
   int failed = 0;
   progress << "valves:\n";

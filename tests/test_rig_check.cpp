@@ -3,6 +3,7 @@
 // `bellows rig check`'s exit status and lines.
 #include <gtest/gtest.h>
 
+#include <deque>
 #include <string>
 
 #include "engine/valve_test.hpp"
@@ -116,9 +117,69 @@ TEST(ValveTest, JudgeNamesAValveThatMovesItsChamberTheWrongWay) {
   before.chamber_bar = {1.2, 1.2};
   before.supply_bar = after.supply_bar = 3.0;
   after.chamber_bar = {1.3, 1.2};  // outlet A raised chamber A
+  after.time_s = 0.1;
   const ValveVerdict v = judge_valve(ValveId::kOutletA, before, after, 1.013, check, 2.0, 0.35);
   EXPECT_FALSE(v.pass);
   EXPECT_NE(v.problem.find("inlet and outlet of A are swapped"), std::string::npos) << v.problem;
+}
+
+TEST(ValveTest, JudgeTakesNoReadingFromBeforeThePulse) {
+  RigCheckParameters check;
+  SensorReading before;
+  before.chamber_bar = {1.013, 1.013};
+  before.supply_bar = 3.0;
+  before.time_s = 2.0;
+  SensorReading after = before;  // the link delivered nothing new: the same reading again
+  const ValveVerdict v = judge_valve(ValveId::kInletA, before, after, 1.013, check, 2.0, 0.35);
+  EXPECT_FALSE(v.pass);
+  EXPECT_NE(v.problem.find("no reading taken after the pulse started"), std::string::npos) << v.problem;
+  EXPECT_EQ(v.problem.find("dead valve"), std::string::npos) << "a stale link is not a dead valve: " << v.problem;
+}
+
+/// A rig whose readings reach the engine `lag_ticks` ticks after they were taken, like a rig over
+/// LCM (its state answers a command a period or two later). Each reading keeps the time it was taken.
+class LaggingDevice final : public Device {
+ public:
+  LaggingDevice(SimulatedArm& arm, int lag_ticks) : arm_(arm), lag_ticks_(lag_ticks) { taken_.push_back(arm.read_sensors()); }
+  SensorReading read_sensors() override { return taken_.front(); }
+  void write_valves(const ValveCommand& command) override { arm_.write_valves(command); }
+  void vent() override { arm_.vent(); }
+  void advance(double dt_s) override {
+    arm_.advance(dt_s);
+    taken_.push_back(arm_.read_sensors());
+    if (static_cast<int>(taken_.size()) > lag_ticks_ + 1) taken_.pop_front();
+  }
+  bool time_follows_ticks() const override { return true; }
+  const char* name() const override { return "lagging"; }
+
+ private:
+  SimulatedArm& arm_;
+  int lag_ticks_;
+  std::deque<SensorReading> taken_;
+};
+
+ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
+  const Configuration c;
+  SimulatedArm arm(c.plant, 1);
+  LaggingDevice device(arm, lag_ticks);
+  EngineCore core(device, c.controller, c.timing, c.safety);
+  SimulatedClock clock(core, device);
+  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad, nullptr,
+                        link_lag_s);
+}
+
+// The default 30 ms pulses on a rig whose readings lag by 4 ticks (20 ms): judged on readings that
+// do not yet show the step, valves of a healthy rig fail; waiting out the link's lag after each step,
+// every valve passes.
+TEST(ValveTest, OnALaggingLinkEachStepIsJudgedOnReadingsThatShowIt) {
+  const int lag_ticks = 4;
+  const double lag_s = lag_ticks * TimingParameters{}.tick_s;
+  const ValveTestReport unaware = check_lagging(lag_ticks, 0.0);
+  EXPECT_FALSE(unaware.all_pass()) << "the lag is not what this test is about: it never mattered";
+  const ValveTestReport settled = check_lagging(lag_ticks, lag_s);
+  ASSERT_TRUE(settled.finished);
+  EXPECT_EQ(settled.aborted, "");
+  for (const ValveVerdict& v : settled.valves) EXPECT_TRUE(v.pass) << valve_name(v.valve) << ": " << v.problem;
 }
 
 TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {

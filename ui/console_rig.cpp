@@ -35,7 +35,8 @@ bool ConsoleController::handle_rig_key(int k) {
 
 void ConsoleController::start_valve_test() {
   valve_test_ = std::make_unique<ValveTest>(env_.config.rig_check, env_.config.safety, env_.config.controller.gas.ambient_bar,
-                                            env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad);
+                                            env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad,
+                                            env_.device_health ? link_lag_s(env_.device_health()) : 0.0);
   const SensorReading latest = state_.live_valid ? state_.live.reading : SensorReading{};
   state_.rig.verdicts_logged = false;
   if (!send_valve_test_commands(valve_test_->begin(state_.engine_state, latest))) return;
