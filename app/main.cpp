@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
+  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
 
   bellows::RigCheckOptions rig_check;

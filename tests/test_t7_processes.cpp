@@ -10,6 +10,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <sstream>
+
 #include <nlohmann/json.hpp>
 
 #include "tests/lcm_test_support.hpp"
@@ -187,6 +190,34 @@ TEST_F(T7Processes, ASilentLinkFaultsTheRunAndTheWatchdogVents) {
   EXPECT_NE(run->err().find("sensor-stale"), std::string::npos) << run->err();
   ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; }));
   EXPECT_TRUE(status().at("safe").get<bool>());
+}
+
+std::string text_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string paper_profile_text() { return text_of(std::filesystem::path(BELLOWS_SOURCE_DIR) / "profiles" / "paper-rig.toml"); }
+
+// `identify --write-model PROFILE`: a rig profile (it has [valves]) gets the fit in its [model],
+// which the profile then carries (the simulated arm's identification: the file path is the same
+// for every device).
+TEST_F(T7Processes, IdentifyWritesTheModelIntoARigProfile) {
+  const std::filesystem::path profile = testing::write_file(dir_, "rig.toml", paper_profile_text());
+  const testing::ProcessResult r = run_cli({"identify", "--device", "sim", "--write-model", profile.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["written_as"], "rig_profile");
+  const std::string written = text_of(profile);
+  EXPECT_NE(written.find("[model]\nkappa_rad_per_bar = "), std::string::npos) << written;
+  EXPECT_NE(written.find("# fitted by bellows identify"), std::string::npos) << written;
+  // The profile with its model is valid: a rig check on it reads it.
+  auto sim = start_sim();
+  const testing::ProcessResult check =
+      run_cli({"rig", "check", "--inputs-only", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "off"});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
 }
 
 TEST_F(T7Processes, ABadRigProfileIsOneLineNamingFileAndKeyAndNoSession) {
