@@ -237,6 +237,8 @@ int main(int argc, char** argv) {
       ->default_str("try");
   rig_check_cmd->add_flag("--yes", rig_check.yes, "Pulse the valves without asking (the operator has cleared the arm)");
   rig_check_cmd->add_flag("--inputs-only", rig_check.inputs_only, "Only show the inputs; open no valve");
+  rig_check_cmd->add_flag("--zero-angle", rig_check.zero_angle,
+                          "Make the angle read now the rig profile's zero (--device t7 --rig-profile FILE); open no valve");
   rig_check_cmd->add_flag("--json", rig_check.json, "Print one JSON object on stdout");
 
   try {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/rig_profile_write.hpp"
 #include "app/signals.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/engine_driver.hpp"
@@ -20,6 +21,9 @@ namespace bellows {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+// Zeroing averages this many fresh readings (a tenth of a second at 200 Hz): the sensor's noise
+// averages out, the arm at rest does not move meanwhile.
+constexpr int kZeroingReadings = 20;
 
 std::string line_of(const char* pattern, auto... values) {
   char text[400];
@@ -49,6 +53,33 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
     const RawInput& in = raw.inputs[i];
     progress << line_of("  %-12s %8.4f V -> %10.4f %s\n", in.name, in.volts, in.value, in.unit);
   }
+}
+
+// The angle read now (the mean of kZeroingReadings fresh readings, the arm at rest where it should read zero)
+// becomes the profile's zero: the new zero is the old one plus what the device reads with it.
+nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const DeviceParameters& device, std::ostream& progress) {
+  if (device.kind != "t7" || device.rig_profile.empty()) {
+    throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
+                     "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
+  }
+  double sum_rad = 0.0;
+  int count = 0;
+  double last_time_s = -INFINITY;
+  TickRecord tick;
+  while (count < kZeroingReadings) {
+    if (stop_requested().load(std::memory_order_relaxed)) throw InputError("--zero-angle stopped: the profile is unchanged");
+    driver.await();
+    if (!driver.core().read_snapshot(tick) || !(tick.reading.time_s > last_time_s)) continue;  // fresh readings only
+    last_time_s = tick.reading.time_s;
+    if (!std::isfinite(tick.reading.angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
+    sum_rad += tick.reading.angle_rad;
+    ++count;
+  }
+  const double previous_rad = rig.angle_zero_rad().value_or(0.0);
+  const double read_rad = sum_rad / count;
+  progress << "angle zero: " << zero_rig_angle(rig, device.rig_profile, read_rad) << " (mean of " << count << " readings)\n";
+  return {{"profile", device.rig_profile}, {"read_deg", read_rad * kDegPerRad}, {"readings", count},
+          {"previous_rad", previous_rad}, {"angle_zero_rad", rig.angle_zero_rad().value_or(0.0)}};
 }
 
 }  // namespace
@@ -95,6 +126,11 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
                                 {"volts", raw.inputs[i].volts},
                                 {"value", raw.inputs[i].value},
                                 {"unit", raw.inputs[i].unit}});
+  }
+  if (options.zero_angle) {
+    report["angle_zero"] = zero_the_angle(*driver, *rig, device, progress);
+    if (options.json) out << report.dump() << std::endl;
+    return 0;
   }
   if (options.inputs_only) {
     if (options.json) out << report.dump() << std::endl;

@@ -164,6 +164,22 @@ std::string profile_copy(const std::string& name) {
   return path;
 }
 
+TEST(RigProfileWrite, TheAngleZeroIsWrittenIntoTheFile) {
+  const std::string path = profile_copy("zero");
+  EXPECT_TRUE(is_rig_profile_file(path));
+  write_rig_profile_angle_zero(path, 0.0421);
+  const RigProfile p = load_rig_profile(path);
+  EXPECT_DOUBLE_EQ(p.angle_zero_rad, 0.0421);
+  EXPECT_EQ(p.input(SensorRole::kAngle).gain_per_V, paper_rig_profile().input(SensorRole::kAngle).gain_per_V);
+  const std::string text = read_file(path);
+  EXPECT_NE(text.find("angle_zero_rad = 0.0421  # zeroed by bellows"), std::string::npos);
+  EXPECT_NE(text.find("# The model identified on this rig"), std::string::npos) << "the file's comments stay";
+  // A zero the profile may not hold (beyond +-pi): refused, the file unchanged.
+  EXPECT_THROW(write_rig_profile_angle_zero(path, 4.0), InputError);
+  EXPECT_EQ(read_file(path), text);
+  ::unlink(path.c_str());
+}
+
 TEST(RigProfileWrite, TheIdentifiedModelIsWrittenIntoTheFile) {
   const std::string path = profile_copy("model");
   ModelParameters m;
