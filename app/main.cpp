@@ -240,6 +240,10 @@ int main(int argc, char** argv) {
   rig_check_cmd->add_flag("--zero-angle", rig_check.zero_angle,
                           "Make the angle read now the rig profile's zero (--device t7 --rig-profile FILE); open no valve");
   rig_check_cmd->add_flag("--json", rig_check.json, "Print one JSON object on stdout");
+  CLI::Option* rig_no_save = rig_check_cmd->add_flag("--no-save", rig_check.no_save, "Do not record the check in a session");
+  rig_check_cmd->add_option("--data-dir", rig_check.data_dir,
+                            "Where the check's session is saved (default: where runs save theirs)")
+      ->excludes(rig_no_save);
 
   try {
     app.parse(argc, argv);

@@ -25,6 +25,11 @@ struct RigCheckOptions {
   bool inputs_only = false;  // no valve opens
   bool zero_angle = false;   // the angle read now becomes the rig profile's zero (written to its file); no valve opens
   bool json = false;
+  // The check is recorded in a session like a run (the device, the configuration, one event per
+  // input, valve verdict and angle zero) unless no_save.
+  bool no_save = false;
+  std::string data_dir;      // empty: the default sessions folder
+  std::string session_name;  // empty: start time and the configured trajectory
 };
 
 /// Runs the check. The question comes from `in` (a line starting with y goes on); the report goes to

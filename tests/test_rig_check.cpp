@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
 
 #include "engine/valve_test.hpp"
@@ -237,6 +240,7 @@ using testing::write_file;
 struct CheckRun {
   int status;
   std::string out, err;
+  std::filesystem::path sessions;  // where the check's session went (--data-dir)
 };
 
 CheckRun rig_check(const std::string& args, const std::string& fault = "", const std::string& answer = "") {
@@ -246,8 +250,10 @@ CheckRun rig_check(const std::string& args, const std::string& fault = "", const
     config_arg = " --config '" + write_file(dir, "rig.toml", "[plant]\nfault = \"" + fault + "\"\nfault_at_s = 0.0\n").string() + "'";
   }
   const std::string input = answer.empty() ? "/dev/null" : write_file(dir, "answer", answer + "\n").string();
-  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + " " + args + " < '" + input + "'");
-  return {r.exit_code, r.out, r.err};
+  const std::filesystem::path sessions = dir / "sessions";
+  const std::string save = args.find("--no-save") == std::string::npos ? " --data-dir '" + sessions.string() + "'" : "";
+  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + save + " " + args + " < '" + input + "'");
+  return {r.exit_code, r.out, r.err, sessions};
 }
 
 int count_of(const std::string& text, const std::string& what) {
@@ -300,6 +306,36 @@ TEST(RigCheckCli, JsonNamesEveryValve) {
   EXPECT_FALSE(report.at("valves")[0].at("pass").get<bool>());
   EXPECT_TRUE(report.at("valves")[1].at("pass").get<bool>());
   EXPECT_FALSE(report.at("all_pass").get<bool>());
+}
+
+// A rig check is recorded in a session like a run: the device, each input, each valve's verdict
+// and the outcome are its events (the manifest), and --json names the session.
+TEST(RigCheckCli, TheCheckIsRecordedInASession) {
+  const CheckRun r = rig_check("--yes --json", "dead-inlet");
+  ASSERT_EQ(r.status, kRigCheckFailedStatus) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(report.at("session").is_string()) << r.out;
+  const std::filesystem::path session = report.at("session").get<std::string>();
+  EXPECT_EQ(session.parent_path(), r.sessions);
+  std::ifstream in(session / "manifest.json");
+  const auto manifest = nlohmann::json::parse(in);
+  EXPECT_EQ(manifest.at("device"), "sim");
+  std::map<std::string, std::vector<std::string>> events;
+  for (const auto& e : manifest.at("events")) events[e.at("kind").get<std::string>()].push_back(e.at("message").get<std::string>());
+  ASSERT_EQ(events["start"].size(), 1u);
+  EXPECT_NE(events["start"][0].find("bellows rig check"), std::string::npos) << events["start"][0];
+  ASSERT_EQ(events["rig-input"].size(), 1u);  // the simulated arm: one line of values, no volts
+  EXPECT_NE(events["rig-input"][0].find("supply"), std::string::npos);
+  ASSERT_EQ(events["valve-test"].size(), 4u);
+  EXPECT_EQ(events["valve-test"][0].rfind("inlet A FAIL: dead valve", 0), 0u) << events["valve-test"][0];
+  EXPECT_EQ(events["valve-test"][1].rfind("inlet B pass", 0), 0u) << events["valve-test"][1];
+  ASSERT_EQ(events["finish"].size(), 1u);
+  EXPECT_NE(events["finish"][0].find("valves failed"), std::string::npos) << events["finish"][0];
+
+  const CheckRun unsaved = rig_check("--yes --json --no-save");
+  EXPECT_EQ(unsaved.status, 0) << unsaved.err;
+  EXPECT_TRUE(nlohmann::json::parse(unsaved.out).at("session").is_null());
+  EXPECT_FALSE(std::filesystem::exists(unsaved.sessions));
 }
 
 }  // namespace
