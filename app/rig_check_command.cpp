@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/run_command.hpp"
 #include "app/trajectory_file.hpp"
 #include "app/rig_profile_write.hpp"
 #include "app/signals.hpp"
@@ -102,8 +103,8 @@ class RigCheckSession {
                              std::string(kPurpose) + (options.zero_angle    ? ": zeroing the angle"
                                                       : options.inputs_only ? ": the inputs"
                                                                             : ": the inputs and the valve test")});
-    // A session has a trajectory: the configured one, the one this rig will learn next.
-    const Trajectory trajectory = resolve_trajectory("", config.timing.sample_s(), config.trajectory);
+    // A session has a trajectory: the one `bellows run` learns by default.
+    const Trajectory trajectory = resolve_trajectory(RunOptions{}.trajectory, config.timing.sample_s(), config.trajectory);
     const std::filesystem::path data_dir = options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
     writer_.emplace(SessionWriter::create(data_dir, options.session_name, std::move(header), trajectory, kPurpose));
   }

@@ -29,7 +29,7 @@ struct RigCheckOptions {
   // input, valve verdict and angle zero) unless no_save.
   bool no_save = false;
   std::string data_dir;      // empty: the default sessions folder
-  std::string session_name;  // empty: start time and the configured trajectory
+  std::string session_name;  // empty: start time and trajectory
 };
 
 /// Runs the check. The question comes from `in` (a line starting with y goes on); the report goes to
