@@ -63,10 +63,6 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
 // The angle read now (the mean of kZeroingReadings fresh readings, the arm at rest where it should read zero)
 // becomes the profile's zero: the new zero is the old one plus what the device reads with it.
 nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const DeviceParameters& device, std::ostream& progress) {
-  if (device.kind != "t7" || device.rig_profile.empty()) {
-    throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
-                     "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
-  }
   double sum_rad = 0.0;
   int count = 0;
   double last_time_s = -INFINITY;
@@ -137,6 +133,10 @@ void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession
 int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress) {
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   const DeviceParameters device = resolve_device(options.device, config.device);
+  if (options.zero_angle && (device.kind != "t7" || device.rig_profile.empty())) {  // before anything opens
+    throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
+                     "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
+  }
   const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   std::unique_ptr<EngineDriver> driver;

@@ -1,5 +1,6 @@
 #include "app/rig_profile_write.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
