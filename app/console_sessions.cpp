@@ -1,4 +1,5 @@
 #include "app/console_sessions.hpp"
+#include "app/memory_policy.hpp"
 
 #include <cstdio>
 #include <ctime>
@@ -144,6 +145,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
+  return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
 }
 

@@ -10,6 +10,7 @@
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
+#include "app/memory_policy.hpp"
 #include "app/rig_check_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/run_command.hpp"
@@ -31,6 +32,7 @@ constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
 int main(int argc, char** argv) {
+  bellows::bound_allocator_retention();
   bellows::check_standard_output_at_exit();
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm"};
   app.require_subcommand(0, 1);
