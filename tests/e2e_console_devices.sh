@@ -48,7 +48,7 @@ device_setup() {
     t7)  "$BELLOWS" t7-sim --listen 127.0.0.1:0 >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
          local port="" tries=0
          while [ -z "$port" ]; do
-           port="$(grep -oE 'on 127\.0\.0\.1:[0-9]+' "$E2E_DIR/t7-sim.out" | head -1 | cut -d: -f2)"
+           port="$(grep -oE 'on 127\.0\.0\.1:[0-9]+' "$E2E_DIR/t7-sim.out" | head -1 | cut -d: -f2 || true)"
            kill -0 "$RIG_PID" 2>/dev/null || e2e_fail "t7-sim did not start: $(cat "$E2E_DIR/t7-sim.out")"
            tries=$((tries + 1)); [ "$tries" -lt 200 ] || e2e_fail "t7-sim never said its port"
            [ -n "$port" ] || sleep 0.05
