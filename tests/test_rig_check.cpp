@@ -143,7 +143,10 @@ TEST(ValveTest, JudgeTakesNoReadingFromBeforeThePulse) {
 /// LCM (its state answers a command a period or two later). Each reading keeps the time it was taken.
 class LaggingDevice final : public Device {
  public:
-  LaggingDevice(SimulatedArm& arm, int lag_ticks) : arm_(arm), lag_ticks_(lag_ticks) { taken_.push_back(arm.read_sensors()); }
+  LaggingDevice(SimulatedArm& arm, int lag_ticks, double tick_s) : arm_(arm), lag_ticks_(lag_ticks) {
+    taken_.push_back(arm.read_sensors());
+    for (int i = 0; i < lag_ticks; ++i) advance(tick_s);  // a full pipe: every tick brings a new reading
+  }
   SensorReading read_sensors() override { return taken_.front(); }
   void write_valves(const ValveCommand& command) override { arm_.write_valves(command); }
   void vent() override { arm_.vent(); }
@@ -164,7 +167,7 @@ class LaggingDevice final : public Device {
 ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
   const Configuration c;
   SimulatedArm arm(c.plant, 1);
-  LaggingDevice device(arm, lag_ticks);
+  LaggingDevice device(arm, lag_ticks, c.timing.tick_s);
   EngineCore core(device, c.controller, c.timing, c.safety);
   SimulatedClock clock(core, device);
   return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad, nullptr,
