@@ -28,6 +28,7 @@ enum class DialogKind {
   kConfirmQuit,      // s / q / Esc
   kConfirmDiscard,   // y/n: unsaved trials would be lost
   kConfirmValveTest, // y/n: the valves open one by one, the arm moves
+  kConfirmZeroAngle, // y/n: the angle read now becomes the rig profile's zero (its file is written)
   kSessionName,      // a name for the session saved as the console goes
 };
 

@@ -202,7 +202,8 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kFault:
       return {{"R", "reset the fault"}};
     case Screen::kRig:
-      return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"}};
+      return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"},
+              {"z", "zero the angle: the angle read now becomes the rig profile's zero (asks first; t7)"}};
     case Screen::kMain:
       return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"}};
     case Screen::kHelp:
