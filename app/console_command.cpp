@@ -9,6 +9,7 @@
 #include "app/config_file.hpp"
 #include "app/console_sessions.hpp"
 #include "app/device_factory.hpp"
+#include "app/rig_profile_write.hpp"
 #include "sessions/session_store.hpp"
 #include "app/plot_console.hpp"
 #include "app/cpu_idle_hold.hpp"
@@ -109,6 +110,11 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.rig_profile = rig->rig_profile_name();
   setup.environment.device_health = [&device] { return device.health(); };
   setup.environment.raw_inputs = [&device] { return device.raw_inputs(); };
+  if (config.device.kind == "t7" && !config.device.rig_profile.empty()) {
+    setup.environment.zero_angle = [&opened = *rig, path = config.device.rig_profile](double read_rad) {
+      return zero_rig_angle(opened, path, read_rad);
+    };
+  }
   setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
     return write_console_figures(snapshot, root);
   };

@@ -1,9 +1,11 @@
 #include "app/console_sessions.hpp"
+#include "app/memory_policy.hpp"
 
 #include <cstdio>
 #include <ctime>
 #include <sstream>
 
+#include "app/transfer_sources.hpp"
 #include "engine/errors.hpp"
 #include "sessions/session_store.hpp"
 
@@ -57,6 +59,20 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
     out.push_back({local_clock_of(e.time_utc), -1.0, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
                    e.kind == "fault", false, e.time_utc, e.iteration});
   }
+  return out;
+}
+
+/// The manifest's first_correction for a new session: the transfer its iteration 0 ran with, in the
+/// shape `bellows run --transfer-from` records (transfer_json); null when it ran with feedback only.
+nlohmann::ordered_json first_correction_json(const ui::Experiment& e) {
+  if (!e.first_correction || e.trials.empty() || e.trials.front().origin.rfind("transferred", 0) != 0) return nullptr;
+  TransferReport report;
+  for (const ui::TransferSourceNote& note : e.first_correction->sources) {
+    report.sources.push_back({note.name, note.directory, note.trajectory, note.trials, note.last_rms_deg});
+  }
+  report.result = e.first_correction->result;
+  nlohmann::ordered_json out = nlohmann::ordered_json::parse(transfer_json(report).dump());
+  out["by"] = "console";  // taken with T (run --transfer-from records no "by")
   return out;
 }
 
@@ -130,6 +146,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     header.device_info = device_info_;
     if (snapshot.device_name == "sim") header.device_info["seed"] = snapshot.seed;  // the arm it continues with
     header.configuration = snapshot.config;
+    header.first_correction = first_correction_json(e);
     for (const ui::LogEntry& entry : snapshot.events) {
       if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
     }
@@ -144,6 +161,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
+  return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
 }
 
@@ -177,6 +195,7 @@ std::vector<ui::SessionListing> StoreSessionGateway::list() {
       l.trajectory = s.manifest.trajectory_name;
       l.iterations = static_cast<int>(s.manifest.iterations.size());
       l.best_rms_deg = best_rms_deg(s.manifest);
+      l.device = s.manifest.device;
     }
     out.push_back(std::move(l));
   }

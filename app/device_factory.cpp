@@ -110,6 +110,8 @@ class T7Rig final : public OpenedDevice {
   std::string rig_profile_name() const override { return device_->profile().name; }
   std::string where() const override { return device_->address(); }
   void stop() override { device_->stop(); }
+  std::optional<double> angle_zero_rad() const override { return device_->angle_zero_rad(); }
+  void set_angle_zero_rad(double zero_rad) override { device_->set_angle_zero_rad(zero_rad); }
 
  private:
   std::unique_ptr<T7Device> device_;

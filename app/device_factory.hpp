@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -60,6 +61,10 @@ class OpenedDevice {
   virtual std::string where() const { return ""; }
   /// Counters for a JSON report (null when there are none).
   virtual nlohmann::json report() const { return nullptr; }
+  /// Zeroing the angle (the first day): the zero in use, where the device has one (t7), and a new
+  /// one, which the readings take from then on. A device without one keeps nothing.
+  virtual std::optional<double> angle_zero_rad() const { return std::nullopt; }
+  virtual void set_angle_zero_rad(double zero_rad) { (void)zero_rad; }
   /// Stops the I/O thread (the rig's last vent goes out). Idempotent.
   virtual void stop() {}
 };

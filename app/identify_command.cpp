@@ -2,9 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <ostream>
-#include <sstream>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -14,6 +12,9 @@
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
+#include "app/rig_profile_file.hpp"
+#include "app/rig_profile_write.hpp"
+#include "app/toml_key_edit.hpp"
 #include "app/signals.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/engine_core.hpp"
@@ -22,16 +23,11 @@
 #include "engine/identification_trial.hpp"
 #include "engine/printable_text.hpp"
 #include "engine/realtime_loop.hpp"
+#include "sessions/atomic_file.hpp"
 #include "sessions/file_access.hpp"
 
 namespace bellows {
 namespace {
-
-std::string format_value(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.6g", value);
-  return text;
-}
 
 struct TrialFit {
   std::string signal;
@@ -85,67 +81,17 @@ nlohmann::json model_json(const ModelParameters& m) {
   return {{"kappa", m.kappa_rad_per_bar}, {"omega0", m.omega0_rad_per_s}, {"damping", m.damping}};
 }
 
-void write_text_atomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    if (!out) throw EnvironmentError("cannot write " + temporary);
-    out << text;
-    if (!out.flush()) throw EnvironmentError("cannot write " + temporary);
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw EnvironmentError("cannot replace " + path + ": " + error.message());
-}
-
 }  // namespace
 
 std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model) {
-  const std::vector<std::pair<std::string, double>> values = {
-      {"kappa", model.kappa_rad_per_bar}, {"omega0", model.omega0_rad_per_s}, {"damping", model.damping}};
-  std::vector<std::string> lines;
-  std::istringstream in(toml_text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-
-  std::vector<bool> written(values.size(), false);
-  bool in_model = false;
-  long header = -1, section_end = -1;
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::string t(trim(lines[i]));
-    if (!t.empty() && t.front() == '[') {
-      if (in_model) section_end = static_cast<long>(i);
-      in_model = t.rfind("[model]", 0) == 0 && (t.size() == 7 || trim(t.substr(7)).rfind('#', 0) == 0);
-      if (in_model) header = static_cast<long>(i);
-      continue;
-    }
-    if (!in_model) continue;
-    const auto equals = t.find('=');
-    if (equals == std::string::npos) continue;
-    const std::string key(trim(t.substr(0, equals)));
-    for (std::size_t v = 0; v < values.size(); ++v) {
-      if (key == values[v].first) {
-        lines[i] = values[v].first + " = " + format_value(values[v].second) + "  # fitted by bellows identify";
-        written[v] = true;
-      }
-    }
-  }
-  if (in_model && section_end < 0) section_end = static_cast<long>(lines.size());
-  std::vector<std::string> missing;
-  for (std::size_t v = 0; v < values.size(); ++v) {
-    if (!written[v]) missing.push_back(values[v].first + " = " + format_value(values[v].second) + "  # fitted by bellows identify");
-  }
-  if (header < 0) {
-    if (!lines.empty() && !trim(lines.back()).empty()) lines.emplace_back();
-    lines.emplace_back("[model]");
-    lines.insert(lines.end(), missing.begin(), missing.end());
-  } else {
-    lines.insert(lines.begin() + header + 1, missing.begin(), missing.end());
-  }
-  std::string text;
-  for (const std::string& line : lines) text += line + "\n";
+  const std::string text = with_table_values(toml_text, "model",
+                                             {{"kappa", toml_number(model.kappa_rad_per_bar)},
+                                              {"omega0", toml_number(model.omega0_rad_per_s)},
+                                              {"damping", toml_number(model.damping)}},
+                                             "fitted by bellows identify");
   Configuration check;
   apply_config_toml(text, source_name, check);  // never write a file the loader would reject
-  if (check.model.kappa_rad_per_bar != std::stod(format_value(model.kappa_rad_per_bar))) {
+  if (check.model.kappa_rad_per_bar != std::stod(toml_number(model.kappa_rad_per_bar))) {
     throw InputError("config " + source_name + ": [model] could not be updated in place (dotted or inline keys?)");
   }
   return text;
@@ -154,16 +100,24 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   std::string plant_source = options.config_path.empty() ? "the default plant" : "the plant of " + options.config_path;
+  // --write-model FILE: a rig profile (it has [valves]) gets the model identified on its rig; a
+  // configuration gets its [model]. Either must be valid before any trial runs.
   std::string existing_text;
+  bool into_profile = false;
   if (!options.write_model_path.empty() && std::filesystem::exists(options.write_model_path)) {
     // A directory, FIFO or device is refused, and the read is bounded, as for --config.
     existing_text = read_regular_file(options.write_model_path, kMaxConfigFileBytes, "config");
-    Configuration written;
-    apply_config_toml(existing_text, options.write_model_path, written);  // fail before any trial runs
-    // The file whose model is fitted describes the arm: without --config, its [plant] is the one fitted.
-    if (options.config_path.empty() && toml::parse(existing_text).contains("plant")) {
-      config = written;
-      plant_source = "the plant of " + options.write_model_path;
+    into_profile = is_rig_profile_file(options.write_model_path);
+    if (into_profile) {
+      parse_rig_profile(existing_text, options.write_model_path);
+    } else {
+      Configuration written;
+      apply_config_toml(existing_text, options.write_model_path, written);
+      // The file whose model is fitted describes the arm: without --config, its [plant] is the one fitted.
+      if (options.config_path.empty() && toml::parse(existing_text).contains("plant")) {
+        config = written;
+        plant_source = "the plant of " + options.write_model_path;
+      }
     }
   }
   if (!options.signal.empty()) config.identify.signal = options.signal;
@@ -189,9 +143,13 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
       normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
 
   if (!options.write_model_path.empty()) {
-    write_text_atomically(options.write_model_path,
-                          with_model_section(existing_text, options.write_model_path, fit.model));
-    progress << "wrote [model] to " << options.write_model_path << std::endl;
+    if (into_profile) {
+      write_rig_profile_model(options.write_model_path, fit.model);
+      progress << "wrote [model] to the rig profile " << options.write_model_path << std::endl;
+    } else {
+      write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model));
+      progress << "wrote [model] to " << options.write_model_path << std::endl;
+    }
   }
   if (options.json) {
     const nlohmann::json report = {
@@ -209,7 +167,9 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
         {"rms_residual_deg", fit.rms_residual_deg},
         {"iterations", fit.iterations},
         {"converged", fit.converged},
-        {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)}};
+        {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
+        {"written_as", options.write_model_path.empty() ? nlohmann::json(nullptr)
+                                                        : nlohmann::json(into_profile ? "rig_profile" : "config")}};
     out << report.dump() << std::endl;
   } else {
     char text[512];

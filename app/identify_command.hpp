@@ -18,7 +18,7 @@ struct IdentifyOptions {
   std::string signal;  // overrides [identify] signal when set
   std::uint64_t seed = 1;
   bool json = false;
-  std::string write_model_path;  // config file whose [model] section receives the fit
+  std::string write_model_path;  // a config file's [model], or a rig profile's (a file with [valves]), receives the fit
   DeviceOptions device;          // --device, --lcm, --t7, --rig-profile over [device]
   RealtimeMode rt = RealtimeMode::kTry;  // the engine loop on a rig (lcm, t7)
 };

@@ -41,11 +41,13 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   RigServer rig(arm, std::move(params), random_nonzero_id());
   LcmIoThread io(url, {&rig});
 
-  progress << "io-sim: serving the simulated arm on " << url << " (rig " << rig.stats().rig_id << ", state every "
-           << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
-           << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
-           << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
-           << ")" << std::endl;
+  io.on_open([&] {
+    progress << "io-sim: serving the simulated arm on " << url << " (rig " << rig.stats().rig_id << ", state every "
+             << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
+             << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
+             << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
+             << ")" << std::endl;
+  });
   const double start_s = monotonic_s();
   io.run(
       [&] {

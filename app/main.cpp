@@ -10,6 +10,7 @@
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
 #include "app/io_sim_command.hpp"
+#include "app/memory_policy.hpp"
 #include "app/rig_check_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/run_command.hpp"
@@ -32,6 +33,7 @@ constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
 int main(int argc, char** argv) {
+  bellows::bound_allocator_retention();
   bellows::check_standard_output_at_exit();
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm", "bellows"};  // not argv[0]: no build path
   app.require_subcommand(0, 1);
@@ -159,7 +161,7 @@ int main(int argc, char** argv) {
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
-  t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on")->capture_default_str();
+  t7_sim_cmd->add_option("--listen", t7_sim.listen, "HOST[:PORT] to listen on (port 0: any free one, named on the first line)")->capture_default_str();
   t7_sim_cmd->add_option("--config", t7_sim.config_path, "TOML configuration file ([plant])");
   t7_sim_cmd->add_option("--rig-profile", t7_sim.rig_profile, "Rig profile (default: the paper rig's)");
   t7_sim_cmd->add_option("--seed", t7_sim.seed, "Seed of the simulated arm's noise")
@@ -223,7 +225,7 @@ int main(int argc, char** argv) {
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into this config file's [model]");
+  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
 
   bellows::RigCheckOptions rig_check;
@@ -239,7 +241,13 @@ int main(int argc, char** argv) {
       ->default_str("try");
   rig_check_cmd->add_flag("--yes", rig_check.yes, "Pulse the valves without asking (the operator has cleared the arm)");
   rig_check_cmd->add_flag("--inputs-only", rig_check.inputs_only, "Only show the inputs; open no valve");
+  rig_check_cmd->add_flag("--zero-angle", rig_check.zero_angle,
+                          "Make the angle read now the rig profile's zero (--device t7 --rig-profile FILE); open no valve");
   rig_check_cmd->add_flag("--json", rig_check.json, "Print one JSON object on stdout");
+  CLI::Option* rig_no_save = rig_check_cmd->add_flag("--no-save", rig_check.no_save, "Do not record the check in a session");
+  rig_check_cmd->add_option("--data-dir", rig_check.data_dir,
+                            "Where the check's session is saved (default: where runs save theirs)")
+      ->excludes(rig_no_save);
 
   try {
     app.parse(argc, argv);

@@ -5,21 +5,30 @@
 #include <istream>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/run_command.hpp"
+#include "app/trajectory_file.hpp"
+#include "app/rig_profile_write.hpp"
 #include "app/signals.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/engine_driver.hpp"
 #include "engine/errors.hpp"
 #include "engine/valve_test.hpp"
+#include "sessions/session_store.hpp"
+#include "sessions/session_writer.hpp"
 
 namespace bellows {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+// Zeroing averages this many fresh readings (a tenth of a second at 200 Hz): the sensor's noise
+// averages out, the arm at rest does not move meanwhile.
+constexpr int kZeroingReadings = 20;
 
 std::string line_of(const char* pattern, auto... values) {
   char text[400];
@@ -51,11 +60,83 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
   }
 }
 
+// The angle read now (the mean of kZeroingReadings fresh readings, the arm at rest where it should read zero)
+// becomes the profile's zero: the new zero is the old one plus what the device reads with it.
+nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const DeviceParameters& device, std::ostream& progress) {
+  double sum_rad = 0.0;
+  int count = 0;
+  double last_time_s = -INFINITY;
+  TickRecord tick;
+  while (count < kZeroingReadings) {
+    if (stop_requested().load(std::memory_order_relaxed)) throw InputError("--zero-angle stopped: the profile is unchanged");
+    driver.await();
+    if (!driver.core().read_snapshot(tick) || !(tick.reading.time_s > last_time_s)) continue;  // fresh readings only
+    last_time_s = tick.reading.time_s;
+    if (!std::isfinite(tick.reading.angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
+    sum_rad += tick.reading.angle_rad;
+    ++count;
+  }
+  const double previous_rad = rig.angle_zero_rad().value_or(0.0);
+  const double read_rad = sum_rad / count;
+  progress << "angle zero: " << zero_rig_angle(rig, device.rig_profile, read_rad) << " (mean of " << count << " readings)\n";
+  return {{"profile", device.rig_profile}, {"read_deg", read_rad * kDegPerRad}, {"readings", count},
+          {"previous_rad", previous_rad}, {"angle_zero_rad", rig.angle_zero_rad().value_or(0.0)}};
+}
+
+// The session a rig check is recorded in, like a run's: its manifest holds the device (with its
+// address and rig profile) and the configuration; its events, each input (raw volts and
+// calibrated value), each valve's verdict, the angle zero and the outcome. Saved at every event.
+class RigCheckSession {
+ public:
+  RigCheckSession(const RigCheckOptions& options, const Configuration& config, const DeviceParameters& device,
+                  const OpenedDevice& rig) {
+    if (options.no_save) return;
+    SessionManifest header;
+    header.device = device.kind;
+    header.device_info = rig.session_info();
+    header.configuration = config;
+    header.events.push_back({utc_now(), 0, "start",
+                             std::string(kPurpose) + (options.zero_angle    ? ": zeroing the angle"
+                                                      : options.inputs_only ? ": the inputs"
+                                                                            : ": the inputs and the valve test")});
+    // A session has a trajectory: the one `bellows run` learns by default.
+    const Trajectory trajectory = resolve_trajectory(RunOptions{}.trajectory, config.timing.sample_s(), config.trajectory);
+    const std::filesystem::path data_dir = options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
+    writer_.emplace(SessionWriter::create(data_dir, options.session_name, std::move(header), trajectory, kPurpose));
+  }
+  void record(const std::string& kind, const std::string& message) {
+    if (writer_) writer_->record_event(kind, message);
+  }
+  std::string path() const { return writer_ ? writer_->directory().string() : std::string(); }
+
+ private:
+  static constexpr const char* kPurpose = "bellows rig check";
+  std::optional<SessionWriter> writer_;
+};
+
+void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession& session) {
+  if (raw.count == 0) {
+    session.record("rig-input", line_of("no volts (simulated): angle %.3f deg, chamber A %.4f bar, chamber B %.4f bar, "
+                                        "supply %.4f bar, temperature %.2f K",
+                                        r.angle_rad * kDegPerRad, r.chamber_bar[0], r.chamber_bar[1], r.supply_bar,
+                                        r.temperature_K));
+    return;
+  }
+  for (int i = 0; i < raw.count; ++i) {
+    const RawInput& in = raw.inputs[i];
+    session.record("rig-input", line_of("%s %.4f V -> %.4f %s", in.name, in.volts, in.value, in.unit));
+  }
+}
+
 }  // namespace
 
 int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress) {
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   const DeviceParameters device = resolve_device(options.device, config.device);
+  if (options.zero_angle && (device.kind != "t7" || device.rig_profile.empty())) {  // before anything opens
+    throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
+                     "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
+  }
   const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   std::unique_ptr<EngineDriver> driver;
@@ -96,6 +177,19 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
                                 {"value", raw.inputs[i].value},
                                 {"unit", raw.inputs[i].unit}});
   }
+  RigCheckSession session(options, config, device, *rig);
+  record_inputs(raw, latest.reading, session);
+  report["session"] = session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path());
+  if (!session.path().empty()) progress << "session: " << session.path() << "\n";
+  if (options.zero_angle) {
+    report["angle_zero"] = zero_the_angle(*driver, *rig, device, progress);
+    session.record("angle-zero", line_of("angle_zero_rad %.6f -> %.6f (the arm read %+.3f deg) in %s",
+                                         report["angle_zero"]["previous_rad"].get<double>(),
+                                         report["angle_zero"]["angle_zero_rad"].get<double>(),
+                                         report["angle_zero"]["read_deg"].get<double>(), device.rig_profile.c_str()));
+    if (options.json) out << report.dump() << std::endl;
+    return 0;
+  }
   if (options.inputs_only) {
     if (options.json) out << report.dump() << std::endl;
     return 0;
@@ -110,12 +204,13 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
     std::string answer;
     std::getline(in, answer);
     if (answer.empty() || (answer[0] != 'y' && answer[0] != 'Y')) {
+      session.record("finish", "valve test not confirmed: no valve was opened");
       throw InputError("valve test not confirmed: no valve was opened (--yes skips the question)");
     }
   }
   const ValveTestReport result =
       run_valve_test(*driver, check, config.safety, config.controller.gas.ambient_bar,
-                     config.model.volume_gain_per_rad, &stop_requested());
+                     config.model.volume_gain_per_rad, &stop_requested(), link_lag_s(rig->device().health()));
   report["valves"] = nlohmann::json::array();
   int failed = 0;
   progress << "valves:\n";
@@ -127,6 +222,9 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
       ++failed;
       progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << "\n";
     }
+    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)", valve_name(v.valve),
+                                                  v.own_change_bar, v.other_change_bar)
+                                        : std::string(valve_name(v.valve)) + " FAIL: " + v.problem);
     report["valves"].push_back({{"valve", valve_name(v.valve)},
                                 {"pass", v.pass},
                                 {"tested", v.tested},
@@ -135,6 +233,8 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
                                 {"problem", v.problem}});
   }
   if (!result.aborted.empty()) progress << "stopped early: " << result.aborted << "\n";
+  session.record("finish", (result.aborted.empty() ? std::string() : "stopped early: " + result.aborted + "; ") +
+                               (failed == 0 ? "every valve passed" : line_of("%d of %d valves failed", failed, kValveCount)));
   progress << (failed == 0 ? "rig check: every valve passed" : line_of("rig check: %d of %d valves failed", failed, kValveCount))
            << std::endl;
   report["aborted"] = result.aborted;

@@ -1,6 +1,7 @@
 // `bellows rig check`: the first day at the bench, headless. Shows every input (raw volts beside
 // the calibrated value, where the device has volts), then, with the operator's confirmation, pulses
-// each valve in turn through the engine (engine/valve_test) and reports each pass or fail.
+// each valve in turn through the engine (engine/valve_test) and reports each pass or fail. With
+// --zero-angle it makes the angle read now the rig profile's zero instead (written into the file).
 #pragma once
 
 #include <cstdint>
@@ -22,7 +23,13 @@ struct RigCheckOptions {
   RealtimeMode rt = RealtimeMode::kTry;
   bool yes = false;          // no question before the valves open
   bool inputs_only = false;  // no valve opens
+  bool zero_angle = false;   // the angle read now becomes the rig profile's zero (written to its file); no valve opens
   bool json = false;
+  // The check is recorded in a session like a run (the device, the configuration, one event per
+  // input, valve verdict and angle zero) unless no_save.
+  bool no_save = false;
+  std::string data_dir;      // empty: the default sessions folder
+  std::string session_name;  // empty: start time and trajectory
 };
 
 /// Runs the check. The question comes from `in` (a line starting with y goes on); the report goes to

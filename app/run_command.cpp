@@ -10,6 +10,7 @@
 #include "app/config_file.hpp"
 #include "app/cpu_idle_hold.hpp"
 #include "app/lcm_url.hpp"
+#include "app/rig_profile_file.hpp"
 #include "app/learning_report.hpp"
 #include "app/run_io.hpp"
 #include "app/run_recording.hpp"
@@ -56,8 +57,9 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
   } catch (const InputError&) {
     // Without a data directory the sources must be paths; resolve_session_dir() says so.
   }
-  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config,
-                                                              resolve_device(options.device, config.device).kind);
+  const DeviceParameters device = resolve_device(options.device, config.device);
+  const std::string rig_profile = device.kind == "t7" ? rig_profile_or_default(device.rig_profile).name : std::string();
+  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config, device.kind, rig_profile);
   return compute_transfer(sessions, config, trajectory, method);
 }
 

@@ -7,6 +7,7 @@
 #include <istream>
 #include <numbers>
 #include <ostream>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -228,8 +229,24 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   }
   if (!m.events.empty()) out << "\nevents\n";
   for (const SessionEvent& e : m.events) {
-    out << "  " << short_time(e.time_utc) << "  iteration " << e.iteration << "  " << shown(e.kind) << ": "
-        << printable(e.message, kPrintableLine) << "\n";
+    // A console-log event holds several log lines, "HH:MM:SS source: text": one row each, indented.
+    const std::string head = "  " + short_time(e.time_utc) + "  iteration " + std::to_string(e.iteration) + "  " + shown(e.kind) + ": ";
+    // Bounded: an edited manifest's message of a million lines must not flood the terminal.
+    constexpr int kMostLinesPerEvent = 100;
+    std::istringstream lines(e.message);
+    std::string text;
+    int shown_lines = 0, skipped_lines = 0;
+    while (std::getline(lines, text)) {
+      if (text.empty()) continue;
+      if (shown_lines == kMostLinesPerEvent) {
+        ++skipped_lines;
+        continue;
+      }
+      out << (shown_lines == 0 ? head : std::string(head.size(), ' ')) << printable(text, kPrintableLine) << "\n";
+      ++shown_lines;
+    }
+    if (shown_lines == 0) out << head << "\n";
+    if (skipped_lines > 0) out << std::string(head.size(), ' ') << "... (" << skipped_lines << " more lines)\n";
   }
   if (!m.black_boxes.empty()) out << "\nblack boxes (the last ticks before each fault; every tick in the file)\n";
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {

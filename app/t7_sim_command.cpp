@@ -24,13 +24,14 @@ constexpr int kSimPriority = 70;
 int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (options.duration_s < 0.0) throw InputError("--duration must not be negative");
   T7SimOptions sim;
-  parse_host_port(options.listen, kDefaultT7SimPort, sim.host, sim.port);
+  parse_host_port(options.listen, kDefaultT7SimPort, sim.host, sim.port, "--listen", 0);  // port 0: any free one
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   sim.plant = config.plant;
   sim.profile = rig_profile_or_default(options.rig_profile);
   sim.plant.pwm_period_s = 1.0 / sim.profile.pwm_frequency_hz;  // the arm's valves follow the profile's PWM
   sim.seed = options.seed;
   sim.status_path = options.status_path;
+  sim.limits = RigLimits::from(config);  // the rig's own limits, as io-sim's
   sim.swapped_chambers = options.swapped_chambers;
   sim.no_supply = options.no_supply;
   sim.silent_after_s = options.silent_after_s;

@@ -5,8 +5,9 @@
 
 namespace bellows {
 
-void parse_host_port(const std::string& address, int default_port, std::string& host, int& port) {
-  const auto bad = [&](const std::string& why) { throw InputError("--t7 '" + address + "': " + why); };
+void parse_host_port(const std::string& address, int default_port, std::string& host, int& port,
+                     const std::string& option, int lowest_port) {
+  const auto bad = [&](const std::string& why) { throw InputError(option + " '" + address + "': " + why); };
   if (address.empty()) bad("an address is needed: HOST[:PORT]");
   std::string port_text;
   if (address.front() == '[') {  // [v6 address]:port
@@ -34,7 +35,9 @@ void parse_host_port(const std::string& address, int default_port, std::string& 
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != port_text.size() || value < 1 || value > 65535) bad("the port must be a number 1..65535");
+    if (used != port_text.size() || value < lowest_port || value > 65535) {
+      bad("the port must be a number " + std::to_string(lowest_port) + "..65535");
+    }
     port = value;
   }
 }

@@ -20,7 +20,9 @@ struct T7Options {
 };
 
 /// Splits "HOST[:PORT]" ("[v6]:PORT" too). Throws InputError naming the address when it is malformed.
-void parse_host_port(const std::string& address, int default_port, std::string& host, int& port);
+/// `option` names it in the error; `lowest_port` 0 lets a server ask for any free port.
+void parse_host_port(const std::string& address, int default_port, std::string& host, int& port,
+                     const std::string& option = "--t7", int lowest_port = 1);
 
 /// Loads the profile and connects. Throws InputError for a bad address or profile (exit 2) and
 /// EnvironmentError for an address that cannot be reached or is no T7 (exit 4); nothing is armed.

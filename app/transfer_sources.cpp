@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -29,20 +30,30 @@ TransferSource transfer_source_from_session(const Session& session) {
   return source;
 }
 
-void check_transfer_source(const Session& session, const Configuration& target, const std::string& device) {
+void check_transfer_source(const Session& session, const Configuration& target, const std::string& device,
+                           const std::string& rig_profile) {
   if (const std::string why = transfer_mismatch(session.manifest.configuration, session.manifest.device, target, device);
       !why.empty()) {
     throw InputError("cannot transfer from " + describe(session) + ": " + why);
+  }
+  if (!rig_profile.empty()) {  // another rig profile is another arm, or the same arm wired otherwise
+    const nlohmann::ordered_json& info = session.manifest.device_info;
+    const std::string theirs = info.contains("rig_profile") && info["rig_profile"].is_string() ? info["rig_profile"].get<std::string>() : "";
+    if (theirs != rig_profile) {
+      throw InputError("cannot transfer from " + describe(session) + ": it was recorded with the rig profile '" +
+                       printable(theirs) + "', this run uses '" + printable(rig_profile) + "'");
+    }
   }
   if (session.iterations.empty()) throw InputError("cannot transfer from " + describe(session) + ": it has no completed trial");
 }
 
 std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names, const std::filesystem::path& data_dir,
-                                            const Configuration& target, const std::string& device) {
+                                            const Configuration& target, const std::string& device,
+                                            const std::string& rig_profile) {
   std::vector<Session> sessions;
   for (const std::string& name : names) {
     Session session = load_session(resolve_session_dir(name, data_dir));
-    check_transfer_source(session, target, device);
+    check_transfer_source(session, target, device, rig_profile);
     sessions.push_back(std::move(session));
   }
   return sessions;

@@ -27,14 +27,17 @@ struct TransferSourceInfo {
 /// The trials of `session` as a transfer source.
 TransferSource transfer_source_from_session(const Session& session);
 
-/// Checks that `session` can teach a run of `target` on `device`: same sample time, same device and
-/// the same simulated plant ([plant]: the same arm). Throws InputError naming the session and why.
-void check_transfer_source(const Session& session, const Configuration& target, const std::string& device);
+/// Checks that `session` can teach a run of `target` on `device`: same sample time, same device, the
+/// same simulated plant ([plant]: the same arm) and, on a rig, the same rig profile (`rig_profile`:
+/// its name; empty: not compared). Throws InputError naming the session and why.
+void check_transfer_source(const Session& session, const Configuration& target, const std::string& device,
+                           const std::string& rig_profile = {});
 
 /// Loads and checks every session (`names`: directories or names in `data_dir`). InputError names the
 /// first session that is missing, damaged, empty or does not fit.
 std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names, const std::filesystem::path& data_dir,
-                                            const Configuration& target, const std::string& device);
+                                            const Configuration& target, const std::string& device,
+                                            const std::string& rig_profile = {});
 
 struct TransferReport {
   std::vector<TransferSourceInfo> sources;

@@ -1,6 +1,8 @@
 #include "devices/lcm_io_thread.hpp"
 
 #include <poll.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -9,11 +11,41 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 
 namespace bellows {
 namespace {
+
+/// Opens an LCM handle with what LCM prints on stderr while doing so (it explains a failure in a
+/// dozen lines of its own) captured instead of shown: bellows reports a failure in one line and
+/// quotes LCM's reason. Opening happens before the run starts, when nothing else writes to stderr.
+std::unique_ptr<lcm::LCM> open_lcm_quietly(const std::string& url, std::string& said) {
+  const int capture = ::memfd_create("lcm-stderr", MFD_CLOEXEC);
+  const int saved = capture >= 0 ? ::dup(STDERR_FILENO) : -1;
+  if (saved >= 0) ::dup2(capture, STDERR_FILENO);
+  auto bus = std::make_unique<lcm::LCM>(url);
+  if (saved >= 0) {
+    ::dup2(saved, STDERR_FILENO);
+    ::close(saved);
+    constexpr std::size_t kMostCaptured = 4096;
+    std::string text(kMostCaptured, '\0');
+    const ssize_t got = ::pread(capture, text.data(), text.size(), 0);
+    text.resize(got > 0 ? static_cast<std::size_t>(got) : 0);
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {  // the first line that says something
+      if (!trim(line).empty()) {
+        said = std::string(trim(line));
+        break;
+      }
+    }
+  }
+  if (capture >= 0) ::close(capture);
+  return bus;
+}
 
 // Upper bound on one wait, so that a stop request is seen promptly even on an idle bus.
 constexpr double kMaxWait_s = 0.05;
@@ -85,16 +117,21 @@ void LcmIoThread::serve(const std::function<bool()>& should_stop, RealtimeMode m
   // The handle lives and dies on this thread: LCM 1.3.1 allows one thread per handle.
   std::unique_ptr<lcm::LCM> bus;
   if (!url_.empty()) {
-    bus = std::make_unique<lcm::LCM>(url_);
+    std::string lcm_said;
+    bus = open_lcm_quietly(url_, lcm_said);
     if (!bus->good()) {
-      start_error_ = "cannot open the LCM bus '" + url_ +
-                     "' (for udpm:// the host needs a multicast route, e.g. `ip route add 224.0.0.0/4 dev lo`)";
+      start_error_ = "cannot open the LCM bus '" + printable(url_) + "'" +
+                     (lcm_said.empty() ? std::string() : " (LCM: " + printable(lcm_said) + ")") +
+                     (url_.rfind("udpm://", 0) == 0
+                          ? "; for udpm:// the host needs a multicast route, e.g. `ip route add 224.0.0.0/4 dev lo`"
+                          : "");
       ready_.store(true, std::memory_order_release);
       return;
     }
     for (LcmEndpoint* endpoint : endpoints_) endpoint->attach(*bus);
   }
   ready_.store(true, std::memory_order_release);
+  if (on_open_) on_open_();
 
   const int fd = bus ? bus->getFileno() : -1;
   while (!should_stop()) {

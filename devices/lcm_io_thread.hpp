@@ -64,6 +64,9 @@ class LcmIoThread {
   void start(RealtimeMode mode, int priority);
   /// Serves on the calling thread until `should_stop()` returns true (checked at least every 50 ms).
   void run(const std::function<bool()>& should_stop, RealtimeMode mode, int priority);
+  /// Called on the I/O thread once the bus is open, before serving (e.g. to announce it: only a bus
+  /// that opened is announced).
+  void on_open(std::function<void()> callback) { on_open_ = std::move(callback); }
   /// Gives every endpoint its last turn and joins the thread.
   void stop();
 
@@ -80,6 +83,7 @@ class LcmIoThread {
   std::atomic<bool> ready_{false};
   std::string start_error_;  // written by the thread before ready_, read after
   bool rt_granted_ = false;
+  std::function<void()> on_open_;
 };
 
 }  // namespace bellows

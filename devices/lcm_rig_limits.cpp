@@ -1,7 +1,5 @@
 #include "devices/lcm_rig_limits.hpp"
 
-#include <bellows/io_state_t.hpp>
-
 #include <cmath>
 #include <numbers>
 
@@ -18,14 +16,14 @@ LimitedValves enforce_rig_limits(const ValveCommand& commanded, const SensorRead
   LimitedValves out{commanded, 0, false};
   if (!(std::abs(reading.angle_rad) <= limits.angle_limit_rad)) {  // NaN too
     out.valves = ValveCommand::vented();
-    out.fault_bits |= io_state_t::FAULT_ANGLE_LIMIT;
+    out.fault_bits |= kRigAngleLimitBit;
     out.angle_exceeded = true;
   }
   for (int i = 0; i < kActuatorCount; ++i) {
     if (!(reading.chamber_bar[i] <= limits.pressure_ceiling_bar)) {
       out.valves.inlet_duty[i] = 0.0;
       out.valves.outlet_duty[i] = 1.0;
-      out.fault_bits |= io_state_t::FAULT_PRESSURE_LIMIT;
+      out.fault_bits |= kRigPressureLimitBit;
     }
   }
   return out;

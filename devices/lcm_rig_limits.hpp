@@ -1,5 +1,6 @@
 // The limits a rig enforces by itself, whatever it is sent: the last line of defence when the
-// engine is wrong, gone, or not the one sending (docs/lcm-protocol.md). Every rig back-end applies
+// engine is wrong, gone, or not the one sending (docs/lcm-protocol.md). Every rig back-end (io-sim,
+// t7-sim) applies
 // them to the valve state it is about to drive, with the sensor values it has just read.
 #pragma once
 
@@ -17,9 +18,14 @@ struct RigLimits {
   static RigLimits from(const Configuration& config);
 };
 
+// The bits of LimitedValves::fault_bits: io_state_t's FAULT_PRESSURE_LIMIT and FAULT_ANGLE_LIMIT
+// (checked where the LCM rig uses them), so that rigs off LCM (t7-sim) apply the same limits.
+inline constexpr std::int32_t kRigPressureLimitBit = 16;
+inline constexpr std::int32_t kRigAngleLimitBit = 32;
+
 struct LimitedValves {
   ValveCommand valves;          // what to drive
-  std::int32_t fault_bits = 0;  // io_state_t FAULT_PRESSURE_LIMIT / FAULT_ANGLE_LIMIT
+  std::int32_t fault_bits = 0;  // kRigPressureLimitBit / kRigAngleLimitBit
   bool angle_exceeded = false;  // the rig must vent and drop its session
 };
 

@@ -92,6 +92,9 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   counters_.out_of_order();
 }
 
+static_assert(kRigPressureLimitBit == io_state_t::FAULT_PRESSURE_LIMIT && kRigAngleLimitBit == io_state_t::FAULT_ANGLE_LIMIT,
+              "the rig limits' bits are io_state_t's");
+
 void RigServer::apply_limits(bool write) {
   const LimitedValves limited = enforce_rig_limits(commanded_, arm_.read_sensors(), params_.limits);
   const std::int32_t before = limit_bits_;

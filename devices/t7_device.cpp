@@ -60,6 +60,7 @@ double duty_of(const ValveCommand& c, ValveRole role) {
 
 T7Device::T7Device(T7DeviceOptions options)
     : options_(std::move(options)),
+      angle_zero_rad_(options_.profile.angle_zero_rad),
       address_(options_.host + ":" + std::to_string(options_.port)),
       client_(options_.host, options_.port),
       clock_(t7::pwm_clock_for(options_.profile.pwm_frequency_hz)) {
@@ -244,7 +245,7 @@ bool T7Device::exchange(const ValveCommand& valves) {
       case SensorRole::kChamberA: r.chamber_bar[0] = valid ? value : kOutOfRangePressure_bar; break;
       case SensorRole::kChamberB: r.chamber_bar[1] = valid ? value : kOutOfRangePressure_bar; break;
       case SensorRole::kSupply: r.supply_bar = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kAngle: r.angle_rad = valid ? value - p.angle_zero_rad : kOutOfRangeAngle_rad; break;
+      case SensorRole::kAngle: r.angle_rad = valid ? value - angle_zero_rad() : kOutOfRangeAngle_rad; break;
       case SensorRole::kTemperature: r.temperature_K = valid ? value : NAN; break;  // no guard watches it
     }
   }
@@ -308,7 +309,7 @@ RawInputs T7Device::raw_inputs() const {
     in.value = c.value(in.volts);
     in.unit = calibrated_unit(role);
     if (role == SensorRole::kAngle) {  // shown in degrees, from the zero
-      in.value = (in.value - options_.profile.angle_zero_rad) * 180.0 / std::numbers::pi;
+      in.value = (in.value - angle_zero_rad()) * 180.0 / std::numbers::pi;
       in.unit = "deg";
     } else if (role == SensorRole::kTemperature) {
       in.unit = "K";

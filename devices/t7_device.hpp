@@ -65,6 +65,10 @@ class T7Device final : public Device {
   /// "host:port".
   const std::string& address() const { return address_; }
   const RigProfile& profile() const { return options_.profile; }
+  /// The angle's zero in use: the profile's, until the first day's zeroing sets a new one, which
+  /// the readings take from their next exchange on.
+  double angle_zero_rad() const { return angle_zero_rad_.load(std::memory_order_relaxed); }
+  void set_angle_zero_rad(double zero_rad) { angle_zero_rad_.store(zero_rad, std::memory_order_relaxed); }
   /// Why the link failed ("" while it works). Set once, by the I/O thread.
   std::string link_error() const;
 
@@ -83,6 +87,7 @@ class T7Device final : public Device {
   void fail_link();
 
   T7DeviceOptions options_;
+  std::atomic<double> angle_zero_rad_;
   std::string address_;
   ModbusClient client_;
   t7::PwmClock clock_;

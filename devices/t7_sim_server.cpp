@@ -73,6 +73,28 @@ void T7SimServer::advance_arm(double now) {
   if (now - arm_time_s_ < kArmStep_s) return;
   arm_.advance(now - arm_time_s_);
   arm_time_s_ = now;
+  apply_limits(false);
+}
+
+// The rig's own limits on what reaches the valves (the lines keep what the client wrote): checked
+// after every step of the arm and every write, as io-sim does (RigServer::apply_limits).
+void T7SimServer::apply_limits(bool write) {
+  const SensorReading r = arm_.read_sensors();
+  const LimitedValves limited = enforce_rig_limits(commanded_, r, options_.limits);
+  const std::int32_t before = limit_bits_;
+  limit_bits_ = limited.fault_bits;
+  status_.chamber_bar = r.chamber_bar;
+  status_.angle_rad = r.angle_rad;
+  const auto rising = [&](std::int32_t bit) { return (limit_bits_ & bit) != 0 && (before & bit) == 0; };
+  if (rising(kRigPressureLimitBit)) ++status_.pressure_limit_trips;
+  if (rising(kRigAngleLimitBit)) ++status_.angle_limit_trips;
+  if (events_ != nullptr && rising(kRigPressureLimitBit)) {
+    (*events_)("t7-sim: a chamber at the rig's ceiling of " + std::to_string(options_.limits.pressure_ceiling_bar) + " bar: vented");
+  }
+  if (events_ != nullptr && rising(kRigAngleLimitBit)) (*events_)("t7-sim: the arm beyond the rig's angle range: every valve vented");
+  if (limited.angle_exceeded) commanded_ = ValveCommand::vented();  // until the client writes its duties again
+  // Written only when something changed: every write starts a new PWM period.
+  if (write || limit_bits_ != 0 || before != 0) arm_.write_valves(limited.valves);
 }
 
 void T7SimServer::update_inputs() {
@@ -101,7 +123,8 @@ void T7SimServer::apply_lines(double now) {
   }
   command.inlet_duty = {duty[0], duty[1]};
   command.outlet_duty = {duty[2], duty[3]};
-  arm_.write_valves(command);  // a new PWM period starts, as at the in-process arm's ticks
+  commanded_ = command;
+  apply_limits(true);  // a new PWM period starts, as at the in-process arm's ticks
 }
 
 void T7SimServer::serve_client(int fd, double now, const std::function<void(const std::string&)>& events) {
@@ -152,6 +175,7 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
 }
 
 void T7SimServer::run(const std::function<bool()>& should_stop, const std::function<void(const std::string&)>& events) {
+  events_ = &events;
   while (!should_stop()) {
     fd_set readable;
     FD_ZERO(&readable);
@@ -193,6 +217,7 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
     write_status(now, false);
   }
   write_status(now_s(), true);
+  events_ = nullptr;
 }
 
 void T7SimServer::write_status(double now, bool force) {
@@ -208,16 +233,19 @@ void T7SimServer::write_status(double now, bool force) {
   }
   if (options_.status_path.empty()) return;
   const T7SimStatus& s = status_;
-  char text[800];
+  char text[1100];
   std::snprintf(text, sizeof text,
                 "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
                 "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
                 "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, "
-                "\"clients\": %d, \"silent\": %s, \"pwm_period_s\": %.6f}\n",
+                "\"clients\": %d, \"silent\": %s, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], \"angle_rad\": %.6f, "
+                "\"limits\": {\"pressure_ceiling_bar\": %.6f, \"angle_limit_rad\": %.6f, \"pressure_trips\": %d, \"angle_trips\": %d}}\n",
                 s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
                 s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
                 static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions), s.clients,
-                s.silent ? "true" : "false", 1.0 / options_.profile.pwm_frequency_hz);
+                s.silent ? "true" : "false", 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1],
+                s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
+                s.angle_limit_trips);
   const std::string temporary = options_.status_path + ".tmp";
   {
     std::ofstream out(temporary, std::ios::trunc);

@@ -2,7 +2,10 @@
 // (devices/t7_sim_registers.hpp), with the simulated arm behind it in real time. The arm's sensor
 // values (noise included) become input voltages through the inverse of the rig profile's
 // calibration; the duty cycles the PWM lines output drive the arm's valves. Drills make it
-// misbehave: swapped chamber wiring, a dead valve, no supply, a silent link.
+// misbehave: swapped chamber wiring, a dead valve, no supply, a silent link. Like io-sim, it is a
+// rig that enforces its own limits whatever it is sent (devices/lcm_rig_limits.hpp): a chamber at
+// the pressure ceiling is vented, and an arm beyond the angle range vents everything until the
+// client writes its duties again.
 //
 // Its valve state can be read by tests and scripts from a status file (JSON, rewritten atomically
 // at most every 10 ms and at every watchdog action; docs/labjack-t7.md has its fields), and each
@@ -18,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "devices/lcm_rig_limits.hpp"
 #include "devices/rig_profile.hpp"
 #include "devices/simulated_arm.hpp"
 #include "devices/t7_sim_registers.hpp"
@@ -37,6 +41,7 @@ struct T7SimOptions {
   bool no_supply = false;              // the supply at ambient pressure
   double silent_after_s = -1.0;        // >= 0: the link goes silent this long after the first request
   std::string status_path;             // "": no status file
+  RigLimits limits;                    // the rig's own limits, enforced whatever the client writes
 };
 
 /// What the T7's lines output and what its watchdog did, for tests and scripts.
@@ -54,6 +59,10 @@ struct T7SimStatus {
   std::uint64_t exceptions = 0;                 // answered with a Modbus exception
   int clients = 0;                              // connected now
   bool silent = false;
+  std::array<double, kActuatorCount> chamber_bar{};  // the arm's true chamber pressures, A and B
+  double angle_rad = 0.0;                       // the arm's true angle
+  int pressure_limit_trips = 0;                 // times a chamber reached the ceiling and was vented
+  int angle_limit_trips = 0;                    // times the arm left the angle range and all was vented
 };
 
 class T7SimServer {
@@ -75,6 +84,7 @@ class T7SimServer {
   void advance_arm(double now);
   void update_inputs();
   void apply_lines(double now);
+  void apply_limits(bool write);
   void serve_client(int fd, double now, const std::function<void(const std::string&)>& events);
   void write_status(double now, bool force);
 
@@ -93,6 +103,9 @@ class T7SimServer {
   mutable std::mutex published_mutex_;
   T7SimStatus published_;
   std::vector<std::uint8_t> query_;
+  ValveCommand commanded_ = ValveCommand::vented();  // what the lines ask of the valves (a dead one shut)
+  std::int32_t limit_bits_ = 0;                      // the limits acting now (kRig*LimitBit)
+  const std::function<void(const std::string&)>* events_ = nullptr;  // run()'s, while it runs
 };
 
 }  // namespace bellows

@@ -44,6 +44,9 @@ struct DeviceHealth {
   std::uint64_t stale_readings = 0;   // reads that brought nothing new
 };
 
+/// How long after a command a reading shows it: the round trip's p99 (0 in process).
+inline double link_lag_s(const DeviceHealth& health) { return health.has_link ? health.round_trip_p99_ms / 1e3 : 0.0; }
+
 /// One analog input as the rig sees it: the raw volts and the calibrated value (rig bring-up).
 struct RawInput {
   const char* name = "";    // e.g. "chamber_a" (static storage)

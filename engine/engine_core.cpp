@@ -129,6 +129,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       manual_ = true;
       pulse_ = command.pulse;
       pulse_remaining_ = command.pulse.ticks;
+      pulse_settle_remaining_ = command.pulse.settle_ticks;
       pulse_report_pending_ = false;
       return;
     case CommandKind::kArm: {
@@ -230,14 +231,20 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
       control_.start_trial(*trajectory_, *correction_, *record_);
     }
     if (manual_) {
-      // The pulse's ticks, then `after`; its end is reported from the first `after` tick, whose
-      // reading was taken once every pulse tick had acted on the rig.
+      // The pulse's ticks, then `after`; its end is reported after `settle_ticks` of `after` (the
+      // link's lag) with the first fresh reading: one taken after the pulse's last valves went out
+      // (a rig's reading repeated while no new one arrived is not, however long the wait).
       if (pulse_remaining_ > 0) {
         valves = pulse_.valves;
-        if (--pulse_remaining_ == 0) pulse_report_pending_ = true;
+        if (--pulse_remaining_ == 0) {
+          pulse_report_pending_ = true;
+          pulse_end_reading_s_ = last_reading_time_s_;
+        }
       } else {
         valves = pulse_.after;
-        if (pulse_report_pending_) {
+        if (pulse_report_pending_ && pulse_settle_remaining_ > 0) {
+          --pulse_settle_remaining_;
+        } else if (pulse_report_pending_ && reading.time_s > pulse_end_reading_s_) {
           pulse_report_pending_ = false;
           EngineEvent event;
           event.kind = EventKind::kValvePulseDone;

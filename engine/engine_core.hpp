@@ -133,7 +133,9 @@ class EngineCore {
   bool manual_ = false;
   ValvePulse pulse_{};
   int pulse_remaining_ = 0;
-  bool pulse_report_pending_ = false;  // the pulse is over: report it with the next tick's reading
+  bool pulse_report_pending_ = false;  // the pulse is over: report it with the next fresh reading
+  int pulse_settle_remaining_ = 0;     // ticks of `after` still to wait before that
+  double pulse_end_reading_s_ = 0.0;   // the newest reading's time when the pulse's last valves went out
 };
 
 }  // namespace bellows

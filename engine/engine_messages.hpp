@@ -26,6 +26,8 @@ struct ValvePulse {
   ValveCommand valves{};
   ValveCommand after{};      // default: every valve closed (the chambers keep their air)
   int ticks = 0;
+  int settle_ticks = 0;      // of `after` before the end is reported: the link's lag, so that the
+                             // reported reading shows the whole pulse (a rig over LCM lags)
   std::uint32_t id = 0;      // echoed in the kValvePulseDone event
 };
 
@@ -77,7 +79,8 @@ enum class EventKind : std::uint8_t {
   kFault,
   kTrialComplete,
   kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
-  kValvePulseDone,  // a valve pulse's `ticks` are over; `reading`: the first one after it; `trial_id`: its id
+  kValvePulseDone,  // a valve pulse's `ticks` and `settle_ticks` are over; `reading`: the first fresh one
+                    // after them (taken after the pulse's last command); `trial_id`: its id
   kWarning,       // something the operator should know that is not a fault (`fault` names it)
   kTrajectorySelected,  // the engine holds `trajectory` now: earlier selections are handed back
 };

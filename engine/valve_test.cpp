@@ -61,7 +61,11 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
   v.own_change_bar = air_bar(after, own, volume_gain_per_rad) - air_bar(before, own, volume_gain_per_rad);
   v.other_change_bar = air_bar(after, other, volume_gain_per_rad) - air_bar(before, other, volume_gain_per_rad);
   const double own_move = sign * v.own_change_bar, other_move = sign * v.other_change_bar;
-  if (!std::isfinite(own_move) || !std::isfinite(other_move)) {
+  if (!(after.time_s > before.time_s)) {  // the same reading twice: nothing to judge the pulse by
+    v.problem = format("not judged: no reading taken after the pulse started (the newest is from %.3f s): the link to "
+                       "the rig delivers no fresh readings",
+                       after.time_s);
+  } else if (!std::isfinite(own_move) || !std::isfinite(other_move)) {
     v.problem = "a chamber pressure reads not-a-number: check the pressure sensors' inputs";
   } else if (!is_inlet(valve) && before.chamber_bar[own] - ambient_bar < m) {
     v.problem = format("not tested: chamber %s held no air to let out (%.3f bar; see inlet %s)", chamber_name(own),
@@ -91,8 +95,13 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
 }
 
 ValveTest::ValveTest(const RigCheckParameters& check, const SafetyParameters& safety, double ambient_bar, double tick_s,
-                     double volume_gain_per_rad)
-    : check_(check), safety_(safety), ambient_bar_(ambient_bar), tick_s_(tick_s), volume_gain_per_rad_(volume_gain_per_rad) {
+                     double volume_gain_per_rad, double link_lag_s)
+    : check_(check),
+      safety_(safety),
+      ambient_bar_(ambient_bar),
+      tick_s_(tick_s),
+      volume_gain_per_rad_(volume_gain_per_rad),
+      settle_ticks_(link_lag_s > 0.0 ? static_cast<int>(std::ceil(link_lag_s / tick_s)) : 0) {
   for (int i = 0; i < kValveCount; ++i) report_.valves[i].valve = static_cast<ValveId>(i);
 }
 
@@ -123,6 +132,7 @@ EngineCommand ValveTest::command_for(Step step) {
   const auto ticks_of = [this](double seconds) { return std::max(1, static_cast<int>(std::lround(seconds / tick_s_))); };
   ValvePulse pulse;  // `after`: every valve closed, the chambers keep what the pulse left
   pulse.id = ++pulse_id_;
+  pulse.settle_ticks = settle_ticks_;  // so that the reading shows all the step did
   switch (step) {
     case Step::kVent:
       pulse.valves = ValveCommand::vented();
@@ -211,9 +221,10 @@ std::string ValveTest::progress() const {
 }
 
 ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& check, const SafetyParameters& safety,
-                               double ambient_bar, double volume_gain_per_rad, const std::atomic<bool>* stop) {
+                               double ambient_bar, double volume_gain_per_rad, const std::atomic<bool>* stop,
+                               double link_lag_s) {
   EngineCore& core = driver.core();
-  ValveTest test(check, safety, ambient_bar, core.timing().tick_s, volume_gain_per_rad);
+  ValveTest test(check, safety, ambient_bar, core.timing().tick_s, volume_gain_per_rad, link_lag_s);
   TickRecord latest;
   driver.await();  // at least one tick: a reading to check the supply with
   while (!core.read_snapshot(latest)) driver.await();

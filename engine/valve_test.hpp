@@ -5,6 +5,10 @@
 // (an inlet fills, an outlet lets out) clearly more than the other one, counted as air (pressure
 // at the nominal volume), since the turning arm squeezes one chamber and lets the other grow. Before each valve both
 // outlets vent the chambers to ambient; before an outlet both inlets first put some air in.
+// Each step ends with every valve closed for the link's lag (the round trip to the rig) and its
+// reading is the first fresh one after that: on a rig whose readings lag its commands (LCM), a
+// chamber still filling is never mistaken for one that did not fall. The judge takes only a
+// reading taken after the one before the pulse.
 // Everything goes through the engine (kValvePulse while ARMED), so the guards and the emergency stop
 // apply as in any trial. A valve that fails is named with the likely problem: swapped tubes or
 // wires, a dead valve, no supply.
@@ -58,8 +62,9 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
 
 class ValveTest {
  public:
+  /// `link_lag_s`: how long after a command a reading shows it (the device's round trip p99; 0 in process).
   ValveTest(const RigCheckParameters& check, const SafetyParameters& safety, double ambient_bar, double tick_s,
-            double volume_gain_per_rad);
+            double volume_gain_per_rad, double link_lag_s = 0.0);
 
   /// The commands that start the test, given the engine's state and a recent reading. With no
   /// supply (below [safety] supply_min_bar) nothing is armed: the test ends at once, every valve
@@ -86,6 +91,7 @@ class ValveTest {
   double ambient_bar_;
   double tick_s_;
   double volume_gain_per_rad_;
+  int settle_ticks_ = 0;  // the link's lag in ticks
   bool started_ = false;
   int valve_ = 0;
   Step step_ = Step::kVent;
@@ -97,6 +103,7 @@ class ValveTest {
 /// Runs the whole test through `driver` (its own event consumer), then disarms. `stop`, when set,
 /// emergency-stops and ends the test early.
 ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& check, const SafetyParameters& safety,
-                               double ambient_bar, double volume_gain_per_rad, const std::atomic<bool>* stop = nullptr);
+                               double ambient_bar, double volume_gain_per_rad, const std::atomic<bool>* stop = nullptr,
+                               double link_lag_s = 0.0);
 
 }  // namespace bellows

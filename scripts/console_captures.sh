@@ -25,7 +25,7 @@ EOF
 e2e_start "$width" "$height" -- console --speed max --rt off
 e2e_wait_for 'law [a-z-]+ '
 e2e_keys '?'
-e2e_wait_for 'Keys \(greyed'
+e2e_wait_for 'Everywhere \(greyed'
 capture help-safe
 e2e_keys Escape a
 e2e_wait_for 'Arm the valves\?'

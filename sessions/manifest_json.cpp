@@ -201,15 +201,29 @@ ControlCore::State controller_state_from_json(const JsonReader& r, const Configu
   return s;
 }
 
+namespace {
+
+/// The manifest without its iterations and events (both empty lists).
+Json manifest_head_to_json(const SessionManifest& m);
+
+}  // namespace
+
 Json manifest_to_json(const SessionManifest& m) {
+  Json out = manifest_head_to_json(m);
+  Json& iterations = out["iterations"];
+  for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_to_json(entry));
+  Json& events = out["events"];
+  for (const SessionEvent& event : m.events) events.push_back(event_to_json(event));
+  return out;
+}
+
+namespace {
+
+Json manifest_head_to_json(const SessionManifest& m) {
   const Configuration& c = m.configuration;
   const double sample_s = c.timing.sample_s();
   const DiscreteArmModel model = discretize_arm_model(c.model, sample_s);
   const Json configuration = configuration_to_json(c);
-  Json iterations = Json::array();
-  for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_to_json(entry));
-  Json events = Json::array();
-  for (const SessionEvent& event : m.events) events.push_back(event_to_json(event));
   Json black_boxes = Json::array();
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
     black_boxes.push_back(black_box_to_json(m.black_boxes[i], static_cast<int>(i)));
@@ -241,8 +255,8 @@ Json manifest_to_json(const SessionManifest& m) {
         {"C", vector_to_json(model.C)}}},
       {"learning", configuration.at("ilc")},  // the law and its weights, as [ilc] has them
       {"configuration", configuration},
-      {"iterations", iterations},
-      {"events", events},
+      {"iterations", Json::array()},
+      {"events", Json::array()},
       {"black_boxes", black_boxes},
   };
   if (!m.first_correction.is_null()) out["first_correction"] = m.first_correction;
@@ -258,8 +272,61 @@ Json manifest_to_json(const SessionManifest& m) {
   return out;
 }
 
+std::string dump_manifest_json(const Json& json) { return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace); }
+
+/// Appends `element` to `list` as an element of a top-level list in the file: four spaces deeper
+/// than its own dump (no JSON string holds a raw newline, so every newline starts a line).
+void append_list_element(std::string& list, const Json& element) {
+  if (!list.empty()) list += ",\n";
+  list += "    ";
+  for (const char c : dump_manifest_json(element)) {
+    list += c;
+    if (c == '\n') list += "    ";
+  }
+}
+
+/// Replaces the empty top-level list `key` of `text` by the elements `head` and then `tail`.
+void splice_list(std::string& text, const char* key, const std::string& head, const std::string& tail) {
+  if (head.empty() && tail.empty()) return;
+  const std::string empty = std::string("\n  \"") + key + "\": []";  // top level: two spaces, after a newline
+  const std::size_t at = text.find(empty);
+  if (at == std::string::npos) throw std::logic_error(std::string("format_manifest: no top-level list ") + key);
+  std::string filled = std::string("\n  \"") + key + "\": [\n" + head;
+  if (!head.empty() && !tail.empty()) filled += ",\n";
+  filled += tail;
+  filled += "\n  ]";
+  text.replace(at, empty.size(), filled);
+}
+
+/// Brings `text` (`count` entries) up to `keep` entries of `entries`.
+template <typename Entry, typename ToJson>
+void extend_cache(const std::vector<Entry>& entries, std::size_t keep, std::size_t& count, std::string& text, ToJson to_json) {
+  if (count > keep) {  // the list shrank (another manifest): start afresh
+    count = 0;
+    text.clear();
+  }
+  for (; count < keep; ++count) append_list_element(text, to_json(entries[count]));
+}
+
+}  // namespace
+
 std::string format_manifest(const SessionManifest& manifest) {
-  return manifest_to_json(manifest).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  ManifestTextCache fresh;
+  return format_manifest(manifest, fresh);
+}
+
+std::string format_manifest(const SessionManifest& m, ManifestTextCache& cache) {
+  const std::size_t iterations_kept = m.iterations.empty() ? 0 : m.iterations.size() - 1;
+  extend_cache(m.iterations, iterations_kept, cache.iterations, cache.iterations_text, summary_to_json);
+  const std::size_t events_kept = m.events.empty() ? 0 : m.events.size() - 1;
+  extend_cache(m.events, events_kept, cache.events, cache.events_text, event_to_json);
+  std::string newest_iteration, newest_event;
+  if (!m.iterations.empty()) append_list_element(newest_iteration, summary_to_json(m.iterations.back()));
+  if (!m.events.empty()) append_list_element(newest_event, event_to_json(m.events.back()));
+  std::string text = dump_manifest_json(manifest_head_to_json(m));
+  splice_list(text, "iterations", cache.iterations_text, newest_iteration);
+  splice_list(text, "events", cache.events_text, newest_event);
+  return text + "\n";
 }
 
 SessionManifest parse_manifest(std::string_view text, const std::string& source) {

@@ -17,6 +17,21 @@ namespace bellows {
 nlohmann::ordered_json manifest_to_json(const SessionManifest& manifest);
 /// Two-space indented JSON text with a final newline.
 std::string format_manifest(const SessionManifest& manifest);
+
+/// The text of a manifest's append-only lists (iterations, events) as far as one writer has
+/// serialized them. A session's manifest is rewritten after every iteration: with the cache each
+/// write serializes only what was added (not a document of every iteration, whose thousands of
+/// small blocks, freed again, fragmented a lab day's heap).
+struct ManifestTextCache {
+  std::size_t iterations = 0;   // entries in iterations_text (all but the newest, which may change)
+  std::size_t events = 0;
+  std::string iterations_text;  // the entries as format_manifest writes them, ",\n"-joined
+  std::string events_text;
+};
+/// The same text as format_manifest(manifest), reusing and extending `cache`. Entries before the
+/// newest must not have changed since the cache took them (a writer only appends); a list that
+/// shrank starts the cache afresh.
+std::string format_manifest(const SessionManifest& manifest, ManifestTextCache& cache);
 /// `source` prefixes every error, e.g. "session /data/s1: manifest.json".
 SessionManifest parse_manifest(std::string_view text, const std::string& source);
 

@@ -120,9 +120,9 @@ IterationDigests write_iteration_files(const DirectoryHandle& iterations, int in
   return digests;
 }
 
-void write_manifest(const DirectoryHandle& session, SessionManifest& manifest) {
+void write_manifest(const DirectoryHandle& session, SessionManifest& manifest, ManifestTextCache* cache) {
   manifest.updated_utc = utc_now();
-  write_file_atomic_at(session, session_layout::kManifest, format_manifest(manifest));
+  write_file_atomic_at(session, session_layout::kManifest, cache ? format_manifest(manifest, *cache) : format_manifest(manifest));
 }
 
 CreatedSession create_session_directory(const fs::path& directory, const SessionManifest& manifest,
@@ -153,7 +153,10 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
   if (::fstatat(parent.fd(), name.c_str(), &existing, AT_SYMLINK_NOFOLLOW) == 0) refuse_existing();
 
   std::string building_name = ".";  // by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
-  building_name.append(name).append(".creating-").append(std::to_string(::getpid()));
+  // Unique to this process and this creation: threads of one process may create sessions at once.
+  static std::atomic<unsigned> creations{0};
+  building_name.append(name).append(".creating-").append(std::to_string(::getpid())).append("-").append(
+      std::to_string(creations.fetch_add(1)));
   fs::remove_all(parent_path / building_name, error);  // a leftover of this pid (a link is removed, not followed)
   if (::mkdirat(parent.fd(), building_name.c_str(), 0755) != 0) {
     throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": " + std::strerror(errno));

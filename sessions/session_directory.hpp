@@ -11,6 +11,7 @@
 
 #include "engine/errors.hpp"
 #include "sessions/file_access.hpp"
+#include "sessions/manifest_json.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_lock.hpp"
 
@@ -55,6 +56,6 @@ IterationDigests write_iteration_files(const DirectoryHandle& iterations, int in
 std::string write_black_box_file(const DirectoryHandle& session, int index, const std::vector<TickRecord>& ticks);
 
 /// Writes the manifest, stamping `updated_utc`.
-void write_manifest(const DirectoryHandle& session, SessionManifest& manifest);
+void write_manifest(const DirectoryHandle& session, SessionManifest& manifest, ManifestTextCache* cache = nullptr);
 
 }  // namespace bellows

@@ -1,6 +1,9 @@
 #include "sessions/session_writer.hpp"
 
 #include <ctime>
+#include <functional>
+#include <optional>
+#include <utility>
 #include <stdexcept>
 
 #include "engine/errors.hpp"
@@ -85,11 +88,26 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
   }
   const IterationDigests digests = write_iteration_files(iterations_, summary.iteration, record, next_correction_bar);
   sync(iterations_);
-  SessionManifest updated = manifest_;
-  updated.iterations.push_back({summary, utc_now(), digests.samples_sha256, digests.telemetry_sha256});
-  updated.resume = std::move(resume);
-  write_manifest(directory_, updated);
-  manifest_ = std::move(updated);  // only once it is on disk
+  std::optional<ResumeState> previous_resume = std::move(manifest_.resume);
+  manifest_.iterations.push_back({summary, utc_now(), digests.samples_sha256, digests.telemetry_sha256});
+  manifest_.resume = std::move(resume);
+  rewrite_manifest([&] {  // not on disk: not in the session
+    manifest_.iterations.pop_back();
+    manifest_.resume = std::move(previous_resume);
+  });
+}
+
+void SessionWriter::rewrite_manifest(const std::function<void()>& undo) {
+  // The manifest is changed in place and the change undone if the write fails: copying it for each
+  // write would copy every iteration's entry after every iteration.
+  const std::string previous_update = manifest_.updated_utc;
+  try {
+    write_manifest(directory_, manifest_, &manifest_text_);
+  } catch (...) {
+    undo();
+    manifest_.updated_utc = previous_update;
+    throw;
+  }
 }
 
 void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar) {
@@ -104,34 +122,26 @@ void SessionWriter::update_next_correction(const TrialRecord& record, const Eige
   const int iteration = next_iteration() - 1;
   const std::string contents = format_samples_csv(record, next_correction_bar);
   write_file_atomic_at(iterations_, session_layout::folder_and_name(session_layout::samples_file(iteration)).second, contents);
-  SessionManifest updated = manifest_;
-  updated.iterations.back().samples_sha256 = sha256_hex(contents);
-  write_manifest(directory_, updated);
-  manifest_ = std::move(updated);
+  std::string previous_digest = std::exchange(manifest_.iterations.back().samples_sha256, sha256_hex(contents));
+  rewrite_manifest([&] { manifest_.iterations.back().samples_sha256 = std::move(previous_digest); });
 }
 
 void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {
   if (ticks.empty()) throw std::invalid_argument("SessionWriter::save_black_box: no ticks");
   const auto index = static_cast<int>(manifest_.black_boxes.size());
   const std::string digest = write_black_box_file(directory_, index, ticks);
-  SessionManifest updated = manifest_;
-  updated.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size()), digest});
-  write_manifest(directory_, updated);
-  manifest_ = std::move(updated);
+  manifest_.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size()), digest});
+  rewrite_manifest([&] { manifest_.black_boxes.pop_back(); });
 }
 
 void SessionWriter::record_event(const std::string& kind, const std::string& message) {
-  SessionManifest updated = manifest_;
-  updated.events.push_back({utc_now(), next_iteration(), kind, message});
-  write_manifest(directory_, updated);
-  manifest_ = std::move(updated);
+  manifest_.events.push_back({utc_now(), next_iteration(), kind, message});
+  rewrite_manifest([&] { manifest_.events.pop_back(); });
 }
 
 void SessionWriter::set_configuration(const Configuration& config) {
-  SessionManifest updated = manifest_;
-  updated.configuration = config;
-  write_manifest(directory_, updated);
-  manifest_ = std::move(updated);
+  Configuration previous = std::exchange(manifest_.configuration, config);
+  rewrite_manifest([&] { manifest_.configuration = std::move(previous); });
 }
 
 }  // namespace bellows

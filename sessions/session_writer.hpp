@@ -6,9 +6,11 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "sessions/file_access.hpp"
+#include "sessions/manifest_json.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_lock.hpp"
 
@@ -52,7 +54,11 @@ class SessionWriter {
 
   DirectoryHandle directory_;  // every file is written relative to it, never through a link
   DirectoryHandle iterations_;
+  /// Writes manifest_ (changed in place); if that fails, `undo` puts the change back and it throws.
+  void rewrite_manifest(const std::function<void()>& undo);
+
   SessionManifest manifest_;
+  ManifestTextCache manifest_text_;  // what of manifest_'s lists is serialized already
   SessionLock lock_;
 };
 

@@ -55,7 +55,7 @@ class MemorySessions final : public ui::SessionGateway {
     std::vector<ui::SessionListing> out;
     for (const auto& [location, s] : saved) {
       out.push_back({location, location, "2024-05-01 12:00", s.experiment.trajectory->name,
-                     static_cast<int>(s.experiment.trials.size()), s.experiment.best_rms_deg(), ""});
+                     static_cast<int>(s.experiment.trials.size()), s.experiment.best_rms_deg(), "", s.device_name, ""});
     }
     return out;
   }

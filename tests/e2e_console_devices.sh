@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The console drives every device: for each one (default: sim lcm) arm, one iteration, emergency
+# The console drives every device: for each one (default: sim lcm t7) arm, one iteration, emergency
 # stop, save, quit; then the saved session reopens in the console on the device it was made on,
 # and the Rig screen's valve test passes every valve. The LCM rig is `bellows io-sim` over UDP
 # multicast inside a private network namespace this script makes for itself (`unshare -n`, loopback
-# multicast set up inside it only): nothing leaves the namespace.
+# multicast set up inside it only): nothing leaves the namespace. The T7 is `bellows t7-sim` on
+# 127.0.0.1 at a port the kernel picks (the console gets it from t7-sim's first line).
 #
 # usage: e2e_console_devices.sh path/to/bellows [DEVICE...]
 # A device is one line in device_setup below: what to start beside the console, and its options.
@@ -22,7 +23,7 @@ ip route add 224.0.0.0/4 dev lo
 source "$(dirname "$0")/e2e_console_lib.sh"
 shift
 DEVICES=("$@")
-[ ${#DEVICES[@]} -gt 0 ] || DEVICES=(sim lcm)
+[ ${#DEVICES[@]} -gt 0 ] || DEVICES=(sim lcm t7)
 
 RIG_PID=""
 stop_rig() {
@@ -43,8 +44,17 @@ device_setup() {
     lcm) "$BELLOWS" io-sim --rt off >"$E2E_DIR/io-sim.out" 2>&1 & RIG_PID=$!
          printf '[rig_check]\nfill_s = 0.1\nvalve_pulse_s = 0.1\n' >"$E2E_DIR/lcm-rig.toml"
          DEVICE_ARGS=(--device lcm --config "$E2E_DIR/lcm-rig.toml") ;;
-    t7)  "$BELLOWS" t7-sim >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
-         DEVICE_ARGS=(--device t7 --t7 127.0.0.1:5020) ;;
+    # Loopback only, on a free port: t7-sim says which one it got on its first line.
+    t7)  "$BELLOWS" t7-sim --listen 127.0.0.1:0 >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
+         local port="" tries=0
+         while [ -z "$port" ]; do
+           port="$(grep -oE 'on 127\.0\.0\.1:[0-9]+' "$E2E_DIR/t7-sim.out" | head -1 | cut -d: -f2 || true)"
+           kill -0 "$RIG_PID" 2>/dev/null || e2e_fail "t7-sim did not start: $(cat "$E2E_DIR/t7-sim.out")"
+           tries=$((tries + 1)); [ "$tries" -lt 200 ] || e2e_fail "t7-sim never said its port"
+           [ -n "$port" ] || sleep 0.05
+         done
+         [ "$port" != 0 ] || e2e_fail "t7-sim reports port 0"
+         DEVICE_ARGS=(--device t7 --t7 "127.0.0.1:$port") ;;
     *) e2e_fail "unknown device '$1'" ;;
   esac
 }

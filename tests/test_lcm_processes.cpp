@@ -4,6 +4,8 @@
 // cannot be made.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <signal.h>
 #include <sys/stat.h>
 
@@ -374,6 +376,9 @@ void expect_refused(const std::string& args, const std::string& fragment, int st
   const auto result = testing::run_process(kBellows + " " + args);
   EXPECT_EQ(result.exit_code, status) << args << "\n" << result.err;
   EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
+  // One line, bellows' own: LCM's library explains its failures in a dozen lines of its own.
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_EQ(result.err.rfind("bellows: ", 0), 0u) << result.err;
 }
 
 TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
@@ -389,6 +394,14 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   const std::string unopenable = "file://" + (dir / "no-such-folder" / "bus.lcmlog").string() + "?mode=r";
   expect_refused("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
   expect_refused("io-sim --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
+  // A multicast bus on a host without a multicast route (a fresh network namespace has none):
+  // LCM's reason is quoted in bellows' one line.
+  if (testing::run_process("unshare -n true").exit_code == 0) {
+    const auto result = testing::run_process("unshare -n " + kBellows + " io-sim --lcm udpm://239.255.76.67:7667?ttl=0");
+    EXPECT_EQ(result.exit_code, kExitEnvironment) << result.err;
+    EXPECT_NE(result.err.find("(LCM: "), std::string::npos) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
   const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
   expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
   expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");

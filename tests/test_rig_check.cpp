@@ -3,6 +3,10 @@
 // `bellows rig check`'s exit status and lines.
 #include <gtest/gtest.h>
 
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
 
 #include "engine/valve_test.hpp"
@@ -116,9 +120,72 @@ TEST(ValveTest, JudgeNamesAValveThatMovesItsChamberTheWrongWay) {
   before.chamber_bar = {1.2, 1.2};
   before.supply_bar = after.supply_bar = 3.0;
   after.chamber_bar = {1.3, 1.2};  // outlet A raised chamber A
+  after.time_s = 0.1;
   const ValveVerdict v = judge_valve(ValveId::kOutletA, before, after, 1.013, check, 2.0, 0.35);
   EXPECT_FALSE(v.pass);
   EXPECT_NE(v.problem.find("inlet and outlet of A are swapped"), std::string::npos) << v.problem;
+}
+
+TEST(ValveTest, JudgeTakesNoReadingFromBeforeThePulse) {
+  RigCheckParameters check;
+  SensorReading before;
+  before.chamber_bar = {1.013, 1.013};
+  before.supply_bar = 3.0;
+  before.time_s = 2.0;
+  SensorReading after = before;  // the link delivered nothing new: the same reading again
+  const ValveVerdict v = judge_valve(ValveId::kInletA, before, after, 1.013, check, 2.0, 0.35);
+  EXPECT_FALSE(v.pass);
+  EXPECT_NE(v.problem.find("no reading taken after the pulse started"), std::string::npos) << v.problem;
+  EXPECT_EQ(v.problem.find("dead valve"), std::string::npos) << "a stale link is not a dead valve: " << v.problem;
+}
+
+/// A rig whose readings reach the engine `lag_ticks` ticks after they were taken, like a rig over
+/// LCM (its state answers a command a period or two later). Each reading keeps the time it was taken.
+class LaggingDevice final : public Device {
+ public:
+  LaggingDevice(SimulatedArm& arm, int lag_ticks, double tick_s) : arm_(arm), lag_ticks_(lag_ticks) {
+    taken_.push_back(arm.read_sensors());
+    for (int i = 0; i < lag_ticks; ++i) advance(tick_s);  // a full pipe: every tick brings a new reading
+  }
+  SensorReading read_sensors() override { return taken_.front(); }
+  void write_valves(const ValveCommand& command) override { arm_.write_valves(command); }
+  void vent() override { arm_.vent(); }
+  void advance(double dt_s) override {
+    arm_.advance(dt_s);
+    taken_.push_back(arm_.read_sensors());
+    if (static_cast<int>(taken_.size()) > lag_ticks_ + 1) taken_.pop_front();
+  }
+  bool time_follows_ticks() const override { return true; }
+  const char* name() const override { return "lagging"; }
+
+ private:
+  SimulatedArm& arm_;
+  int lag_ticks_;
+  std::deque<SensorReading> taken_;
+};
+
+ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
+  const Configuration c;
+  SimulatedArm arm(c.plant, 1);
+  LaggingDevice device(arm, lag_ticks, c.timing.tick_s);
+  EngineCore core(device, c.controller, c.timing, c.safety);
+  SimulatedClock clock(core, device);
+  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad, nullptr,
+                        link_lag_s);
+}
+
+// The default 30 ms pulses on a rig whose readings lag by 4 ticks (20 ms): judged on readings that
+// do not yet show the step, valves of a healthy rig fail; waiting out the link's lag after each step,
+// every valve passes.
+TEST(ValveTest, OnALaggingLinkEachStepIsJudgedOnReadingsThatShowIt) {
+  const int lag_ticks = 4;
+  const double lag_s = lag_ticks * TimingParameters{}.tick_s;
+  const ValveTestReport unaware = check_lagging(lag_ticks, 0.0);
+  EXPECT_FALSE(unaware.all_pass()) << "the lag is not what this test is about: it never mattered";
+  const ValveTestReport settled = check_lagging(lag_ticks, lag_s);
+  ASSERT_TRUE(settled.finished);
+  EXPECT_EQ(settled.aborted, "");
+  for (const ValveVerdict& v : settled.valves) EXPECT_TRUE(v.pass) << valve_name(v.valve) << ": " << v.problem;
 }
 
 TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
@@ -176,6 +243,7 @@ using testing::write_file;
 struct CheckRun {
   int status;
   std::string out, err;
+  std::filesystem::path sessions;  // where the check's session went (--data-dir)
 };
 
 CheckRun rig_check(const std::string& args, const std::string& fault = "", const std::string& answer = "") {
@@ -185,8 +253,10 @@ CheckRun rig_check(const std::string& args, const std::string& fault = "", const
     config_arg = " --config '" + write_file(dir, "rig.toml", "[plant]\nfault = \"" + fault + "\"\nfault_at_s = 0.0\n").string() + "'";
   }
   const std::string input = answer.empty() ? "/dev/null" : write_file(dir, "answer", answer + "\n").string();
-  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + " " + args + " < '" + input + "'");
-  return {r.exit_code, r.out, r.err};
+  const std::filesystem::path sessions = dir / "sessions";
+  const std::string save = args.find("--no-save") == std::string::npos ? " --data-dir '" + sessions.string() + "'" : "";
+  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + save + " " + args + " < '" + input + "'");
+  return {r.exit_code, r.out, r.err, sessions};
 }
 
 int count_of(const std::string& text, const std::string& what) {
@@ -239,6 +309,36 @@ TEST(RigCheckCli, JsonNamesEveryValve) {
   EXPECT_FALSE(report.at("valves")[0].at("pass").get<bool>());
   EXPECT_TRUE(report.at("valves")[1].at("pass").get<bool>());
   EXPECT_FALSE(report.at("all_pass").get<bool>());
+}
+
+// A rig check is recorded in a session like a run: the device, each input, each valve's verdict
+// and the outcome are its events (the manifest), and --json names the session.
+TEST(RigCheckCli, TheCheckIsRecordedInASession) {
+  const CheckRun r = rig_check("--yes --json", "dead-inlet");
+  ASSERT_EQ(r.status, kRigCheckFailedStatus) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(report.at("session").is_string()) << r.out;
+  const std::filesystem::path session = report.at("session").get<std::string>();
+  EXPECT_EQ(session.parent_path(), r.sessions);
+  std::ifstream in(session / "manifest.json");
+  const auto manifest = nlohmann::json::parse(in);
+  EXPECT_EQ(manifest.at("device"), "sim");
+  std::map<std::string, std::vector<std::string>> events;
+  for (const auto& e : manifest.at("events")) events[e.at("kind").get<std::string>()].push_back(e.at("message").get<std::string>());
+  ASSERT_EQ(events["start"].size(), 1u);
+  EXPECT_NE(events["start"][0].find("bellows rig check"), std::string::npos) << events["start"][0];
+  ASSERT_EQ(events["rig-input"].size(), 1u);  // the simulated arm: one line of values, no volts
+  EXPECT_NE(events["rig-input"][0].find("supply"), std::string::npos);
+  ASSERT_EQ(events["valve-test"].size(), 4u);
+  EXPECT_EQ(events["valve-test"][0].rfind("inlet A FAIL: dead valve", 0), 0u) << events["valve-test"][0];
+  EXPECT_EQ(events["valve-test"][1].rfind("inlet B pass", 0), 0u) << events["valve-test"][1];
+  ASSERT_EQ(events["finish"].size(), 1u);
+  EXPECT_NE(events["finish"][0].find("valves failed"), std::string::npos) << events["finish"][0];
+
+  const CheckRun unsaved = rig_check("--yes --json --no-save");
+  EXPECT_EQ(unsaved.status, 0) << unsaved.err;
+  EXPECT_TRUE(nlohmann::json::parse(unsaved.out).at("session").is_null());
+  EXPECT_FALSE(std::filesystem::exists(unsaved.sessions));
 }
 
 }  // namespace

@@ -259,6 +259,10 @@ TEST_F(HostileSession, TextFromASessionReachesTheTerminalEscapedAndShortened) {
   manifest["device_info"]["note"] = attack;
   manifest["events"][0]["message"] = "message" + attack + std::string(10 << 20, 'x');  // a 10 MB field
   manifest["events"][0]["kind"] = "kind" + attack;
+  std::string many_lines;  // a console-log event is shown a line per row: a million rows is too many
+  for (int i = 0; i < 1000000; ++i) many_lines += "12:00:00 operator: line\n";
+  manifest["events"].push_back({{"time_utc", "2024-05-01T12:00:00.000Z"}, {"iteration", 0}, {"kind", "console-log"},
+                                {"message", many_lines}});
   write_manifest(session, manifest);
 
   const ProcessResult shown = run_bellows({"sessions", "show", session.string()});

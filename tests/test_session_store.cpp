@@ -181,6 +181,28 @@ TEST(SessionStore, ManifestRoundTripsThroughJson) {
   EXPECT_EQ(loaded.events.back().message, "quotes \" and\nnewlines, ünïcödé");
 }
 
+TEST(SessionStore, AManifestWrittenPieceByPieceIsTheSameText) {
+  // A writer serializes only what was added since its last write: the text must be what a whole
+  // serialization gives, through appends, a change of the newest entry and a list that shrank.
+  const Session simulated = testing::simulate_session(6);
+  SessionManifest grown = simulated.manifest;
+  grown.iterations.clear();
+  grown.events.clear();
+  ManifestTextCache cache;
+  EXPECT_EQ(format_manifest(grown, cache), format_manifest(grown));
+  for (std::size_t i = 0; i < simulated.manifest.iterations.size(); ++i) {
+    grown.iterations.push_back(simulated.manifest.iterations[i]);
+    grown.events.push_back({"2024-05-01T12:00:00.000Z", static_cast<int>(i), "note", "line\nwith \"quotes\" and \\"});
+    ASSERT_EQ(format_manifest(grown, cache), format_manifest(grown)) << "after iteration " << i;
+  }
+  grown.iterations.back().samples_sha256 = std::string(64, 'a');  // the newest entry may still change
+  EXPECT_EQ(format_manifest(grown, cache), format_manifest(grown));
+  grown.iterations.resize(2);
+  grown.events.clear();
+  EXPECT_EQ(format_manifest(grown, cache), format_manifest(grown));
+  EXPECT_EQ(parse_manifest(format_manifest(grown, cache), "m").iterations.size(), 2u);
+}
+
 TEST(SessionStore, ConfigurationOtherThanTheDefaultsSurvives) {
   Session saved = testing::simulate_session(1);
   saved.manifest.configuration.controller.k_p = 0.45;

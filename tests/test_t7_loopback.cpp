@@ -3,6 +3,7 @@
 // the exception for an unknown register, the watchdog, and a link that dies.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -131,6 +132,76 @@ TEST(T7Loopback, WhenTheEngineFallsSilentTheLinkVentsByItselfAndKeepsTheWatchdog
   const std::uint64_t exchanges = device.health().exchanges;
   ASSERT_TRUE(eventually([&] { return device.health().exchanges > exchanges + 10; }));
   EXPECT_EQ(sim.status().watchdog_actions, 0);
+}
+
+// The rig enforces its own limits whatever it is sent (issue 16): a client that keeps writing both
+// inlets open meets the pressure ceiling, every time, while the lines keep showing what it wrote.
+// Without the limit (a ceiling out of reach) the same client drives the chambers far above it.
+double highest_chamber_bar_while_inlets_open(const RigLimits& limits, T7SimStatus& last) {
+  T7SimOptions options;
+  options.limits = limits;
+  SimThread sim(options);
+  T7Device device(device_options(sim.port()));
+  ValveCommand both_inlets_open;  // both chambers fill: the arm stays near its middle
+  both_inlets_open.inlet_duty = {1.0, 1.0};
+  both_inlets_open.outlet_duty = {0.0, 0.0};
+  double highest = 0.0;
+  for (int i = 0; i < 600; ++i) {  // 3 s of commands, one every 5 ms like the engine's ticks
+    device.write_valves(both_inlets_open);
+    last = sim.status();
+    highest = std::max({highest, last.chamber_bar[0], last.chamber_bar[1]});
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return highest;
+}
+
+TEST(T7Loopback, TheRigKeepsItsPressureCeilingWhateverTheClientWrites) {
+  RigLimits limits;
+  limits.pressure_ceiling_bar = 1.75;
+  T7SimStatus last;
+  const double highest = highest_chamber_bar_while_inlets_open(limits, last);
+  EXPECT_GE(last.pressure_limit_trips, 1) << "the chambers never reached the ceiling";
+  EXPECT_LT(highest, limits.pressure_ceiling_bar + 0.1) << "a chamber went beyond the ceiling";
+  EXPECT_EQ(last.duty[static_cast<int>(ValveRole::kInletA)], 1.0) << "the line still shows what the client wrote";
+
+  RigLimits none;
+  none.pressure_ceiling_bar = 100.0;
+  const double unlimited = highest_chamber_bar_while_inlets_open(none, last);
+  EXPECT_GT(unlimited, limits.pressure_ceiling_bar + 0.5) << "the client alone would go far beyond the ceiling";
+  EXPECT_EQ(last.pressure_limit_trips, 0);
+}
+
+// The same for the angle: a client that keeps turning the arm (A fills, B vents) is vented each time
+// the arm leaves the rig's range; without that range the arm goes much further.
+double widest_angle_rad_while_turning(const RigLimits& limits, T7SimStatus& last) {
+  T7SimOptions options;
+  options.limits = limits;
+  SimThread sim(options);
+  T7Device device(device_options(sim.port()));
+  ValveCommand turn;
+  turn.inlet_duty = {1.0, 0.0};
+  turn.outlet_duty = {0.0, 1.0};
+  double widest = 0.0;
+  for (int i = 0; i < 600; ++i) {
+    device.write_valves(turn);
+    last = sim.status();
+    widest = std::max(widest, std::abs(last.angle_rad));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return widest;
+}
+
+TEST(T7Loopback, AnArmBeyondTheRigsAngleRangeIsVentedWhateverTheClientWrites) {
+  RigLimits narrow;
+  narrow.angle_limit_rad = 0.2;
+  T7SimStatus last;
+  const double limited = widest_angle_rad_while_turning(narrow, last);
+  EXPECT_GE(last.angle_limit_trips, 1) << "the arm never left the range";
+  RigLimits wide;
+  wide.angle_limit_rad = 3.0;
+  const double unlimited = widest_angle_rad_while_turning(wide, last);
+  EXPECT_EQ(last.angle_limit_trips, 0);
+  EXPECT_LT(limited, unlimited - 0.1) << "limited " << limited << " rad, unlimited " << unlimited << " rad";
 }
 
 TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {

@@ -10,6 +10,10 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
 #include <nlohmann/json.hpp>
 
 #include "tests/lcm_test_support.hpp"
@@ -187,6 +191,69 @@ TEST_F(T7Processes, ASilentLinkFaultsTheRunAndTheWatchdogVents) {
   EXPECT_NE(run->err().find("sensor-stale"), std::string::npos) << run->err();
   ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; }));
   EXPECT_TRUE(status().at("safe").get<bool>());
+}
+
+std::string text_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string paper_profile_text() { return text_of(std::filesystem::path(BELLOWS_SOURCE_DIR) / "profiles" / "paper-rig.toml"); }
+
+// Zeroing the angle headless: the profile bellows reads says the zero is 0.1 rad off (t7-sim's arm
+// hangs at its true zero), so the arm reads about -5.7 deg; after `rig check --zero-angle` the
+// file's zero is where the arm is, and the next check reads about 0 deg. No valve opened.
+TEST_F(T7Processes, ZeroingTheAngleWritesTheProfileAndTheArmThenReadsZero) {
+  auto sim = start_sim();
+  std::string text = paper_profile_text();
+  const std::string zero_line = "angle_zero_rad = 0.0";
+  ASSERT_NE(text.find(zero_line), std::string::npos);
+  text.replace(text.find(zero_line), zero_line.size(), "angle_zero_rad = 0.1");
+  const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", text);
+  const std::vector<std::string> device = {"--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "off"};
+  std::vector<std::string> zero = {"rig", "check", "--zero-angle", "--json"};
+  zero.insert(zero.end(), device.begin(), device.end());
+  const testing::ProcessResult r = run_cli(zero);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(report["angle_zero"]["read_deg"].get<double>(), -0.1 * 180.0 / std::numbers::pi, 1.0);
+  EXPECT_NEAR(report["angle_zero"]["angle_zero_rad"].get<double>(), 0.0, 0.02);
+  const std::string written = text_of(profile);
+  EXPECT_NE(written.find("# zeroed by bellows"), std::string::npos) << written;
+  EXPECT_NE(written.find("# The model identified on this rig"), std::string::npos) << "the comments stay";
+  EXPECT_EQ(status()["valves"]["inlet_a"].get<double>(), 0.0) << "no valve opened";
+
+  std::vector<std::string> look = {"rig", "check", "--inputs-only", "--json"};
+  look.insert(look.end(), device.begin(), device.end());
+  const testing::ProcessResult after = run_cli(look);
+  ASSERT_EQ(after.exit_code, 0) << after.err;
+  EXPECT_NEAR(nlohmann::json::parse(after.out)["reading"]["angle_deg"].get<double>(), 0.0, 1.0);
+
+  // The built-in profile has no file to write: one line, exit 2.
+  const testing::ProcessResult builtin = run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_, "--rt", "off"});
+  EXPECT_EQ(builtin.exit_code, 2);
+  EXPECT_NE(builtin.err.find("--rig-profile FILE"), std::string::npos) << builtin.err;
+}
+
+// `identify --write-model PROFILE`: a rig profile (it has [valves]) gets the fit in its [model],
+// which the profile then carries (the simulated arm's identification: the file path is the same
+// for every device).
+TEST_F(T7Processes, IdentifyWritesTheModelIntoARigProfile) {
+  const std::filesystem::path profile = testing::write_file(dir_, "rig.toml", paper_profile_text());
+  const testing::ProcessResult r = run_cli({"identify", "--device", "sim", "--write-model", profile.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["written_as"], "rig_profile");
+  const std::string written = text_of(profile);
+  EXPECT_NE(written.find("[model]\nkappa_rad_per_bar = "), std::string::npos) << written;
+  EXPECT_NE(written.find("# fitted by bellows identify"), std::string::npos) << written;
+  // The profile with its model is valid: a rig check on it reads it.
+  auto sim = start_sim();
+  const testing::ProcessResult check =
+      run_cli({"rig", "check", "--inputs-only", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "off"});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
 }
 
 TEST_F(T7Processes, ABadRigProfileIsOneLineNamingFileAndKeyAndNoSession) {

@@ -1,5 +1,6 @@
 // Rig profiles: the shipped paper rig loads, and every bad profile is one InputError naming the
-// file and the key. The T7's PWM clock arithmetic.
+// file and the key. Writing the angle zero and the identified model into a profile file. The T7's
+// PWM clock arithmetic.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -8,6 +9,9 @@
 #include <unistd.h>
 
 #include "app/rig_profile_file.hpp"
+#include "app/rig_profile_write.hpp"
+#include "app/toml_key_edit.hpp"
+#include "sessions/atomic_file.hpp"
 #include "devices/t7_registers.hpp"
 #include "engine/errors.hpp"
 
@@ -132,6 +136,75 @@ TEST(RigProfile, AnIdentifiedModelIsRead) {
   ASSERT_TRUE(p.model.has_value());
   EXPECT_DOUBLE_EQ(p.model->kappa_rad_per_bar, 6.5);
   EXPECT_NE(error_of(paper_rig_profile_text() + "\n[model]\ndamping = -1\n").find("[model] damping"), std::string::npos);
+}
+
+// What the first day learns goes into the profile file: only the keys concerned change (comments
+// and everything else stay), the result is a valid profile, and a value that would make it invalid
+// leaves the file as it was.
+TEST(TomlKeyEdit, SetsKeysInPlaceAddsMissingOnesAndKeepsComments) {
+  const std::string text = "# my rig\nname = \"r\"  # its name\nangle_zero_rad = 0.0\n\n[valves]\ninlet_a = 2\n\n[model]\n# fitted\ndamping = 0.3\n";
+  const std::string top = with_table_values(text, "", {{"angle_zero_rad", "0.25"}, {"pwm_frequency_hz", "100.0"}}, "why");
+  EXPECT_NE(top.find("angle_zero_rad = 0.25  # why\n"), std::string::npos) << top;
+  EXPECT_EQ(top.find("angle_zero_rad = 0.0"), std::string::npos) << top;
+  EXPECT_LT(top.find("pwm_frequency_hz = 100.0"), top.find("[valves]")) << "a top-level key goes before the first table\n" << top;
+  EXPECT_NE(top.find("# my rig\nname = \"r\"  # its name\n"), std::string::npos) << top;
+  const std::string model = with_table_values(text, "model", {{"damping", "0.4"}, {"kappa_rad_per_bar", "7.5"}}, "fit");
+  EXPECT_NE(model.find("[model]\nkappa_rad_per_bar = 7.5  # fit\n# fitted\ndamping = 0.4  # fit\n"), std::string::npos) << model;
+  const std::string added = with_table_values("name = \"r\"\n", "model", {{"damping", "0.4"}}, "fit");
+  EXPECT_EQ(added, "name = \"r\"\n\n[model]\ndamping = 0.4  # fit\n");
+  EXPECT_TRUE(has_table_header(text, "valves"));
+  EXPECT_FALSE(has_table_header("[valves.x]\n", "valves"));
+  EXPECT_EQ(toml_number(2.0), "2.0");
+  EXPECT_EQ(toml_number(-0.125), "-0.125");
+}
+
+std::string profile_copy(const std::string& name) {
+  const std::string path = "/tmp/bellows-profile-" + std::to_string(::getpid()) + "-" + name + ".toml";
+  write_file_atomic(path, paper_rig_profile_text());
+  return path;
+}
+
+TEST(RigProfileWrite, TheAngleZeroIsWrittenIntoTheFile) {
+  const std::string path = profile_copy("zero");
+  EXPECT_TRUE(is_rig_profile_file(path));
+  write_rig_profile_angle_zero(path, 0.0421);
+  const RigProfile p = load_rig_profile(path);
+  EXPECT_DOUBLE_EQ(p.angle_zero_rad, 0.0421);
+  EXPECT_EQ(p.input(SensorRole::kAngle).gain_per_V, paper_rig_profile().input(SensorRole::kAngle).gain_per_V);
+  const std::string text = read_file(path);
+  EXPECT_NE(text.find("angle_zero_rad = 0.0421  # zeroed by bellows"), std::string::npos);
+  EXPECT_NE(text.find("# The model identified on this rig"), std::string::npos) << "the file's comments stay";
+  // A zero the profile may not hold (beyond +-pi): refused, the file unchanged.
+  EXPECT_THROW(write_rig_profile_angle_zero(path, 4.0), InputError);
+  EXPECT_EQ(read_file(path), text);
+  ::unlink(path.c_str());
+}
+
+TEST(RigProfileWrite, TheIdentifiedModelIsWrittenIntoTheFile) {
+  const std::string path = profile_copy("model");
+  ModelParameters m;
+  m.kappa_rad_per_bar = 6.75;
+  m.omega0_rad_per_s = 12.5;
+  m.damping = 0.42;
+  write_rig_profile_model(path, m);
+  RigProfile p = load_rig_profile(path);
+  ASSERT_TRUE(p.model.has_value());
+  EXPECT_DOUBLE_EQ(p.model->kappa_rad_per_bar, 6.75);
+  EXPECT_DOUBLE_EQ(p.model->omega0_rad_per_s, 12.5);
+  EXPECT_DOUBLE_EQ(p.model->damping, 0.42);
+  m.damping = 0.5;  // a second identification replaces the first
+  write_rig_profile_model(path, m);
+  p = load_rig_profile(path);
+  EXPECT_DOUBLE_EQ(p.model->damping, 0.5);
+  EXPECT_EQ(read_file(path).find("damping = 0.42"), std::string::npos);
+  ::unlink(path.c_str());
+}
+
+TEST(RigProfileWrite, AConfigurationIsNotTakenForAProfile) {
+  const std::string path = "/tmp/bellows-config-" + std::to_string(::getpid()) + ".toml";
+  write_file_atomic(path, "[model]\nkappa = 7.0\n[valves_note]\n");
+  EXPECT_FALSE(is_rig_profile_file(path));
+  ::unlink(path.c_str());
 }
 
 TEST(T7Pwm, TheClockFor200HzAndItsDutyCycles) {

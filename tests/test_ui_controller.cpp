@@ -5,11 +5,15 @@
 #include "engine/learning_law_factory.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 #include "devices/simulated_arm.hpp"
 #include "tests/console_fixture.hpp"
 #include "tests/process_runner.hpp"
+#include "tests/ui_sample_state.hpp"
 #include "ui/canvas.hpp"
+#include "ui/render.hpp"
 
 namespace bellows::ui {
 namespace {
@@ -520,6 +524,60 @@ TEST(UiController, WithoutASessionStoreSaveSaysSo) {
   EXPECT_TRUE(console.quit_requested());
   console.handle_key('o', 0.0);
   EXPECT_EQ(console.state().screen, Screen::kMain);
+}
+
+TEST(UiController, AfterAnEmergencyStopTheLivePanelShowsTheRealState) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().run.sample > 150; }));  // mid-trial, the arm well off zero
+  f.key(' ');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }));
+  f.pump_for(3.0);  // vented, the arm sags
+  f.key(ui::key::kEscape);  // from the fault screen the stop opened, back to the main one
+  ASSERT_EQ(f.state().screen, Screen::kMain);
+  const TickRecord& live = f.state().live;
+  ASSERT_EQ(live.state, EngineState::kFault);
+  const std::string screen = testing::all(render_lines(f.state()));
+  EXPECT_NE(screen.find("set point  none: vented"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
+  // The angle shown is the latest reading, not where the trial was.
+  EXPECT_NE(screen.find(format("angle      %7.2f deg", live.reading.angle_rad * 180.0 / std::numbers::pi)), std::string::npos)
+      << screen;
+  EXPECT_GT(std::abs(live.desired_angle_rad - live.reading.angle_rad) * 180.0 / std::numbers::pi, 1.0)
+      << "the engine keeps its last set point: the panel must not show it as a tracking error";
+}
+
+TEST(UiController, TheBrowserShowsEachSessionsDeviceAndRefusesAnotherOnesBeforeOpening) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  f.key('d');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  {
+    const std::lock_guard<std::mutex> guard(f.sessions.mutex);
+    ASSERT_EQ(f.sessions.saved.size(), 1u);
+    f.sessions.saved.begin()->second.device_name = "t7";  // as if recorded at the bench
+  }
+  f.key('o');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
+  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  const ui::SessionListing& l = f.state().browser.sessions[0];
+  EXPECT_EQ(l.device, "t7");
+  EXPECT_EQ(l.refusal, "recorded on the device 't7'; this console drives 'sim'");
+  const std::string screen = testing::all(render_lines(f.state()));
+  EXPECT_NE(screen.find("t7"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("cannot open it here: recorded on the device 't7'"), std::string::npos) << screen;
+  const int saves = f.sessions.saves;
+  f.key(ui::key::kEnter);
+  EXPECT_NE(f.state().status.find("cannot be opened here: recorded on the device 't7'"), std::string::npos)
+      << f.state().status;
+  EXPECT_FALSE(f.state().learner_busy);  // nothing was opened
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  f.pump_for(0.5);
+  EXPECT_EQ(f.state().experiment.trials.size(), 1u);
+  EXPECT_EQ(f.sessions.saves, saves);
 }
 
 }  // namespace

@@ -265,11 +265,22 @@ TEST(UiRender, TuningLogAndSessionScreens) {
   s.sessions_unavailable_reason = "no store";
   EXPECT_NE(all(render_lines(s)).find("Not available: no store"), std::string::npos);
   s.sessions_available = true;
-  s.browser.sessions = {{"/d/a", "2024-05-01_14-03-07_paper", "2024-05-01 14:03", "paper", 31, 0.987, ""},
-                        {"/d/b", "broken", "", "", 0, -1, "manifest.json: missing"}};
+  s.browser.sessions = {{"/d/a", "2024-05-01_14-03-07_paper", "2024-05-01 14:03", "paper", 31, 0.987, "", "sim", ""},
+                        {"/d/c", "bench", "2024-05-02 09:00", "steps", 12, 1.5, "", "t7",
+                         "recorded on the device 't7'; this console drives 'sim'"},
+                        {"/d/b", "broken", "", "", 0, -1, "manifest.json: missing", "", ""}};
   text = all(render_lines(s));
-  EXPECT_NE(text.find("> 2024-05-01 14:03  paper                31      0.987  2024-05-01_14-03-07_paper"),
+  EXPECT_NE(text.find("> 2024-05-01 14:03  sim    paper               31      0.987  2024-05-01_14-03-07_paper"),
             std::string::npos)
+      << text;
+  // Another device's session: marked in its row, and the reason on the last line when chosen.
+  EXPECT_NE(text.find("  2024-05-02 09:00  t7     steps               12      1.500  bench  (other device)"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("cannot open it here"), std::string::npos) << text;
+  s.browser.selected = 1;
+  text = all(render_lines(s));
+  EXPECT_NE(text.find("cannot open it here: recorded on the device 't7'; this console drives 'sim'"), std::string::npos)
       << text;
   EXPECT_NE(text.find("broken: cannot be read: manifest.json: missing"), std::string::npos);
 }

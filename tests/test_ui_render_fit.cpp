@@ -130,5 +130,96 @@ TEST(UiRenderFit, NoNegativeZeroInTheReadouts) {
   EXPECT_EQ(screen.find("-0.00"), std::string::npos) << screen;
 }
 
+TEST(UiRenderFit, TheFunctionBarKeepsStopBackHelpAndQuitAt80Columns) {
+  for (EngineState state : {EngineState::kSafe, EngineState::kArmed, EngineState::kFault}) {
+    for (Screen screen : {Screen::kMain, Screen::kTuning, Screen::kRig, Screen::kLog}) {
+      ConsoleState s = small_state(state);
+      s.fault_view.code = state == EngineState::kFault ? FaultCode::kHeartbeatLost : FaultCode::kNone;
+      s.screen = screen;
+      const std::string bar = render_lines(s).back();
+      SCOPED_TRACE(bar);
+      if (state == EngineState::kArmed) {
+        EXPECT_NE(bar.find("Space E-STOP"), std::string::npos);
+      }
+      if (screen != Screen::kMain) {
+        EXPECT_NE(bar.find("Esc Back"), std::string::npos);
+      }
+      EXPECT_NE(bar.find("?/F1 Help"), std::string::npos);
+      EXPECT_NE(bar.find("q Quit"), std::string::npos);
+      EXPECT_LE(static_cast<int>(bar.find_last_not_of(' ')), kMinWidth - 1);
+    }
+  }
+}
+
+TEST(UiRenderFit, TheStatusLineWrapsAtAWordAndNeverCutsOne) {
+  ConsoleState s = small_state(EngineState::kArmed);
+  s.unicode = false;
+  s.status = "Run: arm the valves first (a); the learning law is rebuilt after every change of the weights, "
+             "which takes a moment on a slow machine ENDWORD";
+  std::vector<std::string> lines = render_lines(s);
+  const std::string two = lines[lines.size() - 3] + "\n" + lines[lines.size() - 2];
+  EXPECT_NE(two.find("Run: arm the valves first (a);"), std::string::npos) << two;
+  EXPECT_NE(two.find("ENDWORD"), std::string::npos) << two;  // all of it, on two lines
+  for (const char* word : {"rebuilt", "weights,", "machine"}) EXPECT_NE(two.find(word), std::string::npos) << word;
+
+  std::string very_long;
+  for (int i = 0; i < 60; ++i) very_long += "word" + std::to_string(i) + " ";
+  s.status = very_long;
+  lines = render_lines(s);
+  const std::string last = lines[lines.size() - 2];
+  SCOPED_TRACE(last);
+  const auto end = last.find_last_not_of(' ');
+  ASSERT_NE(end, std::string::npos);
+  EXPECT_EQ(last.substr(end - 3, 4), " ...");  // abbreviated after a whole word
+  const std::string before = last.substr(0, end - 3);
+  const std::string tail = before.substr(before.find_last_of(' ') + 1);
+  EXPECT_NE(very_long.find(" " + tail + " "), std::string::npos) << tail;  // a whole word, not a piece of one
+  // The function bar stays below it.
+  EXPECT_NE(lines.back().find("Space E-STOP"), std::string::npos) << lines.back();
+}
+
+TEST(UiRenderFit, TheTuningScreenSaysHowToEditAValueAt80x24) {
+  ConsoleState s = small_state(EngineState::kArmed);
+  s.screen = Screen::kTuning;
+  s.run.mode = RunProgress::Mode::kIdle;
+  s.tuning.selected = 1;
+  std::string screen = all(render_lines(s));
+  EXPECT_NE(screen.find("Up/Down choose   Enter edit: type the value, Enter applies, Esc cancels"), std::string::npos)
+      << screen;
+  s.tuning.selected = TuningForm::kLawRow;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("Enter or Right: next law   Left: the one before"), std::string::npos) << screen;
+  s.run.mode = RunProgress::Mode::kBatch;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("changes wait: trials are running (x stops them)"), std::string::npos) << screen;
+  s = small_state(EngineState::kFault);
+  s.screen = Screen::kTuning;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("changes wait: a fault is latched (R resets)"), std::string::npos) << screen;
+}
+
+TEST(UiRenderFit, VentedTheLivePanelShowsNoSetPointAndNoTrackingError) {
+  // After an emergency stop in the middle of `paper`: the engine still knows its last set point
+  // (40 deg), the arm has sagged to 3 deg.
+  ConsoleState s = small_state(EngineState::kFault);
+  s.live.state = EngineState::kFault;
+  s.live.desired_angle_rad = 40.0 * testing::kDeg;
+  s.live.reading.angle_rad = 3.0 * testing::kDeg;
+  std::string screen = all(render_lines(s));
+  EXPECT_NE(screen.find("angle         3.00 deg"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("set point  none: vented"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
+  EXPECT_EQ(screen.find("40.00"), std::string::npos) << screen;
+  EXPECT_EQ(screen.find("37.00"), std::string::npos) << screen;
+  // Armed, the engine holds a set point, still no trial; running, the tracking error is shown.
+  s.engine_state = s.live.state = EngineState::kArmed;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("set point    40.00 deg hold"), std::string::npos) << screen;
+  EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
+  s.engine_state = s.live.state = EngineState::kRunning;
+  screen = all(render_lines(s));
+  EXPECT_NE(screen.find("error        37.00 deg"), std::string::npos) << screen;
+}
+
 }  // namespace
 }  // namespace bellows::ui

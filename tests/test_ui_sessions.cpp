@@ -169,6 +169,8 @@ TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
   EXPECT_EQ(l.iterations, 2);
   EXPECT_NEAR(l.best_rms_deg, 9.38, 0.3);
   EXPECT_EQ(l.date.size(), 16u) << l.date;
+  EXPECT_EQ(l.device, "sim");  // from its manifest
+  EXPECT_TRUE(l.refusal.empty()) << l.refusal;
   f.key(ui::key::kEnter);
   ASSERT_TRUE(f.pump_until([&] { return !f.state().learner_busy && f.state().law_ready; }));
   ASSERT_EQ(f.state().experiment.trials.size(), 2u);
@@ -205,6 +207,11 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
     location = f.state().experiment.session_location;
   }
   StoreSessionGateway lcm("lcm");
+  const auto listing = lcm.list();  // the browser knows before the operator picks it
+  ASSERT_EQ(listing.size(), 1u);
+  EXPECT_EQ(listing[0].device, "sim");
+  EXPECT_EQ(ui::drive_refusal(listing[0], "lcm"), "recorded on the device 'sim'; this console drives 'lcm'");
+  EXPECT_EQ(ui::drive_refusal(listing[0], "sim"), "");
   try {
     lcm.open(location);
     FAIL() << "opened a sim session on an lcm console";
@@ -256,6 +263,50 @@ TEST(UiSessionGateway, WithoutADataDirectoryItSaysWhy) {
   if (xdg != nullptr) setenv("XDG_DATA_HOME", saved_xdg.c_str(), 1);
   if (home != nullptr) setenv("HOME", saved_home.c_str(), 1);
   else unsetenv("HOME");
+}
+
+TEST_F(UiSessions, ASessionStartedFromATransferRecordsWhereItsFirstCorrectionCameFrom) {
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(6);
+  save_and_wait(f);
+  const std::string taught = f.state().experiment.session_location;
+  f.key('t');
+  f.key(ui::key::kDown);  // steps
+  f.key(ui::key::kEnter);
+  ASSERT_EQ(f.state().experiment.trajectory->name, "steps");
+  ASSERT_TRUE(f.pump_until([&] { return f.state().status.find("T: start from what") != std::string::npos; }, 50.0))
+      << f.state().status;
+  f.key('T');
+  ASSERT_NE(f.state().experiment.first_correction, nullptr);
+  const double predicted = f.state().experiment.first_correction->result.predicted_rms_deg;
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  const std::string started = f.state().experiment.session_location;
+  ASSERT_NE(started, taught);
+  f.console.reset();
+
+  const nlohmann::ordered_json first = load_manifest(started).first_correction;
+  ASSERT_TRUE(first.is_object()) << first.dump();
+  EXPECT_EQ(first["status"], "transferred");
+  EXPECT_EQ(first["by"], "console");
+  EXPECT_FALSE(first["method"].get<std::string>().empty());
+  EXPECT_NEAR(first["prediction"]["rms_deg"].get<double>(), predicted, 1e-9);
+  EXPECT_GT(first["prediction"]["feedback_only_rms_deg"].get<double>(), predicted);
+  ASSERT_EQ(first["sources"].size(), 1u) << first.dump();
+  EXPECT_EQ(first["sources"][0]["trajectory"], "paper");
+  EXPECT_EQ(first["sources"][0]["directory"], taught);  // the taught trajectory's own session
+  EXPECT_EQ(first["sources"][0]["trials"], 6);
+  EXPECT_GT(first["sources"][0]["last_rms_deg"].get<double>(), 0.0);
+  // The same keys as bellows run --transfer-from records.
+  for (const char* key : {"sources", "method", "status", "reason", "prediction", "validation_ratio", "clamped_samples",
+                          "max_abs_correction_bar"}) {
+    EXPECT_TRUE(first.contains(key)) << key;
+  }
+  // A session that started with feedback only records none.
+  EXPECT_TRUE(load_manifest(taught).first_correction.is_null());
 }
 
 }  // namespace

@@ -71,6 +71,7 @@ inline ConsoleState sample_state(int trials, bool unicode) {
     s.experiment.add_trial(std::move(t));
   }
   s.live_valid = true;
+  s.live.state = EngineState::kArmed;  // the latest tick, like the engine it came from
   s.live.reading.angle_rad = 12.5 * kDeg;
   s.live.desired_angle_rad = 12.0 * kDeg;
   s.live.reading.chamber_bar = {1.234, 1.1};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <limits>
 #include <numbers>
 
 #include <time.h>
@@ -299,7 +300,9 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
       if (per_sample > 0 && t.tick % static_cast<std::uint64_t>(per_sample) != 0) return;
       strip_time_[strip_next_] = t.time_s;
       strip_angle_[strip_next_] = t.reading.angle_rad * 180.0 / std::numbers::pi;
-      strip_setpoint_[strip_next_] = t.desired_angle_rad * 180.0 / std::numbers::pi;
+      // Vented, the engine's last set point is none (the plot leaves the gap).
+      strip_setpoint_[strip_next_] =
+          valves_live(t.state) ? t.desired_angle_rad * 180.0 / std::numbers::pi : std::numeric_limits<double>::quiet_NaN();
       strip_next_ = (strip_next_ + 1) % strip_time_.size();
       strip_count_ = std::min(strip_count_ + 1, strip_time_.size());
       ++strip_revision_;

@@ -49,6 +49,9 @@ struct ConsoleEnvironment {
   std::string rig_profile;                       // the rig profile's name, "" without one
   std::function<bellows::DeviceHealth()> device_health;  // Device::health() (any thread); optional
   std::function<RawInputs()> raw_inputs;         // Device::raw_inputs() (any thread); optional
+  /// Makes `read_rad` (the angle read now) the rig profile's zero: the file and the device; returns
+  /// what it did in words, throws InputError. Empty: this device has no profile file to write.
+  std::function<std::string(double read_rad)> zero_angle;
   std::uint64_t seed = 1;
   int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
   std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
@@ -141,6 +144,7 @@ class ConsoleController {
   // The Rig screen and the valve test (console_rig.cpp).
   bool handle_rig_key(int key);
   void start_valve_test();
+  void zero_angle();
   void forward_to_valve_test(const EngineEvent& event);
   bool send_valve_test_commands(const std::vector<EngineCommand>& commands);  // false: refused, stopped
   void show_valve_verdicts();
@@ -214,6 +218,7 @@ class ConsoleController {
   BackgroundTask<std::string> figure_task_;
   BackgroundTask<TransferOffer> transfer_task_;
   std::vector<TransferSource> taught_;  // earlier experiments of this console
+  std::vector<TransferSourceNote> taught_notes_;  // one per taught_ source, for the session's first_correction
   std::vector<std::string> taught_locations_;  // where they are saved (not read back as "saved" sources)
   TransferOffer transfer_offer_;
   bool transfer_wanted_ = false;

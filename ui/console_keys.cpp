@@ -92,6 +92,17 @@ bool ConsoleController::handle_dialog_key(int k) {
         not_an_answer(k);
       }
       return true;
+    case DialogKind::kConfirmZeroAngle:
+      if (k == 'y' || k == 'Y') {
+        state_.dialog = {};
+        zero_angle();
+      } else if (k == 'n' || k == 'N') {
+        state_.dialog = {};
+        set_status("angle zero unchanged");
+      } else {
+        not_an_answer(k);
+      }
+      return true;
     case DialogKind::kConfirmValveTest:
       if (k == 'y' || k == 'Y') {
         state_.dialog = {};
@@ -224,6 +235,7 @@ void ConsoleController::perform(Action action) {
         state_.screen = state_.previous_screen;
       } else {
         state_.previous_screen = state_.screen;
+        state_.help_scroll = 0;
         state_.screen = Screen::kHelp;
       }
       return;

@@ -1,6 +1,8 @@
 // The Rig screen (the first day at the bench): the device's inputs live, its link's health, and
-// the valve test (engine/valve_test) driven through the engine's commands like any trial.
+// the valve test (engine/valve_test) driven through the engine's commands like any trial, and
+// zeroing the angle (written into the rig profile by the app's callback).
 #include <cmath>
+#include <numbers>
 
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
@@ -14,6 +16,20 @@ constexpr double kRigRefreshS = 0.25;  // raw inputs and link figures: a few tim
 }  // namespace
 
 bool ConsoleController::handle_rig_key(int k) {
+  if (k == 'z') {
+    if (!env_.zero_angle) {
+      set_status("zeroing the angle writes the rig profile: it needs --device t7 --rig-profile FILE", true);
+    } else if (valves_live(state_.engine_state) || !state_.live_valid) {
+      set_status("zeroing the angle: only while SAFE (disarm first), with the arm at rest", true);
+    } else {
+      open_dialog(DialogKind::kConfirmZeroAngle, "Zero the angle here?",
+                  {format("The arm reads %+.3f deg now: this becomes 0 deg.", state_.live.reading.angle_rad * 180.0 / std::numbers::pi),
+                   "Hold the arm at rest where it should read zero (hanging straight).",
+                   "The rig profile's angle_zero_rad is written to its file."},
+                  "y zero it   n cancel");
+    }
+    return true;
+  }
   if (k != 'v') return false;
   if (valve_test_ && valve_test_->running()) {
     set_status("the valve test is running (Space stops it)", true);
@@ -33,9 +49,21 @@ bool ConsoleController::handle_rig_key(int k) {
   return true;
 }
 
+void ConsoleController::zero_angle() {
+  try {
+    const std::string done = env_.zero_angle(state_.live.reading.angle_rad);
+    log(LogSource::kOperator, "angle zeroed: " + done);  // the session's event log keeps it
+    set_status("angle zeroed: " + done, false);
+  } catch (const std::exception& e) {
+    log(LogSource::kOperator, std::string("angle not zeroed: ") + e.what(), true);
+    set_status(std::string("angle not zeroed: ") + e.what(), true);
+  }
+}
+
 void ConsoleController::start_valve_test() {
   valve_test_ = std::make_unique<ValveTest>(env_.config.rig_check, env_.config.safety, env_.config.controller.gas.ambient_bar,
-                                            env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad);
+                                            env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad,
+                                            env_.device_health ? link_lag_s(env_.device_health()) : 0.0);
   const SensorReading latest = state_.live_valid ? state_.live.reading : SensorReading{};
   state_.rig.verdicts_logged = false;
   if (!send_valve_test_commands(valve_test_->begin(state_.engine_state, latest))) return;

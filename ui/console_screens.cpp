@@ -8,6 +8,7 @@
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"
+#include "ui/render_parts.hpp"
 #include "ui/text_input.hpp"
 #include "ui/tuning.hpp"
 
@@ -108,6 +109,10 @@ bool ConsoleController::handle_screen_key(int k) {
         const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];
         if (!l.error.empty()) {
           set_status(l.name + " cannot be opened: " + l.error, true);
+        } else if (!l.refusal.empty()) {
+          set_status(l.name + " cannot be opened here: " + l.refusal + " (bellows console --device " + l.device + " --session " +
+                         l.location + ")",
+                     true);
         } else if (!availability(Action::kOpen, state_).available) {
           set_status("cannot open now: " + availability(Action::kOpen, state_).reason, true);
         } else {
@@ -133,8 +138,21 @@ bool ConsoleController::handle_screen_key(int k) {
     }
     case Screen::kRig:
       return handle_rig_key(k);
+    case Screen::kHelp: {
+      const int page = std::max(1, state_.height - 6);  // the help's inner height
+      const int last = std::max(0, detail::help_line_count(state_) - page);
+      int& top = state_.help_scroll;
+      if (k == key::kUp) top -= 1;
+      else if (k == key::kDown) top += 1;
+      else if (k == key::kPageUp) top -= page;
+      else if (k == key::kPageDown) top += page;
+      else if (k == key::kHome) top = 0;
+      else if (k == key::kEnd) top = last;
+      else return false;
+      top = std::clamp(top, 0, last);
+      return true;
+    }
     case Screen::kMain:
-    case Screen::kHelp:
     case Screen::kFault:
       return false;
   }

@@ -50,6 +50,7 @@ void ConsoleController::start_save() {
   snapshot.experiment.saved_events = e.saved_events;
   snapshot.experiment.settings_changed = e.settings_changed;
   snapshot.experiment.faults = e.faults;  // saved ones hold no ticks (released)
+  snapshot.experiment.first_correction = e.first_correction;  // a new session records it
   snapshot.first_trial = first;
   const std::size_t new_events = std::min(state_.log.entries().size(), state_.log.total() - std::min(e.saved_events, state_.log.total()));
   const bool all_events = e.session_location.empty();
@@ -179,6 +180,7 @@ void ConsoleController::poll_session_tasks() {
       state_.browser.sessions = list_task_.take();
       // Newest first is what an operator looks for.
       std::reverse(state_.browser.sessions.begin(), state_.browser.sessions.end());
+      for (SessionListing& l : state_.browser.sessions) l.refusal = drive_refusal(l, env_.device_name);
       state_.browser.selected = 0;
     } catch (const std::exception& error) {
       state_.browser.sessions.clear();

@@ -28,6 +28,7 @@ enum class DialogKind {
   kConfirmQuit,      // s / q / Esc
   kConfirmDiscard,   // y/n: unsaved trials would be lost
   kConfirmValveTest, // y/n: the valves open one by one, the arm moves
+  kConfirmZeroAngle, // y/n: the angle read now becomes the rig profile's zero (its file is written)
   kSessionName,      // a name for the session saved as the console goes
 };
 
@@ -142,6 +143,7 @@ struct ConsoleState {
   std::string status;          // the latest message for the operator
   bool status_important = false;
   int log_scroll = 0;          // log screen: entries scrolled back from the newest
+  int help_scroll = 0;         // help screen: its first line shown
 
   // The engine and the rig.
   EngineState engine_state = EngineState::kSafe;

@@ -28,15 +28,31 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
   return source;
 }
 
+TransferSourceNote transfer_note_of(const Experiment& experiment, std::string name) {
+  TransferSourceNote note;
+  note.name = std::move(name);
+  note.directory = experiment.session_location;
+  note.trajectory = experiment.trajectory ? experiment.trajectory->name : "";
+  note.trials = static_cast<int>(experiment.trials.size());
+  note.last_rms_deg = experiment.trials.empty() ? 0.0 : experiment.trials.back().summary.rms_deg;
+  return note;
+}
+
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
                                      const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved,
-                                     const std::vector<std::string>& taught_locations) {
+                                     const std::vector<std::string>& taught_locations,
+                                     const std::vector<TransferSourceNote>& taught_notes) {
   TransferOffer offer;
   offer.trajectory = target;
   try {
     std::vector<TransferSource> sources;
-    for (TransferSource& s : taught) {
-      if (!s.trials.empty()) sources.push_back(std::move(s));
+    auto record = std::make_shared<FirstCorrection>();
+    for (std::size_t i = 0; i < taught.size(); ++i) {
+      TransferSource& s = taught[i];
+      if (s.trials.empty()) continue;
+      record->sources.push_back(i < taught_notes.size() ? taught_notes[i] : TransferSourceNote{s.name, "", s.name, 0, 0.0});
+      record->sources.back().trials = static_cast<int>(s.trials.size());
+      sources.push_back(std::move(s));
     }
     if (sessions != nullptr && sessions->available()) {
       std::vector<SessionListing> listed = sessions->list();
@@ -52,6 +68,9 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
           TransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
           if (source.trials.empty()) continue;
           source.name = listing.name + " (saved)";
+          TransferSourceNote note = transfer_note_of(snapshot.experiment, listing.name);
+          note.directory = listing.location;
+          record->sources.push_back(std::move(note));
           sources.push_back(std::move(source));
           ++used;
         } catch (const std::exception&) {
@@ -77,6 +96,8 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
     }
     offer.correction_bar = result.correction_bar;
     offer.useful = true;
+    record->result = result;
+    offer.record = std::move(record);
   } catch (const std::exception& error) {
     offer.why_not = error.what();
   }
@@ -89,6 +110,7 @@ void ConsoleController::remember_taught() {
   TransferSource source = transfer_source_of(state_.experiment, env_.config);
   if (source.trials.empty()) return;
   taught_.push_back(std::move(source));
+  taught_notes_.push_back(transfer_note_of(state_.experiment, state_.experiment.trajectory->name + " (this console)"));
   if (!state_.experiment.session_location.empty()) taught_locations_.push_back(state_.experiment.session_location);
 }
 
@@ -100,9 +122,9 @@ void ConsoleController::offer_transfer() {
     return;
   }
   transfer_wanted_ = false;
-  transfer_task_.start([taught = taught_, locations = taught_locations_, sessions = env_.sessions, config = env_.config,
-                        device = env_.device_name, target = state_.experiment.trajectory] {
-    return compute_transfer_offer(taught, sessions, config, device, target, 4, locations);
+  transfer_task_.start([taught = taught_, notes = taught_notes_, locations = taught_locations_, sessions = env_.sessions,
+                        config = env_.config, device = env_.device_name, target = state_.experiment.trajectory] {
+    return compute_transfer_offer(taught, sessions, config, device, target, 4, locations, notes);
   });
 }
 
@@ -137,6 +159,7 @@ bool ConsoleController::handle_transfer_key(int k) {
   }
   const TransferOffer& o = transfer_offer_;
   state_.experiment.set_next(o.correction_bar, "transferred (" + o.method + ")");
+  state_.experiment.first_correction = o.record;  // the session records it with iteration 0
   log(LogSource::kOperator, format("first correction transferred from %s (%s): predicted %.2f deg RMS, feedback only %.2f deg",
                                    o.sources.c_str(), o.method.c_str(), o.predicted_rms_deg, o.feedback_only_rms_deg));
   set_status(format("iteration 0 runs with the transferred correction: predicted %.1f deg RMS", o.predicted_rms_deg));

@@ -12,12 +12,10 @@
 #include "engine/configuration.hpp"
 #include "engine/learning_transfer.hpp"
 #include "ui/experiment.hpp"
+#include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
 
 namespace bellows::ui {
-
-/// The key that takes the offered transfer.
-inline constexpr int kTransferKey = 'T';
 
 struct TransferOffer {
   bool useful = false;
@@ -29,6 +27,7 @@ struct TransferOffer {
   double predicted_rms_deg = 0.0;
   double feedback_only_rms_deg = 0.0;
   std::string why_not;     // when not useful
+  std::shared_ptr<const FirstCorrection> record;  // what the session records when it is taken
   /// "T: start from what 2 sessions taught (inverse-fir): predicted 2.0 deg RMS, feedback only 12.6 deg"
   std::string offer_line() const;
 };
@@ -39,9 +38,12 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 /// Worker thread: the transfer from `taught` (this console's earlier experiments) and the `max_saved`
 /// newest saved sessions that fit this run (transfer_mismatch), for `target`. Never throws: a
 /// transfer that cannot be computed or would not help comes back with `why_not`. `taught_locations`:
-/// where `taught` is saved (the console saves as it goes), so the same trials are not used twice.
+/// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so the same trials are not used twice.
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
                                      const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved = 4,
-                                     const std::vector<std::string>& taught_locations = {});
+                                     const std::vector<std::string>& taught_locations = {},
+                                     const std::vector<TransferSourceNote>& taught_notes = {});
+/// `experiment`'s trials as a transfer source's note (what a session records about it).
+TransferSourceNote transfer_note_of(const Experiment& experiment, std::string name);
 
 }  // namespace bellows::ui

@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "engine/learning_session.hpp"
+#include "engine/learning_transfer.hpp"
 #include "engine/trajectory.hpp"
 #include "engine/engine_messages.hpp"
 #include "engine/trial_record.hpp"
@@ -35,6 +36,22 @@ struct FaultRecord {
   std::vector<TickRecord> ticks;  // oldest first, ending with the fault tick; empty once released
 };
 
+/// A source of a learning transfer, as the session that started from it records it.
+struct TransferSourceNote {
+  std::string name;        // the saved session's name, or the trajectory taught in this console
+  std::string directory;   // where it is saved ("" if it never was)
+  std::string trajectory;
+  int trials = 0;
+  double last_rms_deg = 0.0;
+};
+
+/// Where the first correction came from when a learning transfer gave it (issue 13): the session
+/// records it as its manifest's `first_correction`, like `bellows run --transfer-from`.
+struct FirstCorrection {
+  std::vector<TransferSourceNote> sources;
+  TransferResult result;
+};
+
 struct Experiment {
   /// Full records (tick-rate telemetry, hundreds of kB each) kept in memory for the newest trials
   /// only: a lab day of thousands of iterations must not grow without bound; the session on disk
@@ -54,6 +71,8 @@ struct Experiment {
   std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
   std::vector<FaultRecord> faults;      // black boxes, in the order the faults fired
   int saved_faults = 0;                 // black boxes already in the saved session
+  /// Set when the operator takes a transfer (T) before iteration 0; null: feedback only.
+  std::shared_ptr<const FirstCorrection> first_correction;
 
   /// A fresh experiment on `trajectory`: zero correction, no trials.
   static Experiment start(std::shared_ptr<const Trajectory> trajectory);

@@ -202,12 +202,48 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kFault:
       return {{"R", "reset the fault"}};
     case Screen::kRig:
-      return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"}};
+      return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"},
+              {"z", "zero the angle: the angle read now becomes the rig profile's zero (asks first; t7)"}};
     case Screen::kMain:
+      return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"}};
     case Screen::kHelp:
-      break;
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"?/F1, Esc", "close the help"}};
   }
   return {};
+}
+
+const char* screen_title(Screen screen) {
+  switch (screen) {
+    case Screen::kMain: return "Main screen";
+    case Screen::kHelp: return "This help";
+    case Screen::kTrajectory: return "Trajectory chooser (t)";
+    case Screen::kInspector: return "Correction inspector (c)";
+    case Screen::kTuning: return "Tuning (w)";
+    case Screen::kLog: return "Event log (l)";
+    case Screen::kSessions: return "Session browser (o)";
+    case Screen::kFault: return "Fault view (f)";
+    case Screen::kRig: return "Rig screen (b)";
+  }
+  return "";
+}
+
+std::vector<HelpEntry> help_entries(const ConsoleState& s) {
+  std::vector<HelpEntry> out;
+  const auto add_screen = [&](Screen screen, const std::string& title) {
+    const auto keys = screen_keys(screen);
+    if (keys.empty()) return;
+    out.push_back({true, "", title, {}});
+    for (const auto& [k, what] : keys) out.push_back({false, k, what, {}});
+  };
+  const Screen from = s.previous_screen;
+  if (from != Screen::kMain) add_screen(from, std::string("On the screen you came from: ") + screen_title(from));
+  out.push_back({true, "", "Everywhere (greyed: not available now)", {}});
+  for (const KeyBinding& b : key_bindings()) out.push_back({false, b.key_label, b.description, availability(b.action, s)});
+  for (Screen screen : {Screen::kMain, Screen::kInspector, Screen::kTrajectory, Screen::kTuning, Screen::kSessions,
+                        Screen::kLog, Screen::kFault, Screen::kRig, Screen::kHelp}) {
+    if (screen != from || from == Screen::kMain) add_screen(screen, screen_title(screen));
+  }
+  return out;
 }
 
 }  // namespace bellows::ui

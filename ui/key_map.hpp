@@ -60,7 +60,27 @@ std::vector<Action> function_bar_actions(const ConsoleState& state);
 /// A key as the operator knows it: "z", "Left", "F5" (for messages about keys).
 std::string key_name(int key);
 
-/// Keys of the current screen beyond the global ones: (key, what it does).
+/// The key that takes an offered transfer (main screen, only while an offer stands; issue 13).
+inline constexpr int kTransferKey = 'T';
+
+/// Keys of a screen beyond the global ones: (key, what it does). The screens' key handling
+/// (console_screens.cpp, console_rig.cpp, console_transfer.cpp) answers exactly these.
 std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen);
+
+/// The screen as the help names it: "Correction inspector".
+const char* screen_title(Screen screen);
+
+/// One line of the help: a section title (`section`), or a key, what it does and whether it is
+/// available now (with the reason when not).
+struct HelpEntry {
+  bool section = false;
+  std::string keys;
+  std::string what;
+  Availability availability;
+};
+
+/// The whole help, built from key_bindings() and screen_keys() so it cannot drift from them: the
+/// keys of the screen help was opened from, then the global ones, then every other screen's.
+std::vector<HelpEntry> help_entries(const ConsoleState& state);
 
 }  // namespace bellows::ui

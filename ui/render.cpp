@@ -157,22 +157,62 @@ void render_header(const ConsoleState& s, Canvas& c) {
   put_segments(c, 1, line);
 }
 
+/// The status line, never cut mid-word: a message longer than the window wraps onto the line above
+/// (the body's bottom border), and one longer than two lines ends at a word with an ellipsis.
 void render_status(const ConsoleState& s, Canvas& c) {
   const int y = c.height() - 2;
   std::string text = s.status;
   if (s.learner_busy && !s.learner_task.empty()) text = s.learner_task + "...  " + text;
   if (s.heartbeat_drill) text = "HEARTBEAT DRILL: heartbeats withheld, the engine must vent  " + text;
-  c.put(1, y, text, s.status_important || s.heartbeat_drill ? Role::kWarning : Role::kNormal, s.status_important);
+  const int columns = c.width() - 2;
+  std::vector<std::string> lines = wrap(text, columns);
+  const std::string ellipsis = s.unicode ? "\u2026" : "...";
+  if (lines.size() > 2) {
+    lines.resize(2);
+    std::vector<std::string> last = wrap(lines[1], columns - text_width(ellipsis) - 1);
+    lines[1] = (last.empty() ? std::string() : last.front()) + " " + ellipsis;
+  }
+  const Role role = s.status_important || s.heartbeat_drill ? Role::kWarning : Role::kNormal;
+  const int top = y - static_cast<int>(lines.size()) + 1;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const int row = top + static_cast<int>(i);
+    c.fill({0, row, c.width(), 1}, U' ');
+    c.put(1, row, lines[i], role, s.status_important);
+  }
 }
 
+/// The htop-style bar: the keys that matter now. When they do not all fit, the stop, the way back,
+/// help and quit stay, and the others are dropped from the end.
 void render_function_bar(const ConsoleState& s, Canvas& c) {
   const int y = c.height() - 1;
+  const std::vector<Action> candidates = function_bar_actions(s);
+  const auto width_of = [](Action a) {
+    const KeyBinding& b = binding(a);
+    return text_width(a == Action::kEmergencyStop ? "Space" : b.key_label) + text_width(b.bar_label) + 3;
+  };
+  const auto essential = [](Action a) {
+    return a == Action::kEmergencyStop || a == Action::kMain || a == Action::kHelp || a == Action::kQuit;
+  };
+  int room = c.width();
+  for (Action a : candidates) {
+    if (essential(a)) room -= width_of(a);
+  }
+  std::vector<Action> shown;
+  for (Action a : candidates) {
+    if (essential(a)) {
+      shown.push_back(a);
+    } else if (width_of(a) <= room) {
+      shown.push_back(a);
+      room -= width_of(a);
+    } else {
+      room = 0;  // keep the order: nothing after a dropped key jumps ahead of it
+    }
+  }
   int x = 0;
-  for (Action a : function_bar_actions(s)) {
+  for (Action a : shown) {
     const KeyBinding& b = binding(a);
     const std::string key = a == Action::kEmergencyStop ? "Space" : b.key_label;
-    const int need = text_width(key) + text_width(b.bar_label) + 3;
-    if (x + need > c.width()) break;
+    if (x + width_of(a) - 2 > c.width()) break;
     x = c.put(x, y, key, Role::kKey, true);
     x = c.put(x, y, " ");
     x = c.put(x, y, b.bar_label, a == Action::kEmergencyStop ? Role::kFault : Role::kTitle, true);

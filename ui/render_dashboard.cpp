@@ -50,8 +50,19 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
   const TickRecord& t = s.live;
   int row = 0;
   value_row(c, in, row++, "angle", number("%7.2f deg", to_deg(t.reading.angle_rad)));
-  value_row(c, in, row++, "set point", number("%7.2f deg", to_deg(t.desired_angle_rad)));
-  value_row(c, in, row++, "error", number("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
+  // The latest tick's own state, not the console's: the engine keeps its last set point after a
+  // vent, which is no set point at all then, and a tracking error exists only during a trial.
+  if (valves_live(t.state)) {
+    value_row(c, in, row++, "set point",
+              number("%7.2f deg", to_deg(t.desired_angle_rad)) + (t.state == EngineState::kArmed ? " hold" : ""));
+  } else {
+    value_row(c, in, row++, "set point", "none: vented", Role::kDim);
+  }
+  if (t.state == EngineState::kRunning) {
+    value_row(c, in, row++, "error", number("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
+  } else {
+    value_row(c, in, row++, "error", "no trial", Role::kDim);
+  }
   value_row(c, in, row++, "p A", number("%7.3f bar", t.reading.chamber_bar[0]));
   value_row(c, in, row++, "p B", number("%7.3f bar", t.reading.chamber_bar[1]));
   value_row(c, in, row++, "supply", number("%7.3f bar", t.reading.supply_bar),

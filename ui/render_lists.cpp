@@ -11,29 +11,61 @@
 
 namespace bellows::ui::detail {
 
+namespace {
+
+/// A line of the help as drawn: a section title, or a key (on the first line of its entry only)
+/// and a piece of its wrapped description.
+struct HelpLine {
+  bool section = false;
+  bool available = true;
+  std::string keys;
+  std::string text;
+};
+
+constexpr int kHelpKeyColumn = 20;
+
+std::vector<HelpLine> help_layout(const ConsoleState& s, int inner_width) {
+  std::vector<HelpLine> lines;
+  const int text_columns = std::max(20, inner_width - kHelpKeyColumn - 3);
+  for (const HelpEntry& e : help_entries(s)) {
+    if (e.section) {
+      if (!lines.empty()) lines.push_back({});
+      lines.push_back({true, true, "", e.what});
+      continue;
+    }
+    std::string text = e.what;
+    if (!e.availability.available && !e.availability.reason.empty()) text += "  (" + e.availability.reason + ")";
+    bool first = true;
+    for (const std::string& piece : wrap(text, text_columns)) {
+      lines.push_back({false, e.availability.available, first ? e.keys : "", piece});
+      first = false;
+    }
+  }
+  return lines;
+}
+
+}  // namespace
+
+int help_line_count(const ConsoleState& s) { return static_cast<int>(help_layout(s, s.width - 2).size()); }
+
 void render_help(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  c.frame(body, g, "Keys (greyed: not available now)");
   const Rect in = inner(body);
-  int y = in.y;
-  for (const KeyBinding& b : key_bindings()) {
-    if (y >= in.bottom()) break;
-    const Availability a = availability(b.action, s);
-    const Role role = a.available ? Role::kNormal : Role::kDim;
-    c.put(in.x + 1, y, fit(b.key_label, 7), a.available ? Role::kKey : Role::kDim, a.available);
-    int x = c.put(in.x + 9, y, b.description, role, false, in.right());
-    if (!a.available && !a.reason.empty()) c.put(x, y, "  (" + a.reason + ")", Role::kDim, false, in.right());
-    ++y;
-  }
-  const auto extra = screen_keys(s.previous_screen);
-  if (!extra.empty() && y + 2 < in.bottom()) {
-    ++y;
-    c.put(in.x + 1, y++, "On the screen you came from:", Role::kTitle, true);
-    for (const auto& [keys, what] : extra) {
-      if (y >= in.bottom()) break;
-      c.put(in.x + 1, y, fit(keys, 20), Role::kKey);
-      c.put(in.x + 22, y++, what, Role::kNormal, false, in.right());
+  const std::vector<HelpLine> lines = help_layout(s, in.width);
+  const int total = static_cast<int>(lines.size());
+  const int top = std::clamp(s.help_scroll, 0, std::max(0, total - in.height));
+  const int shown_last = std::min(total, top + in.height);
+  std::string title = "Keys";
+  if (total > in.height) title += format(" (lines %d-%d of %d; Up/Down, PgUp/PgDn scroll)", top + 1, shown_last, total);
+  c.frame(body, g, title);
+  for (int i = top, y = in.y; i < shown_last; ++i, ++y) {
+    const HelpLine& l = lines[static_cast<std::size_t>(i)];
+    if (l.section) {
+      c.put(in.x + 1, y, l.text, Role::kTitle, true, in.right());
+      continue;
     }
+    if (!l.keys.empty()) c.put(in.x + 1, y, fit(l.keys, kHelpKeyColumn), l.available ? Role::kKey : Role::kDim, l.available);
+    c.put(in.x + 2 + kHelpKeyColumn, y, l.text, l.available ? Role::kNormal : Role::kDim, false, in.right());
   }
 }
 
@@ -98,6 +130,20 @@ std::string law_summary(const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+/// How to edit the selected row, and why not now when it cannot change.
+std::string tuning_hint(const ConsoleState& s) {
+  if (s.run.mode != RunProgress::Mode::kIdle || s.engine_state == EngineState::kRunning) {
+    return "Up/Down choose   changes wait: trials are running (x stops them)";
+  }
+  if (s.engine_state == EngineState::kFault) return "Up/Down choose   changes wait: a fault is latched (R resets)";
+  if (s.tuning.selected == TuningForm::kLawRow) return "Up/Down choose   Enter or Right: next law   Left: the one before";
+  return "Up/Down choose   Enter edit: type the value, Enter applies, Esc cancels";
+}
+
+}  // namespace
+
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
   const int form_height = std::min(body.height, 15);
@@ -135,7 +181,10 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
     if (y >= in.bottom()) break;
     c.put(in.x + 1, y++, line, s.convergence_warning ? Role::kWarning : Role::kDim, s.convergence_warning, in.right());
   }
-  const Rect changes{body.x, form.bottom(), body.width, body.height - form_height};
+  if (form_height < body.height) {  // how to edit, under the form
+    c.put(body.x + 2, form.bottom(), tuning_hint(s), Role::kKey, false, body.right() - 1);
+  }
+  const Rect changes{body.x, form.bottom() + 1, body.width, body.height - form_height - 1};
   if (changes.height < 3) return;
   c.frame(changes, g, "Changes recorded in the log");
   const Rect cin = inner(changes);
@@ -205,8 +254,8 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(in.x + 1, in.y, "No saved session yet: s saves the current one.", Role::kDim);
     return;
   }
-  c.put(in.x + 1, in.y, "  started           trajectory   iterations   best RMS  name", Role::kDim);
-  const int rows = in.height - 2;
+  c.put(in.x + 1, in.y, "  started           device trajectory  iterations   best RMS  name", Role::kDim);
+  const int rows = in.height - 3;  // the last line tells why the chosen one cannot be opened
   const int count = static_cast<int>(b.sessions.size());
   const int first = std::clamp(b.selected - rows + 1, 0, std::max(0, count - rows));
   for (int i = first, y = in.y + 1; i < count && y < in.y + 1 + rows; ++i, ++y) {
@@ -214,13 +263,21 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
     const bool selected = i == b.selected;
     std::string row;
     if (l.error.empty()) {
-      row = format("%s %-17s %-12s %10d   %s  %s", selected ? ">" : " ", l.date.c_str(), l.trajectory.c_str(), l.iterations,
-                   l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str());
+      row = format("%s %-17s %-6s %-12s %9d   %s  %s%s", selected ? ">" : " ", l.date.c_str(), l.device.c_str(),
+                   l.trajectory.c_str(), l.iterations,
+                   l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str(),
+                   l.refusal.empty() ? "" : "  (other device)");
     } else {
       row = format("%s %s: cannot be read: %s", selected ? ">" : " ", l.name.c_str(), l.error.c_str());
     }
-    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (l.error.empty() ? Role::kNormal : Role::kDim),
-          selected);
+    const bool openable = l.error.empty() && l.refusal.empty();
+    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (openable ? Role::kNormal : Role::kDim), selected);
+  }
+  if (b.selected >= 0 && b.selected < count) {
+    const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];
+    if (!l.refusal.empty() && b.error.empty()) {
+      c.put(in.x + 1, in.bottom() - 1, "cannot open it here: " + l.refusal, Role::kWarning, true, in.right());
+    }
   }
 }
 

@@ -20,6 +20,8 @@ void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_fault(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_help(const ConsoleState& s, Canvas& c, const Rect& body);
+/// How many lines the help has at the window width (the controller bounds its scrolling by it).
+int help_line_count(const ConsoleState& s);
 void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_log(const ConsoleState& s, Canvas& c, const Rect& body);

@@ -38,7 +38,16 @@ struct SessionListing {
   int iterations = 0;
   double best_rms_deg = -1; // negative: no iteration
   std::string error;        // not empty: the session cannot be read (the reason)
+  std::string device;       // the device it was recorded on (its manifest's "device")
+  std::string refusal;      // not empty: this console cannot drive it (the reason; see drive_refusal)
 };
+
+/// Why a console driving `console_device` cannot open a session recorded on `listing.device`
+/// (it would continue the learning on another rig); empty when it can.
+inline std::string drive_refusal(const SessionListing& listing, const std::string& console_device) {
+  if (listing.device.empty() || listing.device == console_device) return {};
+  return "recorded on the device '" + listing.device + "'; this console drives '" + console_device + "'";
+}
 
 class SessionGateway {
  public:
