@@ -303,6 +303,8 @@ TEST_F(SessionsCommand, ListIsATableAndJson) {
   for (const auto& iteration : first_["iterations"]) best = std::min(best, iteration["rms_deg"].get<double>());
   EXPECT_EQ(list[1]["best_rms_deg"].get<double>(), best);
 
+  // An empty data directory has no sessions; a missing one is a typo, refused (test_cli_conventions).
+  fs::create_directories(dir_ / "none");
   const ProcessResult empty = run_bellows({"sessions", "list", "--data-dir", (dir_ / "none").string()});
   EXPECT_EQ(empty.exit_code, 0);
   EXPECT_EQ(empty.out, "no sessions in " + (dir_ / "none").string() + "\n");

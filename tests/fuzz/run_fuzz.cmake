@@ -16,6 +16,14 @@ if(NOT CLANGXX OR NOT EXISTS "${CLANGXX}")
 endif()
 string(REPLACE "," ";" TARGETS "${TARGETS}")
 if(MODE STREQUAL "build")
+  # A fuzz tree configured by an older bellows with another generator: configure it afresh (the
+  # corpus beside it stays).
+  if(EXISTS ${BUILD_DIR}/CMakeCache.txt)
+    file(STRINGS ${BUILD_DIR}/CMakeCache.txt generator REGEX "^CMAKE_GENERATOR:INTERNAL=")
+    if(NOT generator STREQUAL "CMAKE_GENERATOR:INTERNAL=Ninja")
+      file(REMOVE_RECURSE ${BUILD_DIR}/CMakeCache.txt ${BUILD_DIR}/CMakeFiles)
+    endif()
+  endif()
   # Release: the sanitizer build's -O1 (CMakeLists.txt); line tables name the line of a crash.
   execute_process(
     COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BUILD_DIR} -G Ninja -DCMAKE_CXX_COMPILER=${CLANGXX}
