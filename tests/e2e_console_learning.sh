@@ -91,7 +91,7 @@ e2e_wait_for 'law [a-z-]+  M'
 # The browser lists it: date, trajectory, iterations, best RMS.
 best="$(echo "$history" | awk 'NR == 1 || $2 < b { b = $2 } END { print b }')"
 e2e_keys o
-e2e_wait_for "> [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2} +paper +6 +$best +$(basename "$session")"
+e2e_wait_for "> [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2} +sim +paper +6 +$best +$(basename "$session")"
 e2e_keys Escape
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
