@@ -257,11 +257,12 @@ bool T7Device::exchange(const ValveCommand& valves) {
 }
 
 void T7Device::fail_link() {
-  if (!link_up_.exchange(false, std::memory_order_relaxed)) return;  // reported at the start of the streak
+  if (!link_up_.load(std::memory_order_relaxed)) return;  // reported at the start of the streak (only this thread writes it)
   if (!error_published_.load(std::memory_order_acquire)) {
     link_error_ = client_.last_error();
     error_published_.store(true, std::memory_order_release);
   }
+  link_up_.store(false, std::memory_order_release);  // after the error: whoever sees the link down can read why
   std::fprintf(stderr, "bellows: t7 link %s: %s: no fresh readings while it lasts (the engine faults sensor-stale and vents)\n",
                address_.c_str(), client_.last_error().c_str());
 }
@@ -289,7 +290,7 @@ DeviceHealth T7Device::health() const {
   constexpr auto relaxed = std::memory_order_relaxed;
   DeviceHealth h;
   h.has_link = true;
-  h.connected = link_up_.load(relaxed);
+  h.connected = link_up_.load(std::memory_order_acquire);
   h.round_trip_p50_ms = p50_ms_.load(relaxed);
   h.round_trip_p99_ms = p99_ms_.load(relaxed);
   h.round_trip_max_ms = max_ms_.load(relaxed);

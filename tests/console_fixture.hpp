@@ -51,7 +51,9 @@ class MemorySessions final : public ui::SessionGateway {
     ++saves;
     return location;
   }
+  // Every call runs on a worker of its own (as the console's gateway calls do): each takes the lock.
   std::vector<ui::SessionListing> list() override {
+    const std::lock_guard<std::mutex> guard(mutex);
     std::vector<ui::SessionListing> out;
     for (const auto& [location, s] : saved) {
       out.push_back({location, location, "2024-05-01 12:00", s.experiment.trajectory->name,
@@ -60,6 +62,7 @@ class MemorySessions final : public ui::SessionGateway {
     return out;
   }
   ui::SessionSnapshot open(const std::string& location) override {
+    const std::lock_guard<std::mutex> guard(mutex);
     ui::SessionSnapshot s = saved.at(location);
     s.experiment.session_location = location;
     return s;
