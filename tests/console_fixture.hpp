@@ -2,6 +2,7 @@
 // for the console's tests; and sessions kept in memory.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -69,8 +70,8 @@ class MemorySessions final : public ui::SessionGateway {
   }
   ui::SessionSnapshot read_trials(const std::string& location) override { return open(location); }
   std::map<std::string, ui::SessionSnapshot> saved;
-  int saves = 0;
-  bool fail_saves = false;
+  std::atomic<int> saves{0};  // the tests read and set these while workers save
+  std::atomic<bool> fail_saves{false};
   std::mutex mutex;
 };
 
