@@ -54,7 +54,11 @@ device_setup() {
            [ -n "$port" ] || sleep 0.05
          done
          [ "$port" != 0 ] || e2e_fail "t7-sim reports port 0"
-         DEVICE_ARGS=(--device t7 --t7 "127.0.0.1:$port") ;;
+         # The loaded-machine settings of the T7 process tests: a sanitizer build beside other
+         # tests answers Modbus slower than a rig's 20 ms timeout allows (what the guards do on a
+         # real link has tests of its own).
+         printf '[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n' >"$E2E_DIR/t7-loaded.toml"
+         DEVICE_ARGS=(--device t7 --t7 "127.0.0.1:$port" --config "$E2E_DIR/t7-loaded.toml") ;;
     *) e2e_fail "unknown device '$1'" ;;
   esac
 }
