@@ -137,22 +137,30 @@ TEST(T7Loopback, WhenTheEngineFallsSilentTheLinkVentsByItselfAndKeepsTheWatchdog
 // The rig enforces its own limits whatever it is sent (issue 16): a client that keeps writing both
 // inlets open meets the pressure ceiling, every time, while the lines keep showing what it wrote.
 // Without the limit (a ceiling out of reach) the same client drives the chambers far above it.
-double highest_chamber_bar_while_inlets_open(const RigLimits& limits, T7SimStatus& last) {
+/// A client writing `command` for 3 s, one write every 5 ms like the engine's ticks, to a t7-sim
+/// with `limits`: the largest `measure` of its status seen meanwhile; `last` is its final status.
+double largest_while_writing(const RigLimits& limits, const ValveCommand& command,
+                             const std::function<double(const T7SimStatus&)>& measure, T7SimStatus& last) {
   T7SimOptions options;
   options.limits = limits;
   SimThread sim(options);
   T7Device device(device_options(sim.port()));
+  double largest = 0.0;
+  for (int i = 0; i < 600; ++i) {
+    device.write_valves(command);
+    last = sim.status();
+    largest = std::max(largest, measure(last));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return largest;
+}
+
+double highest_chamber_bar_while_inlets_open(const RigLimits& limits, T7SimStatus& last) {
   ValveCommand both_inlets_open;  // both chambers fill: the arm stays near its middle
   both_inlets_open.inlet_duty = {1.0, 1.0};
   both_inlets_open.outlet_duty = {0.0, 0.0};
-  double highest = 0.0;
-  for (int i = 0; i < 600; ++i) {  // 3 s of commands, one every 5 ms like the engine's ticks
-    device.write_valves(both_inlets_open);
-    last = sim.status();
-    highest = std::max({highest, last.chamber_bar[0], last.chamber_bar[1]});
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return highest;
+  return largest_while_writing(limits, both_inlets_open,
+                               [](const T7SimStatus& s) { return std::max(s.chamber_bar[0], s.chamber_bar[1]); }, last);
 }
 
 TEST(T7Loopback, TheRigKeepsItsPressureCeilingWhateverTheClientWrites) {
@@ -174,21 +182,10 @@ TEST(T7Loopback, TheRigKeepsItsPressureCeilingWhateverTheClientWrites) {
 // The same for the angle: a client that keeps turning the arm (A fills, B vents) is vented each time
 // the arm leaves the rig's range; without that range the arm goes much further.
 double widest_angle_rad_while_turning(const RigLimits& limits, T7SimStatus& last) {
-  T7SimOptions options;
-  options.limits = limits;
-  SimThread sim(options);
-  T7Device device(device_options(sim.port()));
   ValveCommand turn;
   turn.inlet_duty = {1.0, 0.0};
   turn.outlet_duty = {0.0, 1.0};
-  double widest = 0.0;
-  for (int i = 0; i < 600; ++i) {
-    device.write_valves(turn);
-    last = sim.status();
-    widest = std::max(widest, std::abs(last.angle_rad));
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return widest;
+  return largest_while_writing(limits, turn, [](const T7SimStatus& s) { return std::abs(s.angle_rad); }, last);
 }
 
 TEST(T7Loopback, AnArmBeyondTheRigsAngleRangeIsVentedWhateverTheClientWrites) {
