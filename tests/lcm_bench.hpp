@@ -13,6 +13,7 @@
 #include "devices/lcm_rig_server.hpp"
 #include "engine/configuration.hpp"
 #include "tests/lcm_test_support.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows::testing {
 
@@ -50,10 +51,6 @@ inline io_command_t command(std::int64_t session, std::int64_t seq, double inlet
   c.inlet_duty[0] = inlet_a;
   c.outlet_duty[1] = 0.2;
   return c;
-}
-
-inline bool vented(const ValveCommand& c) {
-  return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
 }
 
 inline void publish_garbage(lcm::LCM& bus, const char* channel) {

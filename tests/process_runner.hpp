@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +12,10 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace bellows::testing {
 
@@ -18,7 +23,11 @@ struct ProcessResult {
   int exit_code = -1;
   std::string out;
   std::string err;
+  bool hung = false;  // killed by a hang guard (run_bellows()): a regression that blocks fails, never hangs the suite
 };
+
+/// The bellows binary under test.
+inline const std::string kBellows = BELLOWS_BINARY;
 
 inline std::filesystem::path make_temp_dir(const std::string& prefix) {
   std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "-XXXXXX")).string();
@@ -49,6 +58,24 @@ inline std::filesystem::path write_file(const std::filesystem::path& dir, const 
   const std::filesystem::path path = dir / name;
   std::ofstream(path) << text;
   return path;
+}
+
+/// `bellows ARGS` (stdin from /dev/null, no terminal) is refused: exit `status`, nothing on stdout,
+/// and one line of its own on stderr that contains `fragment`.
+inline void expect_refused_in_one_line(const std::string& args, const std::string& fragment, int status = 2) {
+  const ProcessResult result = run_process(kBellows + " " + args + " < /dev/null");
+  EXPECT_EQ(result.exit_code, status) << args << "\n" << result.err;
+  EXPECT_TRUE(result.out.empty()) << args << ": " << result.out;
+  EXPECT_NE(result.err.find(fragment), std::string::npos) << args << ": " << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << args << ": " << result.err;
+  EXPECT_EQ(result.err.rfind("bellows: ", 0), 0u) << args << ": " << result.err;
+}
+
+/// The RMS of every iteration of a `bellows run --json` report, in order.
+inline std::vector<double> rms_sequence(const nlohmann::json& report) {
+  std::vector<double> rms;
+  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
+  return rms;
 }
 
 }  // namespace bellows::testing

@@ -24,6 +24,7 @@
 #include "engine/learning_law_factory.hpp"
 #include "engine/learning_session.hpp"
 #include "sessions/session.hpp"
+#include "tests/process_runner.hpp"
 
 namespace bellows::testing {
 
@@ -58,12 +59,6 @@ inline std::string read_text(const std::filesystem::path& path) {
   text << in.rdbuf();
   return text.str();
 }
-
-struct ProcessResult {
-  int exit_code = -1;
-  std::string out, err;
-  bool hung = false;  // killed by run_bellows()'s guard: a regression that blocks fails, never hangs the suite
-};
 
 /// How long run_bellows() waits before it kills the process and reports it hung. A hang guard,
 /// not a speed check: every command it runs takes well under a second on an idle machine.

@@ -10,17 +10,11 @@
 namespace bellows {
 namespace {
 
+using testing::expect_refused_in_one_line;
+
 using testing::run_process;
 
 testing::ProcessResult bellows(const std::string& args) { return run_process(std::string(BELLOWS_BINARY) + " " + args + " < /dev/null"); }
-
-void expect_refused(const std::string& args, const std::string& fragment) {
-  const auto result = bellows(args);
-  EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.err;
-  EXPECT_TRUE(result.out.empty()) << args << ": " << result.out;
-  EXPECT_NE(result.err.find(fragment), std::string::npos) << args << ": " << result.err;
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << args << ": " << result.err;
-}
 
 TEST(CliConventions, VersionIsTheOneSessionsRecord) {
   const auto result = bellows("--version");
@@ -49,13 +43,13 @@ TEST(CliConventions, HelpShowsWordsNotCodesOrBuildPaths) {
 }
 
 TEST(CliConventions, TheWordsStillChooseTheMode) {
-  expect_refused("run --rt sometimes", "--rt");
+  expect_refused_in_one_line("run --rt sometimes", "--rt");
   EXPECT_EQ(bellows("run --rt OFF --iterations 0 --no-save --trajectory steps").exit_code, 0);
 }
 
 TEST(CliConventions, SpeedOnTheSimulatedClockIsRefused) {
-  expect_refused("run --speed 10 --no-save", "--speed is for --clock wall");
-  expect_refused("run --clock sim --speed max --no-save", "--speed is for --clock wall");
+  expect_refused_in_one_line("run --speed 10 --no-save", "--speed is for --clock wall");
+  expect_refused_in_one_line("run --clock sim --speed max --no-save", "--speed is for --clock wall");
 }
 
 TEST(CliConventions, AMissingDataDirectoryIsRefusedNotEmpty) {
@@ -63,10 +57,10 @@ TEST(CliConventions, AMissingDataDirectoryIsRefusedNotEmpty) {
   const std::string missing = (dir / "typo").string();
   for (const std::string command : {"sessions list", "sessions show x", "sessions export x", "sessions rm --yes x",
                                     "sessions rename x y", "sessions plot x"}) {
-    expect_refused(command + " --data-dir " + missing, "no such directory");
+    expect_refused_in_one_line(command + " --data-dir " + missing, "no such directory");
   }
   const auto file = testing::write_file(dir, "a-file", "text");
-  expect_refused("sessions list --data-dir " + file.string(), "not a directory");
+  expect_refused_in_one_line("sessions list --data-dir " + file.string(), "not a directory");
   const auto empty = bellows("sessions list --data-dir " + dir.string());
   EXPECT_EQ(empty.exit_code, 0) << empty.err;
   EXPECT_NE(empty.out.find("no sessions"), std::string::npos) << empty.out;
@@ -78,10 +72,10 @@ TEST(CliConventions, ConfigErrorsNameTheFileAndSayWhyItCannotBeRead) {
                                   std::string("[ilc]\nlaw = \"noilc-dense\"\ns = 0.0\nw = 0.0\n"),
                                   std::string("[ilc]\nlaw = \"bogus\"\n"), std::string("[ilc]\nm = -1.0\n")}) {
     const auto file = testing::write_file(dir, "ilc.toml", text);
-    expect_refused("run --no-save --config " + file.string(), "config " + file.string() + ": [ilc]");
+    expect_refused_in_one_line("run --no-save --config " + file.string(), "config " + file.string() + ": [ilc]");
   }
-  expect_refused("config --config " + (dir / "missing.toml").string(), "missing.toml: cannot be read: No such file");
-  expect_refused("config --config " + dir.string(), "is a directory");
+  expect_refused_in_one_line("config --config " + (dir / "missing.toml").string(), "missing.toml: cannot be read: No such file");
+  expect_refused_in_one_line("config --config " + dir.string(), "is a directory");
 }
 
 }  // namespace

@@ -168,7 +168,7 @@ TEST(HostileManifest, BadValuesInASavedSessionAreRefusedByShowAndResumeWithoutHa
 }
 
 // Reads stderr until `text` appears (or the deadline passes); returns what was read.
-std::string read_until(int fd, const std::string& text) {
+std::string read_until_or_deadline(int fd, const std::string& text) {
   std::string got;
   char buffer[4096];
   const auto deadline = Clock::now() + kDeadline;
@@ -188,7 +188,7 @@ TEST(HostileSignals, SigintDuringALongIdentificationStopsItWith130) {
   testing::write_text(config, "[identify]\nduration_s = 600.0\n");  // minutes of simulation
   for (const int signal_number : {SIGINT, SIGTERM}) {
     const Spawned spawned = testing::spawn_bellows({"identify", "--config", config.string(), "--json"});
-    std::string err = read_until(spawned.err, "identification trial");
+    std::string err = read_until_or_deadline(spawned.err, "identification trial");
     ASSERT_NE(err.find("identification trial"), std::string::npos) << err;
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // inside the trial's simulation
     ::kill(spawned.pid, signal_number);

@@ -17,11 +17,7 @@ nlohmann::json run_json(const std::string& args) {
   return nlohmann::json::parse(result.out);
 }
 
-std::vector<double> rms_sequence(const nlohmann::json& report) {
-  std::vector<double> rms;
-  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
-  return rms;
-}
+using testing::rms_sequence;
 
 TEST(CliRun, ReproducesThePapersLearningCurve) {
   const nlohmann::json report = run_json("--trajectory paper --iterations 60");

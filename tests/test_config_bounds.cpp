@@ -17,6 +17,7 @@
 #include "engine/learning_law_factory.hpp"
 #include "engine/arm_model.hpp"
 #include "sessions/manifest_json.hpp"
+#include "tests/config_test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -139,42 +140,33 @@ TEST(ConfigBounds, TheManifestReaderRefusesTheSameValues) {
   }
 }
 
-void expect_refused(const std::string& toml, const std::string& names) {
-  Configuration config;
-  try {
-    apply_config_toml(toml, "lab.toml", config);
-    ADD_FAILURE() << "accepted: " << toml;
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("lab.toml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find(names), std::string::npos) << e.what();
-  }
-}
+using testing::expect_config_refused;
 
 TEST(ConfigBounds, TheIssuesHugeValuesAreRefused) {
-  expect_refused("[timing]\ntick_s = 1e-9\n", "[timing] tick_s");
-  expect_refused("[safety]\nblack_box_s = 1e9\n", "[safety] black_box_s");
-  expect_refused("[plant]\nintegration_step_s = 1e-12\n", "[plant] integration_step_s");
-  expect_refused("[ilc]\nprediction_grid_points = 100000\n", "[ilc] prediction_grid_points");
-  expect_refused("[safety]\nstale_ticks = 4294967299\n", "[safety] stale_ticks");
-  expect_refused("[timing]\nticks_per_sample = 4294967297\n", "[timing] ticks_per_sample");
-  expect_refused("[timing]\nsettle_s = 1e9\n", "[timing] settle_s");
+  expect_config_refused("[timing]\ntick_s = 1e-9\n", "[timing] tick_s");
+  expect_config_refused("[safety]\nblack_box_s = 1e9\n", "[safety] black_box_s");
+  expect_config_refused("[plant]\nintegration_step_s = 1e-12\n", "[plant] integration_step_s");
+  expect_config_refused("[ilc]\nprediction_grid_points = 100000\n", "[ilc] prediction_grid_points");
+  expect_config_refused("[safety]\nstale_ticks = 4294967299\n", "[safety] stale_ticks");
+  expect_config_refused("[timing]\nticks_per_sample = 4294967297\n", "[timing] ticks_per_sample");
+  expect_config_refused("[timing]\nsettle_s = 1e9\n", "[timing] settle_s");
 }
 
 TEST(ConfigBounds, CombinationsOverACostBudgetAreRefusedNamingTheKeys) {
   // Each value is in its own range; together they would allocate or compute far too much.
-  expect_refused("[timing]\ntick_s = 1e-4\n[safety]\nblack_box_s = 60.0\n", "black_box_s");
-  expect_refused("[timing]\ntick_s = 1.0\n[plant]\npwm_period_s = 1.0\nintegration_step_s = 1e-6\n", "integration_step_s");
-  expect_refused("[timing]\ntick_s = 1e-4\n[identify]\nduration_s = 600.0\n", "[identify] duration_s");
-  expect_refused("[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n[identify]\nduration_s = 50.0\n",
+  expect_config_refused("[timing]\ntick_s = 1e-4\n[safety]\nblack_box_s = 60.0\n", "black_box_s");
+  expect_config_refused("[timing]\ntick_s = 1.0\n[plant]\npwm_period_s = 1.0\nintegration_step_s = 1e-6\n", "integration_step_s");
+  expect_config_refused("[timing]\ntick_s = 1e-4\n[identify]\nduration_s = 600.0\n", "[identify] duration_s");
+  expect_config_refused("[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n[identify]\nduration_s = 50.0\n",
                  "[identify] duration_s");
   // A law whose Q-filter is at or above the Nyquist frequency is refused at load, naming the file.
-  expect_refused("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n", "[ilc] pd_q_cutoff_hz");
-  expect_refused("[ilc]\nlaw = \"p-type\"\n", "[ilc] law");
-  expect_refused("[safety]\nsensor_min_bar = 12.0\n", "[safety] sensor_min_bar");
-  expect_refused("[identify]\nchirp_start_hz = 5.0\n", "[identify] chirp_start_hz");
-  expect_refused("[identify]\namplitude_deg = 70.0\n", "[identify] amplitude_deg");
-  expect_refused("[ilc]\nlaw = \"noilc-dense\"\ns = 0.0\nw = 0.0\n", "[ilc] s, w");
-  expect_refused("[identify]\nsignal = \"noise\"\n", "[identify] signal");
+  expect_config_refused("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n", "[ilc] pd_q_cutoff_hz");
+  expect_config_refused("[ilc]\nlaw = \"p-type\"\n", "[ilc] law");
+  expect_config_refused("[safety]\nsensor_min_bar = 12.0\n", "[safety] sensor_min_bar");
+  expect_config_refused("[identify]\nchirp_start_hz = 5.0\n", "[identify] chirp_start_hz");
+  expect_config_refused("[identify]\namplitude_deg = 70.0\n", "[identify] amplitude_deg");
+  expect_config_refused("[ilc]\nlaw = \"noilc-dense\"\ns = 0.0\nw = 0.0\n", "[ilc] s, w");
+  expect_config_refused("[identify]\nsignal = \"noise\"\n", "[identify] signal");
 }
 
 TEST(ConfigBounds, ATrialOverItsBudgetIsRefusedBeforeTheLawIsBuilt) {
@@ -200,12 +192,12 @@ TEST(ConfigBounds, ATrialOverItsBudgetIsRefusedBeforeTheLawIsBuilt) {
 TEST(ConfigBounds, DeeplyNestedOrHugeFilesAreRefusedBeforeParsing) {
   std::string header = "[a";
   while (header.size() < 100000) header += ".a";
-  expect_refused(header + ".b]\nx = 1\n", "nested deeper");
-  expect_refused("[plant]\nkappa = " + std::string(50000, '[') + std::string(50000, ']') + "\n", "nested deeper");
+  expect_config_refused(header + ".b]\nx = 1\n", "nested deeper");
+  expect_config_refused("[plant]\nkappa = " + std::string(50000, '[') + std::string(50000, ']') + "\n", "nested deeper");
   std::string inline_tables = "x = ";
   for (int i = 0; i < 50000; ++i) inline_tables += "{a=";
-  expect_refused(inline_tables + "1" + std::string(50000, '}') + "\n", "nested deeper");
-  expect_refused("[plant]\n" + std::string(300000, '#') + "\n", "larger than");
+  expect_config_refused(inline_tables + "1" + std::string(50000, '}') + "\n", "nested deeper");
+  expect_config_refused("[plant]\n" + std::string(300000, '#') + "\n", "larger than");
   // Brackets and dots inside strings and comments are not nesting.
   Configuration config;
   EXPECT_NO_THROW(apply_config_toml(

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include "engine/errors.hpp"
+#include "tests/config_test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -66,28 +67,19 @@ w = 1e-5
   EXPECT_DOUBLE_EQ(c.plant.pressure_noise_bar, 0.001);
 }
 
-void expect_rejected(const std::string& toml, const std::string& fragment) {
-  Configuration c;
-  try {
-    apply_config_toml(toml, "lab.toml", c);
-    FAIL() << "accepted: " << toml;
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("lab.toml"), std::string::npos) << e.what();
-  }
-}
+using testing::expect_config_refused;
 
 TEST(ConfigFile, RejectsBadConfigurations) {
-  expect_rejected("[plant]\nkapa = 7.0\n", "unknown key");
-  expect_rejected("[plants]\nkappa = 7.0\n", "unknown section");
-  expect_rejected("[plant]\nkappa = \"seven\"\n", "expected a number");
-  expect_rejected("[controller]\nfilter_samples = 2.5\n", "expected a whole number");
-  expect_rejected("[controller]\ntau_p_s = 0.0\n", "must be in (0, ");
-  expect_rejected("[plant]\ncreep_tau_s = -0.8\n", "must be in (0, ");
-  expect_rejected("[controller]\np_max_bar = 1.0\n", "above ambient");
-  expect_rejected("[plant]\nkappa = nan\n", "finite");
-  expect_rejected("[plant\nkappa = 7\n", "lab.toml:");
-  expect_rejected("plant = 3\n", "must be a table");
+  expect_config_refused("[plant]\nkapa = 7.0\n", "unknown key");
+  expect_config_refused("[plants]\nkappa = 7.0\n", "unknown section");
+  expect_config_refused("[plant]\nkappa = \"seven\"\n", "expected a number");
+  expect_config_refused("[controller]\nfilter_samples = 2.5\n", "expected a whole number");
+  expect_config_refused("[controller]\ntau_p_s = 0.0\n", "must be in (0, ");
+  expect_config_refused("[plant]\ncreep_tau_s = -0.8\n", "must be in (0, ");
+  expect_config_refused("[controller]\np_max_bar = 1.0\n", "above ambient");
+  expect_config_refused("[plant]\nkappa = nan\n", "finite");
+  expect_config_refused("[plant\nkappa = 7\n", "lab.toml:");
+  expect_config_refused("plant = 3\n", "must be a table");
 }
 
 TEST(ConfigFile, RoundTripsThroughToml) {

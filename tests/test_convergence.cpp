@@ -62,17 +62,17 @@ class LinearClosedLoop {
   Eigen::Vector3d B_;
 };
 
-struct LearningRun {
+struct ConvergenceRun {
   std::vector<double> correction_norm, change_norm;
 };
 
-LearningRun learn(const Configuration& config, int iterations, double kappa_scale = 1.0, double omega0_scale = 1.0) {
+ConvergenceRun learn(const Configuration& config, int iterations, double kappa_scale = 1.0, double omega0_scale = 1.0) {
   const Trajectory reference = library_trajectory("paper", config.timing.sample_s());
   const int n = reference.learning_samples();
   const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()), n);
   const LinearClosedLoop plant(config, kappa_scale, omega0_scale);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n), next(n);
-  LearningRun run;
+  ConvergenceRun run;
   for (int j = 0; j < iterations; ++j) {
     law->update(u, plant.trial(reference.angle_rad, u), next);
     run.change_norm.push_back((next - u).norm());
@@ -104,7 +104,7 @@ TEST(Convergence, LawsPredictedToContractConvergeOnTheLinearClosedLoop) {
     const ConvergencePrediction p = predict_convergence(*law, config, 400);
     ASSERT_TRUE(p.available);
     ASSERT_LT(p.nominal.contraction, 1.0) << name;
-    const LearningRun run = learn(config, 150);
+    const ConvergenceRun run = learn(config, 150);
     EXPECT_LT(run.change_norm.back(), 1e-3 * run.change_norm.front()) << name;
     EXPECT_LT(run.correction_norm.back(), 10.0) << name;
   }
@@ -116,7 +116,7 @@ TEST(Convergence, LawPredictedToDivergeDivergesAtThePredictedRate) {
   const ConvergencePrediction p = predict_convergence(*law, config, 400);
   ASSERT_GT(p.nominal.contraction, 1.5);
   EXPECT_NE(p.warning.find("predicted to diverge on the nominal model"), std::string::npos) << p.warning;
-  const LearningRun run = learn(config, 40);
+  const ConvergenceRun run = learn(config, 40);
   EXPECT_GT(run.correction_norm.back(), 1e3 * run.correction_norm.front());
   // Growth per trial over iterations 5..20, before the huge errors hit the PID's integrator bound
   // (a nonlinearity); the finite trial grows somewhat slower than the long-trial prediction.
@@ -135,7 +135,7 @@ TEST(Convergence, DefaultLawContractsOverTheWholeGridAndDoesNotWarn) {
   EXPECT_LT(p.worst.contraction, 0.95);
   EXPECT_TRUE(p.warning.empty()) << p.warning;
   // The worst grid point converges on the linear closed loop too.
-  const LearningRun worst = learn(config, 150, p.worst.kappa_scale, p.worst.omega0_scale);
+  const ConvergenceRun worst = learn(config, 150, p.worst.kappa_scale, p.worst.omega0_scale);
   EXPECT_LT(worst.change_norm.back(), 1e-2 * worst.change_norm.front());
 }
 
@@ -149,12 +149,12 @@ TEST(Convergence, GridWorstCaseIsWhereTheLinearClosedLoopDiverges) {
   ASSERT_EQ(p.grid.size(), 25u);
   ASSERT_GT(p.worst.contraction, 1.0);
   EXPECT_NE(p.warning.find("may diverge if the arm differs"), std::string::npos) << p.warning;
-  const LearningRun worst = learn(config, 60, p.worst.kappa_scale, p.worst.omega0_scale);
+  const ConvergenceRun worst = learn(config, 60, p.worst.kappa_scale, p.worst.omega0_scale);
   EXPECT_GT(worst.correction_norm.back(), 100.0 * worst.correction_norm.front());
   // ... while a grid point predicted to contract converges.
   for (const ContractionEstimate& e : p.grid) {
     if (e.contraction < 0.95) {
-      const LearningRun good = learn(config, 150, e.kappa_scale, e.omega0_scale);
+      const ConvergenceRun good = learn(config, 150, e.kappa_scale, e.omega0_scale);
       EXPECT_LT(good.change_norm.back(), 1e-2 * good.change_norm.front())
           << "kappa x" << e.kappa_scale << " omega0 x" << e.omega0_scale;
       break;

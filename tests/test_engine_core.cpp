@@ -6,15 +6,14 @@
 #include <numbers>
 
 #include "tests/engine_fixture.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
 
 using testing::EngineFixture;
 
-bool vented(const ValveCommand& v) {
-  return v.inlet_duty[0] == 0.0 && v.inlet_duty[1] == 0.0 && v.outlet_duty[0] == 1.0 && v.outlet_duty[1] == 1.0;
-}
+using testing::vented;
 
 TEST(EngineCore, StartsSafeAndVentedAndArmsOnlyOnCommand) {
   EngineFixture f;

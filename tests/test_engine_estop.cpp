@@ -10,6 +10,7 @@
 
 #include "engine_fixture.hpp"
 #include "engine/safety.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -41,9 +42,7 @@ class RecordingDevice final : public Device {
   int reads = 0, writes = 0, vents = 0;
 };
 
-bool vented(const ValveCommand& c) {
-  return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
-}
+using testing::vented;
 
 TEST(EmergencyStop, VentsInTheNextTickWhateverTheQueueHolds) {
   EngineFixture f;

@@ -321,7 +321,7 @@ TEST(LcmDevice, NoStateForStaleTicksIsAStaleSensorFaultThatVents) {
   expect_stale_fault_after(6);  // [safety] stale_ticks
 }
 
-Trajectory short_move() {
+Trajectory short_rig_move() {
   return trajectory_from_moves("short", 0.0, {TrapezoidalMove{0.3, 0.0, 20.0, 0.3, 4000.0}}, 1.5, 0.02);
 }
 
@@ -329,7 +329,7 @@ std::vector<double> learn_in_process(const Configuration& c, int trials) {
   SimulatedArm arm(c.plant, 3);
   EngineCore core(arm, c.controller, c.timing, c.safety);
   SimulatedClock clock(core, arm);
-  const Trajectory trajectory = short_move();
+  const Trajectory trajectory = short_rig_move();
   NormOptimalDense law(discretize_arm_model(c.model, 0.02), c.ilc, trajectory.learning_samples());
   LearningSession session(clock, law, trajectory, c.timing, c.controller);
   std::vector<double> rms;
@@ -359,7 +359,7 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   loop.start(RealtimeMode::kTry);
   ASSERT_TRUE(testing::eventually([&] { return device.connected(); }, 10.0)) << "the rig never answered";
 
-  const Trajectory trajectory = short_move();
+  const Trajectory trajectory = short_rig_move();
   NormOptimalDense law(discretize_arm_model(c.model, 0.02), c.ilc, trajectory.learning_samples());
   LearningSession session(loop, law, trajectory, c.timing, c.controller);
   std::vector<double> rms;
@@ -394,7 +394,7 @@ struct TelemetryRun {
   EngineCore core{arm, config.controller, config.timing, config.safety};
   TelemetryRing& tap = core.add_telemetry_tap(1 << 14);
   SimulatedClock clock{core, arm};
-  Trajectory trajectory = short_move();
+  Trajectory trajectory = short_rig_move();
   NormOptimalDense law{discretize_arm_model(config.model, 0.02), config.ilc, trajectory.learning_samples()};
   std::vector<IterationSummary> summaries;
   std::vector<Eigen::VectorXd> corrections;

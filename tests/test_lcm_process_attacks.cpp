@@ -21,9 +21,11 @@
 namespace bellows {
 namespace {
 
+using testing::expect_refused_in_one_line;
+
 using testing::Child;
 
-const std::string kBellows = BELLOWS_BINARY;
+using testing::kBellows;
 
 #define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                       \
   do {                                                                                  \
@@ -138,13 +140,6 @@ TEST(LcmProcessAttacks, WithoutAKeyATakeoverIsDiagnosedNotCalledAStaleSensor) {
   EXPECT_GT(report["lcm"]["rig"]["commands_not_ours"].get<std::uint64_t>(), 0u);
 }
 
-void expect_refused(const std::string& args, const std::string& fragment) {
-  const auto result = testing::run_process(kBellows + " " + args);
-  EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.err;
-  EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << "one line:\n" << result.err;
-}
-
 TEST(LcmKeyCli, AWorldReadableOrWrongSizedKeyIsRefusedWithOneLine) {
   const auto dir = testing::make_temp_dir("bellows-lcm-key-cli");
   const auto world = testing::write_file(dir, "world.key", std::string(32, 'w'));
@@ -153,11 +148,11 @@ TEST(LcmKeyCli, AWorldReadableOrWrongSizedKeyIsRefusedWithOneLine) {
   chmod(small.c_str(), 0600);
   const auto world_config = testing::write_file(dir, "world.toml", "[lcm]\nkey_file = \"world.key\"\n");
   const auto small_config = testing::write_file(dir, "small.toml", "[lcm]\nkey_file = \"small.key\"\n");
-  expect_refused("io-sim --config " + world_config.string(), "readable or writable by everyone");
-  expect_refused("io-sim --config " + small_config.string(), "16 bytes; a key is exactly 32 bytes");
-  expect_refused("run --no-save --device lcm --clock wall --lcm memq:// --config " + world_config.string(),
+  expect_refused_in_one_line("io-sim --config " + world_config.string(), "readable or writable by everyone");
+  expect_refused_in_one_line("io-sim --config " + small_config.string(), "16 bytes; a key is exactly 32 bytes");
+  expect_refused_in_one_line("run --no-save --device lcm --clock wall --lcm memq:// --config " + world_config.string(),
                  "readable or writable by everyone");
-  expect_refused("run --no-save --device lcm --clock wall --lcm memq:// --config " + small_config.string(), "exactly 32 bytes");
+  expect_refused_in_one_line("run --no-save --device lcm --clock wall --lcm memq:// --config " + small_config.string(), "exactly 32 bytes");
 }
 
 }  // namespace

@@ -22,11 +22,13 @@
 namespace bellows {
 namespace {
 
+using testing::expect_refused_in_one_line;
+
 using testing::BusRecorder;
 using testing::Child;
 using testing::Recorded;
 
-const std::string kBellows = BELLOWS_BINARY;
+using testing::kBellows;
 
 /// Sessions of the runs started here go into a fresh directory, never into a real home.
 void isolate_sessions() { setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-lcm-xdg").c_str(), 1); }
@@ -44,11 +46,7 @@ Message decode(const Recorded& recorded) {
   return message;
 }
 
-std::vector<double> rms_sequence(const nlohmann::json& report) {
-  std::vector<double> rms;
-  for (const auto& it : report.at("iterations")) rms.push_back(it.at("rms_deg").get<double>());
-  return rms;
-}
+using testing::rms_sequence;
 
 nlohmann::json parse_report(const Child& child) {
   const std::string out = child.out();
@@ -372,28 +370,19 @@ TEST(LcmCli, OnTheSimulatedClockTheLogHoldsEveryTick) {
   EXPECT_EQ(nlohmann::json::parse(plain.out)["iterations"], report["iterations"]);
 }
 
-void expect_refused(const std::string& args, const std::string& fragment, int status = kExitBadInput) {
-  const auto result = testing::run_process(kBellows + " " + args);
-  EXPECT_EQ(result.exit_code, status) << args << "\n" << result.err;
-  EXPECT_NE(result.err.find(fragment), std::string::npos) << result.err;
-  // One line, bellows' own: LCM's library explains its failures in a dozen lines of its own.
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-  EXPECT_EQ(result.err.rfind("bellows: ", 0), 0u) << result.err;
-}
-
 TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   const auto dir = testing::make_temp_dir("bellows-lcm-cli");
-  expect_refused("run --device lcm", "--device lcm needs --clock wall");
-  expect_refused("run --device lcm --clock sim", "--device lcm needs --clock wall");
-  expect_refused("run --device lcm --clock wall --speed 2", "--speed must be 1");
-  expect_refused("run --device rig", "--device");
+  expect_refused_in_one_line("run --device lcm", "--device lcm needs --clock wall");
+  expect_refused_in_one_line("run --device lcm --clock sim", "--device lcm needs --clock wall");
+  expect_refused_in_one_line("run --device lcm --clock wall --speed 2", "--speed must be 1");
+  expect_refused_in_one_line("run --device rig", "--device");
   // The environment refusing (a bus that cannot be opened) has its own status.
   // A URL that is no LCM URL is bad input; a well-formed one that LCM cannot open is the environment.
-  expect_refused("run --device lcm --clock wall --lcm nowhere://at-all", "unknown provider 'nowhere'");
-  expect_refused("io-sim --lcm nowhere://at-all", "unknown provider 'nowhere'");
+  expect_refused_in_one_line("run --device lcm --clock wall --lcm nowhere://at-all", "unknown provider 'nowhere'");
+  expect_refused_in_one_line("io-sim --lcm nowhere://at-all", "unknown provider 'nowhere'");
   const std::string unopenable = "file://" + (dir / "no-such-folder" / "bus.lcmlog").string() + "?mode=r";
-  expect_refused("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
-  expect_refused("io-sim --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
+  expect_refused_in_one_line("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
+  expect_refused_in_one_line("io-sim --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
   // A multicast bus on a host without a multicast route (a fresh network namespace has none):
   // LCM's reason is quoted in bellows' one line.
   if (testing::run_process("unshare -n true").exit_code == 0) {
@@ -403,8 +392,8 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
   }
   const auto existing = testing::write_file(dir, "old.lcmlog", "precious");
-  expect_refused("run --iterations 0 --lcm-log " + existing.string(), "exists already");
-  expect_refused("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
+  expect_refused_in_one_line("run --iterations 0 --lcm-log " + existing.string(), "exists already");
+  expect_refused_in_one_line("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
 
   // memq:// is private to a process: nobody answers there.
   const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");

@@ -12,11 +12,12 @@
 #include "engine/engine_core.hpp"
 #include "engine/learning_session.hpp"
 #include "engine/zero_phase_filter.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
 
-DiscreteArmModel paper_model() { return discretize_arm_model(ModelParameters{}, 0.02); }
+using testing::paper_model;
 
 std::unique_ptr<LearningLaw> make(const std::string& name, int samples, Configuration config = {}) {
   config.ilc.law = name;

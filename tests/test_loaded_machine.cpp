@@ -24,7 +24,7 @@ namespace {
 using testing::BusRecorder;
 using testing::Child;
 
-const std::string kBellows = BELLOWS_BINARY;
+using testing::kBellows;
 
 TEST(LoadedMachine, OnlyTheInProcessSimulatedArmsTimeFollowsTheTicks) {
   EXPECT_TRUE(SimulatedArm(PlantParameters{}, 1).time_follows_ticks());

@@ -15,11 +15,12 @@
 #include "engine/learning_session.hpp"
 #include "engine/noilc_constrained.hpp"
 #include "engine/noilc_dense.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
 
-DiscreteArmModel paper_model() { return discretize_arm_model(ModelParameters{}, 0.02); }
+using testing::paper_model;
 
 struct RandomProblem {
   Eigen::VectorXd u_j, e_j;

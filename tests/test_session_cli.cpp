@@ -14,6 +14,7 @@
 #include "sessions/iteration_files.hpp"
 #include "sessions/session_lock.hpp"
 #include "sessions/session_store.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -158,16 +159,7 @@ TEST(SessionSaving, ANameInUseIsRefused) {
 }
 
 /// Reads a spawned process's stdout until `text` appears (or the output ends).
-std::string read_until(int fd, const std::string& text) {
-  std::string out;
-  char buffer[1024];
-  while (out.find(text) == std::string::npos) {
-    const ssize_t got = ::read(fd, buffer, sizeof buffer);
-    if (got <= 0) break;
-    out.append(buffer, static_cast<std::size_t>(got));
-  }
-  return out;
-}
+using testing::read_until;
 
 TEST(SessionLocking, ASecondProcessIsRefusedAndTheFirstNamed) {
   TempDir dir;

@@ -20,6 +20,7 @@
 #include "sessions/atomic_file.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -27,16 +28,7 @@ namespace {
 using testing::TempDir;
 namespace fs = std::filesystem;
 
-std::string read_until(int fd, const std::string& text) {
-  std::string out;
-  char buffer[1024];
-  while (text.empty() || out.find(text) == std::string::npos) {
-    const ssize_t got = ::read(fd, buffer, sizeof buffer);
-    if (got <= 0) break;
-    out.append(buffer, static_cast<std::size_t>(got));
-  }
-  return out;
-}
+using testing::read_until;
 
 /// Blocks until the `count`-th temporary file is created in `directories` (a write has begun),
 /// or until the timeout. Returns whether it happened.

@@ -13,6 +13,7 @@
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -20,14 +21,7 @@ namespace {
 using testing::TempDir;
 namespace fs = std::filesystem;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
+using testing::error_of;
 
 struct Damage {
   const char* name;

@@ -12,20 +12,14 @@
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/json_reader.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
 
 using testing::TempDir;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
+using testing::error_of;
 
 TEST(CsvTable, RoundTripsEveryDoubleExactly) {
   Eigen::VectorXd a(6), b(6);

@@ -18,6 +18,7 @@
 #include "sessions/session_lock.hpp"
 #include "sessions/session_store.hpp"
 #include "sessions/session_writer.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -25,14 +26,7 @@ namespace {
 using testing::TempDir;
 namespace fs = std::filesystem;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
+using testing::error_of;
 
 /// Angles pass through degrees: bit for bit where a decimal reads back exactly, else within an ulp.
 void expect_same_angles(const Eigen::VectorXd& loaded, const Eigen::VectorXd& saved, const char* what) {

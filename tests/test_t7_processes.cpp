@@ -24,7 +24,7 @@ namespace {
 
 using testing::Child;
 
-const std::string kBellows = BELLOWS_BINARY;
+using testing::kBellows;
 
 /// A loopback port that was free a moment ago.
 int free_port() {

@@ -70,7 +70,7 @@ TEST(TrajectoryCsv, ParsesAUniformFile) {
   EXPECT_NEAR(t.angle_rad(2), 2.5 * kDeg, 1e-12);
 }
 
-void expect_rejected(const std::string& text, const std::string& fragment) {
+void expect_csv_rejected(const std::string& text, const std::string& fragment) {
   try {
     parse_trajectory_csv(text, "bad.csv", 0.02, {});
     FAIL() << "accepted: " << fragment;
@@ -81,15 +81,15 @@ void expect_rejected(const std::string& text, const std::string& fragment) {
 }
 
 TEST(TrajectoryCsv, RejectsBadFilesWithAClearMessage) {
-  expect_rejected(csv({{0.0, 0.0}, {0.02, 1.0}, {0.04, 2.0}}, "t,angle"), "header");
-  expect_rejected(csv({{0.0, 0.0}, {0.02, 1.0}, {0.05, 2.0}}), "not uniform");
-  expect_rejected(csv({{0.01, 0.0}, {0.03, 1.0}, {0.05, 2.0}}), "not uniform");
-  expect_rejected("time_s,angle_deg\n0,0\n0.02,nan\n0.04,1\n", "not a number");
-  expect_rejected("time_s,angle_deg\n0,0\n0.02,abc\n0.04,1\n", "line 3");
-  expect_rejected("time_s,angle_deg\n0,0\n0.02,1,2\n0.04,1\n", "two fields");
-  expect_rejected(csv({{0.0, 0.0}, {0.02, 120.0}, {0.04, 2.0}}), "joint range");
-  expect_rejected(csv({{0.0, 0.0}}), "too short");
-  expect_rejected("", "header");
+  expect_csv_rejected(csv({{0.0, 0.0}, {0.02, 1.0}, {0.04, 2.0}}, "t,angle"), "header");
+  expect_csv_rejected(csv({{0.0, 0.0}, {0.02, 1.0}, {0.05, 2.0}}), "not uniform");
+  expect_csv_rejected(csv({{0.01, 0.0}, {0.03, 1.0}, {0.05, 2.0}}), "not uniform");
+  expect_csv_rejected("time_s,angle_deg\n0,0\n0.02,nan\n0.04,1\n", "not a number");
+  expect_csv_rejected("time_s,angle_deg\n0,0\n0.02,abc\n0.04,1\n", "line 3");
+  expect_csv_rejected("time_s,angle_deg\n0,0\n0.02,1,2\n0.04,1\n", "two fields");
+  expect_csv_rejected(csv({{0.0, 0.0}, {0.02, 120.0}, {0.04, 2.0}}), "joint range");
+  expect_csv_rejected(csv({{0.0, 0.0}}), "too short");
+  expect_csv_rejected("", "header");
 }
 
 }  // namespace

@@ -5,16 +5,12 @@
 
 #include "ui/canvas.hpp"
 #include "ui/plot.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows::ui {
 namespace {
 
-bool ascii_only(const std::string& text) {
-  for (unsigned char c : text) {
-    if (c >= 0x80) return false;
-  }
-  return true;
-}
+using testing::ascii_only;
 
 int count_braille(const std::string& text) {
   int n = 0;

@@ -8,6 +8,7 @@
 
 #include "engine/trajectory.hpp"
 #include "ui/console_state.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows::testing {
 
@@ -22,13 +23,6 @@ inline std::string all(const std::vector<std::string>& lines) {
   std::string out;
   for (const auto& l : lines) out += l + "\n";
   return out;
-}
-
-inline bool ascii_only(const std::string& text) {
-  for (unsigned char c : text) {
-    if (c >= 0x80) return false;
-  }
-  return true;
 }
 
 // A state with `trials` trials on the paper trajectory: trial i tracks with an error that shrinks
