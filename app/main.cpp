@@ -43,7 +43,8 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless on simulated time, learning between them");
   run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
       ->capture_default_str();
-  run_cmd->add_option("--iterations", run.iterations, "Learning iterations after the feedback-only trial")
+  run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
+                      "(with --resume: K after the newest)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");

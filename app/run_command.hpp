@@ -14,7 +14,7 @@ namespace bellows {
 
 struct RunOptions {
   std::string trajectory = "paper";
-  int iterations = 30;  // learning iterations after the feedback-only trial
+  int iterations = 30;  // learning iterations after the feedback-only iteration 0 (docs/iterations.md)
   std::string config_path;
   std::uint64_t seed = 1;
   bool json = false;

@@ -76,7 +76,7 @@ for device in "${DEVICES[@]}"; do
   e2e_keys y
   e2e_wait_for 'Bellows +ARMED '
   e2e_keys r
-  e2e_wait_for 'it(eration)? 1  RMS' 120
+  e2e_wait_for 'it(eration)? 0  RMS' 120  # iteration 0 ran
 
   # Emergency stop: FAULT, vented.
   e2e_keys Space

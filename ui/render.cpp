@@ -102,8 +102,9 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
     out.push_back({labels ? 0 : 2, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()),
                    Role::kNormal, true});
   }
+  // The newest iteration run, whose RMS follows (docs/iterations.md); "-" before the first.
   out.push_back({2, labels ? "iteration " : "it ", Role::kDim, false});
-  out.push_back({0, format("%d", e.next_iteration()), Role::kNormal, true});
+  out.push_back({0, e.trials.empty() ? std::string("-") : format("%d", e.trials.back().iteration), Role::kNormal, true});
   if (!e.trials.empty()) {
     out.push_back({2, "RMS ", Role::kDim, false});
     out.push_back({0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true});
