@@ -1,4 +1,6 @@
 // bellows: the lab console and its headless commands.
+#include <unistd.h>
+
 #include <csignal>
 #include <iostream>
 #include <map>
@@ -51,7 +53,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
+  run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout (progress then goes to stderr)");
+  CLI::Option* verbose = run_cmd->add_flag("--verbose,-v", run.verbose,
+                                           "A progress line per iteration (default on a terminal: one line, redrawn)");
+  run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors (and the JSON with --json)")->excludes(verbose);
   run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
       ->capture_default_str()
       ->check(CLI::IsMember({"sim", "wall"}));
@@ -262,6 +267,7 @@ int main(int argc, char** argv) {
   try {
     run.lcm_log = lcm_log->count() > 0;
     run.speed_given = run_cmd->get_option("--speed")->count() > 0;
+    run.progress_on_terminal = isatty(run.json ? STDERR_FILENO : STDOUT_FILENO) == 1;
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);
