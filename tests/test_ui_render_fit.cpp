@@ -79,6 +79,17 @@ TEST(UiRenderFit, ARefusedAnswerShowsInItsDialogWithWhatWasTyped) {
   EXPECT_NE(screen.find("Enter run   Esc cancel"), std::string::npos) << screen;
 }
 
+TEST(UiRenderFit, ADialogWrapsALongLineInsteadOfCuttingIt) {
+  ConsoleState s = small_state(EngineState::kArmed);  // 80 columns
+  const std::string why = "Saving is not available: no data directory: neither XDG_DATA_HOME nor HOME is an absolute "
+                          "path; pass --data-dir";
+  s.dialog = {DialogKind::kConfirmQuit, "Quit?", {"1 iteration is not saved.", why}, "", "q quit without saving   Esc cancel", ""};
+  const std::string screen = all(render_lines(s));
+  for (const std::string words : {"1 iteration is not saved.", "absolute path; pass --data-dir", "q quit without saving"}) {
+    EXPECT_NE(screen.find(words), std::string::npos) << words << "\n" << screen;  // cut at the box's edge before
+  }
+}
+
 TEST(UiRenderFit, EveryOtherScreenOffersTheWayBack) {
   for (Screen screen : {Screen::kHelp, Screen::kTrajectory, Screen::kInspector, Screen::kTuning, Screen::kLog,
                         Screen::kSessions, Screen::kFault}) {
