@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/cli_checks.hpp"
+#include "app/completion_command.hpp"
 #include "app/config_file.hpp"
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
@@ -255,6 +256,11 @@ int main(int argc, char** argv) {
                             "Where the check's session is saved (default: where runs save theirs)")
       ->excludes(rig_no_save);
 
+  // Hidden (no group): what the build generates the bash completion with (app/completion_command.hpp).
+  std::string completion_shell;
+  CLI::App* completion_cmd = app.add_subcommand("completion", "Print the shell completion script")->group("");
+  completion_cmd->add_option("shell", completion_shell, "bash")->required()->check(CLI::IsMember({"bash"}));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& help_or_version) {  // --help, --version: printed, exit 0
@@ -268,6 +274,10 @@ int main(int argc, char** argv) {
     run.lcm_log = lcm_log->count() > 0;
     run.speed_given = run_cmd->get_option("--speed")->count() > 0;
     run.progress_on_terminal = isatty(run.json ? STDERR_FILENO : STDOUT_FILENO) == 1;
+    if (completion_cmd->parsed()) {
+      std::cout << bellows::bash_completion(app);
+      return 0;
+    }
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);
