@@ -31,7 +31,9 @@ complete_words() {
 expect_offered() {  # expect_offered WANTED WORD...
   local wanted="$1"
   shift
-  complete_words "$@" | grep -qxF -- "$wanted" || fail "'$*' does not offer '$wanted' (offers: $(complete_words "$@" | tr '\n' ' '))"
+  local offered
+  offered="$(complete_words "$@")"  # whole before grep -q: its early exit would fail a pipe under pipefail
+  grep -qxF -- "$wanted" <<<"$offered" || fail "'$*' does not offer '$wanted' (offers: $(tr '\n' ' ' <<<"$offered"))"
 }
 expect_offered run bellows ru
 expect_offered --iterations bellows run --ite
@@ -69,6 +71,8 @@ cmake --install "$build" --prefix "$work/prefix" > /dev/null
 [ -s "$work/prefix/share/man/man1/bellows.1" ] || fail "no share/man/man1/bellows.1 installed"
 installed="$work/prefix/share/bash-completion/completions/bellows"
 [ -s "$installed" ] || fail "no share/bash-completion/completions/bellows installed"
-bash -c "source '$installed'; complete -p bellows" | grep -q -- '-F _bellows bellows' || fail "the installed completion is not registered"
-"$work/prefix/bin/bellows" --version | grep -q '^bellows ' || fail "the installed bellows does not run"
+registered="$(bash -c "source '$installed'; complete -p bellows")"
+grep -q -- '-F _bellows bellows' <<<"$registered" || fail "the installed completion is not registered: $registered"
+version="$("$work/prefix/bin/bellows" --version)"
+grep -q '^bellows ' <<<"$version" || fail "the installed bellows does not run: $version"
 echo "ok: $checked options and every subcommand in the man page and the completion; installed"
