@@ -152,6 +152,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
       said.error("bellows: " + failure);
       recording.fault(failure);
     }
+    said.begin_trials();
     for (int i = 0; failure.empty() && i < trials; ++i) {
       const IterationSummary s = session.run_trial();
       io.post_trial(s, session.correction_bar());  // the correction this trial applied

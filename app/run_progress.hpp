@@ -28,6 +28,8 @@ class RunProgressReport {
   void note(const std::string& line);
   /// An error or a loss: always, on its own line.
   void error(const std::string& line);
+  /// The first trial starts now: the ETA counts from here, not from the setup before it.
+  void begin_trials() { started_ = std::chrono::steady_clock::now(); }
   /// A completed iteration.
   void iteration(const IterationSummary& summary);
   /// Ends the redrawn line (it stays on screen as the run's last word on progress).
