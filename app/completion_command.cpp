@@ -16,16 +16,23 @@ struct Tables {
   std::map<std::string, std::string> choices;      // "path option" -> the values it accepts
 };
 
-/// The values an option accepts as its help shows them, "TEXT:{sim,wall}" -> "sim wall"; "" when
-/// the help lists none (CLI::IsMember is where they come from).
+/// The values an option accepts as its help shows them: "TEXT:{sim,wall}" (CLI::IsMember) or
+/// "MODE:enforce|off|try=try" (app/cli_checks named_choice) -> "sim wall", "enforce off try"; ""
+/// when the help lists none.
 std::string listed_values(const CLI::Option& option) {
   const std::string shown = CLI::Formatter().make_option_opts(&option);
-  const std::size_t open = shown.find('{');
-  const std::size_t close = shown.find('}', open);
-  if (open == std::string::npos || close == std::string::npos) return "";
+  std::string list;
+  char separator = ',';
+  if (const std::size_t open = shown.find('{'), close = shown.find('}', open); open != std::string::npos && close != std::string::npos) {
+    list = shown.substr(open + 1, close - open - 1);
+  } else if (const std::size_t colon = shown.find(':'); colon != std::string::npos) {
+    list = shown.substr(colon + 1, shown.find_first_of("= ", colon) - colon - 1);
+    separator = '|';
+    if (list.find('|') == std::string::npos) return "";  // a type or a range, not a list of words
+  }
   std::string values;
-  std::stringstream list(shown.substr(open + 1, close - open - 1));
-  for (std::string value; std::getline(list, value, ',');) {
+  std::stringstream words(list);
+  for (std::string value; std::getline(words, value, separator);) {
     value = value.substr(0, value.find("->"));  // a mapping shows as name->code
     if (!value.empty()) values += (values.empty() ? "" : " ") + value;
   }

@@ -39,6 +39,8 @@ expect_offered run bellows ru
 expect_offered --iterations bellows run --ite
 expect_offered export bellows sessions ex
 expect_offered wall bellows run --clock w
+expect_offered try bellows run --rt t
+expect_offered csv bellows sessions export --format c
 expect_offered --format bellows sessions export --data-dir /tmp --fo  # an option's value is skipped
 [ "$(complete_words bellows run --ite)" = "--iterations" ] || fail "run --ite: $(complete_words bellows run --ite)"
 [ -z "$(complete_words bellows com)" ] || fail "the hidden completion subcommand is offered"
