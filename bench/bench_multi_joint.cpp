@@ -1,10 +1,13 @@
 // Arms with several joints (issue 14): the J-joint norm-optimal update in O(N) against the dense
-// lifted form, and its set-up. Results are written up in docs/benchmarks.md ("## Several joints").
+// lifted form, and its set-up; the chain's mechanics (ArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
+#include <cmath>
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "engine/arm_chain.hpp"
+#include "engine/arm_chain_linearization.hpp"
 #include "engine/arm_model.hpp"
 #include "engine/noilc_mimo.hpp"
 #include "engine/noilc_mimo_dense.hpp"
@@ -88,6 +91,34 @@ void BM_MultiJointDenseUpdate(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MultiJointDenseUpdate)->Args({3, 400})->Unit(benchmark::kMicrosecond);
+
+// One simulated second of the chain's mechanics (RK4 at the spec's 0.1 ms), the pressure differences
+// changing every 5 ms tick as a controller's would. Mechanics only: the bellows' pneumatics and the
+// controllers are not in ArmChain. real_time_factor = simulated / wall-clock (CPU) time.
+void BM_ArmChainSecond(benchmark::State& state) {
+  const ChainParameters chain = chain_preset(state.range(0) == 2 ? "arm2" : "arm3");
+  ArmChain arm(chain);
+  const int J = chain.joints;
+  constexpr double kTick_s = 0.005;
+  for (auto _ : state) {
+    for (int tick = 0; tick < 200; ++tick) {
+      const double t = arm.state().time_s;
+      JointVector dp(J);
+      for (int i = 0; i < J; ++i) dp(i) = 0.1 + 0.1 * std::sin((3.0 + i) * t);
+      arm.advance(kTick_s, dp);
+    }
+    benchmark::DoNotOptimize(arm.state().angle_rad.data());
+  }
+  state.counters["real_time_factor"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_ArmChainSecond)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+
+void BM_ArmChainLinearization(benchmark::State& state) {
+  const ArmChain arm(chain_preset("arm3"));
+  const JointVector pose = JointVector::Constant(3, 0.3);
+  for (auto _ : state) benchmark::DoNotOptimize(linearize_chain(arm, pose, kSampleTime_s).A.data());
+}
+BENCHMARK(BM_ArmChainLinearization)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace bellows

@@ -79,53 +79,48 @@ ArmChain::ArmChain(const ChainParameters& chain) : chain_(chain) {
   state_.creep_rad = JointVector::Zero(J);
 }
 
-JointMatrix ArmChain::mass_matrix(const JointVector& q) const {
-  // M = sum over point masses of m J'J, plus each link's I_i times ones over joints 1..i.
-  const int J = joints();
-  const LinkAngles angles(q);
-  JointMatrix M = JointMatrix::Zero(J, J);
-  for_each_point_mass(chain_, [&](int link, double distance_m, double mass_kg) {
-    const PointJacobian jacobian(chain_, angles, link, distance_m);
-    M.noalias() += mass_kg * (jacobian.x * jacobian.x.transpose() + jacobian.y * jacobian.y.transpose());
-  });
-  for (int i = 0; i < J; ++i) M.topLeftCorner(i + 1, i + 1).array() += chain_.links[static_cast<std::size_t>(i)].inertia_kg_m2;
-  return M;
-}
-
-JointVector ArmChain::coriolis_torque(const JointVector& q, const JointVector& q_dot) const {
-  // sum over point masses of m J' (J_dot q_dot); J_dot q_dot of a point on link i at distance d is
-  // -sum_{k<i} l_k w_k^2 (cos theta_k, sin theta_k) - d w_i^2 (cos theta_i, sin theta_i), w_k = theta_k_dot.
-  // (The links' rotation adds nothing: their angular Jacobians are constant.)
+ArmChain::RigidBodyTerms ArmChain::rigid_body_terms(const JointVector& q, const JointVector& q_dot) const {
+  // Over the point masses m with Jacobian J_p: M += m J_p'J_p, C q_dot += m J_p' (J_p_dot q_dot),
+  // G += m g (dy/dq); each link's rotational inertia I_i adds I_i to M over joints 1..i (its angular
+  // Jacobian is constant, so it adds nothing to C q_dot). J_p_dot q_dot of a point on link i at
+  // distance d is -sum_{k<i} l_k w_k^2 (cos theta_k, sin theta_k) - d w_i^2 (cos theta_i, sin theta_i),
+  // w_k = theta_k_dot the absolute angular velocity of link k.
   const int J = joints();
   const LinkAngles angles(q);
   JointVector link_rate(J);
   double rate = 0.0;
   for (int k = 0; k < J; ++k) link_rate(k) = rate += q_dot(k);
-  JointVector torque = JointVector::Zero(J);
+  RigidBodyTerms terms{JointMatrix::Zero(J, J), JointVector::Zero(J), JointVector::Zero(J)};
+  const double g = chain_.gravity ? chain_.gravity_m_per_s2 : 0.0;
   for_each_point_mass(chain_, [&](int link, double distance_m, double mass_kg) {
+    const PointJacobian jacobian(chain_, angles, link, distance_m);
+    terms.mass.noalias() += mass_kg * (jacobian.x * jacobian.x.transpose() + jacobian.y * jacobian.y.transpose());
     const double w2 = link_rate(link) * link_rate(link);
     double ax = -distance_m * w2 * angles.cos(link), ay = -distance_m * w2 * angles.sin(link);
     for (int k = 0; k < link; ++k) {
-      const double l = chain_.links[static_cast<std::size_t>(k)].length_m;
-      ax -= l * link_rate(k) * link_rate(k) * angles.cos(k);
-      ay -= l * link_rate(k) * link_rate(k) * angles.sin(k);
+      const double centripetal = chain_.links[static_cast<std::size_t>(k)].length_m * link_rate(k) * link_rate(k);
+      ax -= centripetal * angles.cos(k);
+      ay -= centripetal * angles.sin(k);
     }
-    const PointJacobian jacobian(chain_, angles, link, distance_m);
-    torque += mass_kg * (jacobian.x * ax + jacobian.y * ay);
+    terms.coriolis += mass_kg * (jacobian.x * ax + jacobian.y * ay);
+    terms.gravity += mass_kg * g * jacobian.y;
   });
-  return torque;
+  for (int i = 0; i < J; ++i) {
+    terms.mass.topLeftCorner(i + 1, i + 1).array() += chain_.links[static_cast<std::size_t>(i)].inertia_kg_m2;
+  }
+  return terms;
+}
+
+JointMatrix ArmChain::mass_matrix(const JointVector& q) const {
+  return rigid_body_terms(q, JointVector::Zero(joints())).mass;
+}
+
+JointVector ArmChain::coriolis_torque(const JointVector& q, const JointVector& q_dot) const {
+  return rigid_body_terms(q, q_dot).coriolis;
 }
 
 JointVector ArmChain::gravity_torque(const JointVector& q) const {
-  // V = sum m g y: G_j = sum m g dy/dq_j.
-  const int J = joints();
-  JointVector torque = JointVector::Zero(J);
-  if (!chain_.gravity) return torque;
-  const LinkAngles angles(q);
-  for_each_point_mass(chain_, [&](int link, double distance_m, double mass_kg) {
-    torque += mass_kg * chain_.gravity_m_per_s2 * PointJacobian(chain_, angles, link, distance_m).y;
-  });
-  return torque;
+  return rigid_body_terms(q, JointVector::Zero(joints())).gravity;
 }
 
 JointMatrix ArmChain::gravity_stiffness(const JointVector& q) const {
@@ -164,9 +159,10 @@ JointVector ArmChain::stop_torque(const JointVector& q, const JointVector& q_dot
 
 JointVector ArmChain::acceleration(const JointVector& q, const JointVector& q_dot, const JointVector& z,
                                    const JointVector& dp_bar) const {
+  const RigidBodyTerms terms = rigid_body_terms(q, q_dot);
   const JointVector torque = bellows_torque(q, z, dp_bar) - damping_.cwiseProduct(q_dot) + stop_torque(q, q_dot) -
-                             coriolis_torque(q, q_dot) - gravity_torque(q);
-  return mass_matrix(q).llt().solve(torque);
+                             terms.coriolis - terms.gravity;
+  return terms.mass.llt().solve(torque);
 }
 
 JointVector ArmChain::holding_pressure_bar(const JointVector& q) const {

@@ -33,6 +33,13 @@ class ArmChain {
   int joints() const { return chain_.joints; }
   const ChainParameters& parameters() const { return chain_; }
 
+  /// M(q), C(q, q_dot) q_dot and G(q) in one pass over the links (what the integrator uses).
+  struct RigidBodyTerms {
+    JointMatrix mass;
+    JointVector coriolis, gravity;
+  };
+  RigidBodyTerms rigid_body_terms(const JointVector& q, const JointVector& q_dot) const;
+
   // The rigid body (spec section 1), for any q, q_dot of joints() entries.
   JointMatrix mass_matrix(const JointVector& q) const;                                  // M(q)
   JointVector coriolis_torque(const JointVector& q, const JointVector& q_dot) const;    // C(q, q_dot) q_dot
