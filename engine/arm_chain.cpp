@@ -5,6 +5,7 @@
 #include <numbers>
 #include <string>
 
+#include "engine/arm_chain_kernel.hpp"
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -53,6 +54,22 @@ void for_each_point_mass(const ChainParameters& chain, F&& f) {
   }
 }
 
+/// Calls f(std::integral_constant<int, J>) for the chain's joint count: the fixed-size kernel's J.
+template <typename F>
+decltype(auto) with_joint_count(int joints, F&& f) {
+  switch (joints) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    default: return f(std::integral_constant<int, kMaxJoints>{});  // validate_chain allows 1..kMaxJoints
+  }
+}
+
+template <int J>
+Eigen::Matrix<double, J, 1> fixed(const JointVector& v) {
+  return v.head<J>();
+}
+
 }  // namespace
 
 ArmChain::ArmChain(const ChainParameters& chain) : chain_(chain) {
@@ -60,7 +77,8 @@ ArmChain::ArmChain(const ChainParameters& chain) : chain_(chain) {
   const int J = chain_.joints;
   stiffness_.resize(J);
   kappa_.resize(J);
-  damping_.resize(J);
+  damping_ = JointVector::Zero(J);
+  straight_inertia_ = JointVector::Zero(J);  // the kernel reads them; the mass matrix does not need them
   for (int i = 0; i < J; ++i) {
     stiffness_(i) = chain_.links[static_cast<std::size_t>(i)].stiffness_Nm_per_rad;
     kappa_(i) = chain_.links[static_cast<std::size_t>(i)].kappa_rad_per_bar;
@@ -80,35 +98,13 @@ ArmChain::ArmChain(const ChainParameters& chain) : chain_(chain) {
 }
 
 ArmChain::RigidBodyTerms ArmChain::rigid_body_terms(const JointVector& q, const JointVector& q_dot) const {
-  // Over the point masses m with Jacobian J_p: M += m J_p'J_p, C q_dot += m J_p' (J_p_dot q_dot),
-  // G += m g (dy/dq); each link's rotational inertia I_i adds I_i to M over joints 1..i (its angular
-  // Jacobian is constant, so it adds nothing to C q_dot). J_p_dot q_dot of a point on link i at
-  // distance d is -sum_{k<i} l_k w_k^2 (cos theta_k, sin theta_k) - d w_i^2 (cos theta_i, sin theta_i),
-  // w_k = theta_k_dot the absolute angular velocity of link k.
-  const int J = joints();
-  const LinkAngles angles(q);
-  JointVector link_rate(J);
-  double rate = 0.0;
-  for (int k = 0; k < J; ++k) link_rate(k) = rate += q_dot(k);
-  RigidBodyTerms terms{JointMatrix::Zero(J, J), JointVector::Zero(J), JointVector::Zero(J)};
-  const double g = chain_.gravity ? chain_.gravity_m_per_s2 : 0.0;
-  for_each_point_mass(chain_, [&](int link, double distance_m, double mass_kg) {
-    const PointJacobian jacobian(chain_, angles, link, distance_m);
-    terms.mass.noalias() += mass_kg * (jacobian.x * jacobian.x.transpose() + jacobian.y * jacobian.y.transpose());
-    const double w2 = link_rate(link) * link_rate(link);
-    double ax = -distance_m * w2 * angles.cos(link), ay = -distance_m * w2 * angles.sin(link);
-    for (int k = 0; k < link; ++k) {
-      const double centripetal = chain_.links[static_cast<std::size_t>(k)].length_m * link_rate(k) * link_rate(k);
-      ax -= centripetal * angles.cos(k);
-      ay -= centripetal * angles.sin(k);
-    }
-    terms.coriolis += mass_kg * (jacobian.x * ax + jacobian.y * ay);
-    terms.gravity += mass_kg * g * jacobian.y;
+  return with_joint_count(joints(), [&]<int J>(std::integral_constant<int, J>) {
+    const arm_chain_kernel::Kernel<J> kernel(chain_, straight_inertia_, damping_);
+    Eigen::Matrix<double, J, J> M;
+    Eigen::Matrix<double, J, 1> coriolis, gravity;
+    kernel.rigid_body(fixed<J>(q), fixed<J>(q_dot), M, coriolis, gravity);
+    return RigidBodyTerms{M, coriolis, gravity};
   });
-  for (int i = 0; i < J; ++i) {
-    terms.mass.topLeftCorner(i + 1, i + 1).array() += chain_.links[static_cast<std::size_t>(i)].inertia_kg_m2;
-  }
-  return terms;
 }
 
 JointMatrix ArmChain::mass_matrix(const JointVector& q) const {
@@ -139,30 +135,25 @@ JointMatrix ArmChain::gravity_stiffness(const JointVector& q) const {
 }
 
 JointVector ArmChain::bellows_torque(const JointVector& q, const JointVector& z, const JointVector& dp_bar) const {
-  return stiffness_.cwiseProduct(kappa_.cwiseProduct(dp_bar) - q - z);
+  return with_joint_count(joints(), [&]<int J>(std::integral_constant<int, J>) {
+    const arm_chain_kernel::Kernel<J> kernel(chain_, straight_inertia_, damping_);
+    return JointVector(kernel.bellows_torque(fixed<J>(q), fixed<J>(z), fixed<J>(dp_bar)));
+  });
 }
 
 JointVector ArmChain::stop_torque(const JointVector& q, const JointVector& q_dot) const {
-  const int J = joints();
-  JointVector torque = JointVector::Zero(J);
-  for (int i = 0; i < J; ++i) {
-    const double stop_rad = chain_.links[static_cast<std::size_t>(i)].hard_stop_deg * std::numbers::pi / 180.0;
-    const double beyond = std::abs(q(i)) - stop_rad;
-    if (beyond > 0.0) {
-      const double direction = q(i) > 0.0 ? 1.0 : -1.0;
-      torque(i) = -straight_inertia_(i) *
-                  (direction * chain_.hard_stop_stiffness_per_s2 * beyond + chain_.hard_stop_damping_per_s * q_dot(i));
-    }
-  }
-  return torque;
+  return with_joint_count(joints(), [&]<int J>(std::integral_constant<int, J>) {
+    const arm_chain_kernel::Kernel<J> kernel(chain_, straight_inertia_, damping_);
+    return JointVector(kernel.stop_torque(fixed<J>(q), fixed<J>(q_dot)));
+  });
 }
 
 JointVector ArmChain::acceleration(const JointVector& q, const JointVector& q_dot, const JointVector& z,
                                    const JointVector& dp_bar) const {
-  const RigidBodyTerms terms = rigid_body_terms(q, q_dot);
-  const JointVector torque = bellows_torque(q, z, dp_bar) - damping_.cwiseProduct(q_dot) + stop_torque(q, q_dot) -
-                             terms.coriolis - terms.gravity;
-  return terms.mass.llt().solve(torque);
+  return with_joint_count(joints(), [&]<int J>(std::integral_constant<int, J>) {
+    const arm_chain_kernel::Kernel<J> kernel(chain_, straight_inertia_, damping_);
+    return JointVector(kernel.acceleration(fixed<J>(q), fixed<J>(q_dot), fixed<J>(z), fixed<J>(dp_bar)));
+  });
 }
 
 JointVector ArmChain::holding_pressure_bar(const JointVector& q) const {
@@ -189,42 +180,24 @@ double ArmChain::mechanical_energy_J(const State& state) const {
   return energy;
 }
 
-ArmChain::Derivative ArmChain::derivative(const JointVector& q, const JointVector& q_dot, const JointVector& z,
-                                          const JointVector& dp_bar) const {
-  Derivative d;
-  d.angle = q_dot;
-  d.velocity = acceleration(q, q_dot, z, dp_bar);
-  d.creep.resize(joints());
-  for (int i = 0; i < joints(); ++i) {
-    const ChainLink& l = chain_.links[static_cast<std::size_t>(i)];
-    d.creep(i) = (l.creep_gain * q(i) - z(i)) / l.creep_tau_s;
-  }
-  return d;
-}
-
-void ArmChain::step(double h, const JointVector& dp_bar) {
-  // Classical RK4, the pressure differences constant over the step.
-  const JointVector& q = state_.angle_rad;
-  const JointVector& v = state_.velocity_rad_per_s;
-  const JointVector& z = state_.creep_rad;
-  const Derivative k1 = derivative(q, v, z, dp_bar);
-  const Derivative k2 = derivative(q + h / 2 * k1.angle, v + h / 2 * k1.velocity, z + h / 2 * k1.creep, dp_bar);
-  const Derivative k3 = derivative(q + h / 2 * k2.angle, v + h / 2 * k2.velocity, z + h / 2 * k2.creep, dp_bar);
-  const Derivative k4 = derivative(q + h * k3.angle, v + h * k3.velocity, z + h * k3.creep, dp_bar);
-  state_.angle_rad += h / 6.0 * (k1.angle + 2.0 * k2.angle + 2.0 * k3.angle + k4.angle);
-  state_.velocity_rad_per_s += h / 6.0 * (k1.velocity + 2.0 * k2.velocity + 2.0 * k3.velocity + k4.velocity);
-  state_.creep_rad += h / 6.0 * (k1.creep + 2.0 * k2.creep + 2.0 * k3.creep + k4.creep);
-  state_.time_s += h;
-}
-
 void ArmChain::advance(double dt_s, const JointVector& dp_bar) {
-  constexpr double kEpsilon_s = 1e-12;  // no sliver steps from float drift
-  double remaining = dt_s;
-  while (remaining > kEpsilon_s) {
-    const double h = std::min(chain_.integration_step_s, remaining);
-    step(h, dp_bar);
-    remaining -= h;
-  }
+  with_joint_count(joints(), [&]<int J>(std::integral_constant<int, J>) {
+    const arm_chain_kernel::Kernel<J> kernel(chain_, straight_inertia_, damping_);
+    Eigen::Matrix<double, J, 1> q = fixed<J>(state_.angle_rad), v = fixed<J>(state_.velocity_rad_per_s),
+                                z = fixed<J>(state_.creep_rad);
+    const Eigen::Matrix<double, J, 1> dp = fixed<J>(dp_bar);
+    constexpr double kEpsilon_s = 1e-12;  // no sliver steps from float drift
+    double remaining = dt_s;
+    while (remaining > kEpsilon_s) {
+      const double h = std::min(chain_.integration_step_s, remaining);
+      kernel.rk4(h, dp, q, v, z);
+      state_.time_s += h;
+      remaining -= h;
+    }
+    state_.angle_rad = q;
+    state_.velocity_rad_per_s = v;
+    state_.creep_rad = z;
+  });
 }
 
 void ArmChain::set_state(const State& state) {

@@ -72,12 +72,6 @@ class ArmChain {
   void set_state(const State& state);
 
  private:
-  struct Derivative {
-    JointVector angle, velocity, creep;
-  };
-  Derivative derivative(const JointVector& q, const JointVector& q_dot, const JointVector& z, const JointVector& dp_bar) const;
-  void step(double h_s, const JointVector& dp_bar);
-
   ChainParameters chain_;
   JointVector stiffness_, kappa_;
   JointVector straight_inertia_, damping_;
