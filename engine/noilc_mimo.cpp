@@ -38,6 +38,8 @@ const char* to_string(MultiJointNoilcStatus status) {
     case MultiJointNoilcStatus::kNotPositiveDefinite: return "the weights do not give a positive definite cost";
     case MultiJointNoilcStatus::kShapeMismatch: return "the data are not N x J";
     case MultiJointNoilcStatus::kNonFiniteData: return "the data hold a NaN or an infinity";
+    case MultiJointNoilcStatus::kBadBounds: return "the bounds are not N x J or a lower bound exceeds its upper bound";
+    case MultiJointNoilcStatus::kNotConverged: return "the bounded update did not converge within its iterations";
   }
   return "unknown";
 }

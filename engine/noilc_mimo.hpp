@@ -43,6 +43,8 @@ enum class MultiJointNoilcStatus {
   kNotPositiveDefinite, // the cost is not strictly convex (e.g. S = W = 0 with a singular model)
   kShapeMismatch,       // solve()'s data are not N x J
   kNonFiniteData,       // solve()'s u_j, e_j or target hold a NaN or an infinity
+  kBadBounds,           // constrained: bounds not N x J, NaN, or a lower bound above its upper bound
+  kNotConverged,        // constrained: ADMM stopped at its iteration limit; the result is feasible, not optimal
 };
 
 const char* to_string(MultiJointNoilcStatus status);

@@ -1,9 +1,6 @@
 // Norm-optimal ILC for J joints: the O(N) Riccati form (engine/noilc_mimo) must give the dense lifted
 // closed form's optimum (engine/noilc_mimo_dense) to 1e-9 relative on random stable models and random
 // data for J = 1..4, coupled and block-diagonal; with one joint both must be the single-joint laws.
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -14,89 +11,16 @@
 #include "engine/noilc_mimo.hpp"
 #include "engine/noilc_mimo_dense.hpp"
 #include "engine/noilc_riccati.hpp"
-
-// Counts global allocations while `g_counting` is set: solve() must allocate nothing.
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "tests/allocation_counter.hpp"
+#include "tests/multi_joint_random.hpp"
 
 namespace bellows {
 namespace {
 
-constexpr double kSampleTime_s = 0.02;
+using namespace mimo_test;
 
 double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& reference) {
   return (a - reference).norm() / reference.norm();
-}
-
-class Random {
- public:
-  explicit Random(unsigned seed) : engine_(seed) {}
-  double normal() { return normal_(engine_); }
-  /// Log-uniform in [low, high].
-  double between(double low, double high) { return low * std::pow(high / low, uniform_(engine_)); }
-  Eigen::MatrixXd matrix(Eigen::Index rows, Eigen::Index cols, double scale) {
-    Eigen::MatrixXd m(rows, cols);
-    for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = scale * normal();
-    return m;
-  }
-  /// A random symmetric positive definite J x J matrix of size ~`scale`, condition number <= ~20.
-  JointMatrix spd(int joints, double scale) {
-    const Eigen::MatrixXd R = matrix(joints, joints, 1.0);
-    Eigen::MatrixXd S = R * R.transpose() / joints;
-    S.diagonal().array() += 0.1 * (1.0 + S.diagonal().maxCoeff());
-    return scale * S / S.diagonal().mean();
-  }
-
- private:
-  std::mt19937 engine_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
-  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
-};
-
-/// A coupled model: random A scaled to spectral radius `radius`, random B and C.
-MultiJointModel random_coupled_model(int joints, double radius, Random& random) {
-  MultiJointModel model;
-  const Eigen::MatrixXd A = random.matrix(2 * joints, 2 * joints, 1.0);
-  const double spectral_radius = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues().cwiseAbs().maxCoeff();
-  model.A = A * (radius / spectral_radius);
-  model.B = random.matrix(2 * joints, joints, 0.5);
-  model.C = random.matrix(joints, 2 * joints, 1.0);
-  model.sample_time_s = kSampleTime_s;
-  return model;
-}
-
-/// J arms of the spec's form with kappa, omega0 and delta drawn around the paper's values.
-std::vector<DiscreteArmModel> random_joint_models(int joints, Random& random) {
-  std::vector<DiscreteArmModel> models;
-  for (int i = 0; i < joints; ++i) {
-    ModelParameters p;
-    p.kappa_rad_per_bar = random.between(3.0, 12.0);
-    p.omega0_rad_per_s = random.between(5.0, 25.0);
-    p.damping = random.between(0.1, 0.9);
-    models.push_back(discretize_arm_model(p, kSampleTime_s));
-  }
-  return models;
-}
-
-MultiJointWeights random_full_weights(int joints, Random& random) {
-  MultiJointWeights w;
-  w.m = random.spd(joints, random.between(0.2, 5.0));
-  w.s = random.spd(joints, random.between(0.01, 1.0));
-  w.w = random.spd(joints, random.between(1e-6, 1e-4));
-  return w;
 }
 
 struct TrialData {
@@ -308,24 +232,23 @@ TEST(NoilcMimo, SolveAllocatesNothing) {
               MultiJointNoilcStatus::kOk);
     const TrialData data(kSamples, joints, random);
     Eigen::MatrixXd out(kSamples, joints);
-    g_allocations.store(0);
     {
-      auto* probe = new int(1);  // the counter sees an allocation: the instrument works
-      g_counting.store(true);
+      testing_allocations::Counter instrument;  // the counter sees an allocation: the instrument works
+      auto* probe = new int(1);
+      EXPECT_EQ(instrument.allocations(), 1);
       delete probe;
-      auto* counted = new int(2);
-      g_counting.store(false);
-      delete counted;
-      EXPECT_EQ(g_allocations.load(), 1);
     }
-    g_allocations.store(0);
-    g_counting.store(true);
-    const MultiJointNoilcStatus solved = law.solve(data.u_j, data.e_j, data.target, out);
-    const MultiJointNoilcStatus updated = law.update(data.u_j, data.e_j, out);
-    g_counting.store(false);
+    long allocations = 0;
+    MultiJointNoilcStatus solved, updated;
+    {
+      testing_allocations::Counter counter;
+      solved = law.solve(data.u_j, data.e_j, data.target, out);
+      updated = law.update(data.u_j, data.e_j, out);
+      allocations = counter.allocations();
+    }
     EXPECT_EQ(solved, MultiJointNoilcStatus::kOk);
     EXPECT_EQ(updated, MultiJointNoilcStatus::kOk);
-    EXPECT_EQ(g_allocations.load(), 0) << "J = " << joints;
+    EXPECT_EQ(allocations, 0) << "J = " << joints;
   }
 }
 
