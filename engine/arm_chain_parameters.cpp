@@ -8,7 +8,7 @@
 namespace bellows {
 namespace {
 
-ChainLink link(double m, double l, double c, double I, double m_a, double K, double kappa, double w0, double delta) {
+ChainLink preset_link(double m, double l, double c, double I, double m_a, double K, double kappa, double w0, double delta) {
   ChainLink out;
   out.mass_kg = m;
   out.length_m = l;
@@ -26,17 +26,17 @@ ChainLink link(double m, double l, double c, double I, double m_a, double K, dou
 
 ChainParameters chain_preset(std::string_view name) {
   // ../shared/spec/multi-joint.md section 2 (reconstructed values), column for column:
-  //          m     l     c      I        m_a   K     kappa w0     delta
+  //                 m     l     c      I        m_a   K     kappa w0     delta
   ChainParameters chain;
   if (name == "arm2") {
     chain.joints = 2;
-    chain.links[0] = link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 2.81, 5.0, 8.0, 0.31);   // shoulder
-    chain.links[1] = link(0.10, 0.30, 0.15, 7.5e-4, 0.0, 0.60, 7.91, 14.14, 0.31);   // elbow: the paper's arm
+    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 2.81, 5.0, 8.0, 0.31);   // shoulder
+    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.0, 0.60, 7.91, 14.14, 0.31);   // elbow: the paper's arm
   } else if (name == "arm3") {
     chain.joints = 3;
-    chain.links[0] = link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 4.13, 5.0, 6.0, 0.31);   // shoulder
-    chain.links[1] = link(0.10, 0.30, 0.15, 7.5e-4, 0.15, 2.63, 6.0, 10.0, 0.31);    // elbow
-    chain.links[2] = link(0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31);   // wrist
+    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 4.13, 5.0, 6.0, 0.31);   // shoulder
+    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.15, 2.63, 6.0, 10.0, 0.31);    // elbow
+    chain.links[2] = preset_link(0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31);   // wrist
   } else {
     throw InputError("unknown arm preset '" + std::string(name) + "' (known: arm2, arm3)");
   }

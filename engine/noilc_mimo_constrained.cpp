@@ -5,7 +5,7 @@
 namespace bellows {
 namespace {
 // Over-relaxation of ADMM: 1.5-1.8 is the usual sweet spot (Boyd et al., section 3.4.3), as for one joint.
-constexpr double kRelaxation = 1.6;
+constexpr double kAdmmOverRelaxation = 1.6;
 }  // namespace
 
 MultiJointNoilcStatus MultiJointNoilcConstrained::setup(const MultiJointModel& model, const MultiJointWeights& weights,
@@ -60,7 +60,7 @@ MultiJointNoilcStatus MultiJointNoilcConstrained::solve(const Eigen::Ref<const E
     target_ = z_ - dual_;
     proximal_.solve(u_j, e_j, target_, x_);
     z_previous_.swap(z_);
-    target_ = kRelaxation * x_ + (1.0 - kRelaxation) * z_previous_;  // the relaxed x
+    target_ = kAdmmOverRelaxation * x_ + (1.0 - kAdmmOverRelaxation) * z_previous_;  // the relaxed x
     z_ = (target_ + dual_).cwiseMax(lower_).cwiseMin(upper_);
     dual_ += target_ - z_;
     report_.admm_iterations = k;
