@@ -14,10 +14,13 @@ namespace bellows {
 
 struct RunOptions {
   std::string trajectory = "paper";
-  int iterations = 30;  // learning iterations after the feedback-only trial
+  int iterations = 30;  // learning iterations after the feedback-only iteration 0 (docs/iterations.md)
   std::string config_path;
   std::uint64_t seed = 1;
   bool json = false;
+  bool verbose = false;              // --verbose: a line per iteration even on a terminal
+  bool quiet = false;                // --quiet: nothing but errors (and the JSON with --json)
+  bool progress_on_terminal = false; // the progress stream is a terminal: one redrawn line
   std::string clock = "sim";   // sim: as fast as possible, deterministic; wall: the real-time loop
   std::string speed = "1";     // wall clock with the simulated arm: 1, 2, 5, 10 or max
   bool speed_given = false;    // --speed on the command line: refused with the simulated clock
@@ -38,7 +41,7 @@ struct RunOptions {
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.
 double parse_speed(const std::string& speed);
 
-/// Runs and reports. Progress lines go to `progress`; with --json one object goes to `out`.
+/// Runs and reports. Progress goes to `progress` (app/run_progress.hpp); with --json one object goes to `out`.
 /// Throws InputError for bad input (before any trial runs). Returns the exit status.
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress);
 
