@@ -3,6 +3,8 @@
 // oracle's cost gradient; loose bounds give the unconstrained optimum; solve allocates nothing.
 #include <gtest/gtest.h>
 
+#include "engine/arm_model.hpp"
+#include "engine/noilc_constrained.hpp"
 #include "engine/noilc_mimo_constrained.hpp"
 #include "engine/noilc_mimo_dense.hpp"
 #include "tests/allocation_counter.hpp"
@@ -70,6 +72,33 @@ TEST(NoilcMimoConstrained, BoundedOptimumIsFeasibleAndOptimalForOneToFourJoints)
     const Eigen::MatrixXd clamped = free.cwiseMax(lower).cwiseMin(upper);
     EXPECT_GT(kkt_violation(dense.cost_gradient(u_j, e_j, u_j, clamped), clamped, lower, upper), 1e-3 * scale);
   }
+}
+
+TEST(NoilcMimoConstrained, OneJointIsTheSingleJointBoundedLaw) {
+  // noilc-constrained with set_bounds (no trial context) is the plain bounded optimum of one joint.
+  const DiscreteArmModel arm = discretize_arm_model(ModelParameters{}, kSampleTime_s);
+  constexpr int kSamples = 200;
+  IlcParameters parameters;
+  parameters.admm_tolerance = 1e-10;
+  parameters.admm_max_iterations = 20000;
+  NormOptimalConstrained single(arm, parameters, kSamples);
+  MultiJointNoilcConstrained law;
+  MultiJointAdmmSettings admm{parameters.admm_rho, parameters.admm_max_iterations, parameters.admm_tolerance};
+  ASSERT_EQ(law.setup(block_diagonal_model(std::span(&arm, 1)), MultiJointWeights::uniform(parameters, 1), kSamples, admm),
+            MultiJointNoilcStatus::kOk);
+  Random random(73);
+  const Eigen::MatrixXd u_j = random.matrix(kSamples, 1, 0.05), e_j = random.matrix(kSamples, 1, 0.5);
+  const Eigen::MatrixXd lower = Eigen::MatrixXd::Constant(kSamples, 1, -0.05) - random.matrix(kSamples, 1, 0.01);
+  const Eigen::MatrixXd upper = lower.array() + 0.1;
+  single.set_bounds(lower.col(0), upper.col(0));
+  ASSERT_EQ(law.set_bounds(lower, upper), MultiJointNoilcStatus::kOk);
+  Eigen::VectorXd expected(kSamples);
+  Eigen::MatrixXd actual(kSamples, 1);
+  single.update(u_j.col(0), e_j.col(0), expected);
+  ASSERT_EQ(law.solve(u_j, e_j, actual), MultiJointNoilcStatus::kOk);
+  EXPECT_GT(single.last_report().active_samples, 10);
+  EXPECT_EQ(law.last_report().active_entries, single.last_report().active_samples);
+  EXPECT_LT((actual.col(0) - expected).cwiseAbs().maxCoeff(), 1e-8);
 }
 
 TEST(NoilcMimoConstrained, LooseBoundsGiveTheUnconstrainedOptimum) {
