@@ -1,0 +1,149 @@
+// Arms with several joints (issue 14): the J-joint norm-optimal update in O(N) against the dense
+// lifted form, and its set-up; the chain's mechanics (ArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "engine/arm_chain.hpp"
+#include "engine/arm_chain_linearization.hpp"
+#include "engine/arm_model.hpp"
+#include "engine/noilc_mimo.hpp"
+#include "engine/noilc_mimo_constrained.hpp"
+#include "engine/noilc_mimo_dense.hpp"
+#include "engine/noilc_riccati.hpp"
+
+namespace bellows {
+namespace {
+
+constexpr double kSampleTime_s = 0.02;
+
+/// J paper-type joints, each with the paper's model, coupled through a small off-diagonal input
+/// gain (a full MIMO model: every block of A, B, C is used by the sweeps whatever its values).
+MultiJointModel coupled_model(int joints) {
+  const std::vector<DiscreteArmModel> arms(static_cast<std::size_t>(joints), discretize_arm_model(ModelParameters{}, kSampleTime_s));
+  MultiJointModel model = block_diagonal_model(arms);
+  for (int i = 0; i + 1 < joints; ++i) model.B(2 * i + 1, i + 1) = 0.2 * model.B(2 * i + 1, i);
+  return model;
+}
+
+struct TrialData {
+  Eigen::MatrixXd u_j, e_j, u_next;
+  TrialData(int samples, int joints) : u_j(samples, joints), e_j(samples, joints), u_next(samples, joints) {
+    std::mt19937 random(1);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    for (Eigen::Index i = 0; i < u_j.size(); ++i) {
+      u_j.data()[i] = 0.1 * normal(random);
+      e_j.data()[i] = 0.05 * normal(random);
+    }
+  }
+};
+
+void BM_MultiJointUpdate(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
+  MultiJointNoilc law;
+  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) != MultiJointNoilcStatus::kOk) {
+    state.SkipWithError("setup failed");
+    return;
+  }
+  TrialData data(n, joints);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(law.update(data.u_j, data.e_j, data.u_next));
+    benchmark::DoNotOptimize(data.u_next.data());
+  }
+  state.counters["memory_MB"] = static_cast<double>(law.info().memory_bytes) / 1e6;
+}
+BENCHMARK(BM_MultiJointUpdate)
+    ->Args({1, 400})->Args({2, 400})->Args({3, 400})->Args({4, 400})->Args({3, 12000})
+    ->Unit(benchmark::kMicrosecond);
+
+// The single-joint law (`noilc`) on the same data, for a comparison under the same machine load.
+void BM_SingleJointUpdate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  NormOptimalRiccati law(discretize_arm_model(ModelParameters{}, kSampleTime_s), IlcParameters{}, n);
+  TrialData data(n, 1);
+  Eigen::VectorXd u_next(n);
+  for (auto _ : state) {
+    law.update(data.u_j.col(0), data.e_j.col(0), u_next);
+    benchmark::DoNotOptimize(u_next.data());
+  }
+}
+BENCHMARK(BM_SingleJointUpdate)->Arg(400)->Unit(benchmark::kMicrosecond);
+
+void BM_MultiJointSetup(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
+  const MultiJointModel model = coupled_model(joints);
+  const MultiJointWeights weights = MultiJointWeights::uniform(IlcParameters{}, joints);
+  for (auto _ : state) {
+    MultiJointNoilc law;
+    benchmark::DoNotOptimize(law.setup(model, weights, n));
+  }
+}
+BENCHMARK(BM_MultiJointSetup)->Args({3, 400})->Args({3, 12000})->Unit(benchmark::kMicrosecond);
+
+// The bounded update, cold: a large random error against +-0.05 bar bounds on every joint, restarted
+// from the same u_j every time (many entries end on a bound), as BM_ConstrainedUpdate for one joint.
+void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
+  MultiJointNoilcConstrained law;
+  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) != MultiJointNoilcStatus::kOk ||
+      law.set_bounds(Eigen::MatrixXd::Constant(n, joints, -0.05), Eigen::MatrixXd::Constant(n, joints, 0.05)) !=
+          MultiJointNoilcStatus::kOk) {
+    state.SkipWithError("setup failed");
+    return;
+  }
+  TrialData data(n, joints);
+  data.e_j *= 10.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(law.solve(data.u_j, data.e_j, data.u_next));
+    benchmark::DoNotOptimize(data.u_next.data());
+  }
+  state.counters["admm_iterations"] = law.last_report().admm_iterations;
+  state.counters["active_entries"] = law.last_report().active_entries;
+}
+BENCHMARK(BM_MultiJointConstrainedUpdate)->Args({3, 400})->Unit(benchmark::kMicrosecond);
+
+void BM_MultiJointDenseUpdate(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
+  const MultiJointNoilcDense law(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n);
+  TrialData data(n, joints);
+  for (auto _ : state) {
+    data.u_next = law.update(data.u_j, data.e_j);
+    benchmark::DoNotOptimize(data.u_next.data());
+  }
+}
+BENCHMARK(BM_MultiJointDenseUpdate)->Args({3, 400})->Unit(benchmark::kMicrosecond);
+
+// One simulated second of the chain's mechanics (RK4 at the spec's 0.1 ms), the pressure differences
+// changing every 5 ms tick as a controller's would. Mechanics only: the bellows' pneumatics and the
+// controllers are not in ArmChain. real_time_factor = simulated / wall-clock (CPU) time.
+void BM_ArmChainSecond(benchmark::State& state) {
+  const ChainParameters chain = chain_preset(state.range(0) == 2 ? "arm2" : "arm3");
+  ArmChain arm(chain);
+  const int J = chain.joints;
+  constexpr double kTick_s = 0.005;
+  for (auto _ : state) {
+    for (int tick = 0; tick < 200; ++tick) {
+      const double t = arm.state().time_s;
+      JointVector dp(J);
+      for (int i = 0; i < J; ++i) dp(i) = 0.1 + 0.1 * std::sin((3.0 + i) * t);
+      arm.advance(kTick_s, dp);
+    }
+    benchmark::DoNotOptimize(arm.state().angle_rad.data());
+  }
+  state.counters["real_time_factor"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_ArmChainSecond)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+
+void BM_ArmChainLinearization(benchmark::State& state) {
+  const ArmChain arm(chain_preset("arm3"));
+  const JointVector pose = JointVector::Constant(3, 0.3);
+  for (auto _ : state) benchmark::DoNotOptimize(linearize_chain(arm, pose, kSampleTime_s).A.data());
+}
+BENCHMARK(BM_ArmChainLinearization)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace bellows
+
+BENCHMARK_MAIN();
