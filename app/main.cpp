@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "bellows " + bellows::program_version());  // as sessions record it
 
   bellows::RunOptions run;
-  CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless on simulated time, learning between them");
+  CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
   run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "Learning iterations after the feedback-only trial")
@@ -51,8 +51,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
   run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
-  run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
-      ->capture_default_str()
+  run_cmd->add_option("--clock", run.clock,
+                      "sim: simulated time, as fast as possible; wall: the real-time loop (default: wall on a rig "
+                      "(--device lcm, t7), sim on the simulated arm)")
       ->check(CLI::IsMember({"sim", "wall"}));
   run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
       ->capture_default_str()
@@ -137,7 +138,7 @@ int main(int argc, char** argv) {
   plot_cmd->add_flag("--no-paper", plot.no_paper, "No overlay on the RMS figure");
   plot_cmd->add_flag("--force", plot.force, "Replace existing figures");
   plot_cmd->add_flag("--json", plot.json, "Print JSON on stdout");
-  bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 need --clock wall
+  bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 run on the wall clock
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find an lcm rig there)");
   CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
                                              "Keep an LCM event log of the telemetry: in FILE (a new file), or without "

@@ -65,6 +65,17 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
 
 }  // namespace
 
+std::string resolve_clock(const std::string& given, const std::string& device_kind) {
+  if (!given.empty() && given != "sim" && given != "wall") throw InputError("--clock must be sim or wall");
+  const bool rig = device_kind != "sim";
+  if (rig && given == "sim") {
+    throw InputError("--clock sim cannot drive --device " + device_kind +
+                     ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out)");
+  }
+  if (!given.empty()) return given;
+  return rig ? "wall" : "sim";
+}
+
 double parse_speed(const std::string& speed) {
   if (speed == "max") return 0.0;
   for (const char* allowed : {"1", "2", "5", "10"}) {
@@ -73,19 +84,21 @@ double parse_speed(const std::string& speed) {
   throw InputError("--speed must be 1, 2, 5, 10 or max, not '" + speed + "'");
 }
 
-int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
-  if (options.iterations < 0) throw InputError("--iterations must not be negative");
-  if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+int run_command(const RunOptions& given_options, std::ostream& out, std::ostream& progress) {
+  if (given_options.iterations < 0) throw InputError("--iterations must not be negative");
+  if (!given_options.clock.empty()) resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
+  if (!given_options.lcm_url.empty()) check_lcm_url(given_options.lcm_url, "--lcm");  // before a session exists
+  const double speed = parse_speed(given_options.speed);
+  RunRecording recording(given_options);  // with --resume: the saved configuration, trajectory and state
+  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
+  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+                               : given_options.config_path.empty() ? Configuration{}
+                                                             : load_config_file(given_options.config_path);
+  RunOptions options = given_options;  // with the clock the device decides when --clock was left out
+  options.clock = resolve_clock(given_options.clock, resolve_device(given_options.device, config.device).kind);
   if (options.speed_given && options.clock != "wall") {  // never ignored in silence
     throw InputError("--speed is for --clock wall: the simulated clock runs as fast as it can");
   }
-  if (!options.lcm_url.empty()) check_lcm_url(options.lcm_url, "--lcm");  // before a session exists
-  const double speed = parse_speed(options.speed);
-  RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
-  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
-  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
-                               : options.config_path.empty() ? Configuration{}
-                                                             : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
   const Trajectory trajectory =
       resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);

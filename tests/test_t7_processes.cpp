@@ -64,7 +64,7 @@ class T7Processes : public ::testing::Test {
     const std::filesystem::path config =
         testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
     return std::make_unique<Child>(
-        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "try",
+        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try",  // a rig: the wall clock
                                  "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},
         dir_ / (name + ".out"), dir_ / (name + ".err"));
   }
@@ -133,6 +133,7 @@ TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
     EXPECT_NEAR(remote_rms[i], local_rms[i], 0.15 * local_rms[i]) << "iteration " << i;
   }
   EXPECT_EQ(t7.at("device"), "t7");
+  EXPECT_EQ(t7.at("clock"), "wall");  // no --clock: a rig runs on the wall clock
   const nlohmann::json link = t7.at("loop").at("link");
   EXPECT_GT(link.at("exchanges").get<std::uint64_t>(), 1000u);
   EXPECT_EQ(link.at("errors").get<std::uint64_t>(), 0u);
