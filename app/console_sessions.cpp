@@ -212,6 +212,7 @@ ui::SessionSnapshot StoreSessionGateway::read_trials(const std::string& location
   ui::SessionSnapshot snapshot;
   snapshot.config = loaded.manifest.configuration;
   snapshot.device_name = loaded.manifest.device;
+  snapshot.rig_profile = rig_profile_of(loaded.manifest);
   snapshot.experiment = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
   const int n = loaded.trajectory.learning_samples();
   for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
@@ -242,6 +243,7 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   ui::SessionSnapshot snapshot;
   snapshot.config = m.configuration;
   snapshot.device_name = m.device;
+  snapshot.rig_profile = rig_profile_of(m);
   const auto seed = m.device_info.find("seed");
   if (seed != m.device_info.end() && seed->is_number_unsigned()) snapshot.seed = seed->get<std::uint64_t>();
   ui::Experiment& e = snapshot.experiment;

@@ -107,6 +107,9 @@ struct Session {
   std::vector<std::vector<TickRecord>> black_boxes;  // in the order of manifest.black_boxes, oldest tick first
 };
 
+/// The rig profile's name the session was recorded with (device_info "rig_profile"); "" without one.
+std::string rig_profile_of(const SessionManifest& manifest);
+
 /// Current UTC time in the manifest's format.
 std::string utc_now();
 
