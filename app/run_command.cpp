@@ -11,6 +11,7 @@
 #include "app/cpu_idle_hold.hpp"
 #include "app/lcm_url.hpp"
 #include "app/rig_profile_file.hpp"
+#include "app/learning_model.hpp"
 #include "app/learning_report.hpp"
 #include "app/run_io.hpp"
 #include "app/run_recording.hpp"
@@ -91,11 +92,22 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   const double speed = parse_speed(given_options.speed);
   RunRecording recording(given_options);  // with --resume: the saved configuration, trajectory and state
   const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
-  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
-                               : given_options.config_path.empty() ? Configuration{}
+  Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+                         : given_options.config_path.empty() ? Configuration{}
                                                              : load_config_file(given_options.config_path);
+  const DeviceParameters device_wanted = resolve_device(given_options.device, config.device);
   RunOptions options = given_options;  // with the clock the device decides when --clock was left out
-  options.clock = resolve_clock(given_options.clock, resolve_device(given_options.device, config.device).kind);
+  options.clock = resolve_clock(given_options.clock, device_wanted.kind);
+  // The model the learning uses: the rig profile's identified one, if it has one (a resumed session:
+  // the one it recorded). The session's configuration records it.
+  LearningModel learning_model;
+  if (resumed != nullptr) {
+    learning_model.model = config.model;
+    if (!resumed->manifest.model_source.empty()) learning_model.source = resumed->manifest.model_source;
+  } else {
+    learning_model = choose_learning_model(config, device_wanted);
+  }
+  config.model = learning_model.model;
   if (options.speed_given && options.clock != "wall") {  // never ignored in silence
     throw InputError("--speed is for --clock wall: the simulated clock runs as fast as it can");
   }
@@ -132,7 +144,8 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
-  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(),
+  if (!learning_model.note.empty()) progress << "bellows: " << learning_model.note << std::endl;
+  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(), learning_model.source,
                   transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
   if (transfer) progress << transfer_line(*transfer) << std::endl;
   if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
@@ -218,6 +231,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
                              {"rig_profile", io.opened().rig_profile_name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
+                             {"model", learning_model_json(learning_model)},
                              {"seed", seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},
