@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
 
   bellows::IdentifyOptions identify;
   CLI::App* identify_cmd =
-      app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
+      app.add_subcommand("identify", "Identification trials on the device; fits kappa, omega0 and damping (recorded in a session)");
   identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
   bellows::add_device_options(*identify_cmd, identify.device);
   identify_cmd->add_option("--rt", identify.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
@@ -228,6 +228,11 @@ int main(int argc, char** argv) {
       ->check(bellows::unsigned_whole_number());
   identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+  CLI::Option* identify_no_save = identify_cmd->add_flag("--no-save", identify.no_save, "Do not record the identification in a session");
+  identify_cmd->add_option("--data-dir", identify.data_dir, "Where its session is saved (default: where runs save theirs)")
+      ->excludes(identify_no_save);
+  identify_cmd->add_option("--name", identify.session_name, "Session name (default: start time and the excitation)")
+      ->excludes(identify_no_save);
 
   bellows::RigCheckOptions rig_check;
   CLI::App* rig_cmd = app.add_subcommand("rig", "The first day at the bench: check the rig's inputs and valves");
