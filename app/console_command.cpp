@@ -113,12 +113,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.device_name = device.name();
   setup.environment.device_where = rig->where();
   setup.environment.rig_profile = rig->rig_profile_name();
-  if (!learning_model.note.empty()) {
-    setup.environment.model_note = learning_model.note;
-  } else if (learning_model.source == kModelFromRigProfile) {
-    setup.environment.model_note = "learning with the rig profile " + learning_model.rig_profile + "'s [model] (" +
-                                   learning_model_json(learning_model).dump() + ")";
-  }
+  setup.environment.model_note = learning_model_line(learning_model);
   setup.environment.device_health = [&device] { return device.health(); };
   setup.environment.raw_inputs = [&device] { return device.raw_inputs(); };
   if (config.device.kind == "t7" && !config.device.rig_profile.empty()) {

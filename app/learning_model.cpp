@@ -7,6 +7,12 @@
 namespace bellows {
 namespace {
 
+std::string model_values(const ModelParameters& m) {
+  char text[160];
+  std::snprintf(text, sizeof text, "kappa %g, omega0 %g, damping %g", m.kappa_rad_per_bar, m.omega0_rad_per_s, m.damping);
+  return text;
+}
+
 bool same_identified(const ModelParameters& a, const ModelParameters& b) {
   return a.kappa_rad_per_bar == b.kappa_rad_per_bar && a.omega0_rad_per_s == b.omega0_rad_per_s && a.damping == b.damping;
 }
@@ -25,15 +31,15 @@ LearningModel choose_learning_model(const Configuration& config, const DevicePar
   chosen.model.omega0_rad_per_s = profile.model->omega0_rad_per_s;
   chosen.model.damping = profile.model->damping;
   if (!same_identified(config.model, ModelParameters{}) && !same_identified(config.model, chosen.model)) {
-    char line[400];
-    std::snprintf(line, sizeof line,
-                  "learning with the rig profile %s's [model] (kappa %g, omega0 %g, damping %g), not the "
-                  "configuration's (kappa %g, omega0 %g, damping %g)",
-                  profile.name.c_str(), chosen.model.kappa_rad_per_bar, chosen.model.omega0_rad_per_s, chosen.model.damping,
-                  config.model.kappa_rad_per_bar, config.model.omega0_rad_per_s, config.model.damping);
-    chosen.note = line;
+    chosen.note = "not the configuration's (" + model_values(config.model) + ")";
   }
   return chosen;
+}
+
+std::string learning_model_line(const LearningModel& chosen) {
+  if (chosen.source != kModelFromRigProfile) return "";
+  return "learning with the rig profile " + chosen.rig_profile + "'s [model] (" + model_values(chosen.model) + ")" +
+         (chosen.note.empty() ? "" : ", " + chosen.note);
 }
 
 nlohmann::ordered_json learning_model_json(const LearningModel& chosen) {

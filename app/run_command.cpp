@@ -144,7 +144,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
-  if (!learning_model.note.empty()) progress << "bellows: " << learning_model.note << std::endl;
+  if (const std::string line = learning_model_line(learning_model); !line.empty()) progress << line << std::endl;
   recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(), learning_model.source,
                   transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
   if (transfer) progress << transfer_line(*transfer) << std::endl;

@@ -180,13 +180,15 @@ TEST(LearningModel, TheRigProfilesIdentifiedModelIsUsedWhenItHasOne) {
   EXPECT_DOUBLE_EQ(chosen.model.damping, 0.4);
   EXPECT_DOUBLE_EQ(chosen.model.volume_gain_per_rad, 0.2) << "volume_gain stays the configuration's";
   EXPECT_TRUE(chosen.note.empty()) << "the configuration had the defaults: nothing replaced";
+  EXPECT_EQ(learning_model_line(chosen), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4)");
   EXPECT_EQ(learning_model_json(chosen)["source"], "rig_profile");
   EXPECT_EQ(learning_model_json(chosen)["kappa_rad_per_bar"], 6.5);
 
   config.model.kappa_rad_per_bar = 8.2;  // e.g. an earlier `identify --write-model lab.toml`
   const LearningModel replacing = choose_learning_model(config, {"t7", "", "127.0.0.1:5020", with_model});
   EXPECT_DOUBLE_EQ(replacing.model.kappa_rad_per_bar, 6.5);
-  EXPECT_NE(replacing.note.find("not the configuration's (kappa 8.2"), std::string::npos) << replacing.note;
+  EXPECT_EQ(learning_model_line(replacing), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4), "
+                                            "not the configuration's (kappa 8.2, omega0 14.14, damping 0.31)");
 
   // Without a [model] in the profile (the built-in paper rig has none), and off a T7: the configuration's.
   const std::string no_model = profile_copy("no-model");
@@ -197,6 +199,7 @@ TEST(LearningModel, TheRigProfilesIdentifiedModelIsUsedWhenItHasOne) {
     EXPECT_EQ(configured.source, "configuration") << device.kind << " " << device.rig_profile;
     EXPECT_DOUBLE_EQ(configured.model.kappa_rad_per_bar, 8.2);
     EXPECT_TRUE(configured.note.empty());
+    EXPECT_EQ(learning_model_line(configured), "");
     EXPECT_FALSE(learning_model_json(configured).contains("rig_profile"));
   }
   // A bad profile is the profile's one line, before anything opens.
