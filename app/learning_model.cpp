@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/rig_profile_file.hpp"
+#include "engine/printable_text.hpp"
 
 namespace bellows {
 namespace {
@@ -38,8 +39,8 @@ LearningModel choose_learning_model(const Configuration& config, const DevicePar
 
 std::string learning_model_line(const LearningModel& chosen) {
   if (chosen.source != kModelFromRigProfile) return "";
-  return "learning with the rig profile " + chosen.rig_profile + "'s [model] (" + model_values(chosen.model) + ")" +
-         (chosen.note.empty() ? "" : ", " + chosen.note);
+  return "learning with the rig profile " + printable(chosen.rig_profile) + "'s [model] (" +  // a file's text
+         model_values(chosen.model) + ")" + (chosen.note.empty() ? "" : ", " + chosen.note);
 }
 
 nlohmann::ordered_json learning_model_json(const LearningModel& chosen) {
