@@ -20,6 +20,7 @@
 #include "devices/simulated_arm.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/errors.hpp"
+#include "engine/iteration_numbering.hpp"
 #include "ui/console.hpp"
 
 namespace bellows {
@@ -135,10 +136,10 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   const ui::ConsoleReport report = ui::run_console(std::move(setup));
   char line[320];
   std::snprintf(line, sizeof line,
-                "bellows console: %.1f s, %d iterations%s; valves vented.\n"
+                "bellows console: %.1f s, iterations %s%s; valves vented.\n"
                 "loop: %llu ticks, missed %llu, latency p50 %.0f p99 %.0f max %.0f us (%s%s); "
                 "console: %llu frames (%.1f/s), UI thread CPU %.1f%%\n",
-                report.seconds, report.iterations,
+                report.seconds, iteration_range(report.iterations).c_str(),
                 report.best_rms_deg >= 0.0 ? (", best RMS " + std::to_string(report.best_rms_deg).substr(0, 6) + " deg").c_str() : "",
                 static_cast<unsigned long long>(report.ticks), static_cast<unsigned long long>(report.loop.missed),
                 report.loop.p50_us, report.loop.p99_us, report.loop.max_us, loop.rt_description().c_str(),

@@ -1,4 +1,6 @@
 // bellows: the lab console and its headless commands.
+#include <unistd.h>
+
 #include <csignal>
 #include <iostream>
 #include <map>
@@ -6,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/cli_checks.hpp"
+#include "app/completion_command.hpp"
 #include "app/config_file.hpp"
 #include "app/console_command.hpp"
 #include "app/identify_command.hpp"
@@ -43,14 +46,18 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
   run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
       ->capture_default_str();
-  run_cmd->add_option("--iterations", run.iterations, "Learning iterations after the feedback-only trial")
+  run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
+                      "(with --resume: K after the newest)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
   run_cmd->add_option("--config", run.config_path, "TOML configuration file");
   run_cmd->add_option("--seed", run.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout");
+  run_cmd->add_flag("--json", run.json, "Print one JSON object on stdout (progress then goes to stderr)");
+  CLI::Option* verbose = run_cmd->add_flag("--verbose,-v", run.verbose,
+                                           "A progress line per iteration (default on a terminal: one line, redrawn)");
+  run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors (and the JSON with --json)")->excludes(verbose);
   run_cmd->add_option("--clock", run.clock,
                       "sim: simulated time, as fast as possible; wall: the real-time loop (default: wall on a rig "
                       "(--device lcm, t7), sim on the simulated arm)")
@@ -255,6 +262,11 @@ int main(int argc, char** argv) {
                             "Where the check's session is saved (default: where runs save theirs)")
       ->excludes(rig_no_save);
 
+  // Hidden (no group): what the build generates the bash completion with (app/completion_command.hpp).
+  std::string completion_shell;
+  CLI::App* completion_cmd = app.add_subcommand("completion", "Print the shell completion script")->group("");
+  completion_cmd->add_option("shell", completion_shell, "bash")->required()->check(CLI::IsMember({"bash"}));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& help_or_version) {  // --help, --version: printed, exit 0
@@ -267,6 +279,11 @@ int main(int argc, char** argv) {
   try {
     run.lcm_log = lcm_log->count() > 0;
     run.speed_given = run_cmd->get_option("--speed")->count() > 0;
+    run.progress_on_terminal = isatty(run.json ? STDERR_FILENO : STDOUT_FILENO) == 1;
+    if (completion_cmd->parsed()) {
+      std::cout << bellows::bash_completion(app);
+      return 0;
+    }
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@
 #include "app/learning_model.hpp"
 #include "app/learning_report.hpp"
 #include "app/run_io.hpp"
+#include "app/run_progress.hpp"
 #include "app/run_recording.hpp"
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
@@ -29,13 +31,6 @@
 
 namespace bellows {
 namespace {
-
-std::string progress_line(const IterationSummary& s) {
-  char line[160];
-  std::snprintf(line, sizeof line, "iteration %3d  rms %7.3f deg  max error %7.3f deg  max correction %6.4f bar",
-                s.iteration, s.rms_deg, s.max_abs_error_deg, s.max_abs_correction_bar);
-  return line;
-}
 
 nlohmann::json to_json(const IterationSummary& s) {
   return {{"iteration", s.iteration},
@@ -144,11 +139,15 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
-  if (const std::string line = learning_model_line(learning_model); !line.empty()) progress << line << std::endl;
   recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(), learning_model.source,
                   transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
-  if (transfer) progress << transfer_line(*transfer) << std::endl;
-  if (!recording.directory().empty()) progress << "session " << recording.directory().string() << std::endl;
+  const int trials = recording.trials(options.iterations);
+  const int first_iteration = resumed != nullptr ? static_cast<int>(resumed->iterations.size()) : 0;
+  RunProgressReport said(progress, choose_progress_style(options.verbose, options.quiet, options.progress_on_terminal),
+                           first_iteration, first_iteration + trials - 1);
+  if (const std::string line = learning_model_line(learning_model); !line.empty()) said.note(line);
+  if (transfer) said.note(transfer_line(*transfer));
+  if (!recording.directory().empty()) said.note("session " + recording.directory().string());
   io.start_telemetry(recording.directory());  // its LCM log goes into the session
   ConvergencePrediction prediction;
   try {
@@ -156,7 +155,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   } catch (const Cancelled&) {
     // Stopped by a signal: the first trial sees the flag too, vents and records why.
   }
-  if (!prediction.warning.empty()) progress << "warning: " << prediction.warning << std::endl;
+  if (!prediction.warning.empty()) said.note("warning: " + prediction.warning);
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
   if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
     for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
@@ -171,21 +170,21 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   int status = 0;
   std::string failure;
   std::string failure_name;
-  const int trials = recording.trials(options.iterations);
   try {
     if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
       failure = std::move(why);
       failure_name = "rig-unavailable";
       status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault
-      progress << "bellows: " << failure << std::endl;
+      said.error("bellows: " + failure);
       recording.fault(failure);
     }
+    said.begin_trials();
     for (int i = 0; failure.empty() && i < trials; ++i) {
       const IterationSummary s = session.run_trial();
       io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
       recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
-      progress << progress_line(s) << std::endl;
+      said.iteration(s);
       nlohmann::json iteration = to_json(s);
       iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
       iterations.push_back(iteration);
@@ -199,9 +198,10 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
       failure_name = "foreign-sender";
     }
     status = interrupted ? 128 + stop_signal() : kExitFault;
-    progress << "bellows: " << failure << " (" << fault_name(fault.code()) << ")" << std::endl;
+    said.error("bellows: " + failure + " (" + fault_name(fault.code()) + ")");
     recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);
   } catch (const std::exception& error) {
+    said.finish();  // main() says what went wrong on a line of its own
     if (loop != nullptr) loop->stop();  // vents
     else device.vent();
     recording.fault(error.what());
@@ -210,19 +210,22 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   if (loop != nullptr) loop->stop();  // vents
   else device.vent();
   io.stop();  // the rig's last vent command, the rest of the telemetry
-  if (const std::string warning = io.warning(); !warning.empty()) progress << "bellows: " << warning << std::endl;
+  said.finish();
+  if (const std::string warning = io.warning(); !warning.empty()) said.error("bellows: " + warning);  // a loss
   if (monitor.windup().detected) {
-    progress << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
-             << ": the correction keeps growing where the set points saturate (largest clamped excess "
-             << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it" << std::endl;
+    std::ostringstream warning;
+    warning << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
+            << ": the correction keeps growing where the set points saturate (largest clamped excess "
+            << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it";
+    said.note(warning.str());
   }
   if (core.dropped_events() > 0) {  // a loss like any other: said, and kept with the session
-    progress << "bellows: " << core.dropped_events() << " engine events dropped (the event queue was full)" << std::endl;
+    said.error("bellows: " + std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
     recording.note("dropped-events", std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
   }
   if (core.missed_deadline_warnings() > 0) {
-    progress << "bellows: " << core.missed_deadline_warnings()
-             << " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)" << std::endl;
+    said.note("bellows: " + std::to_string(core.missed_deadline_warnings()) +
+                " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)");
   }
   if (status == 0) recording.finish(trials);
 

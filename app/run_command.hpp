@@ -14,10 +14,13 @@ namespace bellows {
 
 struct RunOptions {
   std::string trajectory = "paper";
-  int iterations = 30;  // learning iterations after the feedback-only trial
+  int iterations = 30;  // learning iterations after the feedback-only iteration 0 (docs/iterations.md)
   std::string config_path;
   std::uint64_t seed = 1;
   bool json = false;
+  bool verbose = false;              // --verbose: a line per iteration even on a terminal
+  bool quiet = false;                // --quiet: nothing but errors (and the JSON with --json)
+  bool progress_on_terminal = false; // the progress stream is a terminal: one redrawn line
   // sim: as fast as possible, deterministic; wall: the real-time loop; empty: the device's own
   // (resolve_clock: sim for the simulated arm, wall for a rig).
   std::string clock;
@@ -45,7 +48,7 @@ std::string resolve_clock(const std::string& given, const std::string& device_ki
 /// Parses a --speed value ("1", "2", "5", "10", "max"); max is 0. Throws InputError.
 double parse_speed(const std::string& speed);
 
-/// Runs and reports. Progress lines go to `progress`; with --json one object goes to `out`.
+/// Runs and reports. Progress goes to `progress` (app/run_progress.hpp); with --json one object goes to `out`.
 /// Throws InputError for bad input (before any trial runs). Returns the exit status.
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress);
 

@@ -2,6 +2,7 @@
 
 #include "app/arm_state_json.hpp"
 #include "engine/errors.hpp"
+#include "engine/iteration_numbering.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
 
@@ -43,7 +44,7 @@ std::uint64_t RunRecording::resumed_seed() const {
 }
 
 int RunRecording::trials(int iterations) const {
-  return resuming_ && !resumed_.manifest.iterations.empty() ? iterations : iterations + 1;
+  return trials_for_iterations(iterations, resuming_ && !resumed_.manifest.iterations.empty());
 }
 
 void RunRecording::start(const Configuration& config, const Trajectory& trajectory, const std::string& device,

@@ -27,8 +27,8 @@ class RunRecording {
   const Session& resumed() const { return resumed_; }
   /// The simulated arm's seed the resumed session was started with.
   std::uint64_t resumed_seed() const;
-  /// Trials to run for `--iterations K`: K + 1 from scratch (trial 0 is feedback only), K when
-  /// continuing after completed iterations.
+  /// Trials to run for `--iterations K` (docs/iterations.md): K + 1 from scratch (iteration 0 is
+  /// feedback only), K when continuing after completed iterations.
   int trials(int iterations) const;
 
   /// A fresh run: creates the session (nothing with --no-save). `model_source`: where config's

@@ -14,6 +14,7 @@
 
 #include "engine/engine_state.hpp"
 #include "engine/errors.hpp"
+#include "engine/iteration_numbering.hpp"
 #include "engine/printable_text.hpp"
 #include "engine/safety.hpp"
 #include "sessions/atomic_file.hpp"
@@ -88,7 +89,8 @@ Json listing_json(const fs::path& directory, const SessionManifest& m) {
           {"started_utc", m.started_utc},
           {"device", m.device},
           {"trajectory", m.trajectory_name},
-          {"iterations", m.iterations.size()},
+          {"iterations", m.iterations.size()},  // a count: iterations 0..last (docs/iterations.md)
+          {"last_iteration", m.iterations.empty() ? Json(nullptr) : Json(m.iterations.size() - 1)},
           {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)}};
 }
 
@@ -128,8 +130,9 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
     } else {
       const SessionManifest& m = listing.manifest;
       const double best = best_rms_deg(m);
-      std::snprintf(line, sizeof line, "%-40s  %-19s  %-6s  %-16s  %10zu  %12s", name.c_str(),
-                    short_time(m.started_utc).c_str(), shown(m.device).c_str(), shown(m.trajectory_name).c_str(), m.iterations.size(),
+      std::snprintf(line, sizeof line, "%-40s  %-19s  %-6s  %-16s  %10s  %12s", name.c_str(),
+                    short_time(m.started_utc).c_str(), shown(m.device).c_str(), shown(m.trajectory_name).c_str(),
+                    iteration_range(static_cast<long long>(m.iterations.size())).c_str(),
                     best < 0.0 ? "-" : format("%.3f deg", best).c_str());
     }
     out << line << "\n";
@@ -221,7 +224,7 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
       << format("%g", c.model.omega0_rad_per_s) << " 1/s, damping " << format("%g", c.model.damping)
       << (m.model_source.empty() ? std::string() : " (from the " + shown(m.model_source) + ")") << "\n"
       << "learning     " << shown(c.ilc.law) << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
-      << "iterations   " << m.iterations.size();
+      << "iterations   " << iteration_range(static_cast<long long>(m.iterations.size()));
   if (best >= 0.0) out << ", best RMS " << format("%.3f", best) << " deg";
   out << "\n\n";
   char line[256];
@@ -311,7 +314,7 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
   std::string description = "session " + directory.string();
   try {
     const SessionManifest m = load_manifest(directory);
-    description += " (" + std::to_string(m.iterations.size()) + " iterations, started " + short_time(m.started_utc) + ")";
+    description += " (iterations " + iteration_range(static_cast<long long>(m.iterations.size())) + ", started " + short_time(m.started_utc) + ")";
   } catch (const InputError&) {
     description += " (damaged)";
   }

@@ -39,7 +39,7 @@ start=$SECONDS
 batch
 wait_for 'iteration 1[0-9] ' 120
 rss_start=$(rss_kib)
-wait_for 'batch of 1000 done' 3600
+wait_for 'iterations 0\.\.1000 done' 3600  # N 1000 from scratch: 0..1000 (docs/iterations.md)
 rss_mid=$(rss_kib)
 batch
 wait_for 'iteration 2000 ' 3600

@@ -3,7 +3,9 @@
 #   scripts/console_captures.sh build/app/bellows OUT_DIR [WIDTH HEIGHT]
 # One run on the simulated arm (--speed max, --rt off: it never asks for real-time scheduling),
 # in a private data directory; each screen goes to OUT_DIR/NAME.txt as `tmux capture-pane -p`
-# shows it, and the closing summary to OUT_DIR/summary.txt.
+# shows it, and the closing summary to OUT_DIR/summary.txt. The Quit dialog comes from a second,
+# short run without a data directory (the console asks only when something is not saved).
+# scripts/console_captures_into_docs.py OUT_DIR docs/console.md then puts them into the docs.
 set -euo pipefail
 out="${2:?usage: $0 path/to/bellows OUT_DIR [WIDTH HEIGHT]}"
 width="${3:-100}"
@@ -39,17 +41,13 @@ e2e_keys BSpace BSpace 2 . 5 Enter
 e2e_wait_for 'K must be a whole number'
 capture ask-k-refused
 e2e_keys BSpace BSpace BSpace 5 Enter
-e2e_wait_for 'batch of 5 done' 300
+e2e_wait_for 'iterations 0\.\.5 done' 300
 capture main
-e2e_keys q
-e2e_wait_for 'Quit\?'
-capture quit
-e2e_keys Escape
 
 e2e_keys c
 e2e_wait_for 'At the cursor'
 e2e_keys PageDown PageDown PageDown Right Right Right Up Up m Down
-e2e_wait_for 'overlay: it 2'
+e2e_wait_for 'overlay: it 3'
 capture inspector
 e2e_keys Escape t
 e2e_wait_for 'Trajectories'
@@ -63,7 +61,12 @@ e2e_keys Escape w
 e2e_wait_for 'Gains, learning law and weights'
 capture tuning
 e2e_keys Escape s
-e2e_wait_for 'saved: '
+e2e_wait_for 'Name this session'
+capture name
+for _ in $(seq 1 60); do e2e_keys BSpace; done
+e2e_keys -l captures
+e2e_keys Enter
+e2e_wait_for 'named: .*/captures'
 e2e_keys l
 e2e_wait_for 'Event log'
 capture log
@@ -89,4 +92,19 @@ sleep 1
 e2e_screen | grep -q 'Quit?' && e2e_keys q
 e2e_wait_exit > /dev/null
 e2e_history | grep -A3 '^bellows console:' | grep -v '^EXIT STATUS' > "$out/summary.txt"
+
+# Quit asks only when something would be lost: here nothing can be saved (no data directory).
+e2e_start "$width" "$height" XDG_DATA_HOME= HOME= -- console --speed max --rt off
+e2e_wait_for 'law [a-z-]+ '
+e2e_keys a
+e2e_wait_for 'Arm the valves\?'
+e2e_keys y
+e2e_wait_for 'Bellows +ARMED '
+e2e_keys r
+e2e_wait_for 'iteration 0  RMS' 120
+e2e_keys q
+e2e_wait_for 'Quit\?'
+capture quit
+e2e_keys q
+e2e_wait_exit > /dev/null
 echo "captures in $out: $(ls "$out" | tr '\n' ' ')"

@@ -11,7 +11,7 @@ e2e_wait_for 'Arm the valves\?'
 e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 e2e_keys r
-e2e_wait_for 'iteration 1  RMS [0-9]+\.[0-9]{3} deg' 120
+e2e_wait_for 'iteration 0  RMS [0-9]+\.[0-9]{3} deg' 120  # the header names the iteration run
 e2e_wait_for 'Iteration 0: angle and set point'
 e2e_screen | grep -qF '+- Live ---' || e2e_fail "no ASCII frame"
 e2e_screen | grep -qE '\|[^|]*\*\*' || e2e_fail "no ASCII plot marks"
@@ -32,7 +32,7 @@ e2e_wait_for 'Arm the valves\?'
 e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 e2e_keys r
-e2e_wait_for 'iteration 1  RMS [0-9]+\.[0-9]{3} deg' 120
+e2e_wait_for 'iteration 0  RMS [0-9]+\.[0-9]{3} deg' 120  # the header names the iteration run
 escaped="$(e2e_tmux capture-pane -p -e -t console)"
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours on a vt100"
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video on a vt100"

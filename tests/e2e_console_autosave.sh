@@ -13,7 +13,7 @@ await_exit() {
   e2e_wait_exit
 }
 
-# Runs 3 iterations (N 3) in a fresh console on its own data directory $1.
+# Runs iterations 0..2 (N 2, docs/iterations.md) in a fresh console on its own data directory $1.
 three_iterations() {
   e2e_start 120 40 -- console --speed max --rt off --data-dir "$1"
   e2e_wait_for 'law [a-z-]+  M'
@@ -23,8 +23,8 @@ three_iterations() {
   e2e_wait_for 'Bellows +ARMED '
   e2e_keys N
   e2e_wait_for 'Run K'
-  e2e_keys BSpace BSpace 3 Enter
-  e2e_wait_for 'batch of 3 done' 180
+  e2e_keys BSpace BSpace 2 Enter
+  e2e_wait_for 'iterations 0\.\.2 done' 180
   # The header says "unsaved" from a trial's end until its autosave returned (milliseconds).
   for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || return 0; sleep 0.1; done
   e2e_fail "the last iteration stayed unsaved"

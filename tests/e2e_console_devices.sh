@@ -80,7 +80,7 @@ for device in "${DEVICES[@]}"; do
   e2e_keys y
   e2e_wait_for 'Bellows +ARMED '
   e2e_keys r
-  e2e_wait_for 'it(eration)? 1  RMS' 120
+  e2e_wait_for 'it(eration)? 0  RMS' 120  # iteration 0 ran
 
   # Emergency stop: FAULT, vented.
   e2e_keys Space
@@ -119,7 +119,7 @@ for device in "${DEVICES[@]}"; do
 
   # The session reopens in the console, on the device it was made on.
   e2e_start 120 40 -- console --session "$session" $([ "$device" = sim ] && echo --speed 2)
-  e2e_wait_for 'it(eration)? 1  RMS'
+  e2e_wait_for 'it(eration)? 0  RMS'  # its one iteration, 0
   e2e_wait_for "(device )?$device: ok"
   e2e_keys q
   [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "$device: exit status after the reopened session"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The operator's day in the real binary: arm, choose `paper`, run 5 iterations and read the falling
+# The operator's day in the real binary: arm, choose `paper`, run iterations 0..5 (N 5) and read the falling
 # RMS off the screen, inspect the correction and move the cursor, emergency stop and see FAULT,
 # reset, re-arm, run again (saved as it goes), quit with the valves vented; relaunch with --session and see the
 # same RMS history, find it in the browser, and continue learning into the same session.
@@ -24,13 +24,13 @@ e2e_keys Enter
 e2e_wait_for 'trajectory paper \(8.0 s\)'
 e2e_wait_for 'law [a-z-]+  M'  # rebuilt for 400 samples
 
-# Five iterations.
+# Five learning iterations after the feedback-only one: 0..5, as `run --iterations 5` (docs/iterations.md).
 e2e_keys N
 e2e_wait_for 'Run K iterations'
 e2e_keys BSpace BSpace 5 Enter
-e2e_wait_for 'batch of 5 done' 300
+e2e_wait_for 'iterations 0\.\.5 done' 300
 rms="$(e2e_rms_list)"
-[ "$(echo "$rms" | awk '{print $1}' | tr '\n' ' ')" = "0 1 2 3 4 " ] || e2e_fail "RMS list: $rms"
+[ "$(echo "$rms" | awk '{print $1}' | tr '\n' ' ')" = "0 1 2 3 4 5 " ] || e2e_fail "RMS list: $rms"
 e2e_expect_falling "$rms"
 first="$(echo "$rms" | head -1 | awk '{print $2}')"
 last="$(echo "$rms" | tail -1 | awk '{print $2}')"
@@ -40,7 +40,7 @@ e2e_wait_for "iteration 5  RMS $last deg"
 # The correction inspector: the cursor moves along time and across iterations.
 e2e_keys c
 e2e_wait_for 'At the cursor'
-e2e_wait_for 'Iteration 4 of 0\.\.4'
+e2e_wait_for 'Iteration 5 of 0\.\.5'
 e2e_wait_for 'time +0\.00 s'
 e2e_keys Right Right Right Right Right
 e2e_wait_for 'time +0\.10 s'
@@ -48,9 +48,9 @@ e2e_wait_for 'sample +5 / 400'
 e2e_keys PageDown
 e2e_wait_for 'time +0\.90 s'
 e2e_keys Up
-e2e_wait_for 'Iteration 3 of 0\.\.4'
+e2e_wait_for 'Iteration 4 of 0\.\.5'
 e2e_keys m
-e2e_wait_for 'overlay: it 3'
+e2e_wait_for 'overlay: it 4'
 
 # Emergency stop from the inspector: FAULT, the guard and the black box.
 e2e_keys Space
@@ -69,7 +69,7 @@ e2e_wait_for 'Bellows +ARMED '
 
 # One more iteration after the fault: learning continues where it was.
 e2e_keys n
-e2e_wait_for 'iteration 5: RMS' 120
+e2e_wait_for 'iteration 6: RMS' 120
 e2e_wait_for 'iteration 6  RMS'
 
 # Saved as it went: quit does not ask; the closing report names the session, with every iteration.
@@ -78,7 +78,7 @@ history="$(e2e_rms_list)"
 e2e_keys q
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
-e2e_output_has 'bellows console: .* 6 iterations, best RMS .*valves vented'
+e2e_output_has 'bellows console: .* iterations 0\.\.6, best RMS .*valves vented'
 e2e_output_has 'session: /.* \(saved as it went\)'
 session="$(e2e_history | grep -oE '^session: /[^ ]+' | head -1 | cut -c10-)"
 [ -f "$session/manifest.json" ] || e2e_fail "no session at '$session'"
@@ -91,7 +91,7 @@ e2e_wait_for 'law [a-z-]+  M'
 # The browser lists it: date, trajectory, iterations, best RMS.
 best="$(echo "$history" | awk 'NR == 1 || $2 < b { b = $2 } END { print b }')"
 e2e_keys o
-e2e_wait_for "> [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2} +sim +paper +6 +$best +$(basename "$session")"
+e2e_wait_for "> [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2} +sim +paper +0\.\.6 +$best +$(basename "$session")"
 e2e_keys Escape
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
@@ -104,7 +104,7 @@ for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; do
 # Read whole before matching: `grep -q` would stop reading at the match and, under pipefail, the
 # writer's SIGPIPE would fail the test.
 shown="$("$BELLOWS" sessions show "$session")"
-grep -qE '^iterations +7,' <<<"$shown" || e2e_fail "the session did not grow to 7 iterations: $shown"
+grep -qE '^iterations +0\.\.7,' <<<"$shown" || e2e_fail "the session did not grow to iterations 0..7: $shown"
 e2e_keys q
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after the relaunch"
 echo "ok: $(echo "$rms" | tr '\n' ' ')"

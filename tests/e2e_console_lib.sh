@@ -82,7 +82,9 @@ e2e_wait_exit() {
   local deadline=$((SECONDS + limit))
   while [ $SECONDS -lt $deadline ]; do
     local line
-    line="$(e2e_history | grep -oE '^EXIT STATUS [0-9]+' | tail -1)"
+    # `|| true`: before the status is printed grep finds nothing, which under pipefail and set -e
+    # would end the script silently instead of waiting.
+    line="$(e2e_history | grep -oE '^EXIT STATUS [0-9]+' | tail -1 || true)"
     if [ -n "$line" ]; then
       echo "${line#EXIT STATUS }"
       return 0

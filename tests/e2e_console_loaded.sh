@@ -19,14 +19,14 @@ e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 e2e_keys N
 e2e_wait_for 'Run K'
-e2e_keys BSpace BSpace 3 Enter
+e2e_keys BSpace BSpace 2 Enter  # iterations 0..2 (docs/iterations.md)
 e2e_wait_for 'Bellows +RUNNING ' 60
 sleep 2
 pid="$(e2e_pid)"
 kill -STOP "$pid"
 sleep 0.3
 kill -CONT "$pid"
-e2e_wait_for 'batch of 3 done' 240
+e2e_wait_for 'iterations 0\.\.2 done' 240
 e2e_screen | grep -q 'FAULT' && e2e_fail "a fault on the simulated arm under load"
 missed="$(e2e_screen | grep -oE 'missed [0-9]+' | head -1 | grep -oE '[0-9]+')"
 [ "${missed:-0}" -gt 0 ] || e2e_fail "no missed deadline counted after a 0.3 s stall"

@@ -11,8 +11,8 @@ e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 e2e_keys N
 e2e_wait_for 'Run K iterations'
-e2e_keys BSpace BSpace 3 Enter
-e2e_wait_for 'batch +0 of 3 done'
+e2e_keys BSpace BSpace 2 Enter  # iterations 0..2 (docs/iterations.md)
+e2e_wait_for 'batch +it 0\.\.2, 0 done'
 
 e2e_resize 70 20
 e2e_wait_for 'Terminal too small'
@@ -30,7 +30,7 @@ e2e_wait_for 'Correction u_ilc'
 e2e_resize 200 60
 e2e_wait_for 'Live'
 e2e_resize 120 40
-e2e_wait_for 'batch of 3 done' 300
+e2e_wait_for 'iterations 0\.\.2 done' 300
 rms="$(e2e_rms_list)"
 [ "$(echo "$rms" | wc -l)" -eq 3 ] || e2e_fail "RMS list: $rms"
 e2e_expect_falling "$rms"

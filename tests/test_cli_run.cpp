@@ -139,6 +139,58 @@ TEST(CliRun, BadInputGetsOneLineAndExitStatusTwo) {
   expect_bad_input("--iterations many", "iterations");
 }
 
+// Runs `bellows ARGS` on a pseudo-terminal (util-linux `script`), as an operator's shell would.
+testing::ProcessResult run_on_terminal(const std::string& args) {
+  return run_process("script -qec '" + std::string(BELLOWS_BINARY) + " " + args + "' /dev/null");
+}
+
+std::size_t count(const std::string& text, const std::string& part) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + part.size())) ++n;
+  return n;
+}
+
+TEST(CliRun, ProgressIsOneRedrawnLineOnATerminalAndALinePerIterationElsewhere) {
+  // Into a pipe: a line per iteration 0..3, nothing a terminal would interpret.
+  const auto piped = run_process(std::string(BELLOWS_BINARY) + " run --no-save --iterations 3");
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  for (int i = 0; i <= 3; ++i) EXPECT_EQ(count(piped.out, "iteration   " + std::to_string(i) + "  rms"), 1u) << piped.out;
+  EXPECT_EQ(count(piped.out, "\n"), 4u) << piped.out;
+  EXPECT_EQ(piped.out.find_first_of("\r\x1b"), std::string::npos) << piped.out;
+
+  // On a terminal: one line, redrawn for each iteration (carriage return, erase to the end), that
+  // names the iteration, its RMS and the time left, and ends with one newline when the run is done.
+  const auto shown = run_on_terminal("run --no-save --iterations 3");
+  ASSERT_EQ(shown.exit_code, 0) << shown.out << shown.err;
+  for (int i = 0; i <= 3; ++i) EXPECT_EQ(count(shown.out, "\riteration " + std::to_string(i) + " of 0..3  rms "), 1u) << shown.out;
+  EXPECT_EQ(count(shown.out, "ETA "), 3u) << shown.out;
+  EXPECT_EQ(count(shown.out, "done in "), 1u) << shown.out;
+  EXPECT_EQ(count(shown.out, "\x1b[K"), 4u) << shown.out;
+  EXPECT_EQ(count(shown.out, "\n"), 1u) << shown.out;  // the terminal turns it into \r\n
+  EXPECT_EQ(shown.out.find("max error"), std::string::npos) << shown.out;
+
+  // --verbose on a terminal: the lines again.
+  const auto verbose = run_on_terminal("run --no-save --iterations 3 --verbose");
+  ASSERT_EQ(verbose.exit_code, 0) << verbose.out;
+  EXPECT_EQ(count(verbose.out, "max error"), 4u) << verbose.out;
+  EXPECT_EQ(verbose.out.find("\x1b[K"), std::string::npos) << verbose.out;
+}
+
+TEST(CliRun, QuietPrintsNothingButErrorsAndTheJson) {
+  const auto shown = run_on_terminal("run --iterations 2 --quiet --name quiet");  // saved: not even its directory
+  ASSERT_EQ(shown.exit_code, 0) << shown.out;
+  EXPECT_EQ(shown.out, "");
+  const auto piped = run_process(std::string(BELLOWS_BINARY) + " run --no-save --iterations 2 --quiet --json");
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_EQ(piped.err, "");
+  EXPECT_EQ(nlohmann::json::parse(piped.out)["iterations"].size(), 3u);  // iterations 0..2
+  // Errors still say what went wrong.
+  const auto wrong = run_process(std::string(BELLOWS_BINARY) + " run --no-save --quiet --trajectory loops");
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_NE(wrong.err.find("unknown trajectory"), std::string::npos) << wrong.err;
+  EXPECT_EQ(run_process(std::string(BELLOWS_BINARY) + " run --no-save --quiet --verbose").exit_code, 2);
+}
+
 }  // namespace
 }  // namespace bellows
 

@@ -23,11 +23,11 @@ TEST(PlotConsole, TheFigureKeyWritesFiguresWhileTheBatchGoesOn) {
   f.key('g');
   EXPECT_NE(f.state().status.find("no trial has run yet"), std::string::npos) << f.state().status;
   f.arm_valves();
-  // A batch of 3; the key after its first trial.
+  // A batch of iterations 0..2 (K = 2, docs/iterations.md); the key after its first trial.
   f.key('N');
   f.key(ui::key::kBackspace);
   f.key(ui::key::kBackspace);
-  f.type("3");
+  f.type("2");
   f.key(ui::key::kEnter);
   ASSERT_TRUE(f.pump_until([&] { return f.state().experiment.trials.size() >= 1; }));
   f.key('g');

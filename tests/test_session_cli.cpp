@@ -288,7 +288,7 @@ TEST_F(SessionsCommand, ListIsATableAndJson) {
   const std::string row = table.out.substr(first_line + 1, table.out.find('\n', first_line + 1) - first_line - 1);
   EXPECT_NE(row.find(" sim "), std::string::npos) << row;
   EXPECT_NE(row.find(" short "), std::string::npos) << row;
-  EXPECT_NE(row.find(" 4 "), std::string::npos) << row;
+  EXPECT_NE(row.find(" 0..3 "), std::string::npos) << row;  // `run --iterations 3`: iterations 0..3
 
   EXPECT_LT(table.out.find("\nsecond "), first_line);  // newest first, as the console's browser
 
@@ -296,7 +296,8 @@ TEST_F(SessionsCommand, ListIsATableAndJson) {
   ASSERT_EQ(list.size(), 2u);
   EXPECT_EQ(list[0]["name"], "second");
   EXPECT_EQ(list[1]["name"], "first");
-  EXPECT_EQ(list[1]["iterations"], 4);
+  EXPECT_EQ(list[1]["iterations"], 4);  // a count, of iterations 0..3 (docs/iterations.md)
+  EXPECT_EQ(list[1]["last_iteration"], 3);
   EXPECT_EQ(list[1]["device"], "sim");
   EXPECT_EQ(list[1]["trajectory"], "short");
   double best = 1e9;
@@ -435,7 +436,7 @@ TEST_F(SessionsCommand, RmAsksFirstAndRemovesOnlyWhenConfirmed) {
   // No answer (stdin at its end): nothing removed, exit status 1.
   const ProcessResult unanswered = run_bellows({"sessions", "rm", "first", "--data-dir", data_});
   EXPECT_EQ(unanswered.exit_code, 1);
-  EXPECT_NE(unanswered.err.find("remove session " + first + " (4 iterations"), std::string::npos) << unanswered.err;
+  EXPECT_NE(unanswered.err.find("remove session " + first + " (iterations 0..3"), std::string::npos) << unanswered.err;
   EXPECT_NE(unanswered.err.find("not removed"), std::string::npos) << unanswered.err;
   EXPECT_TRUE(fs::exists(first));
   const ProcessResult yes = run_bellows({"sessions", "rm", "first", "--data-dir", data_, "--yes"});

@@ -28,7 +28,7 @@ TEST(ConsoleTransfer, OffersWhatTheLastTrajectoryTaughtAndTakesItWithOneKey) {
   f.key('T');  // nothing taught yet
   EXPECT_NE(f.state().status.find("no transfer is offered"), std::string::npos) << f.state().status;
   f.arm_valves();
-  f.run_batch(8);
+  f.run_batch(7);  // iterations 0..7 (docs/iterations.md)
   ASSERT_EQ(f.state().experiment.trials.size(), 8u);
   choose_steps(f);
   ASSERT_TRUE(f.pump_until([&] { return f.state().status.find("T: start from what") != std::string::npos; }, 50.0))

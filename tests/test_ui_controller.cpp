@@ -49,21 +49,28 @@ TEST(UiController, ArmingAsksForConfirmation) {
 TEST(UiController, FiveIterationsLowerTheRms) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(5);
+  f.run_batch(5);  // N with K = 5 from scratch: iterations 0..5, as `run --iterations 5` (docs/iterations.md)
   const auto rms = f.state().experiment.rms_history_deg();
-  ASSERT_EQ(rms.size(), 5u);
+  ASSERT_EQ(rms.size(), 6u);
+  EXPECT_EQ(f.state().experiment.trials.back().iteration, 5);
   for (std::size_t i = 1; i < rms.size(); ++i) EXPECT_LT(rms[i], rms[i - 1]) << "iteration " << i;
   EXPECT_NEAR(rms[0], 15.06, 0.2);  // the feedback-only trial, as `bellows run` gives it
   EXPECT_EQ(f.state().experiment.trials[0].origin, "feedback only");
   EXPECT_EQ(f.state().experiment.trials[3].origin, "learned from 2");
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
-  EXPECT_TRUE(f.logged("batch of 5 done"));
+  EXPECT_TRUE(f.logged("run iterations 0..5"));
+  EXPECT_TRUE(f.logged("iterations 0..5 done"));
+  // After them, K more continue from the newest: 6..7, K trials (iteration 0 has run).
+  f.run_batch(2);
+  ASSERT_EQ(f.state().experiment.trials.size(), 8u);
+  EXPECT_EQ(f.state().experiment.trials.back().iteration, 7);
+  EXPECT_TRUE(f.logged("iterations 6..7 done"));
   // The law's convergence prediction is shown (for the paper's defaults it warns about model errors).
   EXPECT_NE(f.state().convergence.find("contraction"), std::string::npos) << f.state().convergence;
   // Saved as it went.
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
   EXPECT_FALSE(f.state().experiment.unsaved());
-  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 5u);
+  EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 8u);
 }
 
 TEST(UiController, RunRepeatsAndNextLearnsFirst) {
@@ -114,7 +121,7 @@ TEST(UiController, BatchStopsByItselfWhenTheRmsKeepsRising) {
     return last >= 3 && rms[last] > rms[last - 1] && rms[last - 1] > rms[last - 2] && rms[last - 2] > rms[last - 3];
   };
   ASSERT_GE(rms.size(), 4u);
-  ASSERT_LT(rms.size(), 10u) << "the batch should have stopped by itself";
+  ASSERT_LT(rms.size(), 11u) << "the batch (iterations 0..10) should have stopped by itself";
   EXPECT_TRUE(rose_three_times_until(rms.size() - 1));
   for (std::size_t last = 3; last + 1 < rms.size(); ++last) EXPECT_FALSE(rose_three_times_until(last)) << last;
   EXPECT_TRUE(f.logged("the RMS rose 3 times in a row"));
@@ -175,7 +182,7 @@ TEST(UiController, HeartbeatDrillMakesTheEngineVent) {
 TEST(UiController, InspectorCursorAndGoingBackToAnEarlierCorrection) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(3);
+  f.run_batch(2);  // iterations 0..2
   f.key('c');
   EXPECT_EQ(f.state().screen, Screen::kInspector);
   EXPECT_EQ(f.state().inspector.trial, 2);
@@ -271,7 +278,7 @@ TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
   EXPECT_EQ(f.state().law_name, "inverse");
   // The law learns: two iterations with it lower the RMS.
-  f.run_batch(3);
+  f.run_batch(2);  // iterations 0..2
   const auto rms = f.state().experiment.rms_history_deg();
   ASSERT_EQ(rms.size(), 3u);
   EXPECT_LT(rms[2], rms[0]);
@@ -289,7 +296,7 @@ TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
 TEST(UiController, EachIterationsLogLineCarriesTheLearningDiagnostics) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(3);
+  f.run_batch(2);  // iterations 0..2
   for (const ui::LogEntry& e : f.state().log.entries()) {  // the first trial has nothing to contract from
     if (e.text.rfind("iteration 0: RMS", 0) == 0) {
       EXPECT_EQ(e.text.find("contraction"), std::string::npos) << e.text;
@@ -367,7 +374,7 @@ TEST(UiController, RefusalsAreExplainedAndSendNothing) {
 TEST(UiController, SavesAsItGoesAndOpensFromTheSession) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(3);
+  f.run_batch(2);  // iterations 0..2
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
   ASSERT_EQ(f.sessions.saved.size(), 1u);
   const SessionSnapshot& saved = f.sessions.saved.begin()->second;
@@ -442,7 +449,7 @@ TEST(UiController, QuitFinishesTheSaveAndDisarmsWithoutAsking) {
 TEST(UiController, MemoryHoldsOnlyTheNewestTrialsAndTheEngineHandsTrajectoriesBack) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(Experiment::kTrialsKeptInMemory + 4);
+  f.run_batch(Experiment::kTrialsKeptInMemory + 3);  // iterations 0..kept + 3
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
   const auto& trials = f.state().experiment.trials;
   ASSERT_EQ(trials.size(), static_cast<std::size_t>(Experiment::kTrialsKeptInMemory + 4));

@@ -160,7 +160,7 @@ TEST(UiInput, ABadKKeepsTheQuestionAndWhatWasTyped) {
   f.key(key::kEnter);
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
-  EXPECT_EQ(f.state().experiment.trials.size(), 2u);
+  EXPECT_EQ(f.state().experiment.trials.size(), 3u);  // the good K ran: iterations 0..2 (docs/iterations.md)
 }
 
 TEST(UiInput, BadTrajectoryPathsAndFilesSayWhyAndChangeNothing) {

@@ -25,8 +25,8 @@ TEST(UiRender, DashboardShowsStateTrajectoryIterationsAndLiveValues) {
   EXPECT_NE(lines[0].find("ARMED"), std::string::npos) << lines[0];
   EXPECT_NE(lines[0].find("valves live"), std::string::npos);
   EXPECT_NE(lines[0].find("paper (8.0 s)"), std::string::npos);
-  EXPECT_NE(lines[0].find("iteration 3"), std::string::npos);
-  EXPECT_NE(lines[0].find("RMS 3.333 deg (best 3.333)"), std::string::npos);
+  // The header names the newest iteration run (0..2) and its RMS (docs/iterations.md).
+  EXPECT_NE(lines[0].find("iteration 2  RMS 3.333 deg (best 3.333)"), std::string::npos) << lines[0];
   EXPECT_NE(lines[1].find("p50 24 p99 51 max 80 us"), std::string::npos) << lines[1];
   // RMS per iteration, readable as numbers.
   EXPECT_NE(text.find("   0    10.000"), std::string::npos) << text;
@@ -51,6 +51,13 @@ TEST(UiRender, DashboardShowsStateTrajectoryIterationsAndLiveValues) {
   EXPECT_NE(text.find("Iteration 2: angle and set point (deg)"), std::string::npos);
   EXPECT_NE(text.find("* it 2"), std::string::npos);
   EXPECT_NE(text.find(". it 1"), std::string::npos);
+}
+
+TEST(UiRender, HeaderNamesNoIterationBeforeTheFirstTrial) {
+  // Iteration 0 has not run yet: the header does not claim it (it named the next one before).
+  const std::string header = render_lines(sample_state(0, false))[0];
+  EXPECT_NE(header.find("iteration -"), std::string::npos) << header;
+  EXPECT_EQ(header.find("RMS"), std::string::npos) << header;
 }
 
 TEST(UiRender, FunctionBarFollowsTheState) {
@@ -270,11 +277,11 @@ TEST(UiRender, TuningLogAndSessionScreens) {
                          "recorded on the device 't7'; this console drives 'sim'"},
                         {"/d/b", "broken", "", "", 0, -1, "manifest.json: missing", "", ""}};
   text = all(render_lines(s));
-  EXPECT_NE(text.find("> 2024-05-01 14:03  sim    paper               31      0.987  2024-05-01_14-03-07_paper"),
+  EXPECT_NE(text.find("> 2024-05-01 14:03  sim    paper            0..30      0.987  2024-05-01_14-03-07_paper"),
             std::string::npos)
       << text;
   // Another device's session: marked in its row, and the reason on the last line when chosen.
-  EXPECT_NE(text.find("  2024-05-02 09:00  t7     steps               12      1.500  bench  (other device)"),
+  EXPECT_NE(text.find("  2024-05-02 09:00  t7     steps            0..11      1.500  bench  (other device)"),
             std::string::npos)
       << text;
   EXPECT_EQ(text.find("cannot open it here"), std::string::npos) << text;

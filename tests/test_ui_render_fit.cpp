@@ -35,7 +35,7 @@ TEST(UiRenderFit, HeaderKeepsStateTrajectoryIterationAndRmsAt80Columns) {
       EXPECT_NE(header.find(state == EngineState::kFault ? "FAULT: heartbeat-lost" : to_string(state)), std::string::npos);
       EXPECT_NE(header.find("sim: ok"), std::string::npos);
       EXPECT_NE(header.find("paper (8.0 s)"), std::string::npos);
-      EXPECT_NE(header.find("it 3"), std::string::npos);
+      EXPECT_NE(header.find("it 2  RMS 3.333 deg"), std::string::npos);
       EXPECT_NE(header.find("RMS 3.333 deg"), std::string::npos);  // the last trial's, 10/3
       const std::string& loop = lines[1];
       SCOPED_TRACE(loop);
@@ -49,7 +49,7 @@ TEST(UiRenderFit, HeaderKeepsStateTrajectoryIterationAndRmsAt80Columns) {
   ConsoleState wide = small_state(EngineState::kArmed);
   wide.width = 160;
   const std::string header = render_lines(wide)[0];
-  EXPECT_NE(header.find("ARMED  valves live  device sim: ok  trajectory paper (8.0 s)  iteration 3"), std::string::npos)
+  EXPECT_NE(header.find("ARMED  valves live  device sim: ok  trajectory paper (8.0 s)  iteration 2  RMS"), std::string::npos)
       << header;
   EXPECT_NE(header.find("(best 3.333)"), std::string::npos) << header;
 }
@@ -77,6 +77,17 @@ TEST(UiRenderFit, ARefusedAnswerShowsInItsDialogWithWhatWasTyped) {
   EXPECT_NE(screen.find("> 2.5_"), std::string::npos) << screen;
   EXPECT_NE(screen.find("K must be a whole number from 1 to 1000, not '2.5'"), std::string::npos) << screen;
   EXPECT_NE(screen.find("Enter run   Esc cancel"), std::string::npos) << screen;
+}
+
+TEST(UiRenderFit, ADialogWrapsALongLineInsteadOfCuttingIt) {
+  ConsoleState s = small_state(EngineState::kArmed);  // 80 columns
+  const std::string why = "Saving is not available: no data directory: neither XDG_DATA_HOME nor HOME is an absolute "
+                          "path; pass --data-dir";
+  s.dialog = {DialogKind::kConfirmQuit, "Quit?", {"1 iteration is not saved.", why}, "", "q quit without saving   Esc cancel", ""};
+  const std::string screen = all(render_lines(s));
+  for (const std::string words : {"1 iteration is not saved.", "absolute path; pass --data-dir", "q quit without saving"}) {
+    EXPECT_NE(screen.find(words), std::string::npos) << words << "\n" << screen;  // cut at the box's edge before
+  }
 }
 
 TEST(UiRenderFit, EveryOtherScreenOffersTheWayBack) {

@@ -49,7 +49,7 @@ TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
   ASSERT_TRUE(gateway.available()) << gateway.unavailable_reason();
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
-  f.run_batch(3);
+  f.run_batch(2);  // iterations 0..2 (docs/iterations.md)
   save_and_wait(f);
   const ui::Experiment& saved = f.state().experiment;
   ASSERT_FALSE(saved.session_location.empty());
@@ -88,7 +88,7 @@ TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
-  f.run_batch(2);
+  f.run_batch(1);  // iterations 0..1
   save_and_wait(f);
   const std::string location = f.state().experiment.session_location;
   f.key('w');
@@ -123,8 +123,8 @@ TEST_F(UiSessions, AFaultsBlackBoxIsSavedWithTheSessionAndReopened) {
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
-  f.run_batch(1);
-  f.key(' ');  // emergency stop
+  f.run_batch(1);  // iterations 0..1
+  f.key(' ');  // emergency stop before iteration 2
   ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.black_box.empty(); }));
   ASSERT_EQ(f.state().experiment.faults.size(), 1u);
   save_and_wait(f);
@@ -136,7 +136,7 @@ TEST_F(UiSessions, AFaultsBlackBoxIsSavedWithTheSessionAndReopened) {
   const Session loaded = load_session(location);
   ASSERT_EQ(loaded.manifest.black_boxes.size(), 1u);
   EXPECT_EQ(loaded.manifest.black_boxes[0].fault, "emergency-stop");
-  EXPECT_EQ(loaded.manifest.black_boxes[0].iteration, 1);
+  EXPECT_EQ(loaded.manifest.black_boxes[0].iteration, 2);
   ASSERT_EQ(loaded.black_boxes[0].size(), shown.size());
   EXPECT_EQ(loaded.black_boxes[0].back().tick, shown.back().tick);
   EXPECT_EQ(loaded.black_boxes[0].back().state, EngineState::kFault);
@@ -153,7 +153,7 @@ TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
     StoreSessionGateway gateway("sim");
     ConsoleFixture f(Configuration{}, 3, &gateway);
     f.arm_valves();
-    f.run_batch(2);
+    f.run_batch(1);  // iterations 0..1
     save_and_wait(f);
     location = f.state().experiment.session_location;
   }
@@ -269,7 +269,7 @@ TEST_F(UiSessions, ASessionStartedFromATransferRecordsWhereItsFirstCorrectionCam
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
-  f.run_batch(6);
+  f.run_batch(5);  // iterations 0..5: 6 trials
   save_and_wait(f);
   const std::string taught = f.state().experiment.session_location;
   f.key('t');

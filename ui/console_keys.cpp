@@ -176,9 +176,10 @@ void ConsoleController::accept_input() {
       }
       state_.run = RunProgress{};
       state_.run.mode = RunProgress::Mode::kBatch;
-      state_.run.batch_total = static_cast<int>(k);
-      log(LogSource::kOperator, format("run %d iterations (stops by itself after %d rises of the RMS in a row)",
-                                       state_.run.batch_total, state_.stop_after_rises));
+      state_.run.batch_first = state_.experiment.next_iteration();
+      state_.run.batch_total = trials_for_iterations(static_cast<int>(k), !state_.experiment.trials.empty());
+      log(LogSource::kOperator, format("run iterations %s (stops by itself after %d rises of the RMS in a row)",
+                                       batch_span(state_.run).c_str(), state_.stop_after_rises));
       step();
       return;
     }
@@ -279,7 +280,8 @@ void ConsoleController::perform(Action action) {
       return;
     case Action::kRunIterations:
       open_dialog(DialogKind::kAskIterations, "Run K iterations",
-                  {"Each iteration learns from the last trial, then runs.",
+                  {"Each iteration learns from the last trial, then runs;",
+                   "with no trial yet, iteration 0 (feedback only) runs first.",
                    format("x interrupts; it stops by itself when the RMS rises %d times in a row.", state_.stop_after_rises)},
                   "Enter run   Esc cancel", "10");
       return;

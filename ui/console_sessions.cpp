@@ -232,8 +232,8 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.inspector = InspectorView{};
   state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
   const Experiment& adopted = state_.experiment;
-  log(LogSource::kSession, format("opened %s: %s, %d iterations, best RMS %.3f deg", adopted.session_location.c_str(),
-                                  adopted.trajectory->name.c_str(), static_cast<int>(adopted.trials.size()),
+  log(LogSource::kSession, format("opened %s: %s, iterations %s, best RMS %.3f deg", adopted.session_location.c_str(),
+                                  adopted.trajectory->name.c_str(), iteration_range(static_cast<long long>(adopted.trials.size())).c_str(),
                                   adopted.best_rms_deg()));
   if (!at_start) {
     select_trajectory(adopted.trajectory);

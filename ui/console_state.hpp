@@ -10,6 +10,7 @@
 #include "engine/configuration.hpp"
 #include "engine/engine_messages.hpp"
 #include "engine/engine_state.hpp"
+#include "engine/iteration_numbering.hpp"
 #include "engine/safety.hpp"
 #include "ui/event_log.hpp"
 #include "ui/experiment.hpp"
@@ -88,11 +89,17 @@ struct RunProgress {
   Mode mode = Mode::kIdle;
   enum class Phase { kNone, kLearning, kSettling, kRunning };
   Phase phase = Phase::kNone;
-  int batch_total = 0;   // K of a batch
-  int batch_done = 0;    // steps finished in the batch
+  int batch_first = 0;   // a batch runs iterations batch_first..batch_first + batch_total - 1
+  int batch_total = 0;   // trials of a batch: K, or K + 1 with iteration 0 (docs/iterations.md)
+  int batch_done = 0;    // trials finished in the batch
   int sample = -1;       // sample of the running trial
   bool stop_requested = false;
 };
+
+/// The iterations a batch runs, "0..5" (docs/iterations.md).
+inline std::string batch_span(const RunProgress& r) {
+  return std::to_string(r.batch_first) + ".." + std::to_string(r.batch_first + r.batch_total - 1);
+}
 
 struct InspectorView {
   int trial = -1;     // index into experiment.trials

@@ -178,11 +178,15 @@ void ConsoleController::continue_run() {
   }
   ++r.batch_done;
   if (r.stop_requested) {
-    end_run(format("batch stopped by the operator after %d of %d", r.batch_done, r.batch_total), false);
+    end_run(format("iterations %s stopped by the operator after iteration %d", batch_span(r).c_str(),
+                   state_.experiment.trials.back().iteration), false);
   } else if (state_.experiment.rms_rising(state_.stop_after_rises)) {
-    end_run(format("batch stopped by itself: the RMS rose %d times in a row", state_.stop_after_rises), true);
+    end_run(format("iterations %s stopped by itself after iteration %d: the RMS rose %d times in a row", batch_span(r).c_str(),
+                   state_.experiment.trials.back().iteration, state_.stop_after_rises),
+            true);
   } else if (r.batch_done >= r.batch_total) {
-    end_run(format("batch of %d done: RMS %.3f deg", r.batch_total, state_.experiment.trials.back().summary.rms_deg), false);
+    end_run(format("iterations %s done: RMS %.3f deg", batch_span(r).c_str(), state_.experiment.trials.back().summary.rms_deg),
+            false);
   } else {
     step();
   }

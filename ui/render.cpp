@@ -102,8 +102,9 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
     out.push_back({labels ? 0 : 2, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()),
                    Role::kNormal, true});
   }
+  // The newest iteration run, whose RMS follows (docs/iterations.md); "-" before the first.
   out.push_back({2, labels ? "iteration " : "it ", Role::kDim, false});
-  out.push_back({0, format("%d", e.next_iteration()), Role::kNormal, true});
+  out.push_back({0, e.trials.empty() ? std::string("-") : format("%d", e.trials.back().iteration), Role::kNormal, true});
   if (!e.trials.empty()) {
     out.push_back({2, "RMS ", Role::kDim, false});
     out.push_back({0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true});
@@ -230,12 +231,17 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
   const bool has_input = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
                          d.kind == DialogKind::kEditValue || d.kind == DialogKind::kSessionName;
   const std::vector<std::string> error = d.error.empty() ? std::vector<std::string>{} : wrap(d.error, width - 4);
-  const int height = static_cast<int>(d.text.size() + error.size()) + (has_input ? 2 : 0) + 4;
+  std::vector<std::string> text;  // wrapped at words, never cut, when the window is narrower than a line
+  for (const std::string& line : d.text) {
+    if (line.empty()) text.emplace_back();
+    for (std::string& part : wrap(line, width - 4)) text.push_back(std::move(part));
+  }
+  const int height = static_cast<int>(text.size() + error.size()) + (has_input ? 2 : 0) + 4;
   const Rect box{(c.width() - width) / 2, std::max(2, (c.height() - height) / 2), width, height};
   c.fill(box, U' ');
   c.frame(box, g, d.title, Role::kWarning);
   int y = box.y + 1;
-  for (const std::string& line : d.text) c.put(box.x + 2, y++, line, Role::kNormal, false, box.right() - 2);
+  for (const std::string& line : text) c.put(box.x + 2, y++, line, Role::kNormal, false, box.right() - 2);
   if (has_input) {
     ++y;
     const int field = box.width - 6;

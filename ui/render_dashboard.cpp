@@ -73,7 +73,7 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
   duty_row(c, in, row++, "out B", t.valves.outlet_duty[1], g);
   value_row(c, in, row++, "trial", run_phase_text(s), s.run.phase == RunProgress::Phase::kNone ? Role::kDim : Role::kRunning);
   if (s.run.mode == RunProgress::Mode::kBatch) {
-    value_row(c, in, row++, "batch", format("%d of %d done%s", s.run.batch_done, s.run.batch_total,
+    value_row(c, in, row++, "batch", format("it %s, %d done%s", batch_span(s.run).c_str(), s.run.batch_done,
                                             s.run.stop_requested ? ", stopping" : ""));
   } else {
     value_row(c, in, row++, "next", s.experiment.next_origin, Role::kDim);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "engine/errors.hpp"
+#include "engine/iteration_numbering.hpp"
 #include "engine/learning_law_factory.hpp"
 #include "ui/key_map.hpp"
 #include "ui/plot.hpp"
@@ -263,8 +264,8 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
     const bool selected = i == b.selected;
     std::string row;
     if (l.error.empty()) {
-      row = format("%s %-17s %-6s %-12s %9d   %s  %s%s", selected ? ">" : " ", l.date.c_str(), l.device.c_str(),
-                   l.trajectory.c_str(), l.iterations,
+      row = format("%s %-17s %-6s %-12s %9s   %s  %s%s", selected ? ">" : " ", l.date.c_str(), l.device.c_str(),
+                   l.trajectory.c_str(), iteration_range(l.iterations).c_str(),
                    l.best_rms_deg >= 0.0 ? format("%8.3f", l.best_rms_deg).c_str() : "       -", l.name.c_str(),
                    l.refusal.empty() ? "" : "  (other device)");
     } else {
