@@ -9,6 +9,7 @@
 #include "app/config_file.hpp"
 #include "app/console_sessions.hpp"
 #include "app/device_factory.hpp"
+#include "app/learning_model.hpp"
 #include "app/rig_profile_write.hpp"
 #include "sessions/session_store.hpp"
 #include "app/plot_console.hpp"
@@ -55,6 +56,10 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   if (!options.session_dir.empty()) take_device_of_session(options.session_dir, options, config);
   config.device = resolve_device(options.device, config.device);
+  // The model the learning uses: the rig profile's identified one, if it has one (a reopened session
+  // too: it keeps its gains and law, the model is the rig's as it is now).
+  const LearningModel learning_model = choose_learning_model(config, config.device);
+  config.model = learning_model.model;
   const double sample_s = config.timing.sample_s();
   auto load_trajectory = [sample_s, limits = config.trajectory](const std::string& name_or_path) {
     return resolve_trajectory(name_or_path, sample_s, limits);
@@ -86,7 +91,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
     ~StopRig() { rig.stop(); }
   } stop_rig{*rig};
 
-  StoreSessionGateway sessions(config.device.kind, rig->session_info(), options.data_dir);
+  StoreSessionGateway sessions(config.device.kind, rig->session_info(), options.data_dir, learning_model.source);
   ui::ConsoleSetup setup;
   if (opened_session) {
     setup.session = sessions.open(options.session_dir);  // this gateway saves into it from now on
@@ -109,6 +114,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.device_name = device.name();
   setup.environment.device_where = rig->where();
   setup.environment.rig_profile = rig->rig_profile_name();
+  setup.environment.model_note = learning_model_line(learning_model);
   setup.environment.device_health = [&device] { return device.health(); };
   setup.environment.raw_inputs = [&device] { return device.raw_inputs(); };
   if (config.device.kind == "t7" && !config.device.rig_profile.empty()) {

@@ -95,8 +95,8 @@ std::string local_date_of(const std::string& utc) {
 }
 
 StoreSessionGateway::StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info,
-                                         const std::string& data_dir)
-    : device_name_(std::move(device_name)), device_info_(std::move(device_info)) {
+                                         const std::string& data_dir, std::string model_source)
+    : device_name_(std::move(device_name)), device_info_(std::move(device_info)), model_source_(std::move(model_source)) {
   if (!data_dir.empty()) {
     data_dir_ = data_dir;
     return;
@@ -146,6 +146,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     header.device_info = device_info_;
     if (snapshot.device_name == "sim") header.device_info["seed"] = snapshot.seed;  // the arm it continues with
     header.configuration = snapshot.config;
+    header.model_source = model_source_;
     header.first_correction = first_correction_json(e);
     for (const ui::LogEntry& entry : snapshot.events) {
       if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
@@ -212,6 +213,7 @@ ui::SessionSnapshot StoreSessionGateway::read_trials(const std::string& location
   ui::SessionSnapshot snapshot;
   snapshot.config = loaded.manifest.configuration;
   snapshot.device_name = loaded.manifest.device;
+  snapshot.rig_profile = rig_profile_of(loaded.manifest);
   snapshot.experiment = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
   const int n = loaded.trajectory.learning_samples();
   for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
@@ -242,6 +244,7 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   ui::SessionSnapshot snapshot;
   snapshot.config = m.configuration;
   snapshot.device_name = m.device;
+  snapshot.rig_profile = rig_profile_of(m);
   const auto seed = m.device_info.find("seed");
   if (seed != m.device_info.end() && seed->is_number_unsigned()) snapshot.seed = seed->get<std::uint64_t>();
   ui::Experiment& e = snapshot.experiment;

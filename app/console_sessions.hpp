@@ -24,8 +24,9 @@ class StoreSessionGateway final : public ui::SessionGateway {
   /// `device_name`: the console's device; a session recorded on another one is not opened.
   /// `device_info`: what a new session records about it (seed, bus, address, rig profile).
   /// `data_dir`: where sessions live (--data-dir); empty: the default (XDG_DATA_HOME, HOME).
+  /// `model_source`: where a new session's [model] came from (app/learning_model).
   explicit StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info = nlohmann::ordered_json::object(),
-                               const std::string& data_dir = {});
+                               const std::string& data_dir = {}, std::string model_source = "configuration");
 
   bool available() const override { return !data_dir_.empty(); }
   std::string unavailable_reason() const override { return reason_; }
@@ -41,6 +42,7 @@ class StoreSessionGateway final : public ui::SessionGateway {
   std::mutex mutex_;
   std::string device_name_;
   nlohmann::ordered_json device_info_;
+  std::string model_source_;
   std::filesystem::path data_dir_;  // empty: not available (reason_ says why)
   std::string reason_;
   std::optional<SessionWriter> writer_;  // the session the console saves into

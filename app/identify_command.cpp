@@ -12,6 +12,7 @@
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
+#include "app/identify_session.hpp"
 #include "app/rig_profile_file.hpp"
 #include "app/rig_profile_write.hpp"
 #include "app/toml_key_edit.hpp"
@@ -34,27 +35,33 @@ struct TrialFit {
   IdentificationData data;
 };
 
-TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal) {
+// One trial on `signal`'s excitation; the identification trial (the first) goes into the session.
+TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal, IdentifySession* session) {
   const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
   TrialRecord record;
   run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
-  return {signal, identification_data(record, config.controller, config.timing.tick_s)};
+  TrialFit fit{signal, identification_data(record, config.controller, config.timing.tick_s)};
+  if (session != nullptr) session->save_estimation_trial(config, signal, record);
+  return fit;
 }
 
 // The simulated arm: a fresh arm per trial on simulated time (the seed decides its noise).
-TrialFit record_simulated_trial(const Configuration& config, const std::string& signal, std::uint64_t seed) {
+TrialFit record_simulated_trial(const Configuration& config, const std::string& signal, std::uint64_t seed,
+                                IdentifySession* session) {
   SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
-  TrialFit fit = record_trial(clock, config, signal);
+  TrialFit fit = record_trial(clock, config, signal, session);
   arm.vent();
   return fit;
 }
 
 // A rig (lcm, t7): both trials on the one device, on the real-time loop; vented however it ends.
+// The session begins once the rig serves.
 std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, const DeviceParameters& device,
                                                 const IdentifyOptions& options, const std::string& estimation_signal,
-                                                const std::string& validation_signal, std::ostream& progress) {
+                                                const std::string& validation_signal, IdentifySession& session,
+                                                std::ostream& progress) {
   const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   RealtimeLoop loop(core, rig->device(), 1.0);
@@ -70,10 +77,14 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
   if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
     throw EnvironmentError(why);
   }
+  session.begin(config, device.kind, rig->session_info(),
+                identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()), validation_signal);
+  if (!session.path().empty()) progress << "session " << session.path() << std::endl;
+  if (!session.not_recorded().empty()) progress << "bellows: " << session.not_recorded() << std::endl;
   progress << "identification trial (" << estimation_signal << ") on " << device.kind << " " << rig->where() << std::endl;
-  TrialFit estimation = record_trial(loop, config, estimation_signal);
+  TrialFit estimation = record_trial(loop, config, estimation_signal, &session);
   progress << "validation trial (" << validation_signal << ")" << std::endl;
-  TrialFit validation = record_trial(loop, config, validation_signal);
+  TrialFit validation = record_trial(loop, config, validation_signal, nullptr);
   return {std::move(estimation), std::move(validation)};
 }
 
@@ -125,32 +136,50 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
   const std::string held_out_signal = validation_signal(estimation_signal);
 
   const DeviceParameters device = resolve_device(options.device, config.device);
+  IdentifySession session(options.no_save, options.data_dir, options.session_name);
   TrialFit estimation, validation;
-  if (device.kind == "sim") {
-    progress << "fitting " << plant_source << std::endl;
-    progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
-             << config.identify.duration_s << " s)" << std::endl;
-    estimation = record_simulated_trial(config, estimation_signal, options.seed);
-    progress << "validation trial (" << held_out_signal << ")" << std::endl;
-    validation = record_simulated_trial(config, held_out_signal, options.seed + 1);
-  } else {
-    std::tie(estimation, validation) = record_rig_trials(config, device, options, estimation_signal, held_out_signal, progress);
-  }
-  const ArmModelFit fit = fit_arm_model(estimation.data, config.model, &stop_requested());
-  const double validation_fit =
-      normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
-  const double nominal_validation_fit =
-      normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
-
-  if (!options.write_model_path.empty()) {
-    if (into_profile) {
-      write_rig_profile_model(options.write_model_path, fit.model);
-      progress << "wrote [model] to the rig profile " << options.write_model_path << std::endl;
+  ArmModelFit fit;
+  double validation_fit = 0.0, nominal_validation_fit = 0.0;
+  try {
+    if (device.kind == "sim") {
+      session.begin(config, device.kind, {{"seed", options.seed}},
+                    identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()), held_out_signal);
+      if (!session.path().empty()) progress << "session " << session.path() << std::endl;
+      if (!session.not_recorded().empty()) progress << "bellows: " << session.not_recorded() << std::endl;
+      progress << "fitting " << plant_source << std::endl;
+      progress << "identification trial (" << estimation_signal << ", +-" << config.identify.amplitude_deg << " deg, "
+               << config.identify.duration_s << " s)" << std::endl;
+      estimation = record_simulated_trial(config, estimation_signal, options.seed, &session);
+      progress << "validation trial (" << held_out_signal << ")" << std::endl;
+      validation = record_simulated_trial(config, held_out_signal, options.seed + 1, nullptr);
     } else {
-      write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model));
-      progress << "wrote [model] to " << options.write_model_path << std::endl;
+      std::tie(estimation, validation) =
+          record_rig_trials(config, device, options, estimation_signal, held_out_signal, session, progress);
     }
+    session.note_validation_trial(held_out_signal, validation.data);
+    fit = fit_arm_model(estimation.data, config.model, &stop_requested());
+    validation_fit = normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
+    nominal_validation_fit = normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
+    session.note_fit(fit.model, config.model, fit.fit_percent, validation_fit, fit.rms_residual_deg, fit.iterations, fit.converged);
+
+    if (!options.write_model_path.empty()) {
+      if (into_profile) {
+        write_rig_profile_model(options.write_model_path, fit.model);
+        progress << "wrote [model] to the rig profile " << options.write_model_path << std::endl;
+        session.record("model-written", "[model] kappa_rad_per_bar, omega0_rad_per_s, damping written into the rig profile " +
+                                            options.write_model_path);
+      } else {
+        write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model));
+        progress << "wrote [model] to " << options.write_model_path << std::endl;
+        session.record("model-written", "[model] kappa, omega0, damping written into the configuration " + options.write_model_path);
+      }
+    }
+  } catch (const std::exception& error) {
+    session.record("fault", error.what());  // the trials so far stay in the session
+    throw;
   }
+  session.record("finish", options.write_model_path.empty() ? "identified; the model was written nowhere (--write-model FILE)"
+                                                            : "identified; the model is in " + options.write_model_path);
   if (options.json) {
     const nlohmann::json report = {
         {"device", device.kind},
@@ -169,7 +198,8 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
         {"converged", fit.converged},
         {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
         {"written_as", options.write_model_path.empty() ? nlohmann::json(nullptr)
-                                                        : nlohmann::json(into_profile ? "rig_profile" : "config")}};
+                                                        : nlohmann::json(into_profile ? "rig_profile" : "config")},
+        {"session", session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path())}};
     out << report.dump() << std::endl;
   } else {
     char text[512];

@@ -1,6 +1,6 @@
-// `bellows identify`: an identification trial on the device (the simulated arm), a least-squares
-// fit of kappa, omega0 and delta, a held-out validation trial with the other excitation, and
-// optionally the fitted values written into a config file's [model] section.
+// `bellows identify`: an identification trial on the device, a least-squares fit of kappa, omega0
+// and delta, a held-out validation trial with the other excitation, and optionally the fitted values
+// written into a config file's or a rig profile's [model] section. All of it recorded in a session.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +21,10 @@ struct IdentifyOptions {
   std::string write_model_path;  // a config file's [model], or a rig profile's (a file with [valves]), receives the fit
   DeviceOptions device;          // --device, --lcm, --t7, --rig-profile over [device]
   RealtimeMode rt = RealtimeMode::kTry;  // the engine loop on a rig (lcm, t7)
+  // Recorded in a session like a run (app/identify_session) unless no_save.
+  bool no_save = false;
+  std::string data_dir;      // empty: the default sessions folder
+  std::string session_name;  // empty: start time and the excitation's name
 };
 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress);

@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "bellows " + bellows::program_version());  // as sessions record it
 
   bellows::RunOptions run;
-  CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless on simulated time, learning between them");
+  CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
   run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
@@ -58,8 +58,9 @@ int main(int argc, char** argv) {
   CLI::Option* verbose = run_cmd->add_flag("--verbose,-v", run.verbose,
                                            "A progress line per iteration (default on a terminal: one line, redrawn)");
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors (and the JSON with --json)")->excludes(verbose);
-  run_cmd->add_option("--clock", run.clock, "sim: simulated time, as fast as possible; wall: the real-time loop")
-      ->capture_default_str()
+  run_cmd->add_option("--clock", run.clock,
+                      "sim: simulated time, as fast as possible; wall: the real-time loop (default: wall on a rig "
+                      "(--device lcm, t7), sim on the simulated arm)")
       ->check(CLI::IsMember({"sim", "wall"}));
   run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
       ->capture_default_str()
@@ -144,7 +145,7 @@ int main(int argc, char** argv) {
   plot_cmd->add_flag("--no-paper", plot.no_paper, "No overlay on the RMS figure");
   plot_cmd->add_flag("--force", plot.force, "Replace existing figures");
   plot_cmd->add_flag("--json", plot.json, "Print JSON on stdout");
-  bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 need --clock wall
+  bellows::add_device_options(*run_cmd, run.device, /*with_lcm=*/false);  // lcm and t7 run on the wall clock
   run_cmd->add_option("--lcm", run.lcm_url, "LCM bus URL: publish telemetry there (and find an lcm rig there)");
   CLI::Option* lcm_log = run_cmd->add_option("--lcm-log", run.lcm_log_file,
                                              "Keep an LCM event log of the telemetry: in FILE (a new file), or without "
@@ -222,7 +223,7 @@ int main(int argc, char** argv) {
 
   bellows::IdentifyOptions identify;
   CLI::App* identify_cmd =
-      app.add_subcommand("identify", "Identification trial on the simulated arm; fits kappa, omega0 and damping");
+      app.add_subcommand("identify", "Identification trials on the device; fits kappa, omega0 and damping (recorded in a session)");
   identify_cmd->add_option("--config", identify.config_path, "TOML configuration file");
   bellows::add_device_options(*identify_cmd, identify.device);
   identify_cmd->add_option("--rt", identify.rt, "Real-time scheduling of the engine loop (lcm, t7): enforce, try, off")
@@ -234,6 +235,11 @@ int main(int argc, char** argv) {
       ->check(bellows::unsigned_whole_number());
   identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
+  CLI::Option* identify_no_save = identify_cmd->add_flag("--no-save", identify.no_save, "Do not record the identification in a session");
+  identify_cmd->add_option("--data-dir", identify.data_dir, "Where its session is saved (default: where runs save theirs)")
+      ->excludes(identify_no_save);
+  identify_cmd->add_option("--name", identify.session_name, "Session name (default: start time and the excitation)")
+      ->excludes(identify_no_save);
 
   bellows::RigCheckOptions rig_check;
   CLI::App* rig_cmd = app.add_subcommand("rig", "The first day at the bench: check the rig's inputs and valves");

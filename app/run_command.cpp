@@ -12,6 +12,7 @@
 #include "app/cpu_idle_hold.hpp"
 #include "app/lcm_url.hpp"
 #include "app/rig_profile_file.hpp"
+#include "app/learning_model.hpp"
 #include "app/learning_report.hpp"
 #include "app/run_io.hpp"
 #include "app/run_progress.hpp"
@@ -60,6 +61,17 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
 
 }  // namespace
 
+std::string resolve_clock(const std::string& given, const std::string& device_kind) {
+  if (!given.empty() && given != "sim" && given != "wall") throw InputError("--clock must be sim or wall");
+  const bool rig = device_kind != "sim";
+  if (rig && given == "sim") {
+    throw InputError("--clock sim cannot drive --device " + device_kind +
+                     ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out)");
+  }
+  if (!given.empty()) return given;
+  return rig ? "wall" : "sim";
+}
+
 double parse_speed(const std::string& speed) {
   if (speed == "max") return 0.0;
   for (const char* allowed : {"1", "2", "5", "10"}) {
@@ -68,19 +80,32 @@ double parse_speed(const std::string& speed) {
   throw InputError("--speed must be 1, 2, 5, 10 or max, not '" + speed + "'");
 }
 
-int run_command(const RunOptions& options, std::ostream& out, std::ostream& progress) {
-  if (options.iterations < 0) throw InputError("--iterations must not be negative");
-  if (options.clock != "sim" && options.clock != "wall") throw InputError("--clock must be sim or wall");
+int run_command(const RunOptions& given_options, std::ostream& out, std::ostream& progress) {
+  if (given_options.iterations < 0) throw InputError("--iterations must not be negative");
+  if (!given_options.clock.empty()) resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
+  if (!given_options.lcm_url.empty()) check_lcm_url(given_options.lcm_url, "--lcm");  // before a session exists
+  const double speed = parse_speed(given_options.speed);
+  RunRecording recording(given_options);  // with --resume: the saved configuration, trajectory and state
+  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
+  Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+                         : given_options.config_path.empty() ? Configuration{}
+                                                             : load_config_file(given_options.config_path);
+  const DeviceParameters device_wanted = resolve_device(given_options.device, config.device);
+  RunOptions options = given_options;  // with the clock the device decides when --clock was left out
+  options.clock = resolve_clock(given_options.clock, device_wanted.kind);
+  // The model the learning uses: the rig profile's identified one, if it has one (a resumed session:
+  // the one it recorded). The session's configuration records it.
+  LearningModel learning_model;
+  if (resumed != nullptr) {
+    learning_model.model = config.model;
+    if (!resumed->manifest.model_source.empty()) learning_model.source = resumed->manifest.model_source;
+  } else {
+    learning_model = choose_learning_model(config, device_wanted);
+  }
+  config.model = learning_model.model;
   if (options.speed_given && options.clock != "wall") {  // never ignored in silence
     throw InputError("--speed is for --clock wall: the simulated clock runs as fast as it can");
   }
-  if (!options.lcm_url.empty()) check_lcm_url(options.lcm_url, "--lcm");  // before a session exists
-  const double speed = parse_speed(options.speed);
-  RunRecording recording(options);  // with --resume: the saved configuration, trajectory and state
-  const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
-  const Configuration config = resumed != nullptr          ? resumed->manifest.configuration
-                               : options.config_path.empty() ? Configuration{}
-                                                             : load_config_file(options.config_path);
   const double sample_s = config.timing.sample_s();
   const Trajectory trajectory =
       resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
@@ -114,12 +139,13 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
-  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(),
+  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(), learning_model.source,
                   transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
   const int trials = recording.trials(options.iterations);
   const int first_iteration = resumed != nullptr ? static_cast<int>(resumed->iterations.size()) : 0;
   RunProgressReport said(progress, choose_progress_style(options.verbose, options.quiet, options.progress_on_terminal),
                            first_iteration, first_iteration + trials - 1);
+  if (const std::string line = learning_model_line(learning_model); !line.empty()) said.note(line);
   if (transfer) said.note(transfer_line(*transfer));
   if (!recording.directory().empty()) said.note("session " + recording.directory().string());
   io.start_telemetry(recording.directory());  // its LCM log goes into the session
@@ -208,6 +234,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& prog
                              {"rig_profile", io.opened().rig_profile_name()},
                              {"trajectory", trajectory.name},
                              {"law", law->name()},
+                             {"model", learning_model_json(learning_model)},
                              {"seed", seed},
                              {"clock", options.clock},
                              {"samples", trajectory.learning_samples()},

@@ -52,9 +52,7 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     throw InputError("the LCM log '" + options.lcm_log_file + "' exists already; nothing is overwritten, name a new file");
   }
   if (kind != "sim") {
-    if (options.clock != "wall") {
-      throw InputError("--device " + kind + " needs --clock wall: a real rig's time passes on its own and cannot be simulated");
-    }
+    if (options.clock != "wall") resolve_clock("sim", kind);  // throws (run_command resolved the clock already)
     if (speed != 1.0) throw InputError("--device " + kind + " runs in real time: --speed must be 1");
     if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with --device " + kind);
   }

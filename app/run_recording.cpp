@@ -49,12 +49,13 @@ int RunRecording::trials(int iterations) const {
 
 void RunRecording::start(const Configuration& config, const Trajectory& trajectory, const std::string& device,
                          std::uint64_t seed, int iterations, const nlohmann::ordered_json& device_info,
-                         const nlohmann::ordered_json& first_correction) {
+                         const std::string& model_source, const nlohmann::ordered_json& first_correction) {
   if (options_.no_save || resuming_) return;
   SessionManifest header;
   header.device = device;
   header.device_info = device_info;
   header.configuration = config;
+  header.model_source = model_source;
   header.first_correction = first_correction;
   header.events.push_back({utc_now(), 0, "start",
                            std::string(kPurpose) + ": trajectory " + trajectory.name + ", " + std::to_string(iterations) +

@@ -31,10 +31,12 @@ class RunRecording {
   /// feedback only), K when continuing after completed iterations.
   int trials(int iterations) const;
 
-  /// A fresh run: creates the session (nothing with --no-save). `first_correction` (null: feedback
-  /// only) says where the first trial's correction came from.
+  /// A fresh run: creates the session (nothing with --no-save). `model_source`: where config's
+  /// [model] came from (app/learning_model). `first_correction` (null: feedback only) says where the
+  /// first trial's correction came from.
   void start(const Configuration& config, const Trajectory& trajectory, const std::string& device, std::uint64_t seed,
-             int iterations, const nlohmann::ordered_json& device_info, const nlohmann::ordered_json& first_correction = nullptr);
+             int iterations, const nlohmann::ordered_json& device_info, const std::string& model_source,
+             const nlohmann::ordered_json& first_correction = nullptr);
   /// A resumed run, before the engine's first tick: puts the arm, the engine (armed, with its
   /// controllers' state), the clock and the learning where the session stopped, and records the
   /// resumption. Nothing for a fresh run. `clock` is null on the wall clock; `arm` is null for a rig

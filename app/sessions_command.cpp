@@ -199,6 +199,10 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                           {{"name", m.trajectory_name},
                            {"learning_samples", m.trajectory_samples},
                            {"sample_time_s", c.timing.sample_s()}}},
+                         {"model", {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
+                                    {"omega0_rad_per_s", c.model.omega0_rad_per_s},
+                                    {"damping", c.model.damping},
+                                    {"source", m.model_source.empty() ? Json(nullptr) : Json(m.model_source)}}},
                          {"learning", configuration_to_json(c).at("ilc")},
                          {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)},
                          {"iterations", iterations},
@@ -216,6 +220,9 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
       << "integrity    " << integrity_line(session.integrity) << "\n"
       << "trajectory   " << shown(m.trajectory_name) << ": " << m.trajectory_samples << " samples every " << c.timing.sample_s()
       << " s (" << m.trajectory_samples * c.timing.sample_s() << " s)\n"
+      << "model        kappa " << format("%g", c.model.kappa_rad_per_bar) << " rad/bar, omega0 "
+      << format("%g", c.model.omega0_rad_per_s) << " 1/s, damping " << format("%g", c.model.damping)
+      << (m.model_source.empty() ? std::string() : " (from the " + shown(m.model_source) + ")") << "\n"
       << "learning     " << shown(c.ilc.law) << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
       << "iterations   " << iteration_range(static_cast<long long>(m.iterations.size()));
   if (best >= 0.0) out << ", best RMS " << format("%.3f", best) << " deg";

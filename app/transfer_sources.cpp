@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -36,13 +35,8 @@ void check_transfer_source(const Session& session, const Configuration& target, 
       !why.empty()) {
     throw InputError("cannot transfer from " + describe(session) + ": " + why);
   }
-  if (!rig_profile.empty()) {  // another rig profile is another arm, or the same arm wired otherwise
-    const nlohmann::ordered_json& info = session.manifest.device_info;
-    const std::string theirs = info.contains("rig_profile") && info["rig_profile"].is_string() ? info["rig_profile"].get<std::string>() : "";
-    if (theirs != rig_profile) {
-      throw InputError("cannot transfer from " + describe(session) + ": it was recorded with the rig profile '" +
-                       printable(theirs) + "', this run uses '" + printable(rig_profile) + "'");
-    }
+  if (const std::string why = rig_profile_mismatch(rig_profile_of(session.manifest), rig_profile); !why.empty()) {
+    throw InputError("cannot transfer from " + describe(session) + ": " + why);
   }
   if (session.iterations.empty()) throw InputError("cannot transfer from " + describe(session) + ": it has no completed trial");
 }

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "engine/errors.hpp"
+#include "engine/printable_text.hpp"
 #include "engine/learning_transfer_fit.hpp"
 
 namespace bellows {
@@ -45,6 +46,12 @@ Eigen::VectorXd trial_error(const Trajectory& trajectory, const TransferTrial& t
 }
 
 }  // namespace
+
+std::string rig_profile_mismatch(const std::string& source_profile, const std::string& target_profile) {
+  if (target_profile.empty() || source_profile == target_profile) return {};
+  return "it was recorded with the rig profile '" + printable(source_profile) + "', this run uses '" +
+         printable(target_profile) + "'";
+}
 
 std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
                               const std::string& target_device) {

@@ -51,6 +51,11 @@ struct TransferSource {
 std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
                               const std::string& target_device);
 
+/// Why trials recorded with the rig profile `source_profile` (a session's device_info "rig_profile";
+/// empty when it had none) cannot teach a run with `target_profile`: another rig profile is another
+/// arm, or the same arm wired otherwise. Empty when they can or `target_profile` is empty (not compared).
+std::string rig_profile_mismatch(const std::string& source_profile, const std::string& target_profile);
+
 enum class TransferMethod { kAuto, kReferenceFir, kBasis, kInverseFir };
 std::string transfer_method_name(TransferMethod method);
 /// "auto", "reference-fir", "basis", "inverse-fir"; throws InputError otherwise.

@@ -259,6 +259,7 @@ Json manifest_head_to_json(const SessionManifest& m) {
       {"events", Json::array()},
       {"black_boxes", black_boxes},
   };
+  if (!m.model_source.empty()) out["model"]["source"] = m.model_source;  // absent: not recorded (a rig check learns nothing)
   if (!m.first_correction.is_null()) out["first_correction"] = m.first_correction;
   if (m.resume) {
     Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
@@ -349,6 +350,7 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   m.started_utc = r["started_utc"].text();
   m.updated_utc = r["updated_utc"].text();
   m.configuration = configuration_from_json(r["configuration"]);
+  if (r.has("model") && r["model"].has("source")) m.model_source = r["model"]["source"].text();  // the values: the configuration's
   const JsonReader trajectory = r["trajectory"];
   m.trajectory_name = trajectory["name"].text();
   m.trajectory_samples = trajectory["learning_samples"].integer(m.configuration.trajectory.min_learning_samples, kMostSamples);

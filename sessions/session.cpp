@@ -22,4 +22,9 @@ std::string utc_now() {
   return out;
 }
 
+std::string rig_profile_of(const SessionManifest& manifest) {
+  const auto profile = manifest.device_info.find("rig_profile");
+  return profile != manifest.device_info.end() && profile->is_string() ? profile->get<std::string>() : std::string();
+}
+
 }  // namespace bellows

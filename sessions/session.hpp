@@ -72,6 +72,10 @@ struct SessionManifest {
   std::string started_utc;
   std::string updated_utc;
   Configuration configuration;
+  // Where the configuration's [model] (the model the learning used) came from: "configuration", or
+  // "rig_profile" (the identified model of the rig profile device_info names); empty in sessions
+  // saved before it was recorded.
+  std::string model_source;
   std::string trajectory_name;
   int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
   std::string trajectory_sha256;  // empty in sessions saved before digests were kept
@@ -106,6 +110,9 @@ struct Session {
   std::vector<IterationData> iterations;  // in the order of manifest.iterations
   std::vector<std::vector<TickRecord>> black_boxes;  // in the order of manifest.black_boxes, oldest tick first
 };
+
+/// The rig profile's name the session was recorded with (device_info "rig_profile"); "" without one.
+std::string rig_profile_of(const SessionManifest& manifest);
 
 /// Current UTC time in the manifest's format.
 std::string utc_now();

@@ -58,7 +58,11 @@ device_setup() {
          # tests answers Modbus slower than a rig's 20 ms timeout allows (what the guards do on a
          # real link has tests of its own).
          printf '[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n' >"$E2E_DIR/t7-loaded.toml"
-         DEVICE_ARGS=(--device t7 --t7 "127.0.0.1:$port" --config "$E2E_DIR/t7-loaded.toml") ;;
+         # A rig profile with an identified [model] (the paper rig's wiring): the console learns
+         # with it, says so in its log, and the session records where its model came from.
+         { cat "$(dirname "$0")/../profiles/paper-rig.toml"
+           printf '\n[model]\nkappa_rad_per_bar = 7.5\nomega0_rad_per_s = 14.0\ndamping = 0.3\n'; } >"$E2E_DIR/t7-rig.toml"
+         DEVICE_ARGS=(--device t7 --t7 "127.0.0.1:$port" --rig-profile "$E2E_DIR/t7-rig.toml" --config "$E2E_DIR/t7-loaded.toml") ;;
     *) e2e_fail "unknown device '$1'" ;;
   esac
 }
@@ -104,6 +108,14 @@ for device in "${DEVICES[@]}"; do
   session="$(e2e_history | grep -oE 'session: /[^ ]+ \(saved as it went\)' | head -1 | cut -d' ' -f2)"
   [ -f "$session/manifest.json" ] || e2e_fail "$device: no session at '$session'"
   grep -q "\"device\": *\"$device\"" "$session/manifest.json" || e2e_fail "$device: the session does not record its device"
+  if [ "$device" = t7 ]; then
+    grep -q '"source": *"rig_profile"' "$session/manifest.json" || e2e_fail "t7: the session does not say its model is the rig profile's"
+    grep -q '"kappa_rad_per_bar": *7.5' "$session/manifest.json" || e2e_fail "t7: the session's model is not the rig profile's"
+    grep -q "learning with the rig profile paper-rig's \[model\] (kappa 7.5" "$session/manifest.json" ||
+      e2e_fail "t7: the console's log does not say which model it learns with"
+  else
+    grep -q '"source": *"configuration"' "$session/manifest.json" || e2e_fail "$device: the session does not say its model is the configuration's"
+  fi
 
   # The session reopens in the console, on the device it was made on.
   e2e_start 120 40 -- console --session "$session" $([ "$device" = sim ] && echo --speed 2)

@@ -12,7 +12,7 @@
 namespace bellows {
 namespace {
 
-constexpr double kSampleTime_s = 0.02;
+constexpr double kLinearizationSampleTime_s = 0.02;
 
 TEST(ArmChainLinearization, OneJointWithoutGravityIsTheSingleJointNominalModel) {
   ChainParameters chain;
@@ -27,13 +27,13 @@ TEST(ArmChainLinearization, OneJointWithoutGravityIsTheSingleJointNominalModel) 
   nominal.kappa_rad_per_bar = l.kappa_rad_per_bar;
   nominal.omega0_rad_per_s = l.omega0_straight_rad_per_s;
   nominal.damping = l.damping_ratio;
-  const DiscreteArmModel expected = discretize_arm_model(nominal, kSampleTime_s);
+  const DiscreteArmModel expected = discretize_arm_model(nominal, kLinearizationSampleTime_s);
   for (double pose : {0.0, 0.7}) {  // without gravity the pose does not matter for one joint
-    const MultiJointModel model = linearize_chain(arm, JointVector::Constant(1, pose), kSampleTime_s);
+    const MultiJointModel model = linearize_chain(arm, JointVector::Constant(1, pose), kLinearizationSampleTime_s);
     EXPECT_LT((Eigen::MatrixXd(model.A) - Eigen::MatrixXd(expected.A)).norm(), 1e-12);
     EXPECT_LT((Eigen::MatrixXd(model.B) - Eigen::MatrixXd(expected.B)).norm(), 1e-12);
     EXPECT_LT((Eigen::MatrixXd(model.C) - Eigen::MatrixXd(expected.C)).norm(), 1e-15);
-    EXPECT_EQ(model.sample_time_s, kSampleTime_s);
+    EXPECT_EQ(model.sample_time_s, kLinearizationSampleTime_s);
   }
 }
 
@@ -47,12 +47,12 @@ double step_response_mismatch(const char* preset, const JointVector& pose, const
   ArmChain::State start = arm.state();
   start.angle_rad = pose;
   arm.set_state(start);
-  const MultiJointModel model = linearize_chain(arm, pose, kSampleTime_s);
+  const MultiJointModel model = linearize_chain(arm, pose, kLinearizationSampleTime_s);
   const JointVector input = arm.holding_pressure_bar(pose) + delta_bar;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * arm.joints());
   double largest_response = 0.0, largest_difference = 0.0;
   for (int t = 0; t < samples; ++t) {
-    arm.advance(kSampleTime_s, input);
+    arm.advance(kLinearizationSampleTime_s, input);
     x = model.A * x + model.B * Eigen::VectorXd(delta_bar);
     const Eigen::VectorXd simulated = Eigen::VectorXd(arm.state().angle_rad - pose) / std::numbers::pi;
     const Eigen::VectorXd predicted = model.C * x;
@@ -79,7 +79,7 @@ TEST(ArmChainLinearization, PredictsSmallMotionsOfTheSimulatedArm) {
 
 TEST(ArmChainLinearization, TheChainIsCoupledAndGravityStiffensOrSoftensWithThePose) {
   const ArmChain arm(chain_preset("arm2"));
-  const MultiJointModel straight = linearize_chain(arm, JointVector::Zero(2), kSampleTime_s);
+  const MultiJointModel straight = linearize_chain(arm, JointVector::Zero(2), kLinearizationSampleTime_s);
   // The elbow's pressure moves the shoulder (inertia coupling): off-diagonal blocks of B are not zero.
   EXPECT_GT(std::abs(straight.B(1, 1)), 0.01 * std::abs(straight.B(1, 0)));
   EXPECT_GT(std::abs(straight.B(3, 0)), 0.01 * std::abs(straight.B(3, 1)));
@@ -95,7 +95,7 @@ TEST(ArmChainLinearization, TheChainIsCoupledAndGravityStiffensOrSoftensWithTheP
   continuous_chain_model(arm, up, Ac_up, Bc);
   EXPECT_LT(Ac_down(1, 0), Ac_straight(1, 0) - 0.05 * std::abs(Ac_straight(1, 0)));
   EXPECT_GT(Ac_up(1, 0), Ac_straight(1, 0) + 0.05 * std::abs(Ac_straight(1, 0)));
-  EXPECT_THROW(linearize_chain(arm, JointVector::Zero(3), kSampleTime_s), InputError);
+  EXPECT_THROW(linearize_chain(arm, JointVector::Zero(3), kLinearizationSampleTime_s), InputError);
   EXPECT_THROW(linearize_chain(arm, JointVector::Zero(2), 0.0), InputError);
 }
 

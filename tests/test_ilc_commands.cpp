@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -142,6 +143,47 @@ TEST_F(IlcCommands, IdentifyFitsThePlantOfTheFileItWritesAndSaysWhich) {
   EXPECT_NEAR(report["model"]["kappa"].get<double>(), 5.0, 0.05 * 5.0);
   const Result defaults = bellows("identify --json --signal steps");
   EXPECT_NE(defaults.err.find("fitting the default plant"), std::string::npos) << defaults.err;
+}
+
+// `bellows identify` is recorded in a session where runs save theirs: the identification trial (its
+// excitation is the session's trajectory, the trial its iteration 0), the held-out trial, the fit and
+// what was written where; `sessions show` loads it. --no-save records nothing.
+TEST_F(IlcCommands, IdentifyIsRecordedInASession) {
+  const auto lab = write("lab.toml", "[identify]\nduration_s = 8.0\n");
+  const auto data = dir_ / "data";
+  const Result r = bellows("identify --json --config " + lab.string() + " --write-model " + lab.string() + " --data-dir " +
+                           data.string() + " --name ident");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  ASSERT_EQ(report["session"], (data / "ident").string());
+  EXPECT_NE(r.err.find("session " + (data / "ident").string()), std::string::npos) << r.err;
+
+  const Result shown = bellows("sessions show --json " + (data / "ident").string());
+  ASSERT_EQ(shown.status, 0) << shown.err;
+  const nlohmann::json session = nlohmann::json::parse(shown.out);
+  EXPECT_EQ(session["device"], "sim");
+  EXPECT_EQ(session["device_info"]["seed"], 1);
+  EXPECT_EQ(session["trajectory"]["name"].get<std::string>().find("chirp") != std::string::npos, true) << session["trajectory"];
+  ASSERT_EQ(session["iterations"].size(), 1u);  // the identification trial
+  EXPECT_TRUE(session["model"]["source"].is_null()) << "identify learns nothing: no model source";
+  std::vector<std::string> kinds;
+  std::string fit, written;
+  for (const nlohmann::json& e : session["events"]) {
+    kinds.push_back(e["kind"]);
+    if (e["kind"] == "identify-fit") fit = e["message"];
+    if (e["kind"] == "model-written") written = e["message"];
+  }
+  EXPECT_EQ(kinds, (std::vector<std::string>{"start", "identify-trial", "identify-trial", "identify-fit", "model-written", "finish"}));
+  char kappa[32];
+  std::snprintf(kappa, sizeof kappa, "kappa %.6g rad/bar", report["model"]["kappa"].get<double>());
+  EXPECT_NE(fit.find(kappa), std::string::npos) << fit;
+  EXPECT_NE(written.find("into the configuration " + lab.string()), std::string::npos) << written;
+
+  const Result unsaved = bellows("identify --json --no-save --config " + lab.string());
+  ASSERT_EQ(unsaved.status, 0) << unsaved.err;
+  EXPECT_TRUE(nlohmann::json::parse(unsaved.out)["session"].is_null());
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(data), std::filesystem::directory_iterator()), 1);
+  EXPECT_EQ(bellows("identify --no-save --data-dir " + data.string()).status, 2);  // the two contradict
 }
 
 TEST_F(IlcCommands, IdentifyRefusesAModelFileThatIsNotAFile) {

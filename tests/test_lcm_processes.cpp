@@ -372,8 +372,9 @@ TEST(LcmCli, OnTheSimulatedClockTheLogHoldsEveryTick) {
 
 TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   const auto dir = testing::make_temp_dir("bellows-lcm-cli");
-  expect_refused_in_one_line("run --device lcm", "--device lcm needs --clock wall");
-  expect_refused_in_one_line("run --device lcm --clock sim", "--device lcm needs --clock wall");
+  // A rig runs on the wall clock (the default for it); the simulated clock cannot drive it.
+  expect_refused_in_one_line("run --device lcm --clock sim", "--clock sim cannot drive --device lcm");
+  expect_refused_in_one_line("run --clock sim --device t7 --t7 127.0.0.1:1", "--clock sim cannot drive --device t7");
   expect_refused_in_one_line("run --device lcm --clock wall --speed 2", "--speed must be 1");
   expect_refused_in_one_line("run --device rig", "--device");
   // The environment refusing (a bus that cannot be opened) has its own status.
@@ -395,12 +396,13 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   expect_refused_in_one_line("run --iterations 0 --lcm-log " + existing.string(), "exists already");
   expect_refused_in_one_line("run --iterations 0 --no-save --lcm-log", "name a FILE with --no-save");
 
-  // memq:// is private to a process: nobody answers there.
+  // memq:// is private to a process: nobody answers there. No --clock: a rig runs on the wall clock.
   const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");
-  const auto result = testing::run_process(kBellows + " run --device lcm --clock wall --lcm memq:// --json --config " +
+  const auto result = testing::run_process(kBellows + " run --device lcm --lcm memq:// --json --config " +
                                            config.string());
   EXPECT_EQ(result.exit_code, kExitEnvironment) << result.err;  // no rig: the environment, not a fault
   const nlohmann::json report = nlohmann::json::parse(result.out);
+  EXPECT_EQ(report["clock"], "wall");
   EXPECT_EQ(report["fault"]["name"], "rig-unavailable");
   EXPECT_EQ(report["iterations"].size(), 0u);
   EXPECT_NE(result.err.find("no rig answered on memq://"), std::string::npos) << result.err;

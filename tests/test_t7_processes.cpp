@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/configuration.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/process_runner.hpp"
 
@@ -64,7 +65,7 @@ class T7Processes : public ::testing::Test {
     const std::filesystem::path config =
         testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
     return std::make_unique<Child>(
-        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rt", "try",
+        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try",  // a rig: the wall clock
                                  "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},
         dir_ / (name + ".out"), dir_ / (name + ".err"));
   }
@@ -133,6 +134,9 @@ TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
     EXPECT_NEAR(remote_rms[i], local_rms[i], 0.15 * local_rms[i]) << "iteration " << i;
   }
   EXPECT_EQ(t7.at("device"), "t7");
+  EXPECT_EQ(t7.at("clock"), "wall");  // no --clock: a rig runs on the wall clock
+  EXPECT_EQ(t7.at("model").at("source"), "configuration");  // the built-in profile has no [model]
+  EXPECT_EQ(t7.at("model").at("kappa_rad_per_bar"), Configuration{}.model.kappa_rad_per_bar);
   const nlohmann::json link = t7.at("loop").at("link");
   EXPECT_GT(link.at("exchanges").get<std::uint64_t>(), 1000u);
   EXPECT_EQ(link.at("errors").get<std::uint64_t>(), 0u);
@@ -201,6 +205,76 @@ std::string text_of(const std::filesystem::path& path) {
 }
 
 std::string paper_profile_text() { return text_of(std::filesystem::path(BELLOWS_SOURCE_DIR) / "profiles" / "paper-rig.toml"); }
+
+// The first day's identification on a T7 (t7-sim): the trials run through the rig, the fit goes into
+// the rig profile's [model], and all of it is recorded in a session (the device with its address and
+// rig profile, the identification trial as iteration 0, the fit, what was written where).
+TEST_F(T7Processes, IdentifyOnAT7StoresTheModelInTheProfileAndRecordsASession) {
+  const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", paper_profile_text());
+  const std::filesystem::path config = testing::write_file(
+      dir_, "identify.toml",
+      "[identify]\nduration_s = 6.0\n[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+  auto sim = start_sim();
+  const testing::ProcessResult r =
+      run_cli({"identify", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",
+               config.string(), "--write-model", profile.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["written_as"], "rig_profile");
+  ASSERT_TRUE(report["session"].is_string()) << r.out;
+  EXPECT_NE(text_of(profile).find("# fitted by bellows identify"), std::string::npos);
+
+  const testing::ProcessResult shown = run_cli({"sessions", "show", "--json", report["session"].get<std::string>()});
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  const nlohmann::json session = nlohmann::json::parse(shown.out);
+  EXPECT_EQ(session["device"], "t7");
+  EXPECT_EQ(session["device_info"]["t7"], address_);
+  EXPECT_EQ(session["device_info"]["rig_profile"], "paper-rig");
+  EXPECT_EQ(session["iterations"].size(), 1u);
+  bool fitted = false, written = false;
+  for (const nlohmann::json& e : session["events"]) {
+    fitted = fitted || e["kind"] == "identify-fit";
+    written = written || (e["kind"] == "model-written" &&
+                          e["message"].get<std::string>().find("into the rig profile " + profile.string()) != std::string::npos);
+  }
+  EXPECT_TRUE(fitted) << session["events"];
+  EXPECT_TRUE(written) << session["events"];
+}
+
+// A rig profile with an identified [model]: `bellows run` learns with it, and its session says so
+// (the configuration records the model, `model.source` where it came from). A run without one uses
+// the configuration's (LearningThroughAT7MatchesTheInProcessArm).
+TEST_F(T7Processes, RunLearnsWithTheRigProfilesIdentifiedModel) {
+  std::string text = paper_profile_text();
+  const std::string name_line = "name = \"paper-rig\"";
+  ASSERT_NE(text.find(name_line), std::string::npos);
+  text.replace(text.find(name_line), name_line.size(), "name = \"bench-rig\"");
+  text += "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
+  const std::filesystem::path profile = testing::write_file(dir_, "bench-rig.toml", text);
+  const std::filesystem::path config = testing::write_file(
+      dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+  auto sim = start_sim();
+  const testing::ProcessResult r =
+      run_cli({"run", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",
+               config.string(), "--iterations", "0", "--json", "--data-dir", (dir_ / "data").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["model"]["source"], "rig_profile");
+  EXPECT_EQ(report["model"]["rig_profile"], "bench-rig");
+  EXPECT_EQ(report["model"]["kappa_rad_per_bar"], 6.5);
+  EXPECT_EQ(report["model"]["omega0_rad_per_s"], 12.0);
+  EXPECT_EQ(report["model"]["damping"], 0.4);
+  const nlohmann::json manifest = nlohmann::json::parse(text_of(std::filesystem::path(report["session"].get<std::string>()) / "manifest.json"));
+  EXPECT_EQ(manifest["model"]["source"], "rig_profile");
+  EXPECT_EQ(manifest["model"]["kappa_rad_per_bar"], 6.5);
+  EXPECT_EQ(manifest["configuration"]["model"]["kappa"], 6.5);
+  EXPECT_EQ(manifest["configuration"]["model"]["omega0"], 12.0);
+  EXPECT_EQ(manifest["device_info"]["rig_profile"], "bench-rig");
+  const testing::ProcessResult shown = run_cli({"sessions", "show", report["session"].get<std::string>()});
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("model        kappa 6.5 rad/bar, omega0 12 1/s, damping 0.4 (from the rig_profile)"), std::string::npos)
+      << shown.out;
+}
 
 // Zeroing the angle headless: the profile bellows reads says the zero is 0.1 rad off (t7-sim's arm
 // hangs at its true zero), so the arm reads about -5.7 deg; after `rig check --zero-angle` the

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "app/learning_model.hpp"
 #include "app/rig_profile_file.hpp"
 #include "app/rig_profile_write.hpp"
 #include "app/toml_key_edit.hpp"
@@ -162,6 +163,50 @@ std::string profile_copy(const std::string& name) {
   const std::string path = "/tmp/bellows-profile-" + std::to_string(::getpid()) + "-" + name + ".toml";
   write_file_atomic(path, paper_rig_profile_text());
   return path;
+}
+
+// The model the learning uses (app/learning_model): the rig profile's identified one when it has
+// one, else the configuration's; a configuration's own model that the profile's replaces is said.
+TEST(LearningModel, TheRigProfilesIdentifiedModelIsUsedWhenItHasOne) {
+  const std::string with_model = profile_copy("with-model");
+  write_rig_profile_model(with_model, ModelParameters{6.5, 12.0, 0.4, 0.0});
+  Configuration config;
+  config.model.volume_gain_per_rad = 0.2;
+  const LearningModel chosen = choose_learning_model(config, {"t7", "", "127.0.0.1:5020", with_model});
+  EXPECT_EQ(chosen.source, "rig_profile");
+  EXPECT_EQ(chosen.rig_profile, "paper-rig");
+  EXPECT_DOUBLE_EQ(chosen.model.kappa_rad_per_bar, 6.5);
+  EXPECT_DOUBLE_EQ(chosen.model.omega0_rad_per_s, 12.0);
+  EXPECT_DOUBLE_EQ(chosen.model.damping, 0.4);
+  EXPECT_DOUBLE_EQ(chosen.model.volume_gain_per_rad, 0.2) << "volume_gain stays the configuration's";
+  EXPECT_TRUE(chosen.note.empty()) << "the configuration had the defaults: nothing replaced";
+  EXPECT_EQ(learning_model_line(chosen), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4)");
+  EXPECT_EQ(learning_model_json(chosen)["source"], "rig_profile");
+  EXPECT_EQ(learning_model_json(chosen)["kappa_rad_per_bar"], 6.5);
+
+  config.model.kappa_rad_per_bar = 8.2;  // e.g. an earlier `identify --write-model lab.toml`
+  const LearningModel replacing = choose_learning_model(config, {"t7", "", "127.0.0.1:5020", with_model});
+  EXPECT_DOUBLE_EQ(replacing.model.kappa_rad_per_bar, 6.5);
+  EXPECT_EQ(learning_model_line(replacing), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4), "
+                                            "not the configuration's (kappa 8.2, omega0 14.14, damping 0.31)");
+
+  // Without a [model] in the profile (the built-in paper rig has none), and off a T7: the configuration's.
+  const std::string no_model = profile_copy("no-model");
+  for (const DeviceParameters& device : {DeviceParameters{"t7", "", "127.0.0.1:5020", ""},
+                                         DeviceParameters{"t7", "", "127.0.0.1:5020", no_model},
+                                         DeviceParameters{"sim", "", "", ""}, DeviceParameters{"lcm", "", "", ""}}) {
+    const LearningModel configured = choose_learning_model(config, device);
+    EXPECT_EQ(configured.source, "configuration") << device.kind << " " << device.rig_profile;
+    EXPECT_DOUBLE_EQ(configured.model.kappa_rad_per_bar, 8.2);
+    EXPECT_TRUE(configured.note.empty());
+    EXPECT_EQ(learning_model_line(configured), "");
+    EXPECT_FALSE(learning_model_json(configured).contains("rig_profile"));
+  }
+  // A bad profile is the profile's one line, before anything opens.
+  const std::string bad = profile_copy("bad-model");
+  write_file_atomic(bad, paper_rig_profile_text() + "\n[model]\ndamping = -1\n");
+  EXPECT_THROW(choose_learning_model(config, {"t7", "", "127.0.0.1:5020", bad}), InputError);
+  for (const std::string& path : {with_model, no_model, bad}) std::filesystem::remove(path);
 }
 
 TEST(RigProfileWrite, TheAngleZeroIsWrittenIntoTheFile) {

@@ -5,6 +5,7 @@
 
 #include "console_fixture.hpp"
 #include "test_transfer_scenarios.hpp"
+#include "ui/console_transfer.hpp"
 #include "ui/plot_data.hpp"
 
 namespace bellows {
@@ -51,6 +52,41 @@ TEST(ConsoleTransfer, OffersWhatTheLastTrajectoryTaughtAndTakesItWithOneKey) {
   EXPECT_LT(f.state().experiment.trials[0].summary.rms_deg, 0.6 * feedback_only);
   f.key('T');  // the trajectory has a trial now: no second transfer
   EXPECT_NE(f.state().status.find("no transfer is offered"), std::string::npos) << f.state().status;
+}
+
+// On a rig, a saved session teaches only a console on the same rig profile (as `bellows run
+// --transfer-from` checks): another profile is another arm, or the same arm wired otherwise.
+TEST(ConsoleTransfer, SavedSessionsOfAnotherRigProfileAreNotOffered) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.run_batch(4);
+  ASSERT_TRUE(f.pump_until([&] { return f.sessions.saves > 0 && f.idle(); }));
+  ui::SessionSnapshot recorded;
+  {
+    const std::lock_guard<std::mutex> guard(f.sessions.mutex);
+    ASSERT_EQ(f.sessions.saved.size(), 1u);
+    recorded = f.sessions.saved.begin()->second;
+  }
+  ASSERT_FALSE(recorded.experiment.trials.empty());
+  recorded.device_name = "t7";  // as if recorded through a T7
+  const auto steps = std::make_shared<const Trajectory>(library_trajectory("steps", f.config.timing.sample_s()));
+  const auto offer_from = [&](const std::string& their_profile, const std::string& our_profile) {
+    testing::MemorySessions saved;
+    ui::SessionSnapshot s = recorded;
+    s.rig_profile = their_profile;
+    s.experiment.session_location = "mem://rig";
+    saved.saved["mem://rig"] = s;
+    return ui::compute_transfer_offer({}, &saved, f.config, "t7", our_profile, steps);
+  };
+  const ui::TransferOffer same = offer_from("paper-rig", "paper-rig");
+  EXPECT_EQ(same.source_count, 1) << same.why_not;
+  EXPECT_EQ(same.sources, "mem://rig (saved)");
+  const ui::TransferOffer other = offer_from("other-rig", "paper-rig");
+  EXPECT_EQ(other.source_count, 0);
+  EXPECT_FALSE(other.useful);
+  EXPECT_EQ(other.why_not, "no earlier trials of this arm to learn from");
+  const ui::TransferOffer none = offer_from("", "paper-rig");  // recorded without a profile: not this rig's
+  EXPECT_EQ(none.source_count, 0);
 }
 
 TEST(ConsoleTransfer, TheInspectorKeepsTheTransferredCorrectionInView) {

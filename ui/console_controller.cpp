@@ -103,6 +103,7 @@ void ConsoleController::start(double now_s) {
   rebuild_law();
   log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
                                    env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
+  if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
 

@@ -47,6 +47,7 @@ struct ConsoleEnvironment {
   std::string device_name = "sim";
   std::string device_where;                      // the link, e.g. an LCM URL ("in-process" for sim)
   std::string rig_profile;                       // the rig profile's name, "" without one
+  std::string model_note;                        // where config.model came from, when not the configuration (logged at start)
   std::function<bellows::DeviceHealth()> device_health;  // Device::health() (any thread); optional
   std::function<RawInputs()> raw_inputs;         // Device::raw_inputs() (any thread); optional
   /// Makes `read_rad` (the angle read now) the rig profile's zero: the file and the device; returns

@@ -39,7 +39,8 @@ TransferSourceNote transfer_note_of(const Experiment& experiment, std::string na
 }
 
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved,
+                                     const std::string& device, const std::string& rig_profile,
+                                     std::shared_ptr<const Trajectory> target, int max_saved,
                                      const std::vector<std::string>& taught_locations,
                                      const std::vector<TransferSourceNote>& taught_notes) {
   TransferOffer offer;
@@ -65,6 +66,7 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
         try {
           const SessionSnapshot snapshot = sessions->read_trials(listing.location);
           if (!transfer_mismatch(snapshot.config, snapshot.device_name, config, device).empty()) continue;
+          if (!rig_profile_mismatch(snapshot.rig_profile, rig_profile).empty()) continue;  // another arm, or wired otherwise
           TransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
           if (source.trials.empty()) continue;
           source.name = listing.name + " (saved)";
@@ -123,8 +125,9 @@ void ConsoleController::offer_transfer() {
   }
   transfer_wanted_ = false;
   transfer_task_.start([taught = taught_, notes = taught_notes_, locations = taught_locations_, sessions = env_.sessions,
-                        config = env_.config, device = env_.device_name, target = state_.experiment.trajectory] {
-    return compute_transfer_offer(taught, sessions, config, device, target, 4, locations, notes);
+                        config = env_.config, device = env_.device_name, profile = env_.rig_profile,
+                        target = state_.experiment.trajectory] {
+    return compute_transfer_offer(taught, sessions, config, device, profile, target, 4, locations, notes);
   });
 }
 

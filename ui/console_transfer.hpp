@@ -36,11 +36,13 @@ struct TransferOffer {
 TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config);
 
 /// Worker thread: the transfer from `taught` (this console's earlier experiments) and the `max_saved`
-/// newest saved sessions that fit this run (transfer_mismatch), for `target`. Never throws: a
+/// newest saved sessions that fit this run (transfer_mismatch; on a rig, the same rig profile:
+/// rig_profile_mismatch against `rig_profile`, "" without one), for `target`. Never throws: a
 /// transfer that cannot be computed or would not help comes back with `why_not`. `taught_locations`:
 /// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so the same trials are not used twice.
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, std::shared_ptr<const Trajectory> target, int max_saved = 4,
+                                     const std::string& device, const std::string& rig_profile,
+                                     std::shared_ptr<const Trajectory> target, int max_saved = 4,
                                      const std::vector<std::string>& taught_locations = {},
                                      const std::vector<TransferSourceNote>& taught_notes = {});
 /// `experiment`'s trials as a transfer source's note (what a session records about it).

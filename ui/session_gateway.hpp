@@ -26,6 +26,7 @@ struct SessionSnapshot {
   std::vector<LogEntry> events;   // the operator's and the engine's log (the newest entries)
   std::size_t events_total = 0;   // entries ever logged (EventLog::total()), to tell new ones apart
   std::string device_name;        // e.g. "sim"
+  std::string rig_profile;        // the rig profile's name it was recorded with ("" without one)
   std::uint64_t seed = 1;
 };
 
