@@ -54,6 +54,47 @@ class MultiJointNoilc::Stages {
 
 namespace {
 
+/// The Riccati recursion of the set-up, backwards from P_N: each stage's gain K_t and the inverse of
+/// its curvature H_uu(t). Dynamic sizes and not a template: it runs once per set-up (which may
+/// allocate), and four fixed-size copies of it (J = 1..4, matrices up to 12 x 12) took GCC two
+/// minutes at -O3. The per-iteration sweeps of solve() stay fixed-size.
+MultiJointNoilcStatus riccati_stages(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
+                                     const Eigen::MatrixXd& m, const Eigen::MatrixXd& s, const Eigen::MatrixXd& rate_weight,
+                                     int samples, std::vector<Eigen::MatrixXd>& gains, std::vector<Eigen::MatrixXd>& inverses) {
+  using Dynamic = Eigen::MatrixXd;
+  const Eigen::Index J = B.cols(), states = A.rows(), augmented = states + J;  // z = [dx; v(t-1)]
+  gains.assign(static_cast<std::size_t>(samples), Dynamic());
+  inverses.assign(static_cast<std::size_t>(samples), Dynamic());
+  // Augmented model: Ab = [[A, 0], [0, 0]], Bb = [B; I], Cb = [C, 0].
+  Dynamic Ab = Dynamic::Zero(augmented, augmented);
+  Ab.topLeftCorner(states, states) = A;
+  Dynamic Bb(augmented, J);
+  Bb << B, Dynamic::Identity(J, J);
+  Dynamic Cb = Dynamic::Zero(J, augmented);
+  Cb.leftCols(states) = C;
+  const Dynamic output_weight = Cb.transpose() * m * Cb;
+  Dynamic P = output_weight;  // P_N
+  for (int t = samples - 1; t >= 0; --t) {
+    // As FixedStages::rate_weight: none at t = 0, twice at t = N-1.
+    const Dynamic W = t == 0 ? Dynamic::Zero(J, J) : Dynamic(t == samples - 1 ? 2.0 * rate_weight : rate_weight);
+    Dynamic Q = t >= 1 ? output_weight : Dynamic::Zero(augmented, augmented);
+    Q.bottomRightCorner(J, J) += W;
+    const Dynamic PB = P * Bb;
+    Dynamic curvature = s + W + Bb.transpose() * PB;  // H_uu
+    curvature = (0.5 * (curvature + curvature.transpose())).eval();
+    Dynamic cross = PB.transpose() * Ab;  // H_ux = N' + Bb' P Ab with N = [0; -W]
+    cross.rightCols(J) -= W;
+    const Eigen::LLT<Dynamic> factor(curvature);
+    if (factor.info() != Eigen::Success || !curvature.allFinite()) return MultiJointNoilcStatus::kNotPositiveDefinite;
+    const Dynamic inverse = factor.solve(Dynamic::Identity(J, J));
+    gains[static_cast<std::size_t>(t)] = -inverse * cross;
+    inverses[static_cast<std::size_t>(t)] = inverse;
+    P = Q + Ab.transpose() * P * Ab - cross.transpose() * inverse * cross;
+    P = (0.5 * (P + P.transpose())).eval();
+  }
+  return MultiJointNoilcStatus::kOk;
+}
+
 /// The sweeps for exactly J joints: fixed-size stage matrices, so that the compiler unrolls them.
 template <int J>
 class FixedStages final : public MultiJointNoilc::Stages {
@@ -79,32 +120,12 @@ class FixedStages final : public MultiJointNoilc::Stages {
     gains_.resize(static_cast<std::size_t>(samples));
     inverse_curvature_.resize(static_cast<std::size_t>(samples));
     feedforward_.resize(static_cast<std::size_t>(samples));
-    // Augmented model: Ab = [[A, 0], [0, 0]], Bb = [B; I], Cb = [C, 0].
-    Aug Ab = Aug::Zero();
-    Ab.template topLeftCorner<kStates, kStates>() = A_;
-    Eigen::Matrix<double, kAugmented, J> Bb;
-    Bb << B_, JJ::Identity();
-    Eigen::Matrix<double, J, kAugmented> Cb = Eigen::Matrix<double, J, kAugmented>::Zero();
-    Cb.template leftCols<kStates>() = C_;
-    const Aug output_weight = Cb.transpose() * m_ * Cb;
-    const JJ s = weights.s + rho * JJ::Identity();
-    Aug P = output_weight;  // P_N
-    for (int t = samples - 1; t >= 0; --t) {
-      const JJ W = rate_weight(t);
-      Aug Q = t >= 1 ? output_weight : Aug::Zero();
-      Q.template bottomRightCorner<J, J>() += W;
-      const Eigen::Matrix<double, kAugmented, J> PB = P * Bb;
-      JJ curvature = s + W + Bb.transpose() * PB;  // H_uu
-      curvature = (0.5 * (curvature + curvature.transpose())).eval();
-      Gain cross = PB.transpose() * Ab;  // H_ux = N' + Bb' P Ab with N = [0; -W]
-      cross.template rightCols<J>() -= W;
-      const Eigen::LLT<JJ> factor(curvature);
-      if (factor.info() != Eigen::Success || !curvature.allFinite()) return MultiJointNoilcStatus::kNotPositiveDefinite;
-      const JJ inverse = factor.solve(JJ::Identity());
-      gains_[static_cast<std::size_t>(t)] = -inverse * cross;
-      inverse_curvature_[static_cast<std::size_t>(t)] = inverse;
-      P = Q + Ab.transpose() * P * Ab - cross.transpose() * inverse * cross;
-      P = (0.5 * (P + P.transpose())).eval();
+    std::vector<Eigen::MatrixXd> gains, inverses;
+    const MultiJointNoilcStatus status = riccati_stages(A_, B_, C_, m_, weights.s + rho * JJ::Identity(), rate_weight_, samples, gains, inverses);
+    if (status != MultiJointNoilcStatus::kOk) return status;
+    for (std::size_t t = 0; t < gains.size(); ++t) {
+      gains_[t] = gains[t];
+      inverse_curvature_[t] = inverses[t];
     }
     return MultiJointNoilcStatus::kOk;
   }
