@@ -2,45 +2,18 @@
 // (holding, a whole trial with telemetry taps, a fault and its black box, a reset).
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
+#include "tests/allocation_counter.hpp"
 #include "tests/engine_fixture.hpp"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace bellows {
 namespace {
 
-class CountAllocations {
- public:
-  CountAllocations() {
-    g_allocations.store(0);
-    g_counting.store(true);
-  }
-  ~CountAllocations() { g_counting.store(false); }
-  long count() const { return g_allocations.load(); }
-};
+using CountAllocations = testing_allocations::Counter;
 
 TEST(EngineAllocations, CounterSeesAnAllocation) {  // the instrument works
   CountAllocations counter;
   auto* p = new int(3);
-  EXPECT_EQ(counter.count(), 1);
+  EXPECT_EQ(counter.allocations(), 1);
   delete p;
 }
 
@@ -66,7 +39,7 @@ TEST(EngineAllocations, TicksAllocateNothing) {
     f.send(CommandKind::kReset);
     f.send(CommandKind::kArm);
     f.clock.step(10);
-    allocations = counter.count();
+    allocations = counter.allocations();
   }
   EXPECT_TRUE(record.complete);
   EXPECT_GT(tap.read_available(), 1000u);
