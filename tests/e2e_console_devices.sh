@@ -91,7 +91,9 @@ for device in "${DEVICES[@]}"; do
   # The Rig screen: the inputs, then the valve test (asks first), every valve passes.
   e2e_keys b
   e2e_wait_for "Inputs: $device"
-  e2e_wait_for 'chamber A'
+  # The chamber pressure row: "chamber A" as the engine reads it, or the rig's raw input "chamber_a"
+  # once its volts arrive (which one the first frame shows is a race).
+  e2e_wait_for 'chamber( A|_a) '
   e2e_keys v
   e2e_wait_for 'Valve test: open each valve alone\?'
   e2e_keys y
