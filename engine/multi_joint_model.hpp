@@ -10,15 +10,9 @@
 #include <Eigen/Dense>
 
 #include "engine/arm_model.hpp"
+#include "engine/joints.hpp"  // kMaxJoints, JointVector, JointMatrix
 
 namespace bellows {
-
-/// The largest joint count the multi-joint code handles (fixed capacity, allocation-free ticks).
-inline constexpr int kMaxJoints = 4;
-inline constexpr int kMaxJointStates = 2 * kMaxJoints;
-
-using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
-using JointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;
 
 struct MultiJointModel {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJointStates, kMaxJointStates> A;  // 2J x 2J
