@@ -38,9 +38,9 @@ std::string line_of(const char* pattern, auto... values) {
 
 // The calibrated values as the engine sees them (every device has these).
 nlohmann::json reading_json(const SensorReading& r) {
-  return {{"angle_deg", r.angle_rad * kDegPerRad},
-          {"chamber_a_bar", r.chamber_bar[0]},
-          {"chamber_b_bar", r.chamber_bar[1]},
+  return {{"angle_deg", r.joint[0].angle_rad * kDegPerRad},
+          {"chamber_a_bar", r.joint[0].chamber_bar[0]},
+          {"chamber_b_bar", r.joint[0].chamber_bar[1]},
           {"supply_bar", r.supply_bar},
           {"temperature_K", r.temperature_K}};
 }
@@ -50,7 +50,7 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
     progress << "inputs (" << device << ": no volts, the values the engine reads):\n"
              << line_of("  angle        %9.3f deg\n  chamber A    %9.4f bar\n  chamber B    %9.4f bar\n"
                         "  supply       %9.4f bar\n  temperature  %9.2f K\n",
-                        r.angle_rad * kDegPerRad, r.chamber_bar[0], r.chamber_bar[1], r.supply_bar, r.temperature_K);
+                        r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1], r.supply_bar, r.temperature_K);
     return;
   }
   progress << "inputs (" << device << "): raw volts -> calibrated value\n";
@@ -72,8 +72,8 @@ nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const Dev
     driver.await();
     if (!driver.core().read_snapshot(tick) || !(tick.reading.time_s > last_time_s)) continue;  // fresh readings only
     last_time_s = tick.reading.time_s;
-    if (!std::isfinite(tick.reading.angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
-    sum_rad += tick.reading.angle_rad;
+    if (!std::isfinite(tick.reading.joint[0].angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
+    sum_rad += tick.reading.joint[0].angle_rad;
     ++count;
   }
   const double previous_rad = rig.angle_zero_rad().value_or(0.0);
@@ -118,7 +118,7 @@ void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession
   if (raw.count == 0) {
     session.record("rig-input", line_of("no volts (simulated): angle %.3f deg, chamber A %.4f bar, chamber B %.4f bar, "
                                         "supply %.4f bar, temperature %.2f K",
-                                        r.angle_rad * kDegPerRad, r.chamber_bar[0], r.chamber_bar[1], r.supply_bar,
+                                        r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1], r.supply_bar,
                                         r.temperature_K));
     return;
   }

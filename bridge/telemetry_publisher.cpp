@@ -115,12 +115,12 @@ void TelemetryPublisher::on_tick(lcm::LCM* bus, const TickRecord& tick) {
   t.trial_id = static_cast<std::int32_t>(tick.trial_id);
   t.sample = tick.sample;
   t.reading_time_s = tick.reading.time_s;
-  t.angle_rad = tick.reading.angle_rad;
+  t.angle_rad = tick.reading.joint[0].angle_rad;
   t.desired_angle_rad = tick.desired_angle_rad;
   for (int i = 0; i < kActuatorCount; ++i) {
-    t.chamber_bar[i] = tick.reading.chamber_bar[i];
-    t.inlet_duty[i] = tick.valves.inlet_duty[i];
-    t.outlet_duty[i] = tick.valves.outlet_duty[i];
+    t.chamber_bar[i] = tick.reading.joint[0].chamber_bar[i];
+    t.inlet_duty[i] = tick.valves.joint[0].inlet_duty[i];
+    t.outlet_duty[i] = tick.valves.joint[0].outlet_duty[i];
   }
   t.supply_bar = tick.reading.supply_bar;
   t.temperature_K = tick.reading.temperature_K;

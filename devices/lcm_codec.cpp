@@ -5,8 +5,20 @@
 #include <climits>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "engine/errors.hpp"
 
 namespace bellows {
+namespace {
+
+// The I/O messages (io_command_t, io_state_t) carry one joint's valves and sensors.
+std::string single_joint_protocol(const char* what, int joints) {
+  return std::string("the LCM I/O messages carry one joint: ") + what + " for " + std::to_string(joints) +
+         " joints cannot be sent (use the simulated device for an arm of several joints)";
+}
+
+}  // namespace
 
 const char* to_string(DecodeStatus status) {
   switch (status) {
@@ -91,36 +103,39 @@ bool valid_state(const io_state_t& state) {
 
 ValveCommand to_valves(const io_command_t& command) {
   if (!command.armed) return ValveCommand::vented();
-  ValveCommand valves;
+  ValveCommand valves;  // one joint: what the message carries
   for (int i = 0; i < kActuatorCount; ++i) {
-    valves.inlet_duty[i] = command.inlet_duty[i];
-    valves.outlet_duty[i] = command.outlet_duty[i];
+    valves.joint[0].inlet_duty[i] = command.inlet_duty[i];
+    valves.joint[0].outlet_duty[i] = command.outlet_duty[i];
   }
   return valves;
 }
 
 void fill_command(const ValveCommand& valves, bool armed, io_command_t& command) {
+  if (valves.joint_count != 1) throw InputError(single_joint_protocol("a valve command", valves.joint_count));
   command.armed = armed;
   for (int i = 0; i < kActuatorCount; ++i) {
-    command.inlet_duty[i] = valves.inlet_duty[i];
-    command.outlet_duty[i] = valves.outlet_duty[i];
+    command.inlet_duty[i] = valves.joint[0].inlet_duty[i];
+    command.outlet_duty[i] = valves.joint[0].outlet_duty[i];
   }
 }
 
 SensorReading to_reading(const io_state_t& state) {
   SensorReading reading;
   reading.time_s = state.time_s;
-  reading.angle_rad = state.angle_rad;
-  for (int i = 0; i < kActuatorCount; ++i) reading.chamber_bar[i] = state.chamber_bar[i];
+  reading.joint_count = 1;  // what the message carries
+  reading.joint[0].angle_rad = state.angle_rad;
+  for (int i = 0; i < kActuatorCount; ++i) reading.joint[0].chamber_bar[i] = state.chamber_bar[i];
   reading.supply_bar = state.supply_bar;
   reading.temperature_K = state.temperature_K;
   return reading;
 }
 
 void fill_state(const SensorReading& reading, io_state_t& state) {
+  if (reading.joint_count != 1) throw InputError(single_joint_protocol("a reading", reading.joint_count));
   state.time_s = reading.time_s;
-  state.angle_rad = reading.angle_rad;
-  for (int i = 0; i < kActuatorCount; ++i) state.chamber_bar[i] = reading.chamber_bar[i];
+  state.angle_rad = reading.joint[0].angle_rad;
+  for (int i = 0; i < kActuatorCount; ++i) state.chamber_bar[i] = reading.joint[0].chamber_bar[i];
   state.supply_bar = reading.supply_bar;
   state.temperature_K = reading.temperature_K;
 }

@@ -188,7 +188,9 @@ bool valid_command(const io_command_t& command);
 /// judged here: a NaN or an absurd pressure reaches the engine's guards, which fault on it.
 bool valid_state(const io_state_t& state);
 
-/// What the rig applies: the duties when armed, else the vented state.
+/// What the rig applies: the duties when armed, else the vented state (one joint: the messages
+/// carry one). fill_command and fill_state throw InputError for a command or reading of another
+/// joint count than one: today's messages cannot carry it, and nothing of it is sent.
 ValveCommand to_valves(const io_command_t& command);
 void fill_command(const ValveCommand& valves, bool armed, io_command_t& command);
 /// The sensor values of a state (time_s is the rig's; the device replaces it by its own clock).

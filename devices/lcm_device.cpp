@@ -37,10 +37,13 @@ SensorReading LcmDevice::read_sensors() {
 void LcmDevice::write_valves(const ValveCommand& command) {
   Outgoing out;
   out.armed = true;
+  // The messages carry one joint: a command for another joint count goes out vented (fill_command
+  // would refuse it on the I/O thread), and the engine's guard faults on the one-joint readings.
+  const JointValves valves = single_joint_valves(command);
   for (int i = 0; i < kActuatorCount; ++i) {  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
-    const double inlet = command.inlet_duty[i], outlet = command.outlet_duty[i];
-    out.valves.inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
-    out.valves.outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
+    const double inlet = valves.inlet_duty[i], outlet = valves.outlet_duty[i];
+    out.valves.joint[0].inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
+    out.valves.joint[0].outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
   }
   outbox_.write(out);
 }

@@ -42,7 +42,7 @@ SimulatedFault simulated_fault_from_string(const std::string& name) {
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
     : params_(params), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
   state_.chamber_Pa = {params.gas.ambient_bar * kPaPerBar, params.gas.ambient_bar * kPaPerBar};
-  state_.command = ValveCommand::vented();
+  state_.command = ValveCommand::vented().joint[0];
   state_.noise = noise_.state();
   const SimulatedFault configured = simulated_fault_from_string(params.fault);
   if (configured != SimulatedFault::kNone) inject_fault(configured, params.fault_at_s);
@@ -89,27 +89,29 @@ SensorReading SimulatedArm::read_sensors() {
   SensorReading r;
   r.time_s = state_.time_s;
   const double resolution_rad = params_.encoder_resolution_deg * kRadPerDeg;
-  r.angle_rad = resolution_rad > 0.0 ? std::round(state_.angle_rad / resolution_rad) * resolution_rad
-                                     : state_.angle_rad;
+  JointReading& joint = r.joint[0];
+  joint.angle_rad = resolution_rad > 0.0 ? std::round(state_.angle_rad / resolution_rad) * resolution_rad
+                                         : state_.angle_rad;
   for (int i = 0; i < kActuatorCount; ++i) {
-    r.chamber_bar[i] = state_.chamber_Pa[i] / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
+    joint.chamber_bar[i] = state_.chamber_Pa[i] / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
   }
   r.supply_bar = supply_Pa_ / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
   r.temperature_K = params_.gas.temperature_K;
-  if (state_.fault == SimulatedFault::kNanAngle) r.angle_rad = std::numeric_limits<double>::quiet_NaN();
+  if (state_.fault == SimulatedFault::kNanAngle) joint.angle_rad = std::numeric_limits<double>::quiet_NaN();
   if (state_.fault == SimulatedFault::kPressureSpike && state_.time_s - state_.fault_since_s < params_.spike_s) {
-    r.chamber_bar[0] += params_.spike_bar;
+    joint.chamber_bar[0] += params_.spike_bar;
   }
   frozen_reading_ = r;
   return r;
 }
 
 void SimulatedArm::write_valves(const ValveCommand& command) {
+  const JointValves valves = single_joint_valves(command);
   for (int i = 0; i < kActuatorCount; ++i) {
-    state_.command.inlet_duty[i] = std::clamp(command.inlet_duty[i], 0.0, 1.0);
-    state_.command.outlet_duty[i] = std::clamp(command.outlet_duty[i], 0.0, 1.0);
-    if (!std::isfinite(command.inlet_duty[i])) state_.command.inlet_duty[i] = 0.0;
-    if (!std::isfinite(command.outlet_duty[i])) state_.command.outlet_duty[i] = 1.0;
+    state_.command.inlet_duty[i] = std::clamp(valves.inlet_duty[i], 0.0, 1.0);
+    state_.command.outlet_duty[i] = std::clamp(valves.outlet_duty[i], 0.0, 1.0);
+    if (!std::isfinite(valves.inlet_duty[i])) state_.command.inlet_duty[i] = 0.0;
+    if (!std::isfinite(valves.outlet_duty[i])) state_.command.outlet_duty[i] = 1.0;
   }
   state_.pwm_phase_s = 0.0;  // a new command starts a new PWM period
 }

@@ -2,6 +2,7 @@
 // ISO 6358 flow, angle-dependent volumes with the full gas law, a second-order arm with creep and
 // hard stops, a quantized encoder and noisy pressure sensors. Fixed internal step, deterministic
 // for a given seed; its whole state can be read and written, so a run can be resumed exactly.
+// One joint: its readings say joint_count 1; a command for another joint count vents it.
 #pragma once
 
 #include <array>
@@ -43,7 +44,7 @@ class SimulatedArm final : public Device {
     double creep_rad = 0.0;                        // z of the viscoelastic creep
     std::array<double, kActuatorCount> chamber_Pa{};
     double pwm_phase_s = 0.0;                      // time since the current PWM period began
-    ValveCommand command{};                        // duty cycles of the current period
+    JointValves command{};                         // duty cycles of the current period (one joint)
     GaussianNoise::State noise{};
     SimulatedFault fault = SimulatedFault::kNone;  // active fault
     double fault_since_s = 0.0;

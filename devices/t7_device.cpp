@@ -36,17 +36,20 @@ void sleep_s(double seconds) {
 }
 
 
+// The T7's wiring drives one joint: a command for another joint count vents it.
 ValveCommand clamped(const ValveCommand& command) {
+  const JointValves valves = single_joint_valves(command);
   ValveCommand c;  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
   for (int i = 0; i < kActuatorCount; ++i) {
-    const double inlet = command.inlet_duty[i], outlet = command.outlet_duty[i];
-    c.inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
-    c.outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
+    const double inlet = valves.inlet_duty[i], outlet = valves.outlet_duty[i];
+    c.joint[0].inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
+    c.joint[0].outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
   }
   return c;
 }
 
-double duty_of(const ValveCommand& c, ValveRole role) {
+double duty_of(const ValveCommand& command, ValveRole role) {
+  const JointValves& c = command.joint[0];
   switch (role) {
     case ValveRole::kInletA: return c.inlet_duty[0];
     case ValveRole::kInletB: return c.inlet_duty[1];
@@ -242,10 +245,10 @@ bool T7Device::exchange(const ValveCommand& valves) {
     const bool valid = c.valid(volts);
     const double value = c.value(volts);
     switch (role) {
-      case SensorRole::kChamberA: r.chamber_bar[0] = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kChamberB: r.chamber_bar[1] = valid ? value : kOutOfRangePressure_bar; break;
+      case SensorRole::kChamberA: r.joint[0].chamber_bar[0] = valid ? value : kOutOfRangePressure_bar; break;
+      case SensorRole::kChamberB: r.joint[0].chamber_bar[1] = valid ? value : kOutOfRangePressure_bar; break;
       case SensorRole::kSupply: r.supply_bar = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kAngle: r.angle_rad = valid ? value - angle_zero_rad() : kOutOfRangeAngle_rad; break;
+      case SensorRole::kAngle: r.joint[0].angle_rad = valid ? value - angle_zero_rad() : kOutOfRangeAngle_rad; break;
       case SensorRole::kTemperature: r.temperature_K = valid ? value : NAN; break;  // no guard watches it
     }
   }

@@ -83,8 +83,8 @@ void T7SimServer::apply_limits(bool write) {
   const LimitedValves limited = enforce_rig_limits(commanded_, r, options_.limits);
   const std::int32_t before = limit_bits_;
   limit_bits_ = limited.fault_bits;
-  status_.chamber_bar = r.chamber_bar;
-  status_.angle_rad = r.angle_rad;
+  status_.chamber_bar = r.joint[0].chamber_bar;
+  status_.angle_rad = r.joint[0].angle_rad;
   const auto rising = [&](std::int32_t bit) { return (limit_bits_ & bit) != 0 && (before & bit) == 0; };
   if (rising(kRigPressureLimitBit)) ++status_.pressure_limit_trips;
   if (rising(kRigAngleLimitBit)) ++status_.angle_limit_trips;
@@ -100,12 +100,13 @@ void T7SimServer::apply_limits(bool write) {
 void T7SimServer::update_inputs() {
   const SensorReading r = arm_.read_sensors();
   const RigProfile& p = options_.profile;
-  const double chamber_a = options_.swapped_chambers ? r.chamber_bar[1] : r.chamber_bar[0];
-  const double chamber_b = options_.swapped_chambers ? r.chamber_bar[0] : r.chamber_bar[1];
+  const std::array<double, kActuatorCount>& chambers = r.joint[0].chamber_bar;  // the simulated arm's one joint
+  const double chamber_a = options_.swapped_chambers ? chambers[1] : chambers[0];
+  const double chamber_b = options_.swapped_chambers ? chambers[0] : chambers[1];
   registers_.set_ain(p.input(SensorRole::kChamberA).ain, p.input(SensorRole::kChamberA).volts(chamber_a));
   registers_.set_ain(p.input(SensorRole::kChamberB).ain, p.input(SensorRole::kChamberB).volts(chamber_b));
   registers_.set_ain(p.input(SensorRole::kSupply).ain, p.input(SensorRole::kSupply).volts(r.supply_bar));
-  registers_.set_ain(p.input(SensorRole::kAngle).ain, p.input(SensorRole::kAngle).volts(r.angle_rad + p.angle_zero_rad));
+  registers_.set_ain(p.input(SensorRole::kAngle).ain, p.input(SensorRole::kAngle).volts(r.joint[0].angle_rad + p.angle_zero_rad));
   registers_.set_ain(p.input(SensorRole::kTemperature).ain, p.input(SensorRole::kTemperature).volts(r.temperature_K));
 }
 
@@ -121,8 +122,8 @@ void T7SimServer::apply_lines(double now) {
   for (ValveRole role : kValveRoles) {
     if (options_.dead_valve && *options_.dead_valve == role) duty[static_cast<int>(role)] = 0.0;
   }
-  command.inlet_duty = {duty[0], duty[1]};
-  command.outlet_duty = {duty[2], duty[3]};
+  command.joint[0].inlet_duty = {duty[0], duty[1]};
+  command.joint[0].outlet_duty = {duty[2], duty[3]};
   commanded_ = command;
   apply_limits(true);  // a new PWM period starts, as at the in-process arm's ticks
 }

@@ -59,7 +59,7 @@ void ControlCore::set_state(const State& state) {
 }
 
 void ControlCore::run_sample(const SensorReading& reading) {
-  const double measured = reading.angle_rad / std::numbers::pi;
+  const double measured = reading.joint[0].angle_rad / std::numbers::pi;
   double u_ilc = 0.0;
   if (trajectory_ != nullptr) {
     const int k = sample_;
@@ -67,10 +67,10 @@ void ControlCore::run_sample(const SensorReading& reading) {
     TrialSamples& s = record_->samples;
     s.time_s(k) = k * trajectory_->sample_time_s;
     s.setpoint_rad(k) = desired_rad_;
-    s.angle_rad(k) = reading.angle_rad;
-    s.error_rad(k) = k == 0 ? 0.0 : desired_rad_ - reading.angle_rad;
-    s.pressure_a_bar(k) = reading.chamber_bar[0];
-    s.pressure_b_bar(k) = reading.chamber_bar[1];
+    s.angle_rad(k) = reading.joint[0].angle_rad;
+    s.error_rad(k) = k == 0 ? 0.0 : desired_rad_ - reading.joint[0].angle_rad;
+    s.pressure_a_bar(k) = reading.joint[0].chamber_bar[0];
+    s.pressure_b_bar(k) = reading.joint[0].chamber_bar[1];
     if (k < trajectory_->learning_samples()) u_ilc = (*correction_)(k);
   } else {
     desired_rad_ = hold_rad_;
@@ -95,18 +95,18 @@ void ControlCore::run_sample(const SensorReading& reading) {
 ValveCommand ControlCore::tick(const SensorReading& reading) {
   if (tick_in_sample_ == 0) run_sample(reading);
   const bool recording = trajectory_ != nullptr;
-  const DutyCycles a = pressure_a_.step(setpoints_.a_bar, reading.chamber_bar[0], reading.supply_bar);
-  const DutyCycles b = pressure_b_.step(setpoints_.b_bar, reading.chamber_bar[1], reading.supply_bar);
+  const DutyCycles a = pressure_a_.step(setpoints_.a_bar, reading.joint[0].chamber_bar[0], reading.supply_bar);
+  const DutyCycles b = pressure_b_.step(setpoints_.b_bar, reading.joint[0].chamber_bar[1], reading.supply_bar);
   ValveCommand command;
-  command.inlet_duty = {a.inlet, b.inlet};
-  command.outlet_duty = {a.outlet, b.outlet};
+  command.joint[0].inlet_duty = {a.inlet, b.inlet};
+  command.joint[0].outlet_duty = {a.outlet, b.outlet};
   if (recording) {
     TrialTicks& t = record_->ticks;
     const int i = tick_in_trial_;
     t.time_s(i) = i * timing_.tick_s;
-    t.angle_rad(i) = reading.angle_rad;
-    t.pressure_a_bar(i) = reading.chamber_bar[0];
-    t.pressure_b_bar(i) = reading.chamber_bar[1];
+    t.angle_rad(i) = reading.joint[0].angle_rad;
+    t.pressure_a_bar(i) = reading.joint[0].chamber_bar[0];
+    t.pressure_b_bar(i) = reading.joint[0].chamber_bar[1];
     t.supply_bar(i) = reading.supply_bar;
     t.setpoint_a_bar(i) = setpoints_.a_bar;
     t.setpoint_b_bar(i) = setpoints_.b_bar;

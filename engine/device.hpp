@@ -5,31 +5,56 @@
 #include <array>
 #include <cstdint>
 
+#include "engine/joints.hpp"
+
 namespace bellows {
 
-inline constexpr int kActuatorCount = 2;  // A (index 0) and B (index 1)
+inline constexpr int kActuatorCount = 2;  // per joint: A (index 0) and B (index 1)
 
-/// One reading of every sensor, taken at the start of a tick.
-struct SensorReading {
-  double time_s = 0.0;        // device time of the reading
+/// One joint's sensors: its encoder and its two chambers.
+struct JointReading {
   double angle_rad = 0.0;     // encoder, quantized by the device
   std::array<double, kActuatorCount> chamber_bar{};  // absolute pressures of A and B
+};
+
+/// One reading of every sensor, taken at the start of a tick. Fixed capacity (kMaxJoints joints,
+/// no allocation); joints [0, joint_count) are read, the rest stay zero. Supply and temperature
+/// are shared by all joints.
+struct SensorReading {
+  double time_s = 0.0;        // device time of the reading
+  int joint_count = 1;
+  std::array<JointReading, kMaxJoints> joint{};
   double supply_bar = 0.0;    // absolute supply pressure
   double temperature_K = 0.0; // supply temperature
 };
 
-/// The full desired valve state for one PWM period: duty cycles in [0, 1] per actuator.
-struct ValveCommand {
+/// One joint's valves for one PWM period: duty cycles in [0, 1] per actuator.
+struct JointValves {
   std::array<double, kActuatorCount> inlet_duty{};
   std::array<double, kActuatorCount> outlet_duty{};
+};
 
-  /// Inlets closed, outlets fully open: the safe state.
-  static ValveCommand vented() {
+/// The full desired valve state for one PWM period, per joint. Fixed capacity like SensorReading:
+/// joints [0, joint_count) are commanded. Default: every valve closed (the chambers keep their air).
+struct ValveCommand {
+  int joint_count = 1;
+  std::array<JointValves, kMaxJoints> joint{};
+
+  /// Inlets closed, outlets fully open on every joint, also beyond `joint_count` (a device that
+  /// reads more joints than the command names still vents them): the safe state.
+  static ValveCommand vented(int joint_count = 1) {
     ValveCommand c;
-    c.outlet_duty = {1.0, 1.0};
+    c.joint_count = joint_count;
+    for (JointValves& j : c.joint) j.outlet_duty = {1.0, 1.0};
     return c;
   }
 };
+
+/// What a device with one joint applies of `command`: joint 0's valves, or vented ones when the
+/// command is for another number of joints (meant for another arm: nothing of it is safe to apply).
+inline JointValves single_joint_valves(const ValveCommand& command) {
+  return command.joint_count == 1 ? command.joint[0] : ValveCommand::vented().joint[0];
+}
 
 /// How the link to a rig is doing (all zero for an in-process device). The round trip is one
 /// exchange with the rig (for a T7: one read of the inputs and one write of the duties).

@@ -212,7 +212,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   const SensorReading reading = device_.read_sensors();
   stale_count_ = reading.time_s > last_reading_time_s_ ? 0 : stale_count_ + 1;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
-  if (std::isfinite(reading.angle_rad)) last_angle_rad_ = reading.angle_rad;
+  if (std::isfinite(reading.joint[0].angle_rad)) last_angle_rad_ = reading.joint[0].angle_rad;
   count_missed_deadlines(missed_deadlines, now_s);
 
   if (valves_live(state())) {

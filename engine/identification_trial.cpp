@@ -91,11 +91,11 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       throw Cancelled("identification stopped by a signal, valves vented");
     }
     core.read_snapshot(tick);
-    if (std::abs(tick.reading.angle_rad) > bound_rad) {
+    if (std::abs(tick.reading.joint[0].angle_rad) > bound_rad) {
       core.request_emergency_stop();  // a latch: the next tick vents
       while (core.state() != EngineState::kFault) driver.await();
       std::ostringstream message;
-      message << "identification aborted, valves vented: angle " << tick.reading.angle_rad / kRadPerDeg
+      message << "identification aborted, valves vented: angle " << tick.reading.joint[0].angle_rad / kRadPerDeg
               << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
               << " deg; lower [identify] amplitude_deg";
       throw InputError(message.str());

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <span>
 
 namespace bellows {
 
@@ -42,18 +43,37 @@ const char* fault_message(FaultCode code) {
 FaultCode check_guards(const SensorReading& r, const GuardInputs& in, const SafetyParameters& limits) {
   constexpr double kDeg = std::numbers::pi / 180.0;
   if (in.stale_count >= limits.stale_ticks) return FaultCode::kSensorStale;
-  const double pressures[] = {r.chamber_bar[0], r.chamber_bar[1], r.supply_bar};
-  if (!std::isfinite(r.angle_rad)) return FaultCode::kSensorNotANumber;
-  for (double p : pressures) {
-    if (!std::isfinite(p)) return FaultCode::kSensorNotANumber;
+  // A reading for another number of joints than the engine drives cannot be checked joint by joint.
+  if (r.joint_count != in.joint_count || !valid_joint_count(r.joint_count)) return FaultCode::kSensorOutOfRange;
+  const std::span<const JointReading> joints(r.joint.data(), static_cast<std::size_t>(r.joint_count));
+  // Each kind of fault is looked for on every joint before the next kind: the most basic one wins,
+  // whichever joint shows it (with one joint, the order of the single-joint guards).
+  for (const JointReading& j : joints) {
+    if (!std::isfinite(j.angle_rad)) return FaultCode::kSensorNotANumber;
   }
-  if (std::abs(r.angle_rad) > limits.sensor_max_angle_deg * kDeg) return FaultCode::kSensorOutOfRange;
-  for (double p : pressures) {
-    if (p < limits.sensor_min_bar || p > limits.sensor_max_bar) return FaultCode::kSensorOutOfRange;
+  for (const JointReading& j : joints) {
+    for (double p : j.chamber_bar) {
+      if (!std::isfinite(p)) return FaultCode::kSensorNotANumber;
+    }
   }
-  if (std::abs(r.angle_rad) > limits.angle_limit_deg * kDeg) return FaultCode::kAngleLimit;
-  for (int i = 0; i < kActuatorCount; ++i) {
-    if (r.chamber_bar[i] > in.p_max_bar + limits.pressure_margin_bar) return FaultCode::kOverpressure;
+  if (!std::isfinite(r.supply_bar)) return FaultCode::kSensorNotANumber;
+  for (const JointReading& j : joints) {
+    if (std::abs(j.angle_rad) > limits.sensor_max_angle_deg * kDeg) return FaultCode::kSensorOutOfRange;
+  }
+  const auto implausible = [&](double p) { return p < limits.sensor_min_bar || p > limits.sensor_max_bar; };
+  for (const JointReading& j : joints) {
+    for (double p : j.chamber_bar) {
+      if (implausible(p)) return FaultCode::kSensorOutOfRange;
+    }
+  }
+  if (implausible(r.supply_bar)) return FaultCode::kSensorOutOfRange;
+  for (const JointReading& j : joints) {
+    if (std::abs(j.angle_rad) > limits.angle_limit_deg * kDeg) return FaultCode::kAngleLimit;
+  }
+  for (const JointReading& j : joints) {
+    for (double p : j.chamber_bar) {
+      if (p > in.p_max_bar + limits.pressure_margin_bar) return FaultCode::kOverpressure;
+    }
   }
   if (r.supply_bar < limits.supply_min_bar) return FaultCode::kSupplyLow;
   if (in.missed_streak >= limits.missed_deadline_streak) return FaultCode::kMissedDeadlines;

@@ -41,6 +41,7 @@ const char* fault_message(FaultCode code);
 /// What the guards need to know besides the reading.
 struct GuardInputs {
   double p_max_bar = 1.4;
+  int joint_count = 1;        // the joints the engine drives: a reading for another count is implausible
   int stale_count = 0;        // consecutive ticks without a fresh reading
   int missed_streak = 0;      // consecutive missed deadlines
   double heartbeat_age_s = 0; // time since the console's last heartbeat (0 when not monitored)

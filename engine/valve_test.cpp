@@ -46,7 +46,7 @@ std::vector<std::string> ValveTestReport::failure_lines() const {
 // A closed chamber that the turning arm squeezes keeps its air; its pressure alone would not.
 double air_bar(const SensorReading& r, int chamber, double volume_gain_per_rad) {
   const double sign = chamber == 0 ? 1.0 : -1.0;
-  return r.chamber_bar[chamber] * (1.0 + sign * volume_gain_per_rad * r.angle_rad);
+  return r.joint[0].chamber_bar[chamber] * (1.0 + sign * volume_gain_per_rad * r.joint[0].angle_rad);
 }
 
 ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const SensorReading& after, double ambient_bar,
@@ -67,9 +67,9 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
                        after.time_s);
   } else if (!std::isfinite(own_move) || !std::isfinite(other_move)) {
     v.problem = "a chamber pressure reads not-a-number: check the pressure sensors' inputs";
-  } else if (!is_inlet(valve) && before.chamber_bar[own] - ambient_bar < m) {
+  } else if (!is_inlet(valve) && before.joint[0].chamber_bar[own] - ambient_bar < m) {
     v.problem = format("not tested: chamber %s held no air to let out (%.3f bar; see inlet %s)", chamber_name(own),
-                       before.chamber_bar[own], chamber_name(own));
+                       before.joint[0].chamber_bar[own], chamber_name(own));
   } else if (own_move >= m && own_move >= other_move + m) {
     v.pass = true;
   } else if (other_move >= m && other_move >= own_move + m) {
@@ -139,12 +139,12 @@ EngineCommand ValveTest::command_for(Step step) {
       pulse.ticks = ticks_of(check_.vent_s);
       break;
     case Step::kFill:
-      pulse.valves.inlet_duty = {1.0, 1.0};
+      pulse.valves.joint[0].inlet_duty = {1.0, 1.0};
       pulse.ticks = ticks_of(check_.fill_s);
       break;
     case Step::kPulse: {
       const auto valve = static_cast<ValveId>(valve_);
-      auto& duties = is_inlet(valve) ? pulse.valves.inlet_duty : pulse.valves.outlet_duty;
+      auto& duties = is_inlet(valve) ? pulse.valves.joint[0].inlet_duty : pulse.valves.joint[0].outlet_duty;
       duties[chamber_of(valve)] = 1.0;
       pulse.ticks = ticks_of(check_.valve_pulse_s);
       break;

@@ -15,6 +15,7 @@
 //
 // ValveTest is a step machine for an operator thread that owns the engine's event queue (the
 // console forwards its events); run_valve_test() drives it to the end on its own (headless).
+// It tests joint 0's valves (an arm of one joint; the other joints' valves stay closed).
 #pragma once
 
 #include <array>

@@ -125,11 +125,11 @@ std::vector<Eigen::VectorXd> black_box_values(const std::vector<TickRecord>& tic
   for (Eigen::Index k = 0; k < rows; ++k) {
     const TickRecord& t = ticks[static_cast<std::size_t>(k)];
     const double values[] = {static_cast<double>(t.tick), t.time_s, t.reading.time_s, static_cast<double>(t.state),
-                             static_cast<double>(t.fault), degrees_for_exact_radians(t.reading.angle_rad),
-                             degrees_for_exact_radians(t.desired_angle_rad), t.reading.chamber_bar[0],
-                             t.reading.chamber_bar[1], t.reading.supply_bar, t.u_total_bar, t.setpoints.a_bar,
-                             t.setpoints.b_bar, t.valves.inlet_duty[0], t.valves.outlet_duty[0], t.valves.inlet_duty[1],
-                             t.valves.outlet_duty[1], static_cast<double>(t.sample), static_cast<double>(t.trial_id)};
+                             static_cast<double>(t.fault), degrees_for_exact_radians(t.reading.joint[0].angle_rad),
+                             degrees_for_exact_radians(t.desired_angle_rad), t.reading.joint[0].chamber_bar[0],
+                             t.reading.joint[0].chamber_bar[1], t.reading.supply_bar, t.u_total_bar, t.setpoints.a_bar,
+                             t.setpoints.b_bar, t.valves.joint[0].inlet_duty[0], t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1],
+                             t.valves.joint[0].outlet_duty[1], static_cast<double>(t.sample), static_cast<double>(t.trial_id)};
     for (std::size_t i = 0; i < c.size(); ++i) c[i](k) = values[i];
   }
   return c;
@@ -183,16 +183,16 @@ std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::st
     t.time_s = c[1](k);
     t.state = static_cast<EngineState>(whole_at(c[3], k, 0, kLastState, source, "state"));
     t.fault = static_cast<FaultCode>(whole_at(c[4], k, 0, kLastFault, source, "fault"));
-    t.reading.angle_rad = radians_from_degrees(c[5](k));
+    t.reading.joint[0].angle_rad = radians_from_degrees(c[5](k));
     t.reading.time_s = c[2](k);
     t.desired_angle_rad = radians_from_degrees(c[6](k));
-    t.reading.chamber_bar = {c[7](k), c[8](k)};
+    t.reading.joint[0].chamber_bar = {c[7](k), c[8](k)};
     t.reading.supply_bar = c[9](k);
     t.u_total_bar = c[10](k);
     t.setpoints.a_bar = c[11](k);
     t.setpoints.b_bar = c[12](k);
-    t.valves.inlet_duty = {c[13](k), c[15](k)};
-    t.valves.outlet_duty = {c[14](k), c[16](k)};
+    t.valves.joint[0].inlet_duty = {c[13](k), c[15](k)};
+    t.valves.joint[0].outlet_duty = {c[14](k), c[16](k)};
     t.sample = static_cast<int>(whole_at(c[17], k, -1, std::numeric_limits<int>::max(), source, "sample"));
     t.trial_id = static_cast<std::uint32_t>(whole_at(c[18], k, 0, std::numeric_limits<std::uint32_t>::max(), source, "trial_id"));
   }

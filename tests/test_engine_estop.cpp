@@ -23,7 +23,7 @@ class RecordingDevice final : public Device {
   SensorReading read_sensors() override {
     SensorReading r;
     r.time_s = ++reads * 0.005;
-    r.chamber_bar = {1.2, 1.2};
+    r.joint[0].chamber_bar = {1.2, 1.2};
     r.supply_bar = 6.0;
     r.temperature_K = 293.0;
     return r;

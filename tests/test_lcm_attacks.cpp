@@ -77,29 +77,54 @@ TEST(LcmRigLimits, VentTheChamberAboveTheCeilingAndEverythingBeyondTheAngleRange
   const RigLimits limits = RigLimits::from(Configuration{});
   EXPECT_DOUBLE_EQ(limits.pressure_ceiling_bar, 1.4 + 0.35);
   ValveCommand open;
-  open.inlet_duty = {1.0, 0.5};
-  open.outlet_duty = {0.0, 0.0};
+  open.joint[0].inlet_duty = {1.0, 0.5};
+  open.joint[0].outlet_duty = {0.0, 0.0};
   SensorReading r;
-  r.chamber_bar = {1.2, 1.2};
-  r.angle_rad = 0.1;
+  r.joint[0].chamber_bar = {1.2, 1.2};
+  r.joint[0].angle_rad = 0.1;
   LimitedValves out = enforce_rig_limits(open, r, limits);
   EXPECT_EQ(out.fault_bits, 0);
-  EXPECT_EQ(out.valves.inlet_duty[0], 1.0);
-  r.chamber_bar = {1.8, 1.2};
+  EXPECT_EQ(out.valves.joint[0].inlet_duty[0], 1.0);
+  r.joint[0].chamber_bar = {1.8, 1.2};
   out = enforce_rig_limits(open, r, limits);
   EXPECT_EQ(out.fault_bits, io_state_t::FAULT_PRESSURE_LIMIT);
-  EXPECT_EQ(out.valves.inlet_duty[0], 0.0);
-  EXPECT_EQ(out.valves.outlet_duty[0], 1.0);
-  EXPECT_EQ(out.valves.inlet_duty[1], 0.5) << "only the chamber above the ceiling";
-  r.chamber_bar = {1.2, std::nan("")};
-  EXPECT_EQ(enforce_rig_limits(open, r, limits).valves.inlet_duty[1], 0.0) << "a NaN pressure counts as too high";
-  r.chamber_bar = {1.2, 1.2};
-  r.angle_rad = -1.8;
+  EXPECT_EQ(out.valves.joint[0].inlet_duty[0], 0.0);
+  EXPECT_EQ(out.valves.joint[0].outlet_duty[0], 1.0);
+  EXPECT_EQ(out.valves.joint[0].inlet_duty[1], 0.5) << "only the chamber above the ceiling";
+  r.joint[0].chamber_bar = {1.2, std::nan("")};
+  EXPECT_EQ(enforce_rig_limits(open, r, limits).valves.joint[0].inlet_duty[1], 0.0) << "a NaN pressure counts as too high";
+  r.joint[0].chamber_bar = {1.2, 1.2};
+  r.joint[0].angle_rad = -1.8;
   out = enforce_rig_limits(open, r, limits);
   EXPECT_TRUE(out.angle_exceeded);
   EXPECT_TRUE(vented(out.valves));
-  r.angle_rad = std::nan("");
+  r.joint[0].angle_rad = std::nan("");
   EXPECT_TRUE(enforce_rig_limits(open, r, limits).angle_exceeded);
+}
+
+TEST(LcmRigLimits, ActJointByJoint) {
+  const RigLimits limits = RigLimits::from(Configuration{});
+  ValveCommand open;
+  open.joint_count = 2;
+  SensorReading r;
+  r.joint_count = 2;
+  for (int j = 0; j < 2; ++j) {
+    open.joint[static_cast<std::size_t>(j)].inlet_duty = {1.0, 0.5};
+    r.joint[static_cast<std::size_t>(j)].chamber_bar = {1.2, 1.2};
+  }
+  r.joint[1].chamber_bar = {1.2, 1.8};  // the second joint's chamber B above the ceiling
+  LimitedValves out = enforce_rig_limits(open, r, limits);
+  EXPECT_EQ(out.fault_bits, io_state_t::FAULT_PRESSURE_LIMIT);
+  EXPECT_EQ(out.valves.joint[1].inlet_duty[1], 0.0);
+  EXPECT_EQ(out.valves.joint[1].outlet_duty[1], 1.0);
+  EXPECT_EQ(out.valves.joint[1].inlet_duty[0], 1.0) << "only that chamber";
+  EXPECT_EQ(out.valves.joint[0].inlet_duty[1], 0.5) << "the other joint untouched";
+  r.joint[1].chamber_bar = {1.2, 1.2};
+  r.joint[1].angle_rad = -1.8;  // the second joint beyond the range: the whole arm vents
+  out = enforce_rig_limits(open, r, limits);
+  EXPECT_TRUE(out.angle_exceeded);
+  EXPECT_EQ(out.valves.joint_count, 2);
+  EXPECT_TRUE(vented(out.valves));
 }
 
 TEST(LcmAttacks, ForgedCommandsOnAnIdleRigCannotPassItsPressureCeilingNorItsAngleRange) {
@@ -171,8 +196,8 @@ struct SessionBench {
   }
   void drive(double inlet_a) {
     ValveCommand v;
-    v.inlet_duty = {inlet_a, 0.0};
-    v.outlet_duty = {0.0, 1.0};
+    v.joint[0].inlet_duty = {inlet_a, 0.0};
+    v.joint[0].outlet_duty = {0.0, 1.0};
     device.write_valves(v);
     step();
     step(0.001);  // the rig applies what arrived after its last turn
@@ -251,7 +276,7 @@ TEST(LcmAttacks, WithAKeyForgedStatesAreIgnoredAndDiagnosed) {
   publish(s.b.bus, kIoStateChannel, forged, test_key(9));   // signed with another key
   s.step();
   s.step();
-  EXPECT_LT(std::abs(s.device.read_sensors().angle_rad), 0.1) << "the forged 60 deg never reached the engine";
+  EXPECT_LT(std::abs(s.device.read_sensors().joint[0].angle_rad), 0.1) << "the forged 60 deg never reached the engine";
   const LcmDeviceStats d = s.device.stats();
   EXPECT_EQ(d.states.unauthenticated, 2u);
   EXPECT_GT(d.states.accepted, 0u);

@@ -12,6 +12,7 @@
 
 #include "devices/lcm_codec.hpp"
 #include "engine/safety.hpp"
+#include "tests/test_support.hpp"
 
 namespace bellows {
 namespace {
@@ -247,10 +248,10 @@ TEST(LcmCodec, CommandsARigMayApply) {
   c = sample_command();
   c.armed = false;
   const ValveCommand vented = to_valves(c);
-  EXPECT_EQ(vented.inlet_duty[0], 0.0);
-  EXPECT_EQ(vented.outlet_duty[0], 1.0);
-  EXPECT_EQ(vented.outlet_duty[1], 1.0);
-  EXPECT_EQ(to_valves(sample_command()).inlet_duty[0], 0.25);
+  EXPECT_EQ(vented.joint[0].inlet_duty[0], 0.0);
+  EXPECT_EQ(vented.joint[0].outlet_duty[0], 1.0);
+  EXPECT_EQ(vented.joint[0].outlet_duty[1], 1.0);
+  EXPECT_EQ(to_valves(sample_command()).joint[0].inlet_duty[0], 0.25);
 }
 
 TEST(LcmCodec, StatesAnEngineMayRead) {
@@ -265,7 +266,24 @@ TEST(LcmCodec, StatesAnEngineMayRead) {
   s = sample_state();
   s.angle_rad = std::numeric_limits<double>::quiet_NaN();
   EXPECT_TRUE(valid_state(s));
-  EXPECT_TRUE(std::isnan(to_reading(s).angle_rad));
+  EXPECT_TRUE(std::isnan(to_reading(s).joint[0].angle_rad));
+}
+
+TEST(LcmCodec, TheIoMessagesCarryOneJointAndRefuseMore) {
+  io_command_t command{};
+  ValveCommand two_joints;
+  two_joints.joint_count = 2;
+  two_joints.joint[0].inlet_duty = {0.5, 0.0};
+  EXPECT_NE(testing::error_of([&] { fill_command(two_joints, true, command); }).find("carry one joint"), std::string::npos);
+  EXPECT_EQ(command.inlet_duty[0], 0.0) << "nothing of it filled in";
+  fill_command(ValveCommand::vented(), true, command);
+  EXPECT_EQ(command.outlet_duty[1], 1.0);
+  io_state_t state{};
+  SensorReading reading;
+  reading.joint_count = 3;
+  EXPECT_NE(testing::error_of([&] { fill_state(reading, state); }).find("for 3 joints"), std::string::npos);
+  EXPECT_EQ(to_reading(sample_state()).joint_count, 1);
+  EXPECT_EQ(to_valves(sample_command()).joint_count, 1);
 }
 
 TEST(LcmCodec, TheProtocolDocListsEveryFaultCode) {

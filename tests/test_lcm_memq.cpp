@@ -177,8 +177,8 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   EXPECT_EQ(b.last_command().seq, 1);
 
   ValveCommand valves;
-  valves.inlet_duty = {0.3, 2.0};  // clamped by the device contract
-  valves.outlet_duty = {std::nan(""), 0.1};
+  valves.joint[0].inlet_duty = {0.3, 2.0};  // clamped by the device contract
+  valves.joint[0].outlet_duty = {std::nan(""), 0.1};
   b.device.write_valves(valves);
   b.step();
   io_command_t c = b.last_command();
@@ -210,7 +210,7 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   b.step();
   EXPECT_TRUE(b.device.connected());
   SensorReading r = b.device.read_sensors();
-  EXPECT_DOUBLE_EQ(r.angle_rad, 0.03);
+  EXPECT_DOUBLE_EQ(r.joint[0].angle_rad, 0.03);
   EXPECT_GT(r.time_s, 0.0);
   const double first_time = r.time_s;
   b.device.write_valves(valves);
@@ -236,7 +236,7 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   b.step();
   r = b.device.read_sensors();
   EXPECT_GT(r.time_s, first_time);
-  EXPECT_DOUBLE_EQ(r.angle_rad, 0.08);
+  EXPECT_DOUBLE_EQ(r.joint[0].angle_rad, 0.08);
 
   // Vented, the device follows a restarted rig (new id, a new offer, its sequence from 1) once the
   // old one has been silent for the rig timeout.
@@ -254,7 +254,7 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   served.binding = 99;
   publish(b.bus, kIoStateChannel, served);
   b.step();
-  EXPECT_DOUBLE_EQ(b.device.read_sensors().angle_rad, 0.02);
+  EXPECT_DOUBLE_EQ(b.device.read_sensors().joint[0].angle_rad, 0.02);
 
   const LcmDeviceStats s = b.device.stats();
   EXPECT_EQ(s.rig_id, 66);

@@ -193,33 +193,33 @@ TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {
   f.clock.step(1);
   f.send(CommandKind::kArm);
   ValvePulse pulse;
-  pulse.valves.inlet_duty = {1.0, 0.0};
+  pulse.valves.joint[0].inlet_duty = {1.0, 0.0};
   pulse.ticks = 3;
   pulse.id = 7;
   ASSERT_TRUE(f.core.send(EngineCommand::valve_pulse(pulse)));
   for (int i = 0; i < 3; ++i) {
     f.clock.step(1);
-    EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 1.0) << "tick " << i;
-    EXPECT_EQ(f.snapshot().valves.outlet_duty[0], 0.0) << "tick " << i;
+    EXPECT_EQ(f.snapshot().valves.joint[0].inlet_duty[0], 1.0) << "tick " << i;
+    EXPECT_EQ(f.snapshot().valves.joint[0].outlet_duty[0], 0.0) << "tick " << i;
   }
   f.clock.step(1);  // the first tick after the pulse reports it, with a reading taken after it
-  EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 0.0);
+  EXPECT_EQ(f.snapshot().valves.joint[0].inlet_duty[0], 0.0);
   bool done = false;
   for (const EngineEvent& e : f.drain_events()) {
     if (e.kind == EventKind::kValvePulseDone) {
       done = true;
       EXPECT_EQ(e.trial_id, 7u);
-      EXPECT_GT(e.reading.chamber_bar[0], e.reading.chamber_bar[1]) << "inlet A filled chamber A";
+      EXPECT_GT(e.reading.joint[0].chamber_bar[0], e.reading.joint[0].chamber_bar[1]) << "inlet A filled chamber A";
     }
   }
   EXPECT_TRUE(done);
   f.clock.step(5);
-  EXPECT_EQ(f.snapshot().valves.inlet_duty[0], 0.0) << "then every valve closed";
-  EXPECT_EQ(f.snapshot().valves.outlet_duty[1], 0.0);
+  EXPECT_EQ(f.snapshot().valves.joint[0].inlet_duty[0], 0.0) << "then every valve closed";
+  EXPECT_EQ(f.snapshot().valves.joint[0].outlet_duty[1], 0.0);
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
   f.send(CommandKind::kDisarm);
   f.clock.step(1);
-  EXPECT_EQ(f.snapshot().valves.outlet_duty[0], 1.0) << "disarmed: vented";
+  EXPECT_EQ(f.snapshot().valves.joint[0].outlet_duty[0], 1.0) << "disarmed: vented";
 }
 
 TEST(ValveTest, ThePulseCommandNeedsArmedValves) {

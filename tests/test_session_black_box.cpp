@@ -44,15 +44,15 @@ void expect_same_ticks(const std::vector<TickRecord>& loaded, const std::vector<
     EXPECT_EQ(a.reading.time_s, b.reading.time_s);
     EXPECT_EQ(a.state, b.state);
     EXPECT_EQ(a.fault, b.fault);
-    EXPECT_TRUE(same_number(a.reading.angle_rad, b.reading.angle_rad)) << a.reading.angle_rad << " " << b.reading.angle_rad;
+    EXPECT_TRUE(same_number(a.reading.joint[0].angle_rad, b.reading.joint[0].angle_rad)) << a.reading.joint[0].angle_rad << " " << b.reading.joint[0].angle_rad;
     EXPECT_EQ(a.desired_angle_rad, b.desired_angle_rad);
-    EXPECT_EQ(a.reading.chamber_bar, b.reading.chamber_bar);
+    EXPECT_EQ(a.reading.joint[0].chamber_bar, b.reading.joint[0].chamber_bar);
     EXPECT_EQ(a.reading.supply_bar, b.reading.supply_bar);
     EXPECT_EQ(a.u_total_bar, b.u_total_bar);
     EXPECT_EQ(a.setpoints.a_bar, b.setpoints.a_bar);
     EXPECT_EQ(a.setpoints.b_bar, b.setpoints.b_bar);
-    EXPECT_EQ(a.valves.inlet_duty, b.valves.inlet_duty);
-    EXPECT_EQ(a.valves.outlet_duty, b.valves.outlet_duty);
+    EXPECT_EQ(a.valves.joint[0].inlet_duty, b.valves.joint[0].inlet_duty);
+    EXPECT_EQ(a.valves.joint[0].outlet_duty, b.valves.joint[0].outlet_duty);
     EXPECT_EQ(a.sample, b.sample);
     EXPECT_EQ(a.trial_id, b.trial_id);
   }
@@ -69,7 +69,7 @@ SessionWriter new_writer(const TempDir& dir, const std::string& name) {
 TEST(SessionBlackBox, TheFaultsTicksRoundTripIncludingTheNanThatCausedIt) {
   const std::vector<TickRecord> box = black_box_of(SimulatedFault::kNanAngle);
   ASSERT_FALSE(box.empty());
-  ASSERT_TRUE(std::isnan(box.back().reading.angle_rad));  // the reading the guard caught
+  ASSERT_TRUE(std::isnan(box.back().reading.joint[0].angle_rad));  // the reading the guard caught
   EXPECT_EQ(box.back().fault, FaultCode::kSensorNotANumber);
   const std::string text = format_black_box_csv(box);
   expect_same_ticks(parse_black_box_csv(text, "box.csv", static_cast<int>(box.size())), box);

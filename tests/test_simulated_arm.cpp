@@ -16,7 +16,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 ValveCommand inlet_a(double duty) {
   ValveCommand c;
-  c.inlet_duty = {duty, 0.0};
+  c.joint[0].inlet_duty = {duty, 0.0};
   return c;
 }
 
@@ -138,11 +138,11 @@ TEST(SimulatedArm, EncoderIsQuantizedAndPressureSensorsAreNoisy) {
   s.creep_rad = plant.creep_gain * s.angle_rad;
   arm.set_state(s);
   const SensorReading r = arm.read_sensors();
-  EXPECT_NEAR(r.angle_rad / kDeg, 12.3, 1e-9);
+  EXPECT_NEAR(r.joint[0].angle_rad / kDeg, 12.3, 1e-9);
   double sum = 0.0, sum_sq = 0.0;
   const int n = 4000;
   for (int i = 0; i < n; ++i) {
-    const double noise = arm.read_sensors().chamber_bar[0] - plant.gas.ambient_bar;
+    const double noise = arm.read_sensors().joint[0].chamber_bar[0] - plant.gas.ambient_bar;
     sum += noise;
     sum_sq += noise * noise;
   }
@@ -156,7 +156,7 @@ TEST(SimulatedArm, DeterministicForAGivenSeedAndResumableFromItsState) {
     double signature = 0.0;
     for (int i = 0; i < periods; ++i) {
       const SensorReading r = arm.read_sensors();
-      signature += r.chamber_bar[0] + 3.0 * r.chamber_bar[1] + r.angle_rad;
+      signature += r.joint[0].chamber_bar[0] + 3.0 * r.joint[0].chamber_bar[1] + r.joint[0].angle_rad;
       arm.write_valves(inlet_a(0.3 + 0.2 * std::sin(i * 0.1)));
       arm.advance(plant.pwm_period_s);
     }

@@ -32,9 +32,15 @@ inline std::string error_of(const std::function<void()>& action) {
   return "(no error)";
 }
 
-/// Inlets shut and outlets open: the safe state.
+/// Inlets shut and outlets open: the safe state (of one joint's valves, of every joint commanded).
+inline bool vented(const JointValves& v) {
+  return v.inlet_duty[0] == 0.0 && v.inlet_duty[1] == 0.0 && v.outlet_duty[0] == 1.0 && v.outlet_duty[1] == 1.0;
+}
 inline bool vented(const ValveCommand& c) {
-  return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
+  for (int j = 0; j < c.joint_count; ++j) {
+    if (!vented(c.joint[static_cast<std::size_t>(j)])) return false;
+  }
+  return true;
 }
 
 /// No byte of `text` outside 7-bit ASCII.

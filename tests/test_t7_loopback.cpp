@@ -77,8 +77,8 @@ TEST(T7Loopback, DutyCyclesReachTheLinesAndCalibratedReadingsComeBack) {
   SimThread sim;
   T7Device device(device_options(sim.port()));
   ValveCommand command;
-  command.inlet_duty = {0.25, 0.0};
-  command.outlet_duty = {0.0, 0.5};
+  command.joint[0].inlet_duty = {0.25, 0.0};
+  command.joint[0].outlet_duty = {0.0, 0.5};
   // The engine sends a command every tick; so does this loop, until the lines show it.
   ASSERT_TRUE(eventually([&] {
     device.write_valves(command);
@@ -97,8 +97,8 @@ TEST(T7Loopback, DutyCyclesReachTheLinesAndCalibratedReadingsComeBack) {
   const PlantParameters plant;
   EXPECT_NEAR(r.supply_bar, plant.supply_bar, 0.05);            // through volts and back
   EXPECT_NEAR(r.temperature_K, plant.gas.temperature_K, 0.5);
-  EXPECT_LT(std::abs(r.angle_rad), 0.2);
-  EXPECT_GT(r.chamber_bar[0], 0.9);
+  EXPECT_LT(std::abs(r.joint[0].angle_rad), 0.2);
+  EXPECT_GT(r.joint[0].chamber_bar[0], 0.9);
 
   const RawInputs raw = device.raw_inputs();
   ASSERT_EQ(raw.count, 5);
@@ -120,8 +120,8 @@ TEST(T7Loopback, WhenTheEngineFallsSilentTheLinkVentsByItselfAndKeepsTheWatchdog
   SimThread sim;
   T7Device device(device_options(sim.port()));
   ValveCommand open_inlet;
-  open_inlet.inlet_duty = {1.0, 0.0};
-  open_inlet.outlet_duty = {0.0, 1.0};
+  open_inlet.joint[0].inlet_duty = {1.0, 0.0};
+  open_inlet.joint[0].outlet_duty = {0.0, 1.0};
   ASSERT_TRUE(eventually([&] {
     device.write_valves(open_inlet);
     return sim.status().duty[static_cast<int>(ValveRole::kInletA)] == 1.0;
@@ -157,8 +157,8 @@ double largest_while_writing(const RigLimits& limits, const ValveCommand& comman
 
 double highest_chamber_bar_while_inlets_open(const RigLimits& limits, T7SimStatus& last) {
   ValveCommand both_inlets_open;  // both chambers fill: the arm stays near its middle
-  both_inlets_open.inlet_duty = {1.0, 1.0};
-  both_inlets_open.outlet_duty = {0.0, 0.0};
+  both_inlets_open.joint[0].inlet_duty = {1.0, 1.0};
+  both_inlets_open.joint[0].outlet_duty = {0.0, 0.0};
   return largest_while_writing(limits, both_inlets_open,
                                [](const T7SimStatus& s) { return std::max(s.chamber_bar[0], s.chamber_bar[1]); }, last);
 }
@@ -183,8 +183,8 @@ TEST(T7Loopback, TheRigKeepsItsPressureCeilingWhateverTheClientWrites) {
 // the arm leaves the rig's range; without that range the arm goes much further.
 double widest_angle_rad_while_turning(const RigLimits& limits, T7SimStatus& last) {
   ValveCommand turn;
-  turn.inlet_duty = {1.0, 0.0};
-  turn.outlet_duty = {0.0, 1.0};
+  turn.joint[0].inlet_duty = {1.0, 0.0};
+  turn.joint[0].outlet_duty = {0.0, 1.0};
   return largest_while_writing(limits, turn, [](const T7SimStatus& s) { return std::abs(s.angle_rad); }, last);
 }
 
@@ -207,15 +207,15 @@ TEST(T7Loopback, SwappedChamberWiringShowsOnTheInputs) {
   SimThread sim(options);
   T7Device device(device_options(sim.port()));
   ValveCommand inflate_a;
-  inflate_a.inlet_duty = {1.0, 0.0};
-  inflate_a.outlet_duty = {0.0, 1.0};
+  inflate_a.joint[0].inlet_duty = {1.0, 0.0};
+  inflate_a.joint[0].outlet_duty = {0.0, 1.0};
   SensorReading r;
   ASSERT_TRUE(eventually([&] {
     device.write_valves(inflate_a);
     r = device.read_sensors();
-    return r.chamber_bar[1] > 1.5;  // chamber A fills, but its pressure shows on B's input
+    return r.joint[0].chamber_bar[1] > 1.5;  // chamber A fills, but its pressure shows on B's input
   }));
-  EXPECT_LT(r.chamber_bar[0], r.chamber_bar[1] - 0.1);
+  EXPECT_LT(r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1] - 0.1);
   device.vent();
 }
 
@@ -240,8 +240,8 @@ double chamber_b_after_inflating(T7SimOptions options, double& supply_bar) {
   SimThread sim(std::move(options));
   T7Device device(device_options(sim.port()));
   ValveCommand inflate_b;
-  inflate_b.inlet_duty = {0.0, 1.0};
-  inflate_b.outlet_duty = {1.0, 0.0};
+  inflate_b.joint[0].inlet_duty = {0.0, 1.0};
+  inflate_b.joint[0].outlet_duty = {1.0, 0.0};
   EXPECT_TRUE(eventually([&] {
     device.write_valves(inflate_b);
     return sim.status().duty[static_cast<int>(ValveRole::kInletB)] == 1.0;
@@ -253,7 +253,7 @@ double chamber_b_after_inflating(T7SimOptions options, double& supply_bar) {
   const SensorReading r = device.read_sensors();
   supply_bar = r.supply_bar;
   device.vent();
-  return r.chamber_bar[1];
+  return r.joint[0].chamber_bar[1];
 }
 
 TEST(T7Loopback, DrillsADeadInletAndNoSupply) {

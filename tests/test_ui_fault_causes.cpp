@@ -21,10 +21,10 @@ class TamperedArm final : public Device {
   SensorReading read_sensors() override {
     SensorReading r = arm_.read_sensors();
     switch (fault) {
-      case FaultCode::kAngleLimit: r.angle_rad = 100.0 * M_PI / 180.0; break;
-      case FaultCode::kOverpressure: r.chamber_bar[0] = 3.0; break;
+      case FaultCode::kAngleLimit: r.joint[0].angle_rad = 100.0 * M_PI / 180.0; break;
+      case FaultCode::kOverpressure: r.joint[0].chamber_bar[0] = 3.0; break;
       case FaultCode::kSupplyLow: r.supply_bar = 1.0; break;
-      case FaultCode::kSensorNotANumber: r.angle_rad = std::numeric_limits<double>::quiet_NaN(); break;
+      case FaultCode::kSensorNotANumber: r.joint[0].angle_rad = std::numeric_limits<double>::quiet_NaN(); break;
       case FaultCode::kSensorOutOfRange: r.supply_bar = 50.0; break;
       case FaultCode::kSensorStale: r.time_s = frozen_time_s; break;
       default: break;

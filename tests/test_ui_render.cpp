@@ -89,7 +89,7 @@ TEST(UiRender, FaultIsShownInColourAndInWords) {
     TickRecord t;
     t.time_s = 10.0 - (399 - i) * 0.005;
     t.state = i == 399 ? EngineState::kFault : EngineState::kRunning;
-    t.reading.chamber_bar = {1.2 + 0.001 * i, 1.05};
+    t.reading.joint[0].chamber_bar = {1.2 + 0.001 * i, 1.05};
     t.reading.supply_bar = 3.0;
     s.fault_view.black_box.push_back(t);
   }

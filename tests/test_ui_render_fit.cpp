@@ -112,7 +112,7 @@ TEST(UiRenderFit, TheFaultScreenSaysWhichGuardAndWhenInFullAt80Columns) {
     TickRecord t;
     t.time_s = 1234.5 - 0.005 * (399 - i);
     t.state = i == 399 ? EngineState::kFault : EngineState::kRunning;
-    t.reading.chamber_bar = {1.0 + 0.003 * i, 1.0};
+    t.reading.joint[0].chamber_bar = {1.0 + 0.003 * i, 1.0};
     t.reading.supply_bar = 3.0;
     s.fault_view.black_box.push_back(t);
   }
@@ -134,7 +134,7 @@ TEST(UiRenderFit, NoNegativeZeroInTheReadouts) {
   ConsoleState s = small_state(EngineState::kArmed);
   s.width = 120;
   s.height = 40;
-  s.live.reading.angle_rad = -1e-9;
+  s.live.reading.joint[0].angle_rad = -1e-9;
   s.live.desired_angle_rad = 0.0;
   const std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("angle         0.00 deg"), std::string::npos) << screen;
@@ -215,7 +215,7 @@ TEST(UiRenderFit, VentedTheLivePanelShowsNoSetPointAndNoTrackingError) {
   ConsoleState s = small_state(EngineState::kFault);
   s.live.state = EngineState::kFault;
   s.live.desired_angle_rad = 40.0 * testing::kDeg;
-  s.live.reading.angle_rad = 3.0 * testing::kDeg;
+  s.live.reading.joint[0].angle_rad = 3.0 * testing::kDeg;
   std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("angle         3.00 deg"), std::string::npos) << screen;
   EXPECT_NE(screen.find("set point  none: vented"), std::string::npos) << screen;

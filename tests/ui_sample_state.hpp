@@ -66,12 +66,12 @@ inline ConsoleState sample_state(int trials, bool unicode) {
   }
   s.live_valid = true;
   s.live.state = EngineState::kArmed;  // the latest tick, like the engine it came from
-  s.live.reading.angle_rad = 12.5 * kDeg;
+  s.live.reading.joint[0].angle_rad = 12.5 * kDeg;
   s.live.desired_angle_rad = 12.0 * kDeg;
-  s.live.reading.chamber_bar = {1.234, 1.1};
+  s.live.reading.joint[0].chamber_bar = {1.234, 1.1};
   s.live.reading.supply_bar = 3.0;
-  s.live.valves.inlet_duty = {0.5, 0.0};
-  s.live.valves.outlet_duty = {0.0, 0.25};
+  s.live.valves.joint[0].inlet_duty = {0.5, 0.0};
+  s.live.valves.joint[0].outlet_duty = {0.0, 0.25};
   s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false, "", 0});
   s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false, "", 0});
   s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true, "", 0});

@@ -276,8 +276,12 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
   DeviceHealth health{env_.device_name, false, "no data"};
   if (state_.live_valid && now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS) {
     const SensorReading& r = state_.live.reading;
-    if (!std::isfinite(r.angle_rad) || !std::isfinite(r.chamber_bar[0]) || !std::isfinite(r.chamber_bar[1]) ||
-        !std::isfinite(r.supply_bar)) {
+    bool finite = std::isfinite(r.supply_bar);
+    for (int j = 0; j < std::clamp(r.joint_count, 1, kMaxJoints); ++j) {
+      const JointReading& joint = r.joint[static_cast<std::size_t>(j)];
+      finite = finite && std::isfinite(joint.angle_rad) && std::isfinite(joint.chamber_bar[0]) && std::isfinite(joint.chamber_bar[1]);
+    }
+    if (!finite) {
       health.status = "sensor not a number";
     } else if (r.supply_bar < env_.config.safety.supply_min_bar) {
       health.status = format("supply low (%.2f bar)", r.supply_bar);
@@ -300,7 +304,7 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
     env_.telemetry->consume_all([&](const TickRecord& t) {
       if (per_sample > 0 && t.tick % static_cast<std::uint64_t>(per_sample) != 0) return;
       strip_time_[strip_next_] = t.time_s;
-      strip_angle_[strip_next_] = t.reading.angle_rad * 180.0 / std::numbers::pi;
+      strip_angle_[strip_next_] = t.reading.joint[0].angle_rad * 180.0 / std::numbers::pi;
       // Vented, the engine's last set point is none (the plot leaves the gap).
       strip_setpoint_[strip_next_] =
           valves_live(t.state) ? t.desired_angle_rad * 180.0 / std::numbers::pi : std::numeric_limits<double>::quiet_NaN();

@@ -23,7 +23,7 @@ bool ConsoleController::handle_rig_key(int k) {
       set_status("zeroing the angle: only while SAFE (disarm first), with the arm at rest", true);
     } else {
       open_dialog(DialogKind::kConfirmZeroAngle, "Zero the angle here?",
-                  {format("The arm reads %+.3f deg now: this becomes 0 deg.", state_.live.reading.angle_rad * 180.0 / std::numbers::pi),
+                  {format("The arm reads %+.3f deg now: this becomes 0 deg.", state_.live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi),
                    "Hold the arm at rest where it should read zero (hanging straight).",
                    "The rig profile's angle_zero_rad is written to its file."},
                   "y zero it   n cancel");
@@ -51,7 +51,7 @@ bool ConsoleController::handle_rig_key(int k) {
 
 void ConsoleController::zero_angle() {
   try {
-    const std::string done = env_.zero_angle(state_.live.reading.angle_rad);
+    const std::string done = env_.zero_angle(state_.live.reading.joint[0].angle_rad);
     log(LogSource::kOperator, "angle zeroed: " + done);  // the session's event log keeps it
     set_status("angle zeroed: " + done, false);
   } catch (const std::exception& e) {

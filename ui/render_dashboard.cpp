@@ -49,7 +49,7 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
   }
   const TickRecord& t = s.live;
   int row = 0;
-  value_row(c, in, row++, "angle", number("%7.2f deg", to_deg(t.reading.angle_rad)));
+  value_row(c, in, row++, "angle", number("%7.2f deg", to_deg(t.reading.joint[0].angle_rad)));
   // The latest tick's own state, not the console's: the engine keeps its last set point after a
   // vent, which is no set point at all then, and a tracking error exists only during a trial.
   if (valves_live(t.state)) {
@@ -59,18 +59,18 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
     value_row(c, in, row++, "set point", "none: vented", Role::kDim);
   }
   if (t.state == EngineState::kRunning) {
-    value_row(c, in, row++, "error", number("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.angle_rad)));
+    value_row(c, in, row++, "error", number("%7.2f deg", to_deg(t.desired_angle_rad - t.reading.joint[0].angle_rad)));
   } else {
     value_row(c, in, row++, "error", "no trial", Role::kDim);
   }
-  value_row(c, in, row++, "p A", number("%7.3f bar", t.reading.chamber_bar[0]));
-  value_row(c, in, row++, "p B", number("%7.3f bar", t.reading.chamber_bar[1]));
+  value_row(c, in, row++, "p A", number("%7.3f bar", t.reading.joint[0].chamber_bar[0]));
+  value_row(c, in, row++, "p B", number("%7.3f bar", t.reading.joint[0].chamber_bar[1]));
   value_row(c, in, row++, "supply", number("%7.3f bar", t.reading.supply_bar),
             t.reading.supply_bar < s.config.safety.supply_min_bar ? Role::kWarning : Role::kNormal);
-  duty_row(c, in, row++, "in A", t.valves.inlet_duty[0], g);
-  duty_row(c, in, row++, "out A", t.valves.outlet_duty[0], g);
-  duty_row(c, in, row++, "in B", t.valves.inlet_duty[1], g);
-  duty_row(c, in, row++, "out B", t.valves.outlet_duty[1], g);
+  duty_row(c, in, row++, "in A", t.valves.joint[0].inlet_duty[0], g);
+  duty_row(c, in, row++, "out A", t.valves.joint[0].outlet_duty[0], g);
+  duty_row(c, in, row++, "in B", t.valves.joint[0].inlet_duty[1], g);
+  duty_row(c, in, row++, "out B", t.valves.joint[0].outlet_duty[1], g);
   value_row(c, in, row++, "trial", run_phase_text(s), s.run.phase == RunProgress::Phase::kNone ? Role::kDim : Role::kRunning);
   if (s.run.mode == RunProgress::Mode::kBatch) {
     value_row(c, in, row++, "batch", format("it %s, %d done%s", batch_span(s.run).c_str(), s.run.batch_done,

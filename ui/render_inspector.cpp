@@ -125,10 +125,10 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   for (std::size_t i = 0; i < n; ++i) {
     const TickRecord& t = f.black_box[i];
     time[i] = t.time_s - f.time_s;
-    angle[i] = to_deg(t.reading.angle_rad);
+    angle[i] = to_deg(t.reading.joint[0].angle_rad);
     desired[i] = to_deg(t.desired_angle_rad);
-    pa[i] = t.reading.chamber_bar[0];
-    pb[i] = t.reading.chamber_bar[1];
+    pa[i] = t.reading.joint[0].chamber_bar[0];
+    pb[i] = t.reading.joint[0].chamber_bar[1];
     supply[i] = t.reading.supply_bar;
   }
   constexpr int kTableRows = 8;
@@ -157,8 +157,8 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     const TickRecord& t = f.black_box[i];
     c.put(in.x + 1, in.y + 1 + static_cast<int>(i - first),
           format("%8.3f   %-9s %9.2f %8.3f %8.3f %7.3f %5.2f %6.2f %5.2f %6.2f", t.time_s - f.time_s, to_string(t.state),
-                 to_deg(t.reading.angle_rad), t.reading.chamber_bar[0], t.reading.chamber_bar[1], t.reading.supply_bar,
-                 t.valves.inlet_duty[0], t.valves.outlet_duty[0], t.valves.inlet_duty[1], t.valves.outlet_duty[1]),
+                 to_deg(t.reading.joint[0].angle_rad), t.reading.joint[0].chamber_bar[0], t.reading.joint[0].chamber_bar[1], t.reading.supply_bar,
+                 t.valves.joint[0].inlet_duty[0], t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1], t.valves.joint[0].outlet_duty[1]),
           t.state == EngineState::kFault ? Role::kFault : Role::kNormal, false, in.right());
   }
 }

@@ -30,9 +30,9 @@ void render_rig(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(in.x + 1, y++, "no volts: " + s.device.name + " reports calibrated values only", Role::kDim, false, in.right());
     c.put(in.x + 1, y++, fit("input", 14) + "value (as the engine reads it)", Role::kTitle, true, in.right());
     const std::pair<const char*, std::string> rows[] = {
-        {"angle", number("%.3f deg", to_deg(r.angle_rad))},
-        {"chamber A", number("%.4f bar", r.chamber_bar[0])},
-        {"chamber B", number("%.4f bar", r.chamber_bar[1])},
+        {"angle", number("%.3f deg", to_deg(r.joint[0].angle_rad))},
+        {"chamber A", number("%.4f bar", r.joint[0].chamber_bar[0])},
+        {"chamber B", number("%.4f bar", r.joint[0].chamber_bar[1])},
         {"supply", number("%.4f bar", r.supply_bar)},
         {"temperature", number("%.2f K", r.temperature_K)},
     };

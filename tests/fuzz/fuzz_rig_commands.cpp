@@ -26,7 +26,7 @@ void put_big_endian(std::uint8_t* p, std::int64_t value) {
   }
 }
 
-bool vented(const bellows::ValveCommand& c) {
+bool vented(const bellows::JointValves& c) {  // the simulated arm's one joint
   return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
 }
 
