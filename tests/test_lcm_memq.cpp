@@ -166,6 +166,23 @@ struct DeviceBench {
   io_command_t last_command() { return decode<io_command_t>(commands.messages().back()); }
 };
 
+TEST(LcmDevice, SendsACommandForSeveralJointsAsAVent) {
+  DeviceBench b;
+  ValveCommand two_joints;  // today's messages carry one joint: nothing of this is safe to send
+  two_joints.joint_count = 2;
+  two_joints.joint[0].inlet_duty = {0.7, 0.0};
+  two_joints.joint[1].inlet_duty = {0.0, 0.7};
+  b.device.write_valves(two_joints);
+  b.step();
+  ASSERT_EQ(b.commands.size(), 1u);
+  const io_command_t c = b.last_command();
+  EXPECT_TRUE(c.armed);
+  EXPECT_EQ(c.inlet_duty[0], 0.0);
+  EXPECT_EQ(c.inlet_duty[1], 0.0);
+  EXPECT_EQ(c.outlet_duty[0], 1.0);
+  EXPECT_EQ(c.outlet_duty[1], 1.0);
+}
+
 TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   DeviceBench b;
   b.step();

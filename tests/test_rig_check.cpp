@@ -117,9 +117,9 @@ TEST(ValveTest, TheEmergencyStopEndsTheTest) {
 TEST(ValveTest, JudgeNamesAValveThatMovesItsChamberTheWrongWay) {
   RigCheckParameters check;
   SensorReading before, after;
-  before.chamber_bar = {1.2, 1.2};
+  before.joint[0].chamber_bar = {1.2, 1.2};
   before.supply_bar = after.supply_bar = 3.0;
-  after.chamber_bar = {1.3, 1.2};  // outlet A raised chamber A
+  after.joint[0].chamber_bar = {1.3, 1.2};  // outlet A raised chamber A
   after.time_s = 0.1;
   const ValveVerdict v = judge_valve(ValveId::kOutletA, before, after, 1.013, check, 2.0, 0.35);
   EXPECT_FALSE(v.pass);
@@ -129,7 +129,7 @@ TEST(ValveTest, JudgeNamesAValveThatMovesItsChamberTheWrongWay) {
 TEST(ValveTest, JudgeTakesNoReadingFromBeforeThePulse) {
   RigCheckParameters check;
   SensorReading before;
-  before.chamber_bar = {1.013, 1.013};
+  before.joint[0].chamber_bar = {1.013, 1.013};
   before.supply_bar = 3.0;
   before.time_s = 2.0;
   SensorReading after = before;  // the link delivered nothing new: the same reading again
