@@ -25,6 +25,7 @@
 #include "engine/cancellation.hpp"
 #include "engine/errors.hpp"
 #include "engine/printable_text.hpp"
+#include "engine/trajectory.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_store.hpp"
 
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
 
   bellows::RunOptions run;
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
-  run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
+  run_cmd->add_option("--trajectory", run.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
                       "(with --resume: K after the newest)")
@@ -193,7 +194,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
   console_cmd->add_option("--config", console.config_path, "TOML configuration file");
-  console_cmd->add_option("--trajectory", console.trajectory, "Library name (paper, steps, sine) or a CSV file")
+  console_cmd->add_option("--trajectory", console.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();
   console_cmd->add_option("--session", console.session_dir, "Open this saved session at start");
   console_cmd->add_option("--data-dir", console.data_dir,
