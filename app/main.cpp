@@ -19,6 +19,7 @@
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
+#include "app/trajectories_command.hpp"
 #include "app/signals.hpp"
 #include "app/standard_output.hpp"
 #include "devices/lcm_channels.hpp"
@@ -220,6 +221,14 @@ int main(int argc, char** argv) {
   bool config_markdown = false;
   config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
 
+  bellows::TrajectoriesOptions trajectories;
+  CLI::App* trajectories_cmd = app.add_subcommand(
+      "trajectories", "The trajectory library (joints, duration, samples); with a name or a CSV file, that trajectory as CSV");
+  trajectories_cmd->add_option("trajectory", trajectories.trajectory,
+                               "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file to check");
+  trajectories_cmd->add_option("--config", trajectories.config_path, "TOML configuration file ([timing], [trajectory])");
+  trajectories_cmd->add_option("--output", trajectories.output_path, "Write the CSV into this file instead of stdout");
+
   bellows::install_stop_signal_handlers();
 
   bellows::IdentifyOptions identify;
@@ -294,6 +303,7 @@ int main(int argc, char** argv) {
       std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
       return 0;
     }
+    if (trajectories_cmd->parsed()) return bellows::trajectories_command(trajectories, std::cout);
     if (identify_cmd->parsed()) {
       return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
     }

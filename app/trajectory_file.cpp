@@ -153,6 +153,9 @@ std::string trajectory_csv(const Trajectory& trajectory) {
 }
 
 void write_trajectory_file(const std::filesystem::path& path, const Trajectory& trajectory) {
+  if (std::filesystem::is_directory(path)) {
+    throw InputError("trajectory file " + printable(path.string()) + " is a directory: name a file in it");
+  }
   const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   write_file_atomic_at(DirectoryHandle::open(directory), path.filename().string(), trajectory_csv(trajectory));
 }
