@@ -1,6 +1,13 @@
 // The chain's equations (engine/arm_chain.hpp) for exactly J joints, with fixed-size matrices so that
-// the compiler unrolls them: the integrator's right-hand side runs ~40 000 times per simulated second.
-// Internal to arm_chain.cpp; ArmChain's interface is the place to read what the terms mean.
+// the compiler unrolls them: the integrators' right-hand side runs ~45 000 times per simulated second.
+// Used by ArmChain (mechanics alone) and PneumaticArmChain (with each joint's bellows); ArmChain's
+// interface is the place to read what the terms mean.
+//
+// Speed (docs/benchmarks.md, "Several joints"): the sines and cosines of the links' absolute angles
+// are carried from stage to stage and step to step by the angle-addition formulas with a short series
+// for the small increment (Trig::advanced), exact std::sin/std::cos only every kTrigRefreshSteps
+// steps; each link's point masses and inertia enter as three moments (mass, first, second); the
+// J x J solve is an unrolled LDL'.
 #pragma once
 
 #include <array>
@@ -12,6 +19,73 @@
 #include "engine/arm_chain_parameters.hpp"
 
 namespace bellows::arm_chain_kernel {
+
+/// Steps between exact evaluations of the links' sines and cosines (the rotations in between drift
+/// by about one rounding error per step).
+inline constexpr int kTrigRefreshSteps = 50;
+
+/// sin and cos of the links' absolute angles theta_k = q_1 + ... + q_k.
+template <int J>
+struct Trig {
+  std::array<double, J> sin{}, cos{};
+
+  static Trig exact(const Eigen::Matrix<double, J, 1>& q) {
+    Trig t;
+    double theta = 0.0;
+    for (int k = 0; k < J; ++k) {
+      theta += q(k);
+      t.sin[k] = std::sin(theta);
+      t.cos[k] = std::cos(theta);
+    }
+    return t;
+  }
+
+  /// The same at q + dq, from these values: sin(theta + d) = sin theta cos d + cos theta sin d with
+  /// sin d, cos d - 1 from their series (exact to rounding for |d| <= 0.05 rad: the increment of a
+  /// 0.1 ms step at up to 500 rad/s). Larger increments take the exact path at `q_new`.
+  Trig advanced(const Eigen::Matrix<double, J, 1>& dq, const Eigen::Matrix<double, J, 1>& q_new) const {
+    Trig t;
+    double d = 0.0;
+    for (int k = 0; k < J; ++k) {
+      d += dq(k);
+      if (!(std::abs(d) <= 0.05)) return exact(q_new);
+      const double d2 = d * d;
+      const double sin_d = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0))));
+      const double cos_d_minus_1 = -d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0 * (1.0 - d2 / 90.0))));
+      t.sin[k] = sin[k] + (sin[k] * cos_d_minus_1 + cos[k] * sin_d);
+      t.cos[k] = cos[k] + (cos[k] * cos_d_minus_1 - sin[k] * sin_d);
+    }
+    return t;
+  }
+};
+
+/// Solves M x = b for a symmetric positive definite J x J M (LDL', unrolled).
+template <int J>
+Eigen::Matrix<double, J, 1> solve_spd(const Eigen::Matrix<double, J, J>& M, const Eigen::Matrix<double, J, 1>& b) {
+  double L[J][J] = {}, inv_d[J] = {}, d[J] = {};
+  for (int j = 0; j < J; ++j) {
+    double dj = M(j, j);
+    for (int k = 0; k < j; ++k) dj -= L[j][k] * L[j][k] * d[k];
+    d[j] = dj;
+    inv_d[j] = 1.0 / dj;
+    for (int i = j + 1; i < J; ++i) {
+      double lij = M(i, j);
+      for (int k = 0; k < j; ++k) lij -= L[i][k] * L[j][k] * d[k];
+      L[i][j] = lij * inv_d[j];
+    }
+  }
+  Eigen::Matrix<double, J, 1> x;
+  for (int i = 0; i < J; ++i) {  // L y = b
+    double yi = b(i);
+    for (int k = 0; k < i; ++k) yi -= L[i][k] * x(k);
+    x(i) = yi;
+  }
+  for (int i = 0; i < J; ++i) x(i) *= inv_d[i];
+  for (int i = J - 1; i >= 0; --i) {  // L' x = D^-1 y
+    for (int k = i + 1; k < J; ++k) x(i) -= L[k][i] * x(k);
+  }
+  return x;
+}
 
 template <int J>
 class Kernel {
@@ -27,7 +101,12 @@ class Kernel {
     for (int i = 0; i < J; ++i) {
       const ChainLink& l = chain.links[static_cast<std::size_t>(i)];
       length_[i] = l.length_m;
-      inertia_[i] = l.inertia_kg_m2;
+      // The link's centre-of-mass point, its distal point mass and its own inertia as moments of
+      // the distance d from its joint: sum m, sum m d, sum m d^2 + I.
+      mass_[i] = l.mass_kg + l.tip_mass_kg;
+      first_moment_[i] = l.mass_kg * l.center_of_mass_m + l.tip_mass_kg * l.length_m;
+      second_moment_[i] = l.mass_kg * l.center_of_mass_m * l.center_of_mass_m + l.tip_mass_kg * l.length_m * l.length_m +
+                          l.inertia_kg_m2;
       stiffness_(i) = l.stiffness_Nm_per_rad;
       kappa_(i) = l.kappa_rad_per_bar;
       damping_(i) = damping(i);
@@ -35,62 +114,54 @@ class Kernel {
       stop_rad_(i) = l.hard_stop_deg * std::numbers::pi / 180.0;
       creep_gain_(i) = l.creep_gain;
       creep_rate_(i) = 1.0 / l.creep_tau_s;
-      if (l.mass_kg > 0.0) points_[points_count_++] = {i, l.center_of_mass_m, l.mass_kg};
-      if (l.tip_mass_kg > 0.0) points_[points_count_++] = {i, l.length_m, l.tip_mass_kg};
     }
   }
 
-  /// M(q), C(q, q_dot) q_dot and G(q): over the point masses m with Jacobian J_p, M += m J_p'J_p,
-  /// C q_dot += m J_p' (J_p_dot q_dot), G += m g dy/dq; link i's own inertia adds I_i over joints 1..i.
-  /// Column j <= i of J_p for a point on link i at distance d is
-  ///   sum_{k=j}^{i-1} l_k (-sin theta_k, cos theta_k) + d (-sin theta_i, cos theta_i),
-  /// and J_p_dot q_dot = -sum_{k<i} l_k w_k^2 (cos theta_k, sin theta_k) - d w_i^2 (cos theta_i, sin theta_i),
-  /// theta_k = q_1 + ... + q_k, w_k its rate.
-  void rigid_body(const Vec& q, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
-    std::array<double, J> sin{}, cos{}, rate{};
-    double theta = 0.0, w = 0.0;
-    for (int k = 0; k < J; ++k) {
-      theta += q(k);
-      w += q_dot(k);
-      sin[k] = std::sin(theta);
-      cos[k] = std::cos(theta);
-      rate[k] = w;
-    }
+  /// M(q), C(q, q_dot) q_dot and G(q). A point at distance d on link i has the Jacobian columns
+  /// (a <= i) P_a + d t_i, P_a = sum_{k=a}^{i-1} l_k t_k, t_k = (-sin theta_k, cos theta_k), and the
+  /// velocity-product acceleration A_i - d w_i^2 n_i, A_i = -sum_{k<i} l_k w_k^2 n_k,
+  /// n_k = (cos theta_k, sin theta_k), w_k the rate of theta_k. Summed over the link's points with
+  /// its moments (mu0, mu1, mu2 = sum m, sum m d, sum m d^2 + I):
+  ///   M_ab += mu0 P_a.P_b + mu1 (P_a.t_i + P_b.t_i) + mu2
+  ///   (C q_dot)_a += mu0 P_a.A_i + mu1 (t_i.A_i - w_i^2 P_a.n_i)      (t_i.n_i = 0)
+  ///   G_a += g (mu0 P_a.y + mu1 cos theta_i)
+  void rigid_body(const Trig<J>& trig, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
     M.setZero();
     coriolis.setZero();
     gravity.setZero();
-    for (int p = 0; p < points_count_; ++p) {
-      const Point& point = points_[p];
-      const int i = point.link;
-      std::array<double, J> jx{}, jy{};
-      double x = -point.distance_m * sin[i], y = point.distance_m * cos[i];
-      double ax = -point.distance_m * rate[i] * rate[i] * cos[i], ay = -point.distance_m * rate[i] * rate[i] * sin[i];
-      for (int j = i; j >= 0; --j) {
-        if (j < i) {
-          x -= length_[j] * sin[j];
-          y += length_[j] * cos[j];
-          const double centripetal = length_[j] * rate[j] * rate[j];
-          ax -= centripetal * cos[j];
-          ay -= centripetal * sin[j];
-        }
-        jx[j] = x;
-        jy[j] = y;
-      }
-      const double m = point.mass_kg;
-      for (int a = 0; a <= i; ++a) {
-        for (int b = 0; b <= a; ++b) M(a, b) += m * (jx[a] * jx[b] + jy[a] * jy[b]);
-        coriolis(a) += m * (jx[a] * ax + jy[a] * ay);
-        gravity(a) += m * gravity_ * jy[a];
-      }
-    }
+    double ax = 0.0, ay = 0.0;  // A_i
+    double w = 0.0;
     for (int i = 0; i < J; ++i) {
-      for (int a = 0; a <= i; ++a) {
-        for (int b = 0; b <= a; ++b) M(a, b) += inertia_[i];
+      w += q_dot(i);
+      const double w2 = w * w;
+      const double tx = -trig.sin[i], ty = trig.cos[i];
+      std::array<double, J> px{}, py{}, pt{};  // P_a and P_a.t_i, a <= i
+      double sx = 0.0, sy = 0.0;
+      for (int a = i - 1; a >= 0; --a) {
+        sx -= length_[a] * trig.sin[a];
+        sy += length_[a] * trig.cos[a];
+        px[a] = sx;
+        py[a] = sy;
       }
+      for (int a = 0; a <= i; ++a) pt[a] = px[a] * tx + py[a] * ty;
+      const double mu0 = mass_[i], mu1 = first_moment_[i], mu2 = second_moment_[i];
+      const double tA = tx * ax + ty * ay;
+      for (int a = 0; a <= i; ++a) {
+        for (int b = 0; b <= a; ++b) M(a, b) += mu0 * (px[a] * px[b] + py[a] * py[b]) + mu1 * (pt[a] + pt[b]) + mu2;
+        const double pn = px[a] * trig.cos[i] + py[a] * trig.sin[i];
+        coriolis(a) += mu0 * (px[a] * ax + py[a] * ay) + mu1 * (tA - w2 * pn);
+        gravity(a) += gravity_ * (mu0 * py[a] + mu1 * ty);
+      }
+      ax -= length_[i] * w2 * trig.cos[i];
+      ay -= length_[i] * w2 * trig.sin[i];
     }
     for (int a = 0; a < J; ++a) {
       for (int b = a + 1; b < J; ++b) M(a, b) = M(b, a);
     }
+  }
+
+  void rigid_body(const Vec& q, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
+    rigid_body(Trig<J>::exact(q), q_dot, M, coriolis, gravity);
   }
 
   /// K (kappa o dp - q - z)
@@ -110,39 +181,41 @@ class Kernel {
     return torque;
   }
 
-  Vec acceleration(const Vec& q, const Vec& q_dot, const Vec& z, const Vec& dp_bar) const {
+  /// q_ddot, with `trig` the sines and cosines at q.
+  Vec acceleration(const Trig<J>& trig, const Vec& q, const Vec& q_dot, const Vec& z, const Vec& dp_bar) const {
     Mat M;
     Vec coriolis, gravity;
-    rigid_body(q, q_dot, M, coriolis, gravity);
+    rigid_body(trig, q_dot, M, coriolis, gravity);
     const Vec torque =
         bellows_torque(q, z, dp_bar) - damping_.cwiseProduct(q_dot) + stop_torque(q, q_dot) - coriolis - gravity;
-    return M.llt().solve(torque);
+    return solve_spd<J>(M, torque);
+  }
+
+  Vec acceleration(const Vec& q, const Vec& q_dot, const Vec& z, const Vec& dp_bar) const {
+    return acceleration(Trig<J>::exact(q), q, q_dot, z, dp_bar);
   }
 
   Vec creep_rate(const Vec& q, const Vec& z) const { return (creep_gain_.cwiseProduct(q) - z).cwiseProduct(creep_rate_); }
 
-  /// One classical RK4 step of (q, q_dot, z) with the pressure differences held.
-  void rk4(double h, const Vec& dp_bar, Vec& q, Vec& v, Vec& z) const {
-    const Vec a1 = acceleration(q, v, z, dp_bar), c1 = creep_rate(q, z);
-    const Vec q2 = q + h / 2 * v, v2 = v + h / 2 * a1, z2 = z + h / 2 * c1;
-    const Vec a2 = acceleration(q2, v2, z2, dp_bar), c2 = creep_rate(q2, z2);
-    const Vec q3 = q + h / 2 * v2, v3 = v + h / 2 * a2, z3 = z + h / 2 * c2;
-    const Vec a3 = acceleration(q3, v3, z3, dp_bar), c3 = creep_rate(q3, z3);
-    const Vec q4 = q + h * v3, v4 = v + h * a3, z4 = z + h * c3;
-    const Vec a4 = acceleration(q4, v4, z4, dp_bar), c4 = creep_rate(q4, z4);
-    q += h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4);
+  /// One classical RK4 step of (q, q_dot, z) with the pressure differences held; `trig` is at q
+  /// before and after.
+  void rk4(double h, const Vec& dp_bar, Vec& q, Vec& v, Vec& z, Trig<J>& trig) const {
+    const Vec a1 = acceleration(trig, q, v, z, dp_bar), c1 = creep_rate(q, z);
+    const Vec d2 = h / 2 * v, q2 = q + d2, v2 = v + h / 2 * a1, z2 = z + h / 2 * c1;
+    const Vec a2 = acceleration(trig.advanced(d2, q2), q2, v2, z2, dp_bar), c2 = creep_rate(q2, z2);
+    const Vec d3 = h / 2 * v2, q3 = q + d3, v3 = v + h / 2 * a2, z3 = z + h / 2 * c2;
+    const Vec a3 = acceleration(trig.advanced(d3, q3), q3, v3, z3, dp_bar), c3 = creep_rate(q3, z3);
+    const Vec d4 = h * v3, q4 = q + d4, v4 = v + h * a3, z4 = z + h * c3;
+    const Vec a4 = acceleration(trig.advanced(d4, q4), q4, v4, z4, dp_bar), c4 = creep_rate(q4, z4);
+    const Vec dq = h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4);
+    q += dq;
     v += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
     z += h / 6.0 * (c1 + 2.0 * c2 + 2.0 * c3 + c4);
+    trig = trig.advanced(dq, q);
   }
 
  private:
-  struct Point {
-    int link = 0;
-    double distance_m = 0.0, mass_kg = 0.0;
-  };
-  std::array<Point, 2 * J> points_{};
-  int points_count_ = 0;
-  std::array<double, J> length_{}, inertia_{};
+  std::array<double, J> length_{}, mass_{}, first_moment_{}, second_moment_{};
   Vec stiffness_, kappa_, damping_, stop_scale_, stop_rad_, creep_gain_, creep_rate_;
   double gravity_, stop_stiffness_, stop_damping_;
 };
