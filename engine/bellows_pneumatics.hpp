@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "engine/parameters.hpp"
-#include "engine/valve_flow.hpp"
 
 namespace bellows {
 
@@ -74,10 +74,9 @@ class BellowsPneumatics {
         v0_m3_(bellows.volume_l * 1e-3),
         beta_(bellows.volume_gain_per_rad),
         v0_beta_(v0_m3_ * beta_),
-        conductance_(bellows.valve_conductance_m3_per_sPa),
         critical_ratio_(bellows.valve_critical_ratio),
-        density_(gas.reference_density_kg_per_m3),
-        valves_(bellows.valves_per_port) {}
+        subsonic_scale_(1.0 / ((1.0 - critical_ratio_) * (1.0 - critical_ratio_))),
+        flow_scale_(bellows.valves_per_port * bellows.valve_conductance_m3_per_sPa * gas.reference_density_kg_per_m3) {}
 
   /// V_A = V0 (1 + beta q) for chamber 0, V_B = V0 (1 - beta q) for chamber 1 (m^3).
   double chamber_volume_m3(int chamber, double angle_rad) const {
@@ -90,31 +89,44 @@ class BellowsPneumatics {
     return (chamber_Pa[0] * chamber_volume_m3(0, angle_rad) + chamber_Pa[1] * chamber_volume_m3(1, angle_rad)) / rt_;
   }
 
-  /// p_dot of chambers A and B (Pa/s): p_dot = mdot R T / V - p V_dot / V, mdot through the open
-  /// valves (inlets from `supply_Pa`, outlets to ambient). The second term is the bounce-back: a
+  /// Mass flow (kg/s) through a port's valves from `from_Pa` to `to_Pa`, signed: ISO 6358 as
+  /// iso6358_mass_flow_kg_per_s (engine/valve_flow.hpp) times the valves per port, rearranged without
+  /// a division, up psi(down / up) = sqrt(up^2 - ((down - b up) / (1 - b))^2) when not choked: the
+  /// integrators evaluate it up to 16 times per right-hand side.
+  double port_flow_kg_per_s(double from_Pa, double to_Pa) const {
+    const bool forward = from_Pa >= to_Pa;
+    const double up = forward ? from_Pa : to_Pa, down = forward ? to_Pa : from_Pa;
+    if (up <= 0.0) return 0.0;
+    const double excess = down - critical_ratio_ * up;  // > 0: not choked
+    const double effective_up =
+        excess <= 0.0 ? up : std::sqrt(std::max(0.0, up * up - subsonic_scale_ * excess * excess));
+    const double magnitude = flow_scale_ * effective_up;
+    return forward ? magnitude : -magnitude;
+  }
+
+  /// p_dot of chambers A and B (Pa/s): p_dot = (mdot R T - p V_dot) / V, mdot through the open
+  /// valves (inlets from `supply_Pa`, outlets to ambient). The V_dot term is the bounce-back: a
   /// shrinking bellows is compressed and pushes back.
   void pressure_rates(double angle_rad, double velocity_rad_per_s, double pa_Pa, double pb_Pa,
                       const BellowsOpenings& open, double supply_Pa, double& pa_rate, double& pb_rate) const {
-    pa_rate = chamber_rate(1.0, angle_rad, velocity_rad_per_s, pa_Pa, open.inlet[0], open.outlet[0], supply_Pa);
-    pb_rate = chamber_rate(-1.0, angle_rad, velocity_rad_per_s, pb_Pa, open.inlet[1], open.outlet[1], supply_Pa);
+    const double stretch = beta_ * angle_rad;
+    const double volume_a = v0_m3_ * (1.0 + stretch), volume_b = v0_m3_ * (1.0 - stretch);
+    const double inverse_product = 1.0 / (volume_a * volume_b);  // one division for both chambers
+    const double volume_rate_a = v0_beta_ * velocity_rad_per_s;   // V_B's is its negative
+    double flow_a = 0.0, flow_b = 0.0;
+    if (open.inlet[0]) flow_a += port_flow_kg_per_s(supply_Pa, pa_Pa);
+    if (open.outlet[0]) flow_a -= port_flow_kg_per_s(pa_Pa, ambient_Pa_);
+    if (open.inlet[1]) flow_b += port_flow_kg_per_s(supply_Pa, pb_Pa);
+    if (open.outlet[1]) flow_b -= port_flow_kg_per_s(pb_Pa, ambient_Pa_);
+    pa_rate = (flow_a * rt_ - pa_Pa * volume_rate_a) * (volume_b * inverse_product);
+    pb_rate = (flow_b * rt_ + pb_Pa * volume_rate_a) * (volume_a * inverse_product);
   }
 
   double ambient_Pa() const { return ambient_Pa_; }
 
  private:
-  double chamber_rate(double sign, double angle_rad, double velocity_rad_per_s, double chamber_Pa, bool inlet,
-                      bool outlet, double supply_Pa) const {
-    const double volume = v0_m3_ * (1.0 + sign * beta_ * angle_rad);
-    const double volume_rate = sign * v0_beta_ * velocity_rad_per_s;
-    double mass_flow = 0.0;
-    if (inlet) mass_flow += valves_ * iso6358_mass_flow_kg_per_s(supply_Pa, chamber_Pa, conductance_, critical_ratio_, density_);
-    if (outlet) mass_flow -= valves_ * iso6358_mass_flow_kg_per_s(chamber_Pa, ambient_Pa_, conductance_, critical_ratio_, density_);
-    return mass_flow * rt_ / volume - chamber_Pa * volume_rate / volume;
-  }
-
   double rt_ = 0.0, ambient_Pa_ = 0.0, v0_m3_ = 0.0, beta_ = 0.0, v0_beta_ = 0.0;
-  double conductance_ = 0.0, critical_ratio_ = 0.0, density_ = 0.0;
-  int valves_ = 0;
+  double critical_ratio_ = 0.0, subsonic_scale_ = 0.0, flow_scale_ = 0.0;
 };
 
 }  // namespace bellows

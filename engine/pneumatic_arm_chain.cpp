@@ -12,6 +12,7 @@ namespace bellows {
 namespace {
 
 constexpr double kPaPerBar = 1e5;
+constexpr double kBarPerPa = 1e-5;  // a product: a division here was the step's slowest instruction
 
 /// Calls f(std::integral_constant<int, J>) for the chain's joint count.
 template <typename F>
@@ -24,14 +25,20 @@ void with_joint_count(int joints, F&& f) {
   }
 }
 
-/// The integrated states of J joints, and their time derivatives.
+/// The integrated states of J joints in one vector (the RK4 combinations are single vector operations):
+/// angles, rates, creep, chamber A and chamber B pressures, J entries each.
 template <int J>
-struct Physical {
-  using Vec = Eigen::Matrix<double, J, 1>;
-  Vec q, v, z, pa, pb;
+using Physical = Eigen::Matrix<double, 5 * J, 1>;
+enum Segment { kAngle = 0, kRate = 1, kCreep = 2, kChamberA = 3, kChamberB = 4 };
 
-  Physical plus(double k, const Physical& d) const { return {q + k * d.q, v + k * d.v, z + k * d.z, pa + k * d.pa, pb + k * d.pb}; }
-};
+template <int J>
+auto segment(Physical<J>& x, Segment s) {
+  return x.template segment<J>(s * J);
+}
+template <int J>
+auto segment(const Physical<J>& x, Segment s) {
+  return x.template segment<J>(s * J);
+}
 
 }  // namespace
 
@@ -131,34 +138,43 @@ void PneumaticArmChain::advance_fixed(double dt_s) {
   const double period = parameters_.pwm_period_s, supply_Pa = supply_Pa_;
   std::array<BellowsOpenings, J> open{};
 
-  // The right-hand side with the valve openings `open` held; `trig` at x.q.
+  // The right-hand side with the valve openings `open` held; `trig` at the angles of x.
   auto derivative = [&](const Physical<J>& x, const Trig& trig) {
     Physical<J> d;
-    d.q = x.v;
-    d.v = kernel.acceleration(trig, x.q, x.v, x.z, (x.pa - x.pb) / kPaPerBar);
-    d.z = kernel.creep_rate(x.q, x.z);
+    const Vec q = segment<J>(x, kAngle), v = segment<J>(x, kRate), z = segment<J>(x, kCreep);
+    const Vec pa = segment<J>(x, kChamberA), pb = segment<J>(x, kChamberB);
+    segment<J>(d, kAngle) = v;
+    segment<J>(d, kRate) = kernel.acceleration(trig, q, v, z, (pa - pb) * kBarPerPa);
+    segment<J>(d, kCreep) = kernel.creep_rate(q, z);
+#pragma GCC unroll 4
     for (int i = 0; i < J; ++i) {
-      bellows_[static_cast<std::size_t>(i)].pressure_rates(x.q(i), x.v(i), x.pa(i), x.pb(i), open[static_cast<std::size_t>(i)],
-                                                            supply_Pa, d.pa(i), d.pb(i));
+      bellows_[static_cast<std::size_t>(i)].pressure_rates(q(i), v(i), pa(i), pb(i), open[static_cast<std::size_t>(i)],
+                                                            supply_Pa, d(kChamberA * J + i), d(kChamberB * J + i));
     }
     return d;
   };
+  // The trig of stage x_s, from the step's start x.
+  auto trig_at = [](const Trig& trig, const Physical<J>& x, const Physical<J>& x_s) {
+    const Vec q_s = segment<J>(x_s, kAngle);
+    return trig.advanced(q_s - segment<J>(x, kAngle), q_s);
+  };
 
   Physical<J> x;
-  x.q = state_.angle_rad.template head<J>();
-  x.v = state_.velocity_rad_per_s.template head<J>();
-  x.z = state_.creep_rad.template head<J>();
+  segment<J>(x, kAngle) = state_.angle_rad.template head<J>();
+  segment<J>(x, kRate) = state_.velocity_rad_per_s.template head<J>();
+  segment<J>(x, kCreep) = state_.creep_rad.template head<J>();
   for (int i = 0; i < J; ++i) {
-    x.pa(i) = state_.chamber_Pa[static_cast<std::size_t>(i)][0];
-    x.pb(i) = state_.chamber_Pa[static_cast<std::size_t>(i)][1];
+    x(kChamberA * J + i) = state_.chamber_Pa[static_cast<std::size_t>(i)][0];
+    x(kChamberB * J + i) = state_.chamber_Pa[static_cast<std::size_t>(i)][1];
   }
   Trig trig;
   constexpr double kEpsilon_s = 1e-12;  // no sliver steps from float drift at period boundaries
   double remaining = dt_s;
   for (int step = 0; remaining > kEpsilon_s; ++step) {
-    if (step % arm_chain_kernel::kTrigRefreshSteps == 0) trig = Trig::exact(x.q);
+    if (step % arm_chain_kernel::kTrigRefreshSteps == 0) trig = Trig::exact(segment<J>(x, kAngle));
     if (state_.pwm_phase_s >= period - kEpsilon_s) state_.pwm_phase_s = 0.0;  // PWM repeats
     double h = std::min(parameters_.chain.integration_step_s, remaining);
+#pragma GCC unroll 4
     for (int i = 0; i < J; ++i) {
       const BellowsDuties& duties = state_.duties[static_cast<std::size_t>(i)];
       h = std::min(h, pwm_time_to_next_edge(duties, state_.pwm_phase_s, period));
@@ -166,27 +182,25 @@ void PneumaticArmChain::advance_fixed(double dt_s) {
     }
     // Classical RK4 with the openings constant over the step (steps end on switching edges).
     const Physical<J> k1 = derivative(x, trig);
-    const Physical<J> x2 = x.plus(h / 2, k1);
-    const Physical<J> k2 = derivative(x2, trig.advanced(x2.q - x.q, x2.q));
-    const Physical<J> x3 = x.plus(h / 2, k2);
-    const Physical<J> k3 = derivative(x3, trig.advanced(x3.q - x.q, x3.q));
-    const Physical<J> x4 = x.plus(h, k3);
-    const Physical<J> k4 = derivative(x4, trig.advanced(x4.q - x.q, x4.q));
-    auto combine = [&](Vec Physical<J>::*f) -> Vec {
-      return x.*f + h / 6.0 * (k1.*f + 2.0 * k2.*f + 2.0 * k3.*f + k4.*f);
-    };
-    Physical<J> next{combine(&Physical<J>::q), combine(&Physical<J>::v), combine(&Physical<J>::z),
-                     combine(&Physical<J>::pa).cwiseMax(1.0), combine(&Physical<J>::pb).cwiseMax(1.0)};
-    trig = trig.advanced(next.q - x.q, next.q);
+    const Physical<J> x2 = x + h / 2 * k1;
+    const Physical<J> k2 = derivative(x2, trig_at(trig, x, x2));
+    const Physical<J> x3 = x + h / 2 * k2;
+    const Physical<J> k3 = derivative(x3, trig_at(trig, x, x3));
+    const Physical<J> x4 = x + h * k3;
+    const Physical<J> k4 = derivative(x4, trig_at(trig, x, x4));
+    Physical<J> next = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    segment<J>(next, kChamberA) = segment<J>(next, kChamberA).cwiseMax(1.0);  // as for one joint: never a vacuum
+    segment<J>(next, kChamberB) = segment<J>(next, kChamberB).cwiseMax(1.0);
+    trig = trig_at(trig, x, next);
     x = next;
     state_.pwm_phase_s += h;
     state_.time_s += h;
     remaining -= h;
   }
-  state_.angle_rad = x.q;
-  state_.velocity_rad_per_s = x.v;
-  state_.creep_rad = x.z;
-  for (int i = 0; i < J; ++i) state_.chamber_Pa[static_cast<std::size_t>(i)] = {x.pa(i), x.pb(i)};
+  state_.angle_rad = segment<J>(x, kAngle);
+  state_.velocity_rad_per_s = segment<J>(x, kRate);
+  state_.creep_rad = segment<J>(x, kCreep);
+  for (int i = 0; i < J; ++i) state_.chamber_Pa[static_cast<std::size_t>(i)] = {x(kChamberA * J + i), x(kChamberB * J + i)};
 }
 
 }  // namespace bellows
