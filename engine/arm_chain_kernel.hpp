@@ -6,9 +6,10 @@
 // Speed (docs/benchmarks.md, "Several joints"): the sines and cosines of the links' absolute angles
 // are carried from stage to stage and step to step by the angle-addition formulas with a short series
 // for the small increment (Trig::advanced), exact std::sin/std::cos only every kTrigRefreshSteps
-// steps; each link's point masses and inertia enter as three moments (mass, first, second); the
+// steps; M(q) comes from the tip's composite bodies and C q_dot + G from one recursive Newton-Euler
+// pass, each link's point masses and inertia entering as three moments (mass, first, second); the
 // J x J solve is by the adjugate up to J = 3. The loops over joints are unrolled explicitly: left
-// to itself GCC kept the rigid-body sweep's nested loops rolled, at 8x the time.
+// to itself GCC kept an earlier rigid-body sweep's nested loops rolled, at 8x the time.
 #pragma once
 
 #include <array>
@@ -136,54 +137,82 @@ class Kernel {
     }
   }
 
-  /// M(q), C(q, q_dot) q_dot and G(q). A point at distance d on link i has the Jacobian columns
-  /// (a <= i) P_a + d t_i, P_a = sum_{k=a}^{i-1} l_k t_k, t_k = (-sin theta_k, cos theta_k), and the
-  /// velocity-product acceleration A_i - d w_i^2 n_i, A_i = -sum_{k<i} l_k w_k^2 n_k,
-  /// n_k = (cos theta_k, sin theta_k), w_k the rate of theta_k. Summed over the link's points with
-  /// its moments (mu0, mu1, mu2 = sum m, sum m d, sum m d^2 + I):
-  ///   M_ab += mu0 P_a.P_b + mu1 (P_a.t_i + P_b.t_i) + mu2
-  ///   (C q_dot)_a += mu0 P_a.A_i + mu1 (t_i.A_i - w_i^2 P_a.n_i)      (t_i.n_i = 0)
-  ///   G_a += g (mu0 P_a.y + mu1 cos theta_i)
-  [[gnu::always_inline]] void rigid_body(const Trig<J>& trig, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
-    M.setZero();
-    coriolis.setZero();
-    gravity.setZero();
-    double ax = 0.0, ay = 0.0;  // A_i
-    double w = 0.0;
+  /// M(q) from the tip's composites (composite rigid bodies): with o_i joint i's position and, for
+  /// the links i..J together, Mc_i their mass, S_i their first moment about o_i (a vector) and Ic_i
+  /// their inertia about o_i (own inertias included),
+  ///   M_ii = Ic_i,  M_ai = Ic_i + (o_i - o_a).S_i  (a < i),
+  /// since a point p on link i or beyond has the Jacobian columns z x (p - o_a). Shifting link i+1's
+  /// composite to o_i by e = o_{i+1} - o_i = l_i n_i: Ic += 2 e.S + Mc l_i^2, S += Mc e; then link i
+  /// adds its moments (mu0, mu1, mu2 = sum m, sum m d, sum m d^2 + I over its centre of mass and its
+  /// distal point mass): S += mu1 n_i, Ic += mu2, Mc += mu0. n_k = (cos theta_k, sin theta_k).
+  [[gnu::always_inline]] void mass_matrix(const Trig<J>& trig, Mat& M) const {
+    double mc = 0.0, sx = 0.0, sy = 0.0, ic = 0.0;
+    std::array<double, J> composite_sx{}, composite_sy{};
+#pragma GCC unroll 4
+    for (int i = J - 1; i >= 0; --i) {
+      const double ex = length_[i] * trig.cos[i], ey = length_[i] * trig.sin[i];
+      if (i < J - 1) {
+        ic += 2.0 * (ex * sx + ey * sy) + mc * length_[i] * length_[i];
+        sx += mc * ex;
+        sy += mc * ey;
+      }
+      sx += first_moment_[i] * trig.cos[i];
+      sy += first_moment_[i] * trig.sin[i];
+      ic += second_moment_[i];
+      mc += mass_[i];
+      composite_sx[i] = sx;
+      composite_sy[i] = sy;
+      M(i, i) = ic;
+    }
+#pragma GCC unroll 4
+    for (int i = 1; i < J; ++i) {
+      double dx = 0.0, dy = 0.0;  // o_i - o_a
+#pragma GCC unroll 4
+      for (int a = i - 1; a >= 0; --a) {
+        dx += length_[a] * trig.cos[a];
+        dy += length_[a] * trig.sin[a];
+        M(a, i) = M(i, i) + dx * composite_sx[i] + dy * composite_sy[i];
+        M(i, a) = M(a, i);
+      }
+    }
+  }
+
+  /// The velocity-product and gravity torques C(q, q_dot) q_dot + G(q) (recursive Newton-Euler at zero
+  /// joint acceleration): tau_a = sum over the points p beyond joint a of (p - o_a) x m_p acc_p, with
+  /// acc_p the point's acceleration from the rates alone plus `gravity_m_per_s2` upward (the base
+  /// accelerating upward is gravity pulling down). Forward: acc_o(i+1) = acc_o(i) - w_i^2 l_i n_i;
+  /// link i's force F_i = mu0 acc_o(i) - w_i^2 mu1 n_i and moment about o_i N_i = mu1 n_i x acc_o(i).
+  /// Backward: N_c(i) = N_i + N_c(i+1) + l_i n_i x F_c(i+1), F_c(i) = F_i + F_c(i+1); tau_i = N_c(i).
+  [[gnu::always_inline]] Vec bias_torque(const Trig<J>& trig, const Vec& q_dot, double gravity_m_per_s2) const {
+    std::array<double, J> fx{}, fy{}, moment{};
+    double ax = 0.0, ay = gravity_m_per_s2, w = 0.0;
 #pragma GCC unroll 4
     for (int i = 0; i < J; ++i) {
       w += q_dot(i);
-      const double w2 = w * w;
-      const double tx = -trig.sin[i], ty = trig.cos[i];
-      std::array<double, J> px{}, py{}, pt{};  // P_a and P_a.t_i, a <= i
-      double sx = 0.0, sy = 0.0;
-#pragma GCC unroll 4
-      for (int a = i - 1; a >= 0; --a) {
-        sx -= length_[a] * trig.sin[a];
-        sy += length_[a] * trig.cos[a];
-        px[a] = sx;
-        py[a] = sy;
-      }
-#pragma GCC unroll 4
-      for (int a = 0; a <= i; ++a) pt[a] = px[a] * tx + py[a] * ty;
-      const double mu0 = mass_[i], mu1 = first_moment_[i], mu2 = second_moment_[i];
-      const double tA = tx * ax + ty * ay;
-#pragma GCC unroll 4
-      for (int a = 0; a <= i; ++a) {
-#pragma GCC unroll 4
-        for (int b = 0; b <= a; ++b) M(a, b) += mu0 * (px[a] * px[b] + py[a] * py[b]) + mu1 * (pt[a] + pt[b]) + mu2;
-        const double pn = px[a] * trig.cos[i] + py[a] * trig.sin[i];
-        coriolis(a) += mu0 * (px[a] * ax + py[a] * ay) + mu1 * (tA - w2 * pn);
-        gravity(a) += gravity_ * (mu0 * py[a] + mu1 * ty);
-      }
-      ax -= length_[i] * w2 * trig.cos[i];
-      ay -= length_[i] * w2 * trig.sin[i];
+      const double w2 = w * w, nx = trig.cos[i], ny = trig.sin[i];
+      fx[i] = mass_[i] * ax - w2 * first_moment_[i] * nx;
+      fy[i] = mass_[i] * ay - w2 * first_moment_[i] * ny;
+      moment[i] = first_moment_[i] * (nx * ay - ny * ax);
+      ax -= w2 * length_[i] * nx;
+      ay -= w2 * length_[i] * ny;
     }
+    Vec tau;
+    double fcx = 0.0, fcy = 0.0, nc = 0.0;
 #pragma GCC unroll 4
-    for (int a = 0; a < J; ++a) {
-#pragma GCC unroll 4
-      for (int b = a + 1; b < J; ++b) M(a, b) = M(b, a);
+    for (int i = J - 1; i >= 0; --i) {
+      nc += moment[i] + length_[i] * (trig.cos[i] * fcy - trig.sin[i] * fcx);
+      fcx += fx[i];
+      fcy += fy[i];
+      tau(i) = nc;
     }
+    return tau;
+  }
+
+  /// M(q), C(q, q_dot) q_dot and G(q) (the queries; the integrators use mass_matrix and bias_torque).
+  void rigid_body(const Trig<J>& trig, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
+    mass_matrix(trig, M);
+    coriolis = bias_torque(trig, q_dot, 0.0);
+    gravity = bias_torque(trig, Vec::Zero(), gravity_);
   }
 
   void rigid_body(const Vec& q, const Vec& q_dot, Mat& M, Vec& coriolis, Vec& gravity) const {
@@ -212,13 +241,12 @@ class Kernel {
   [[gnu::always_inline]] Vec acceleration(const Trig<J>& trig, const Vec& q, const Vec& q_dot, const Vec& z,
                                           const Vec& dp_bar) const {
     Mat M;
-    Vec coriolis, gravity;
-    rigid_body(trig, q_dot, M, coriolis, gravity);
+    mass_matrix(trig, M);
+    const Vec bias = bias_torque(trig, q_dot, gravity_);
     Vec torque;
 #pragma GCC unroll 4
     for (int i = 0; i < J; ++i) {
-      torque(i) = stiffness_kappa_(i) * dp_bar(i) - stiffness_(i) * (q(i) + z(i)) - damping_(i) * q_dot(i) - coriolis(i) -
-                  gravity(i);
+      torque(i) = stiffness_kappa_(i) * dp_bar(i) - stiffness_(i) * (q(i) + z(i)) - damping_(i) * q_dot(i) - bias(i);
       const double beyond = std::abs(q(i)) - stop_rad_(i);
       if (beyond > 0.0) {  // the hard stop, as stop_torque
         const double direction = q(i) > 0.0 ? 1.0 : -1.0;
