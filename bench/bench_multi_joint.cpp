@@ -1,5 +1,6 @@
 // Arms with several joints (issue 14): the J-joint norm-optimal update in O(N) against the dense
-// lifted form, and its set-up; the chain's mechanics (ArmChain) and the whole simulated J-joint arm (PneumaticArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
+// lifted form, and its set-up; the chain's mechanics (ArmChain) and the whole simulated J-joint arm
+// (PneumaticArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
 #include <algorithm>
 #include <array>
 #include <cmath>
