@@ -46,6 +46,21 @@ PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant) {
   return parameters;
 }
 
+PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant, const ArmParameters& arm) {
+  if (arm.preset.empty()) return pneumatic_chain_of(plant);
+  PneumaticChainParameters parameters = pneumatic_chain_preset(arm.preset);
+  const PneumaticChainParameters shared = pneumatic_chain_of(plant);
+  parameters.supply_bar = shared.supply_bar;
+  parameters.encoder_resolution_deg = shared.encoder_resolution_deg;
+  parameters.pressure_noise_bar = shared.pressure_noise_bar;
+  parameters.pwm_period_s = shared.pwm_period_s;
+  parameters.gas = shared.gas;
+  parameters.chain.integration_step_s = shared.chain.integration_step_s;
+  parameters.chain.hard_stop_stiffness_per_s2 = shared.chain.hard_stop_stiffness_per_s2;
+  parameters.chain.hard_stop_damping_per_s = shared.chain.hard_stop_damping_per_s;
+  return parameters;
+}
+
 void validate_pneumatic_chain(const PneumaticChainParameters& parameters) {
   validate_chain(parameters.chain);
   auto check = [](bool ok, int joint, const char* what, double value) {

@@ -31,6 +31,11 @@ PneumaticChainParameters pneumatic_chain_preset(std::string_view name);
 /// integration step the plant's. Fault settings are not part of the chain.
 PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant);
 
+/// The simulated arm `[arm] preset` names: "" gives pneumatic_chain_of(plant); a preset gives its
+/// links and bellows with [plant]'s supply, sensors, PWM period, gas, integration step and hard-stop
+/// stiffness and damping. InputError for an unknown preset.
+PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant, const ArmParameters& arm);
+
 /// validate_chain, then per joint a positive finite bellows volume, conductance and valve count, a
 /// critical ratio in [0, 1), |beta| small enough that no chamber empties within 1.5 x the joint's
 /// stops; a positive supply, PWM period and gas; a non-negative encoder resolution and noise. Throws

@@ -120,6 +120,25 @@ TEST(PneumaticArmChain, PresetsGiveTheShoulderTwiceTheBellowsAndTheValves) {
   }
 }
 
+TEST(PneumaticArmChain, TheConfigurationsArmPresetChoosesTheChainWithThePlantsSharedSettings) {
+  PlantParameters plant;
+  plant.supply_bar = 2.5;
+  plant.pressure_noise_bar = 1e-3;
+  plant.integration_step_s = 5e-5;
+  const PneumaticChainParameters one = pneumatic_chain_of(plant, ArmParameters{});
+  EXPECT_EQ(one.chain.joints, 1);  // absent: the single joint
+  EXPECT_FALSE(one.chain.gravity);
+  const PneumaticChainParameters arm3 = pneumatic_chain_of(plant, ArmParameters{"arm3"});
+  EXPECT_EQ(arm3.chain.joints, 3);
+  EXPECT_TRUE(arm3.chain.gravity);
+  EXPECT_EQ(arm3.bellows[0].volume_l, 0.9);
+  EXPECT_EQ(arm3.chain.links[2].kappa_rad_per_bar, 7.91);
+  EXPECT_EQ(arm3.supply_bar, 2.5);
+  EXPECT_EQ(arm3.pressure_noise_bar, 1e-3);
+  EXPECT_EQ(arm3.chain.integration_step_s, 5e-5);
+  EXPECT_THROW(pneumatic_chain_of(plant, ArmParameters{"arm9"}), InputError);
+}
+
 TEST(PneumaticArmChain, ClosedValvesKeepEachJointsAirWhileTheChainSwingsAndItsVolumesFollowItsOwnAngle) {
   PneumaticArmChain arm(pneumatic_chain_preset("arm3"), 1);
   PneumaticArmChain::State s = arm.state();
