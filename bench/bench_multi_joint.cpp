@@ -1,11 +1,16 @@
 // Arms with several joints (issue 14): the J-joint norm-optimal update in O(N) against the dense
-// lifted form, and its set-up; the chain's mechanics (ArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
+// lifted form, and its set-up; the chain's mechanics (ArmChain) and the whole simulated J-joint arm
+// (PneumaticArmChain) against real time. Results are written up in docs/benchmarks.md ("## Several joints").
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "devices/simulated_arm.hpp"
 #include "engine/arm_chain.hpp"
 #include "engine/arm_chain_linearization.hpp"
 #include "engine/arm_model.hpp"
@@ -13,6 +18,7 @@
 #include "engine/noilc_mimo_constrained.hpp"
 #include "engine/noilc_mimo_dense.hpp"
 #include "engine/noilc_riccati.hpp"
+#include "engine/pneumatic_arm_chain.hpp"
 
 namespace bellows {
 namespace {
@@ -135,6 +141,60 @@ void BM_ArmChainSecond(benchmark::State& state) {
   state.counters["real_time_factor"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_ArmChainSecond)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+
+// One simulated second of the whole simulated arm (PneumaticArmChain: the mechanics with every joint's
+// bellows, valves and sensors), as the engine drives it: every 5 ms tick a reading and a new valve
+// command per joint (duties moving like a pressure controller's, inlet or outlet per chamber, a few
+// edges per period), then 5 ms of physics. Arg: joints (1: the single joint as a chain).
+void BM_PneumaticArmChainSecond(benchmark::State& state) {
+  const int J = static_cast<int>(state.range(0));
+  const PneumaticChainParameters parameters =
+      J == 1 ? pneumatic_chain_of(PlantParameters{}) : pneumatic_chain_preset(J == 2 ? "arm2" : "arm3");
+  PneumaticArmChain arm(parameters, 1);
+  constexpr double kTick_s = 0.005;
+  std::array<BellowsDuties, kMaxJoints> duties{};
+  double angle_sum = 0.0;
+  for (auto _ : state) {
+    for (int tick = 0; tick < 200; ++tick) {
+      const PneumaticArmChain::Reading reading = arm.read_sensors();
+      angle_sum += reading.angle_rad.sum();
+      const double t = reading.time_s;
+      for (int i = 0; i < J; ++i) {
+        const double u = 0.5 * std::sin((3.0 + i) * t) + 0.3 * std::sin((11.0 + 2 * i) * t);
+        auto& d = duties[static_cast<std::size_t>(i)];
+        d.inlet = {std::max(0.0, u), std::max(0.0, -u)};
+        d.outlet = {std::max(0.0, -0.8 * u), std::max(0.0, 0.8 * u)};
+      }
+      arm.write_valves(std::span<const BellowsDuties>(duties.data(), static_cast<std::size_t>(J)));
+      arm.advance(kTick_s);
+    }
+  }
+  benchmark::DoNotOptimize(angle_sum);
+  state.counters["real_time_factor"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_PneumaticArmChainSecond)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
+
+// The single-joint simulated arm (devices/simulated_arm) on the same drive, for comparison.
+void BM_SimulatedArmSecond(benchmark::State& state) {
+  SimulatedArm arm(PlantParameters{}, 1);
+  double angle_sum = 0.0;
+  for (auto _ : state) {
+    for (int tick = 0; tick < 200; ++tick) {
+      const SensorReading reading = arm.read_sensors();
+      angle_sum += reading.angle_rad;
+      const double t = reading.time_s;
+      const double u = 0.5 * std::sin(3.0 * t) + 0.3 * std::sin(11.0 * t);
+      ValveCommand command;
+      command.inlet_duty = {std::max(0.0, u), std::max(0.0, -u)};
+      command.outlet_duty = {std::max(0.0, -0.8 * u), std::max(0.0, 0.8 * u)};
+      arm.write_valves(command);
+      arm.advance(0.005);
+    }
+  }
+  benchmark::DoNotOptimize(angle_sum);
+  state.counters["real_time_factor"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_SimulatedArmSecond)->Unit(benchmark::kMillisecond);
 
 void BM_ArmChainLinearization(benchmark::State& state) {
   const ArmChain arm(chain_preset("arm3"));

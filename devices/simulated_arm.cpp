@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "engine/errors.hpp"
-#include "engine/valve_flow.hpp"
 
 namespace bellows {
 namespace {
@@ -40,7 +39,7 @@ SimulatedFault simulated_fault_from_string(const std::string& name) {
 }
 
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
-    : params_(params), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
+    : params_(params), bellows_(bellows_of(params), params.gas), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
   state_.chamber_Pa = {params.gas.ambient_bar * kPaPerBar, params.gas.ambient_bar * kPaPerBar};
   state_.command = ValveCommand::vented().joint[0];
   state_.noise = noise_.state();
@@ -73,15 +72,9 @@ void SimulatedArm::set_state(const State& state) {
   noise_.set_state(state.noise);
 }
 
-double SimulatedArm::chamber_volume_m3(int actuator) const {
-  const double sign = actuator == 0 ? 1.0 : -1.0;
-  return params_.volume_l * 1e-3 * (1.0 + sign * params_.volume_gain_per_rad * state_.angle_rad);
-}
+double SimulatedArm::chamber_volume_m3(int actuator) const { return bellows_.chamber_volume_m3(actuator, state_.angle_rad); }
 
-double SimulatedArm::air_mass_kg() const {
-  const double rt = params_.gas.gas_constant_J_per_kgK * params_.gas.temperature_K;
-  return (state_.chamber_Pa[0] * chamber_volume_m3(0) + state_.chamber_Pa[1] * chamber_volume_m3(1)) / rt;
-}
+double SimulatedArm::air_mass_kg() const { return bellows_.air_mass_kg(state_.angle_rad, state_.chamber_Pa); }
 
 SensorReading SimulatedArm::read_sensors() {
   activate_scheduled_fault();
@@ -118,13 +111,10 @@ void SimulatedArm::write_valves(const ValveCommand& command) {
 
 void SimulatedArm::vent() { write_valves(ValveCommand::vented()); }
 
-SimulatedArm::Openings SimulatedArm::openings_at(double phase_s) const {
-  Openings open;
-  const double period = params_.pwm_period_s;
-  for (int i = 0; i < kActuatorCount; ++i) {
-    open.inlet[i] = phase_s < state_.command.inlet_duty[i] * period;
-    open.outlet[i] = phase_s < state_.command.outlet_duty[i] * period;
-  }
+BellowsDuties SimulatedArm::duties() const { return {state_.command.inlet_duty, state_.command.outlet_duty}; }
+
+BellowsOpenings SimulatedArm::openings_at(double phase_s) const {
+  BellowsOpenings open = pwm_openings(duties(), phase_s, params_.pwm_period_s);
   if (state_.fault == SimulatedFault::kStuckInlet) open.inlet[0] = true;
   if (state_.fault == SimulatedFault::kDeadInlet) open.inlet[0] = false;
   if (state_.fault == SimulatedFault::kSwappedChambers) {
@@ -135,42 +125,14 @@ SimulatedArm::Openings SimulatedArm::openings_at(double phase_s) const {
 }
 
 double SimulatedArm::time_to_next_switch(double phase_s) const {
-  const double period = params_.pwm_period_s;
-  double next = period - phase_s;  // the period restarts and every valve with duty > 0 opens
-  for (int i = 0; i < kActuatorCount; ++i) {
-    for (double duty : {state_.command.inlet_duty[i], state_.command.outlet_duty[i]}) {
-      const double edge = duty * period - phase_s;
-      if (edge > 0.0) next = std::min(next, edge);
-    }
-  }
-  return next;
+  return pwm_time_to_next_edge(duties(), phase_s, params_.pwm_period_s);
 }
 
-SimulatedArm::Physical SimulatedArm::derivative(const Physical& x, const Openings& open) const {
+SimulatedArm::Physical SimulatedArm::derivative(const Physical& x, const BellowsOpenings& open) const {
   const PlantParameters& p = params_;
-  const double rt = p.gas.gas_constant_J_per_kgK * p.gas.temperature_K;
-  const double ambient_Pa = p.gas.ambient_bar * kPaPerBar;
-  const double v0 = p.volume_l * 1e-3;
-  const double chamber[2] = {x.pa_Pa, x.pb_Pa};
   double pressure_rate[2];
-  for (int i = 0; i < kActuatorCount; ++i) {
-    const double sign = i == 0 ? 1.0 : -1.0;
-    const double volume = v0 * (1.0 + sign * p.volume_gain_per_rad * x.angle_rad);
-    const double volume_rate = sign * v0 * p.volume_gain_per_rad * x.velocity_rad_per_s;
-    double mass_flow = 0.0;
-    if (open.inlet[i]) {
-      mass_flow += p.valves_per_port * iso6358_mass_flow_kg_per_s(supply_Pa_, chamber[i], p.valve_conductance_m3_per_sPa,
-                                                                 p.valve_critical_ratio,
-                                                                 p.gas.reference_density_kg_per_m3);
-    }
-    if (open.outlet[i]) {
-      mass_flow -= p.valves_per_port * iso6358_mass_flow_kg_per_s(chamber[i], ambient_Pa, p.valve_conductance_m3_per_sPa,
-                                                                 p.valve_critical_ratio,
-                                                                 p.gas.reference_density_kg_per_m3);
-    }
-    // Full gas law: the shrinking bellows is compressed and pushes back.
-    pressure_rate[i] = mass_flow * rt / volume - chamber[i] * volume_rate / volume;
-  }
+  bellows_.pressure_rates(x.angle_rad, x.velocity_rad_per_s, x.pa_Pa, x.pb_Pa, open, supply_Pa_, pressure_rate[0],
+                          pressure_rate[1]);
   const double w0 = p.omega0_rad_per_s;
   const double dp_bar = (x.pa_Pa - x.pb_Pa) / kPaPerBar;
   double acceleration = w0 * w0 * (p.kappa_rad_per_bar * dp_bar - x.angle_rad - x.creep_rad) -
@@ -185,7 +147,7 @@ SimulatedArm::Physical SimulatedArm::derivative(const Physical& x, const Opening
           pressure_rate[0], pressure_rate[1]};
 }
 
-void SimulatedArm::integrate(double h, const Openings& open) {
+void SimulatedArm::integrate(double h, const BellowsOpenings& open) {
   // Classical RK4 with the valve openings constant over the step (steps end on switching edges).
   const Physical x{state_.angle_rad, state_.angular_velocity_rad_per_s, state_.creep_rad, state_.chamber_Pa[0],
                    state_.chamber_Pa[1]};

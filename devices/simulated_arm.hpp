@@ -10,8 +10,9 @@
 #include <string>
 #include <cstdint>
 
-#include "devices/gaussian_noise.hpp"
+#include "engine/bellows_pneumatics.hpp"
 #include "engine/device.hpp"
+#include "engine/gaussian_noise.hpp"
 #include "engine/parameters.hpp"
 
 namespace bellows {
@@ -79,18 +80,16 @@ class SimulatedArm final : public Device {
   struct Physical {  // the integrated part of the state
     double angle_rad, velocity_rad_per_s, creep_rad, pa_Pa, pb_Pa;
   };
-  struct Openings {
-    std::array<bool, kActuatorCount> inlet{}, outlet{};
-  };
-
-  Physical derivative(const Physical& x, const Openings& open) const;
-  void integrate(double h_s, const Openings& open);
-  Openings openings_at(double phase_s) const;
+  Physical derivative(const Physical& x, const BellowsOpenings& open) const;
+  void integrate(double h_s, const BellowsOpenings& open);
+  BellowsDuties duties() const;
+  BellowsOpenings openings_at(double phase_s) const;
   double time_to_next_switch(double phase_s) const;
 
   void activate_scheduled_fault();
 
   PlantParameters params_;
+  BellowsPneumatics bellows_;  // the chambers' physics, shared with every joint of engine/pneumatic_arm_chain
   double supply_Pa_;
   State state_;
   GaussianNoise noise_;

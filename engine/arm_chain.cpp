@@ -187,10 +187,12 @@ void ArmChain::advance(double dt_s, const JointVector& dp_bar) {
                                 z = fixed<J>(state_.creep_rad);
     const Eigen::Matrix<double, J, 1> dp = fixed<J>(dp_bar);
     constexpr double kEpsilon_s = 1e-12;  // no sliver steps from float drift
+    arm_chain_kernel::Trig<J> trig;
     double remaining = dt_s;
-    while (remaining > kEpsilon_s) {
+    for (int step = 0; remaining > kEpsilon_s; ++step) {
+      if (step % arm_chain_kernel::kTrigRefreshSteps == 0) trig = arm_chain_kernel::Trig<J>::exact(q);
       const double h = std::min(chain_.integration_step_s, remaining);
-      kernel.rk4(h, dp, q, v, z);
+      kernel.rk4(h, dp, q, v, z, trig);
       state_.time_s += h;
       remaining -= h;
     }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "engine/errors.hpp"
+#include "engine/parameters.hpp"
 
 namespace bellows {
 namespace {
@@ -38,7 +39,9 @@ ChainParameters chain_preset(std::string_view name) {
     chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.15, 2.63, 6.0, 10.0, 0.31);    // elbow
     chain.links[2] = preset_link(0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31);   // wrist
   } else {
-    throw InputError("unknown arm preset '" + std::string(name) + "' (known: arm2, arm3)");
+    std::string known;
+    for (std::string_view preset : kArmPresets) known += (known.empty() ? "" : ", ") + std::string(preset);
+    throw InputError("unknown arm preset '" + std::string(name) + "' (known: " + known + ")");
   }
   return chain;
 }

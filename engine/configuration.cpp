@@ -143,6 +143,8 @@ std::vector<ParameterBinding> make_bindings() {
       name("device", "lcm", "lcm: the rig's LCM bus URL (empty: udpm://239.255.76.67:7667?ttl=0)", [](C& c) { return &c.device.lcm_url; }),
       name("device", "t7", "t7: the T7's address HOST[:PORT] (port 502 by default)", [](C& c) { return &c.device.t7_address; }),
       name("device", "rig_profile", "t7: the rig profile file (empty: the paper's rig)", [](C& c) { return &c.device.rig_profile; }),
+      // [arm]: which simulated arm
+      name("arm", "preset", "the simulated arm's chain: arm2 (shoulder, elbow) or arm3 (shoulder, elbow, wrist) of ../shared/spec/multi-joint.md; empty: one joint, the [plant] arm", [](C& c) { return &c.arm.preset; }),
       // [rig_check]: the valve test of the first day (docs/rig-bring-up.md)
       number("rig_check", "vent_s", "s", "both outlets open before each valve's test (back to ambient)", pos(60.0), [](C& c) { return &c.rig_check.vent_s; }),
       number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", pos(10.0), [](C& c) { return &c.rig_check.fill_s; }),
@@ -239,6 +241,11 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.device.kind != "sim" && config.device.kind != "lcm" && config.device.kind != "t7") {
     throw InputError("[device] kind = '" + config.device.kind + "': unknown device (known: sim, lcm, t7)");
+  }
+  if (!config.arm.preset.empty() && std::find(kArmPresets.begin(), kArmPresets.end(), config.arm.preset) == kArmPresets.end()) {
+    std::string known;
+    for (std::string_view preset : kArmPresets) known += (known.empty() ? "" : ", ") + std::string(preset);
+    throw InputError("[arm] preset = '" + config.arm.preset + "': unknown arm (known: " + known + "; empty: one joint)");
   }
   if (config.lcm.seq_window > 1000000) {
     throw InputError("[lcm] seq_window = " + std::to_string(config.lcm.seq_window) + ": must be at most 1000000");

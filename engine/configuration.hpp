@@ -24,6 +24,7 @@ struct Configuration {
   SafetyParameters safety;
   LcmParameters lcm;
   DeviceParameters device;
+  ArmParameters arm;
   RigCheckParameters rig_check;
   T7Parameters t7;
 };

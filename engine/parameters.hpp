@@ -2,8 +2,10 @@
 // The engine reads these; loading them from TOML is app/'s business (engine knows no files).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace bellows {
 
@@ -143,6 +145,15 @@ struct DeviceParameters {
   std::string t7_address;       // HOST[:PORT] of the T7 (Modbus TCP, port 502 by default)
   std::string rig_profile;      // the rig profile file (t7); empty: the shipped profile of the paper's rig
 };
+
+/// Which simulated arm (`[arm]`): the single joint of [plant], or a chain of several joints from
+/// ../shared/spec/multi-joint.md (engine/pneumatic_arm_chain_parameters: pneumatic_chain_of).
+struct ArmParameters {
+  std::string preset;  // "" (absent): one joint; else one of kArmPresets
+};
+
+/// The chains engine/arm_chain_parameters knows by name (chain_preset).
+inline constexpr std::array<std::string_view, 2> kArmPresets = {"arm2", "arm3"};
 
 /// The valve test of the first day at the bench (`bellows rig check`, the console's Rig screen):
 /// each valve opened alone for `valve_pulse_s`, the chamber pressures compared before and after.

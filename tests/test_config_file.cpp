@@ -82,6 +82,18 @@ TEST(ConfigFile, RejectsBadConfigurations) {
   expect_config_refused("plant = 3\n", "must be a table");
 }
 
+TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
+  Configuration c;
+  EXPECT_EQ(c.arm.preset, "");  // absent: the single joint of [plant]
+  apply_config_toml("[arm]\npreset = \"arm3\"\n", "arm3.toml", c);
+  EXPECT_EQ(c.arm.preset, "arm3");
+  apply_config_toml("[arm]\npreset = \"arm2\"\n", "arm2.toml", c);
+  EXPECT_EQ(c.arm.preset, "arm2");
+  expect_config_refused("[arm]\npreset = \"arm7\"\n", "[arm] preset = 'arm7': unknown arm (known: arm2, arm3; empty: one joint)");
+  expect_config_refused("[arm]\npreset = 2\n", "[arm] preset");
+  expect_config_refused("[arm]\njoints = 2\n", "unknown key");
+}
+
 TEST(ConfigFile, RoundTripsThroughToml) {
   Configuration c;
   c.plant.kappa_rad_per_bar = 6.5;

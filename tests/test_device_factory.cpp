@@ -62,6 +62,18 @@ TEST(DeviceFactory, TheSimulatedArmRecordsItsSeed) {
   EXPECT_FALSE(opened->device().health().has_link);
 }
 
+TEST(DeviceFactory, AnArmOfSeveralJointsIsRefusedUntilTheEngineRunsIt) {
+  Configuration c;
+  c.arm.preset = "arm2";
+  try {
+    open_device(resolve_device({"sim", "", "", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
+    FAIL() << "arm2 must not silently run one joint";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': arms of several joints do not run in the engine yet (issue 14); "
+                           "leave [arm] out for one joint");
+  }
+}
+
 TEST(DeviceFactory, AnLcmRigOnAnInProcessBusReportsItsLink) {
   const Configuration c;
   const auto opened = open_device(resolve_device({"lcm", "memq://", "", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
