@@ -62,7 +62,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   config.model = learning_model.model;
   const double sample_s = config.timing.sample_s();
   auto load_trajectory = [sample_s, limits = config.trajectory](const std::string& name_or_path) {
-    return resolve_trajectory(name_or_path, sample_s, limits);
+    Trajectory trajectory = resolve_trajectory(name_or_path, sample_s, limits);
+    require_driven_joints(trajectory);  // the --trajectory at start and every one the chooser offers
+    return trajectory;
   };
 
   // The seed first (a session continues on the simulated arm it was recorded with), then the device.

@@ -76,6 +76,29 @@ nlohmann::ordered_json first_correction_json(const ui::Experiment& e) {
   return out;
 }
 
+/// What the console shows of a session read from disk: its configuration, device, trajectory and
+/// trials (their records move out of `loaded`).
+ui::SessionSnapshot snapshot_of(Session& loaded, const std::filesystem::path& directory) {
+  ui::SessionSnapshot snapshot;
+  snapshot.config = loaded.manifest.configuration;
+  snapshot.device_name = loaded.manifest.device;
+  snapshot.rig_profile = rig_profile_of(loaded.manifest);
+  ui::Experiment& e = snapshot.experiment;
+  e = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
+  const int n = loaded.trajectory.learning_samples();
+  for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
+    ui::Trial trial;
+    trial.iteration = static_cast<int>(i);
+    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
+    trial.record = std::move(loaded.iterations[i].record);
+    trial.summary = loaded.manifest.iterations[i].summary;
+    trial.origin = "saved";
+    e.trials.push_back(std::move(trial));
+  }
+  e.session_location = directory.string();
+  return snapshot;
+}
+
 }  // namespace
 
 std::string local_date_of(const std::string& utc) {
@@ -210,23 +233,7 @@ ui::SessionSnapshot StoreSessionGateway::read_trials(const std::string& location
     directory = resolve_session_dir(location, data_dir_);
   }
   Session loaded = load_session(directory);  // read only: no lock, our own session unchanged
-  ui::SessionSnapshot snapshot;
-  snapshot.config = loaded.manifest.configuration;
-  snapshot.device_name = loaded.manifest.device;
-  snapshot.rig_profile = rig_profile_of(loaded.manifest);
-  snapshot.experiment = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
-  const int n = loaded.trajectory.learning_samples();
-  for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
-    ui::Trial trial;
-    trial.iteration = static_cast<int>(i);
-    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
-    trial.record = std::move(loaded.iterations[i].record);
-    trial.summary = loaded.manifest.iterations[i].summary;
-    trial.origin = "saved";
-    snapshot.experiment.trials.push_back(std::move(trial));
-  }
-  snapshot.experiment.session_location = directory.string();
-  return snapshot;
+  return snapshot_of(loaded, directory);
 }
 
 ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
@@ -241,24 +248,10 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
                      "'; this console drives '" + device_name_ + "' (open it with bellows console --session " +
                      directory.string() + ")");
   }
-  ui::SessionSnapshot snapshot;
-  snapshot.config = m.configuration;
-  snapshot.device_name = m.device;
-  snapshot.rig_profile = rig_profile_of(m);
+  ui::SessionSnapshot snapshot = snapshot_of(loaded, directory);
   const auto seed = m.device_info.find("seed");
   if (seed != m.device_info.end() && seed->is_number_unsigned()) snapshot.seed = seed->get<std::uint64_t>();
   ui::Experiment& e = snapshot.experiment;
-  e = ui::Experiment::start(std::make_shared<const Trajectory>(loaded.trajectory));
-  const int n = loaded.trajectory.learning_samples();
-  for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
-    ui::Trial trial;
-    trial.iteration = static_cast<int>(i);
-    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
-    trial.record = std::move(loaded.iterations[i].record);
-    trial.summary = m.iterations[i].summary;
-    trial.origin = "saved";
-    e.trials.push_back(std::move(trial));
-  }
   if (!loaded.iterations.empty()) {
     e.next_correction_bar = loaded.iterations.back().next_correction_bar;
     e.next_origin = "saved with the session";
@@ -269,7 +262,6 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   for (std::size_t i = 0; i < loaded.black_boxes.size(); ++i) {
     e.faults.push_back({m.black_boxes[i].fault, m.black_boxes[i].iteration, std::move(loaded.black_boxes[i])});
   }
-  e.session_location = directory.string();
   e.saved_trials = static_cast<int>(e.trials.size());
   e.saved_faults = static_cast<int>(e.faults.size());
   snapshot.events = log_of(m);

@@ -19,12 +19,14 @@
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
+#include "app/trajectories_command.hpp"
 #include "app/signals.hpp"
 #include "app/standard_output.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/cancellation.hpp"
 #include "engine/errors.hpp"
 #include "engine/printable_text.hpp"
+#include "engine/trajectory.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_store.hpp"
 
@@ -44,7 +46,7 @@ int main(int argc, char** argv) {
 
   bellows::RunOptions run;
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
-  run_cmd->add_option("--trajectory", run.trajectory, "Library name (paper, steps, sine) or a CSV file")
+  run_cmd->add_option("--trajectory", run.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
                       "(with --resume: K after the newest)")
@@ -193,7 +195,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
   console_cmd->add_option("--config", console.config_path, "TOML configuration file");
-  console_cmd->add_option("--trajectory", console.trajectory, "Library name (paper, steps, sine) or a CSV file")
+  console_cmd->add_option("--trajectory", console.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();
   console_cmd->add_option("--session", console.session_dir, "Open this saved session at start");
   console_cmd->add_option("--data-dir", console.data_dir,
@@ -218,6 +220,14 @@ int main(int argc, char** argv) {
   config_cmd->add_option("--config", config_path, "TOML configuration file");
   bool config_markdown = false;
   config_cmd->add_flag("--markdown", config_markdown, "Print the key reference as Markdown tables instead");
+
+  bellows::TrajectoriesOptions trajectories;
+  CLI::App* trajectories_cmd = app.add_subcommand(
+      "trajectories", "The trajectory library (joints, duration, samples); with a name or a CSV file, that trajectory as CSV");
+  trajectories_cmd->add_option("trajectory", trajectories.trajectory,
+                               "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file to check");
+  trajectories_cmd->add_option("--config", trajectories.config_path, "TOML configuration file ([timing], [trajectory])");
+  trajectories_cmd->add_option("--output", trajectories.output_path, "Write the CSV into this file instead of stdout");
 
   bellows::install_stop_signal_handlers();
 
@@ -293,6 +303,7 @@ int main(int argc, char** argv) {
       std::cout << (config_markdown ? bellows::config_to_markdown(config) : bellows::config_to_toml(config));
       return 0;
     }
+    if (trajectories_cmd->parsed()) return bellows::trajectories_command(trajectories, std::cout);
     if (identify_cmd->parsed()) {
       return bellows::identify_command(identify, std::cout, identify.json ? std::cerr : std::cout);
     }

@@ -7,6 +7,7 @@
 #include "app/plot_gnuplot.hpp"
 #include "engine/errors.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/session_store.hpp"
 
 #ifndef BELLOWS_PAPER_RMS_CSV
@@ -18,15 +19,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kScriptName = "figures.gp";
-
-bool is_inside(const fs::path& path, const fs::path& directory) {
-  std::error_code error;
-  const fs::path inner = fs::weakly_canonical(fs::absolute(path), error);
-  const fs::path outer = fs::weakly_canonical(fs::absolute(directory), error);
-  if (error) return false;
-  const fs::path relative = inner.lexically_relative(outer);
-  return !relative.empty() && *relative.begin() != "..";
-}
 
 }  // namespace
 

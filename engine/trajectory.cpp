@@ -15,6 +15,16 @@ std::string format_number(double value) {
   out << value;
   return out.str();
 }
+
+void check_joint_count(const std::string& name, std::size_t joints) {
+  if (joints < 1 || joints > static_cast<std::size_t>(kMaxJoints)) {
+    throw InputError("trajectory '" + name + "' has " + std::to_string(joints) + " joints: 1 to " +
+                     std::to_string(kMaxJoints) + " are possible");
+  }
+}
+
+// "" for a single-joint trajectory (its messages stay as they always were), "joint 2: " otherwise.
+std::string joint_label(int joints, int joint) { return joints == 1 ? "" : "joint " + std::to_string(joint + 1) + ": "; }
 }  // namespace
 
 double trapezoidal_move_angle_deg(const TrapezoidalMove& move, double time_s) {
@@ -50,34 +60,61 @@ double trapezoidal_move_angle_deg(const TrapezoidalMove& move, double time_s) {
 
 Trajectory trajectory_from_moves(const std::string& name, double initial_deg, const std::vector<TrapezoidalMove>& moves,
                                  double duration_s, double sample_time_s) {
+  return trajectory_from_joint_moves(name, {JointMoves{initial_deg, moves}}, duration_s, sample_time_s);
+}
+
+Trajectory trajectory_from_joint_moves(const std::string& name, const std::vector<JointMoves>& joints, double duration_s,
+                                       double sample_time_s) {
+  check_joint_count(name, joints.size());
   const int samples = static_cast<int>(std::lround(duration_s / sample_time_s));
   Trajectory trajectory{name, sample_time_s, Eigen::VectorXd(samples + 1)};
-  for (int k = 0; k <= samples; ++k) {
-    const double t = k * sample_time_s;
-    double angle = initial_deg;
-    for (const TrapezoidalMove& move : moves) {
-      if (t >= move.start_s) angle = trapezoidal_move_angle_deg(move, t);
+  trajectory.more_joints_rad.resize(joints.size() - 1);
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    Eigen::VectorXd& angle_rad = j == 0 ? trajectory.angle_rad : trajectory.more_joints_rad[j - 1];
+    angle_rad.resize(samples + 1);
+    for (int k = 0; k <= samples; ++k) {
+      const double t = k * sample_time_s;
+      double angle = joints[j].initial_deg;
+      for (const TrapezoidalMove& move : joints[j].moves) {
+        if (t >= move.start_s) angle = trapezoidal_move_angle_deg(move, t);
+      }
+      angle_rad(k) = angle * kRadPerDeg;
     }
-    trajectory.angle_rad(k) = angle * kRadPerDeg;
   }
   return trajectory;
 }
 
+JointVector Trajectory::setpoint_rad(Eigen::Index sample) const {
+  JointVector setpoint(joints());
+  for (int j = 0; j < joints(); ++j) setpoint(j) = joint_angle_rad(j)(sample);
+  return setpoint;
+}
+
 void validate_trajectory(const Trajectory& trajectory, const TrajectoryLimits& limits) {
+  check_joint_count(trajectory.name, static_cast<std::size_t>(trajectory.joints()));
   if (trajectory.learning_samples() < limits.min_learning_samples) {
     throw InputError("trajectory '" + trajectory.name + "' is too short: " +
                      std::to_string(trajectory.angle_rad.size()) + " samples, at least " +
                      std::to_string(limits.min_learning_samples + 1) + " needed");
   }
-  for (Eigen::Index k = 0; k < trajectory.angle_rad.size(); ++k) {
-    const double angle_deg = trajectory.angle_rad(k) / kRadPerDeg;
-    if (!std::isfinite(angle_deg)) {
-      throw InputError("trajectory '" + trajectory.name + "': angle at sample " + std::to_string(k) + " is not a number");
+  for (int j = 0; j < trajectory.joints(); ++j) {
+    const Eigen::VectorXd& angle_rad = trajectory.joint_angle_rad(j);
+    // One joint keeps today's messages; with several, each names its joint.
+    const std::string where = "trajectory '" + trajectory.name + "': " + joint_label(trajectory.joints(), j);
+    if (angle_rad.size() != trajectory.angle_rad.size()) {
+      throw InputError(where + "has " + std::to_string(angle_rad.size()) + " samples, joint 1 has " +
+                       std::to_string(trajectory.angle_rad.size()));
     }
-    if (std::abs(angle_deg) > limits.max_abs_angle_deg) {
-      throw InputError("trajectory '" + trajectory.name + "': angle " + format_number(angle_deg) + " deg at t = " +
-                       format_number(static_cast<double>(k) * trajectory.sample_time_s) + " s is outside the joint range of +-" +
-                       format_number(limits.max_abs_angle_deg) + " deg");
+    for (Eigen::Index k = 0; k < angle_rad.size(); ++k) {
+      const double angle_deg = angle_rad(k) / kRadPerDeg;
+      if (!std::isfinite(angle_deg)) {
+        throw InputError(where + "angle at sample " + std::to_string(k) + " is not a number");
+      }
+      if (std::abs(angle_deg) > limits.max_abs_angle_deg) {
+        throw InputError(where + "angle " + format_number(angle_deg) + " deg at t = " +
+                         format_number(static_cast<double>(k) * trajectory.sample_time_s) +
+                         " s is outside the joint range of +-" + format_number(limits.max_abs_angle_deg) + " deg");
+      }
     }
   }
 }
@@ -85,9 +122,17 @@ void validate_trajectory(const Trajectory& trajectory, const TrajectoryLimits& l
 Trajectory trajectory_from_samples(const std::string& name, const std::vector<double>& time_s,
                                    const std::vector<double>& angle_deg, double sample_time_s,
                                    const TrajectoryLimits& limits) {
+  return trajectory_from_joint_samples(name, time_s, {angle_deg}, sample_time_s, limits);
+}
+
+Trajectory trajectory_from_joint_samples(const std::string& name, const std::vector<double>& time_s,
+                                         const std::vector<std::vector<double>>& joint_angle_deg, double sample_time_s,
+                                         const TrajectoryLimits& limits) {
   constexpr double kTimeTolerance_s = 1e-6;
-  if (time_s.size() != angle_deg.size()) throw InputError("trajectory '" + name + "': time and angle counts differ");
-  Trajectory trajectory{name, sample_time_s, Eigen::VectorXd(static_cast<Eigen::Index>(angle_deg.size()))};
+  check_joint_count(name, joint_angle_deg.size());
+  for (const std::vector<double>& angle_deg : joint_angle_deg) {
+    if (time_s.size() != angle_deg.size()) throw InputError("trajectory '" + name + "': time and angle counts differ");
+  }
   for (std::size_t k = 0; k < time_s.size(); ++k) {
     if (!std::isfinite(time_s[k])) {
       throw InputError("trajectory '" + name + "': time at sample " + std::to_string(k) + " is not a number");
@@ -98,51 +143,23 @@ Trajectory trajectory_from_samples(const std::string& name, const std::vector<do
                        format_number(sample_time_s) + " s: sample " + std::to_string(k) + " is at t = " +
                        format_number(time_s[k]) + " s, expected " + format_number(expected) + " s");
     }
-    trajectory.angle_rad(static_cast<Eigen::Index>(k)) = angle_deg[k] * kRadPerDeg;
+  }
+  Trajectory trajectory{name, sample_time_s, {}};
+  trajectory.more_joints_rad.resize(joint_angle_deg.size() - 1);
+  for (std::size_t j = 0; j < joint_angle_deg.size(); ++j) {
+    Eigen::VectorXd& angle_rad = j == 0 ? trajectory.angle_rad : trajectory.more_joints_rad[j - 1];
+    angle_rad = Eigen::Map<const Eigen::VectorXd>(joint_angle_deg[j].data(), static_cast<Eigen::Index>(time_s.size())) *
+                kRadPerDeg;
   }
   validate_trajectory(trajectory, limits);
   return trajectory;
 }
 
-std::vector<std::string> trajectory_library_names() { return {"paper", "steps", "sine"}; }
-
-std::string trajectory_library_description(const std::string& name) {
-  if (name == "paper") return "8 s, six 0.2 s moves between +-30 deg (the paper's reference)";
-  if (name == "steps") return "10 s, staircase 0 -> 20 -> 40 -> -20 -> -40 -> 0 deg, 0.3 s moves";
-  if (name == "sine") return "8 s, 30 deg amplitude at 0.5 Hz with a 1 s raised-cosine fade in and out";
-  throw InputError("unknown trajectory '" + name + "' (library: paper, steps, sine)");
-}
-
-Trajectory library_trajectory(const std::string& name, double sample_time_s) {
-  constexpr double kDuration = 0.2, kAccel = 12000.0;  // spec section 6
-  if (name == "paper") {
-    const std::vector<TrapezoidalMove> moves = {
-        {0.6, 0, 30, kDuration, kAccel},   {1.6, 30, -30, kDuration, kAccel}, {2.6, -30, 30, kDuration, kAccel},
-        {3.6, 30, -30, kDuration, kAccel}, {4.6, -30, 30, kDuration, kAccel}, {5.6, 30, 0, kDuration, kAccel}};
-    return trajectory_from_moves("paper", 0.0, moves, 8.0, sample_time_s);
-  }
-  if (name == "steps") {
-    constexpr double kSlow = 0.3, kSlowAccel = 4000.0;
-    const std::vector<TrapezoidalMove> moves = {
-        {0.5, 0, 20, kSlow, kSlowAccel},    {2.0, 20, 40, kSlow, kSlowAccel},  {3.5, 40, -20, kSlow, kSlowAccel},
-        {5.0, -20, -40, kSlow, kSlowAccel}, {6.5, -40, 0, kSlow, kSlowAccel}};
-    return trajectory_from_moves("steps", 0.0, moves, 10.0, sample_time_s);
-  }
-  if (name == "sine") {
-    constexpr double kDuration_s = 8.0, kAmplitude_deg = 30.0, kFrequency_Hz = 0.5, kFade_s = 1.0;
-    const int samples = static_cast<int>(std::lround(kDuration_s / sample_time_s));
-    Trajectory trajectory{"sine", sample_time_s, Eigen::VectorXd(samples + 1)};
-    for (int k = 0; k <= samples; ++k) {
-      const double t = k * sample_time_s;
-      const double edge = std::min(t, kDuration_s - t);
-      const double fade = edge >= kFade_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * edge / kFade_s));
-      trajectory.angle_rad(k) =
-          fade * kAmplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * kFrequency_Hz * t);
-    }
-    return trajectory;
-  }
-  trajectory_library_description(name);  // throws the "unknown trajectory" error
-  return {};
+void require_trajectory_joints(const Trajectory& trajectory, int arm_joints, const std::string& arm_source) {
+  if (trajectory.joints() == arm_joints) return;
+  throw InputError("trajectory '" + trajectory.name + "' has " + std::to_string(trajectory.joints()) + " joint" +
+                   (trajectory.joints() == 1 ? "" : "s") + "; the arm has " + std::to_string(arm_joints) + " (" +
+                   arm_source + ")");
 }
 
 }  // namespace bellows

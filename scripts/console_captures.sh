@@ -51,7 +51,7 @@ e2e_wait_for 'overlay: it 3'
 capture inspector
 e2e_keys Escape t
 e2e_wait_for 'Trajectories'
-e2e_keys Down Down Down Enter
+e2e_keys Down Down Down Down Down Enter  # past paper, steps, sine, paper2, paper3
 e2e_wait_for 'Trajectory file'
 e2e_keys -l "$E2E_DIR/wave.csv"
 e2e_keys Enter

@@ -33,18 +33,9 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
   const std::filesystem::path temporary = temporary_path_for(path);
   FileDescriptor fd(::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
   if (fd.get() < 0) fail("create", temporary, errno);
-  const char* data = contents.data();
-  std::size_t left = contents.size();
-  while (left > 0) {
-    const ssize_t written = ::write(fd.get(), data, left);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      const int error_number = errno;
-      ::unlink(temporary.c_str());
-      fail("write", temporary, error_number);
-    }
-    data += written;
-    left -= static_cast<std::size_t>(written);
+  if (const int error_number = write_all(fd.get(), contents); error_number != 0) {
+    ::unlink(temporary.c_str());
+    fail("write", temporary, error_number);
   }
   if (::fsync(fd.get()) != 0) {
     const int error_number = errno;

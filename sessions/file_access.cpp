@@ -15,7 +15,18 @@
 #include "sessions/atomic_file.hpp"
 
 namespace bellows {
+
 namespace fs = std::filesystem;
+
+bool is_inside(const fs::path& path, const fs::path& directory) {
+  std::error_code error;
+  const fs::path inner = fs::weakly_canonical(fs::absolute(path), error);
+  const fs::path outer = fs::weakly_canonical(fs::absolute(directory), error);
+  if (error) return false;
+  const fs::path relative = inner.lexically_relative(outer);
+  return !relative.empty() && *relative.begin() != "..";
+}
+
 namespace {
 
 std::string shown(const fs::path& path) { return printable(path.string(), kPrintableField); }
@@ -163,6 +174,21 @@ std::string read_regular_file(const fs::path& path, std::size_t max_bytes, const
   return read_bounded(fd.get(), max_bytes, where);
 }
 
+int write_all(int fd, std::string_view contents) {
+  const char* data = contents.data();
+  std::size_t left = contents.size();
+  while (left > 0) {
+    const ssize_t written = ::write(fd, data, left);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    data += written;
+    left -= static_cast<std::size_t>(written);
+  }
+  return 0;
+}
+
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
                           DirectorySync directory_sync) {
   const std::string temporary = temporary_path_for(name).filename().string();
@@ -177,17 +203,7 @@ void write_file_atomic_at(const DirectoryHandle& directory, const std::string& n
     const int error_number = errno;
     throw InputError("cannot create " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
   }
-  const char* data = contents.data();
-  std::size_t left = contents.size();
-  while (left > 0) {
-    const ssize_t written = ::write(fd.get(), data, left);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      fail("write", errno);
-    }
-    data += written;
-    left -= static_cast<std::size_t>(written);
-  }
+  if (const int error_number = write_all(fd.get(), contents); error_number != 0) fail("write", error_number);
   if (::fsync(fd.get()) != 0) fail("flush", errno);
   if (::close(fd.release()) != 0) fail("close", errno);
   if (::renameat(directory.fd(), temporary.c_str(), directory.fd(), name.c_str()) != 0) fail("rename", errno);

@@ -14,6 +14,10 @@
 
 namespace bellows {
 
+/// Whether `path` lies inside `directory`, both resolved (`..`, symbolic links): where an output
+/// would land inside a session it was made from.
+bool is_inside(const std::filesystem::path& path, const std::filesystem::path& directory);
+
 /// Closes a descriptor on every path out of a scope.
 class FileDescriptor {
  public:
@@ -78,6 +82,9 @@ std::string file_type_name(unsigned mode);
 
 /// Writes `name` in `directory` atomically: a hidden temporary file created exclusively (so never
 /// through a link), written, flushed, renamed over `name` (which replaces a link, never follows it).
+/// Writes all of `contents` to `fd`, again after an interrupted write(2): 0, or the errno that stopped it.
+int write_all(int fd, std::string_view contents);
+
 enum class DirectorySync { kNow, kLater /* the caller calls sync() once for a batch */ };
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
                           DirectorySync directory_sync = DirectorySync::kNow);

@@ -4,6 +4,7 @@
 
 #include "engine/errors.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/iteration_files.hpp"
 
@@ -32,16 +33,6 @@ std::string stacked(const std::string& key, const std::vector<std::string>& tabl
 
 fs::path sibling(const fs::path& path, const std::string& suffix) {
   return path.parent_path() / (path.stem().string() + suffix + path.extension().string());
-}
-
-/// Whether `path` lies inside `directory` (both resolved: `..`, symbolic links).
-bool is_inside(const fs::path& path, const fs::path& directory) {
-  std::error_code error;
-  const fs::path inner = fs::weakly_canonical(fs::absolute(path), error);
-  const fs::path outer = fs::weakly_canonical(fs::absolute(directory), error);
-  if (error) return false;
-  const fs::path relative = inner.lexically_relative(outer);
-  return !relative.empty() && *relative.begin() != "..";
 }
 
 }  // namespace

@@ -90,7 +90,11 @@ struct ConsoleFixture {
     env.core = &core;
     env.telemetry = &core.add_telemetry_tap(4096);
     env.config = config;
-    env.load_trajectory = [c](const std::string& name) { return resolve_trajectory(name, c.timing.sample_s(), c.trajectory); };
+    env.load_trajectory = [c](const std::string& name) {  // as app/console_command's: one joint so far
+      Trajectory trajectory = resolve_trajectory(name, c.timing.sample_s(), c.trajectory);
+      require_driven_joints(trajectory);
+      return trajectory;
+    };
     env.sessions = gateway != nullptr ? gateway : &sessions;
     env.stop_after_rises = stop_after_rises;
     env.write_figures = std::move(write_figures);

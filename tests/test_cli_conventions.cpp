@@ -26,7 +26,7 @@ TEST(CliConventions, VersionIsTheOneSessionsRecord) {
 const char* const kCommands[] = {"",           "run",          "sessions",     "sessions list", "sessions show",
                                  "sessions export", "sessions rm", "sessions rename", "sessions plot", "io-sim",
                                  "t7-sim",     "console",      "config",       "identify",      "rig",
-                                 "rig check"};
+                                 "rig check",  "trajectories"};
 
 TEST(CliConventions, HelpShowsWordsNotCodesOrBuildPaths) {
   for (const std::string command : kCommands) {

@@ -3,6 +3,7 @@
 // path, a bad trajectory file and a bad number each say why, and lose nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -66,7 +67,7 @@ TEST(UiInput, EmergencyStopFromEveryScreenAndEveryDialog) {
   expect_stop_from(f, "trajectory chooser", armed([&] { f.key('t'); }));
   expect_stop_from(f, "trajectory path dialog", armed([&] {
                      f.key('t');
-                     for (int i = 0; i < 3; ++i) f.key(key::kDown);
+                     for (std::size_t i = 0; i < trajectory_library_names().size(); ++i) f.key(key::kDown);  // to "from a file..."
                      f.key(key::kEnter);
                      ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
                    }));
@@ -163,6 +164,22 @@ TEST(UiInput, ABadKKeepsTheQuestionAndWhatWasTyped) {
   EXPECT_EQ(f.state().experiment.trials.size(), 3u);  // the good K ran: iterations 0..2 (docs/iterations.md)
 }
 
+TEST(UiInput, TheChooserListsMultiJointTrajectoriesAndSaysWhyNotYet) {
+  ConsoleFixture f;
+  f.key('t');
+  ASSERT_EQ(f.state().screen, Screen::kTrajectory);
+  const auto& names = f.state().chooser.names;
+  const auto paper2 = std::find(names.begin(), names.end(), "paper2");
+  ASSERT_NE(paper2, names.end());
+  EXPECT_TRUE(has(f.state().chooser.descriptions[static_cast<std::size_t>(paper2 - names.begin())], "2 joints"));
+  for (auto i = names.begin(); i != paper2; ++i) f.key(key::kDown);
+  EXPECT_FALSE(f.state().chooser.preview);
+  EXPECT_EQ(f.state().chooser.preview_error, "trajectory 'paper2' has 2 joints; the arm has 1 ([arm] preset)");
+  f.key(key::kEnter);  // nothing to use: the paper stays
+  EXPECT_EQ(f.state().screen, Screen::kTrajectory);
+  EXPECT_EQ(f.state().experiment.trajectory->name, "paper");
+}
+
 TEST(UiInput, BadTrajectoryPathsAndFilesSayWhyAndChangeNothing) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("ui_input_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -173,7 +190,7 @@ TEST(UiInput, BadTrajectoryPathsAndFilesSayWhyAndChangeNothing) {
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   f.key('t');
-  for (int i = 0; i < 3; ++i) f.key(key::kDown);
+  for (std::size_t i = 0; i < trajectory_library_names().size(); ++i) f.key(key::kDown);  // to "from a file..."
   f.key(key::kEnter);
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   f.key(key::kEnter);  // nothing typed

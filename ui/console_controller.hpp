@@ -131,6 +131,9 @@ class ConsoleController {
                    std::string input = {});
   void accept_input();
   void reject_input(std::string why);  // the prompt stays open with the input and the reason
+  /// y/Y closes the dialog and runs `on_yes`; n/N closes it with `status_on_no`; any other key leaves
+  /// it open with "... is not an answer here" (then returns false).
+  bool answer_yes_no(int key, const std::function<void()>& on_yes, const char* status_on_no);
   void not_an_answer(int key);
   void open_trajectory_chooser();
   void preview_selected_trajectory();

@@ -82,52 +82,21 @@ bool ConsoleController::handle_dialog_key(int k) {
   }
   switch (d.kind) {
     case DialogKind::kConfirmArm:
-      if (k == 'y' || k == 'Y') {
-        state_.dialog = {};
-        if (send_simple(CommandKind::kArm, "arm")) log(LogSource::kOperator, "arm");
-      } else if (k == 'n' || k == 'N') {
-        state_.dialog = {};
-        set_status("not armed");
-      } else {
-        not_an_answer(k);
-      }
+      answer_yes_no(k, [this] { if (send_simple(CommandKind::kArm, "arm")) log(LogSource::kOperator, "arm"); }, "not armed");
       return true;
     case DialogKind::kConfirmZeroAngle:
-      if (k == 'y' || k == 'Y') {
-        state_.dialog = {};
-        zero_angle();
-      } else if (k == 'n' || k == 'N') {
-        state_.dialog = {};
-        set_status("angle zero unchanged");
-      } else {
-        not_an_answer(k);
-      }
+      answer_yes_no(k, [this] { zero_angle(); }, "angle zero unchanged");
       return true;
     case DialogKind::kConfirmValveTest:
-      if (k == 'y' || k == 'Y') {
-        state_.dialog = {};
-        start_valve_test();
-      } else if (k == 'n' || k == 'N') {
-        state_.dialog = {};
-        set_status("valve test cancelled: no valve opened");
-      } else {
-        not_an_answer(k);
-      }
+      answer_yes_no(k, [this] { start_valve_test(); }, "valve test cancelled: no valve opened");
       return true;
-    case DialogKind::kConfirmDiscard:
-      if (k == 'y' || k == 'Y') {
-        state_.dialog = {};
-        auto action = std::move(pending_discard_action_);
-        pending_discard_action_ = nullptr;
-        if (action) action();
-      } else if (k == 'n' || k == 'N') {
-        state_.dialog = {};
-        pending_discard_action_ = nullptr;
-        set_status("cancelled");
-      } else {
-        not_an_answer(k);
-      }
+    case DialogKind::kConfirmDiscard: {
+      // Taken out before the answer: a "no" drops it, a "yes" runs it once.
+      auto action = std::move(pending_discard_action_);
+      pending_discard_action_ = nullptr;
+      if (!answer_yes_no(k, [&action] { if (action) action(); }, "cancelled")) pending_discard_action_ = std::move(action);
       return true;
+    }
     case DialogKind::kConfirmQuit:
       if (k == 's' && state_.sessions_available) {  // the autosave failed: try once more, then quit
         state_.dialog = {};
@@ -149,6 +118,20 @@ bool ConsoleController::handle_dialog_key(int k) {
     default:
       return true;
   }
+}
+
+bool ConsoleController::answer_yes_no(int k, const std::function<void()>& on_yes, const char* status_on_no) {
+  if (k == 'y' || k == 'Y') {
+    state_.dialog = {};
+    on_yes();
+  } else if (k == 'n' || k == 'N') {
+    state_.dialog = {};
+    set_status(status_on_no);
+  } else {
+    not_an_answer(k);
+    return false;  // still open
+  }
+  return true;
 }
 
 void ConsoleController::not_an_answer(int k) {
