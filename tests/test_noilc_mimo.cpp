@@ -234,7 +234,7 @@ TEST(NoilcMimo, SolveAllocatesNothing) {
     Eigen::MatrixXd out(kSamples, joints);
     {
       testing_allocations::Counter instrument;  // the counter sees an allocation: the instrument works
-      auto* probe = new int(1);
+      int* volatile probe = new int(1);  // volatile: else clang elides the new/delete pair
       EXPECT_EQ(instrument.allocations(), 1);
       delete probe;
     }
