@@ -20,6 +20,15 @@ class Counter {
   ~Counter() { counting.store(false); }
   long allocations() const { return count.load(); }
 };
+
+/// The allocations a Counter sees for one `new`: 1 when the instrument works.
+inline long probe_allocations() {
+  Counter counter;
+  int* volatile probe = new int(1);  // volatile: else the compiler may elide the new/delete pair (C++14 allows it)
+  const long seen = counter.allocations();
+  delete probe;
+  return seen;
+}
 }  // namespace bellows::testing_allocations
 
 void* operator new(std::size_t size) {
