@@ -7,11 +7,11 @@
 #include <utility>
 
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
 constexpr double kPaPerBar = 1e5;
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }  // namespace
 
 const char* to_string(SimulatedFault fault) {

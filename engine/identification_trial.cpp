@@ -7,10 +7,10 @@
 #include <sstream>
 
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 constexpr double kFade_s = 1.0;
 // Steps: each level change is a 0.15 s trapezoidal move at the paper's peak acceleration.
 constexpr double kStepMove_s = 0.15, kStepAcceleration_deg_per_s2 = 12000.0;

@@ -5,10 +5,10 @@
 #include <sstream>
 
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 std::string format_number(double value) {
   std::ostringstream out;

@@ -5,11 +5,10 @@
 
 #include "engine/errors.hpp"
 #include "engine/trajectory.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
-
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 // The paper's moves (reference-system.md section 6): 0.2 s trapezoids at 12000 deg/s^2 peak.
 constexpr double kPaperMove_s = 0.2, kPaperAcceleration_deg_per_s2 = 12000.0;

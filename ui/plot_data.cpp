@@ -2,9 +2,10 @@
 
 #include <numbers>
 
+#include "engine/units.hpp"
+
 namespace bellows::ui {
 namespace {
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 std::vector<double> to_vector(const Eigen::VectorXd& v, double scale, Eigen::Index count) {
   std::vector<double> out(static_cast<std::size_t>(count));
