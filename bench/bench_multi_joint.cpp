@@ -181,12 +181,12 @@ void BM_SimulatedArmSecond(benchmark::State& state) {
   for (auto _ : state) {
     for (int tick = 0; tick < 200; ++tick) {
       const SensorReading reading = arm.read_sensors();
-      angle_sum += reading.angle_rad;
+      angle_sum += reading.joint[0].angle_rad;
       const double t = reading.time_s;
       const double u = 0.5 * std::sin(3.0 * t) + 0.3 * std::sin(11.0 * t);
       ValveCommand command;
-      command.inlet_duty = {std::max(0.0, u), std::max(0.0, -u)};
-      command.outlet_duty = {std::max(0.0, -0.8 * u), std::max(0.0, 0.8 * u)};
+      command.joint[0].inlet_duty = {std::max(0.0, u), std::max(0.0, -u)};
+      command.joint[0].outlet_duty = {std::max(0.0, -0.8 * u), std::max(0.0, 0.8 * u)};
       arm.write_valves(command);
       arm.advance(0.005);
     }

@@ -65,9 +65,9 @@ TEST(PneumaticArmChain, OneJointWithoutGravityIsTheSingleJointSimulatedArm) {
     const PneumaticArmChain::Reading b = chain.read_sensors();
     ASSERT_EQ(a.time_s, b.time_s);
     ASSERT_EQ(a.supply_bar, b.supply_bar);  // the same noise, drawn in the same order
-    for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.chamber_bar[c], b.chamber_bar[0][c], 1e-9) << "tick " << tick;
-    if (a.angle_rad != b.angle_rad(0)) ++readings_differing;  // at most where the angle sits on a quantization edge
-    EXPECT_NEAR(a.angle_rad, b.angle_rad(0), 0.1 * std::numbers::pi / 180.0 + 1e-12);
+    for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.joint[0].chamber_bar[c], b.chamber_bar[0][c], 1e-9) << "tick " << tick;
+    if (a.joint[0].angle_rad != b.angle_rad(0)) ++readings_differing;  // at most where the angle sits on a quantization edge
+    EXPECT_NEAR(a.joint[0].angle_rad, b.angle_rad(0), 0.1 * std::numbers::pi / 180.0 + 1e-12);
     const SimulatedArm::State s = single.state();
     const PneumaticArmChain::State t = chain.state();
     ASSERT_NEAR(s.angle_rad, t.angle_rad(0), 1e-10) << "tick " << tick;
@@ -78,8 +78,8 @@ TEST(PneumaticArmChain, OneJointWithoutGravityIsTheSingleJointSimulatedArm) {
     largest_pressure_difference_bar = std::max(largest_pressure_difference_bar, std::abs(s.chamber_Pa[0] - s.chamber_Pa[1]) / 1e5);
     const BellowsDuties d = drive(0, a.time_s);
     ValveCommand command;
-    command.inlet_duty = d.inlet;
-    command.outlet_duty = d.outlet;
+    command.joint[0].inlet_duty = d.inlet;
+    command.joint[0].outlet_duty = d.outlet;
     single.write_valves(command);
     chain.write_valves(commands(duties, b.time_s));
     single.advance(kTick_s);
