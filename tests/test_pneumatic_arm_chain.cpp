@@ -206,7 +206,8 @@ TEST(PneumaticArmChain, CommandsAreClampedAndMisSizedOnesRefused) {
   std::vector<BellowsDuties> duties(2);
   duties[0] = {{1.7, std::nan("")}, {-0.3, std::nan("")}};
   arm.write_valves(duties);
-  const BellowsDuties& applied = arm.state().duties[0];
+  const PneumaticArmChain::State state = arm.state();  // by value: a reference into the temporary would dangle
+  const BellowsDuties& applied = state.duties[0];
   EXPECT_EQ(applied.inlet[0], 1.0);
   EXPECT_EQ(applied.inlet[1], 0.0);   // a non-finite inlet duty closes it
   EXPECT_EQ(applied.outlet[0], 0.0);
