@@ -61,9 +61,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   const LearningModel learning_model = choose_learning_model(config, config.device);
   config.model = learning_model.model;
   const double sample_s = config.timing.sample_s();
-  auto load_trajectory = [sample_s, limits = config.trajectory](const std::string& name_or_path) {
+  auto load_trajectory = [sample_s, limits = config.trajectory, arm = config.arm](const std::string& name_or_path) {
     Trajectory trajectory = resolve_trajectory(name_or_path, sample_s, limits);
-    require_driven_joints(trajectory);  // the --trajectory at start and every one the chooser offers
+    require_driven_joints(trajectory, arm);  // the --trajectory at start and every one the chooser offers
     return trajectory;
   };
 

@@ -148,13 +148,17 @@ DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParamete
   return d;
 }
 
+void require_driven_arm(const ArmParameters& arm) {
+  if (!arm.preset.empty()) {  // engine/pneumatic_arm_chain simulates it; no device drives it yet
+    throw InputError("[arm] preset = '" + arm.preset +
+                     "': arms of several joints do not run in the engine yet (issue 14); leave [arm] out for one joint");
+  }
+}
+
 std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const Configuration& config,
                                           std::uint64_t seed, RealtimeMode rt, std::int64_t session_id,
                                           const std::filesystem::path& config_dir) {
-  if (!config.arm.preset.empty()) {  // engine/pneumatic_arm_chain simulates it; no device drives it yet
-    throw InputError("[arm] preset = '" + config.arm.preset +
-                     "': arms of several joints do not run in the engine yet (issue 14); leave [arm] out for one joint");
-  }
+  require_driven_arm(config.arm);
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
     return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),

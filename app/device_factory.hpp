@@ -69,6 +69,9 @@ class OpenedDevice {
   virtual void stop() {}
 };
 
+/// Refuses, in one line, an arm the engine does not drive yet (an [arm] preset of several joints).
+void require_driven_arm(const ArmParameters& arm);
+
 /// Opens the device `device` names. `seed`: the simulated arm's noise; `rt`: the I/O thread's
 /// scheduling; `session_id`: the LCM session (0: a random one); `config_dir`: where a relative
 /// [lcm] key_file is found (the configuration file's folder). Throws InputError for bad options (and a

@@ -109,7 +109,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   const double sample_s = config.timing.sample_s();
   const Trajectory trajectory =
       resumed != nullptr ? resumed->trajectory : resolve_trajectory(options.trajectory, sample_s, config.trajectory);
-  require_driven_joints(trajectory);
+  require_driven_joints(trajectory, config.arm);
   const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<LearningLaw> law = make_learning_law(config, model, trajectory.learning_samples());

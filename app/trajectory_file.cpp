@@ -3,11 +3,12 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 #include <sstream>
 #include <vector>
 
+#include "app/device_factory.hpp"
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 #include "engine/printable_text.hpp"
 #include "sessions/file_access.hpp"
 
@@ -123,13 +124,13 @@ Trajectory parse_trajectory_csv(const std::string& text, const std::string& sour
   }
 }
 
-void require_driven_joints(const Trajectory& trajectory) {
+void require_driven_joints(const Trajectory& trajectory, const ArmParameters& arm) {
+  require_driven_arm(arm);  // an [arm] preset first: its joints are what the operator asked for
   constexpr int kDrivenJoints = 1;  // the engine's loop, readings and records are single-joint today
   require_trajectory_joints(trajectory, kDrivenJoints, "[arm] preset");
 }
 
 std::string trajectory_csv(const Trajectory& trajectory) {
-  constexpr double kDegPerRad = 180.0 / std::numbers::pi;
   std::string text = "time_s";
   if (trajectory.joints() == 1) {
     text += ",angle_deg";

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "engine/parameters.hpp"
 #include "engine/trajectory.hpp"
 
 namespace bellows {
@@ -23,7 +24,7 @@ Trajectory resolve_trajectory(const std::string& name_or_path, double sample_tim
 /// `bellows run` and the console drive one joint until the J-joint loop lands: a trajectory of
 /// several joints is refused with one line ("trajectory 'paper2' has 2 joints; the arm has 1
 /// ([arm] preset)") rather than one of its columns used in silence. Throws InputError.
-void require_driven_joints(const Trajectory& trajectory);
+void require_driven_joints(const Trajectory& trajectory, const ArmParameters& arm);
 
 /// The CSV text parse_trajectory_csv reads back: `time_s,angle_deg` for one joint, else
 /// `time_s,q1_deg,...`; angles in the shortest form that reads back to the same degrees.

@@ -92,7 +92,7 @@ struct ConsoleFixture {
     env.config = config;
     env.load_trajectory = [c](const std::string& name) {  // as app/console_command's: one joint so far
       Trajectory trajectory = resolve_trajectory(name, c.timing.sample_s(), c.trajectory);
-      require_driven_joints(trajectory);
+      require_driven_joints(trajectory, c.arm);
       return trajectory;
     };
     env.sessions = gateway != nullptr ? gateway : &sessions;
