@@ -187,6 +187,11 @@ int main(int argc, char** argv) {
   t7_sim_cmd->add_flag("--no-supply", t7_sim.no_supply, "Drill: the supply at ambient pressure");
   t7_sim_cmd->add_option("--silent-after", t7_sim.silent_after_s, "Drill: the link falls silent this many seconds after the first request")
       ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--stall-after", t7_sim.stall_after_s, "Drill: one answer comes late (--stall-s) this many seconds after the first request")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--stall-s", t7_sim.stall_s, "Drill: how late that answer comes")
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");

@@ -18,6 +18,7 @@
 #include "engine/engine_core.hpp"
 #include "engine/engine_driver.hpp"
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 #include "engine/valve_test.hpp"
 #include "sessions/session_store.hpp"
 #include "sessions/session_writer.hpp"
@@ -25,10 +26,6 @@
 namespace bellows {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-// Zeroing averages this many fresh readings (a tenth of a second at 200 Hz): the sensor's noise
-// averages out, the arm at rest does not move meanwhile.
-constexpr int kZeroingReadings = 20;
 
 std::string line_of(const char* pattern, auto... values) {
   char text[400];
@@ -60,17 +57,30 @@ void print_inputs(const RawInputs& raw, const SensorReading& r, const std::strin
   }
 }
 
-// The angle read now (the mean of kZeroingReadings fresh readings, the arm at rest where it should read zero)
-// becomes the profile's zero: the new zero is the old one plus what the device reads with it.
-nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const DeviceParameters& device, std::ostream& progress) {
+// The angle read now (the mean of `readings` fresh readings, the arm at rest where it should read zero)
+// becomes the profile's zero: the new zero is the old one plus what the device reads with it. A link
+// that brings no fresh reading for `patience_s` ends it: one line, the profile unchanged.
+nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const DeviceParameters& device, int readings,
+                              double patience_s, double tick_s, std::ostream& progress) {
   double sum_rad = 0.0;
   int count = 0;
   double last_time_s = -INFINITY;
+  const auto patience_ticks = static_cast<std::uint64_t>(std::ceil(patience_s / tick_s));
+  std::optional<std::uint64_t> fresh_tick;  // the engine's tick of the last fresh reading
   TickRecord tick;
-  while (count < kZeroingReadings) {
+  while (count < readings) {
     if (stop_requested().load(std::memory_order_relaxed)) throw InputError("--zero-angle stopped: the profile is unchanged");
     driver.await();
-    if (!driver.core().read_snapshot(tick) || !(tick.reading.time_s > last_time_s)) continue;  // fresh readings only
+    if (!driver.core().read_snapshot(tick)) continue;
+    if (!fresh_tick) fresh_tick = tick.tick;
+    if (!(tick.reading.time_s > last_time_s)) {  // fresh readings only
+      if (tick.tick - *fresh_tick > patience_ticks) {
+        throw EnvironmentError(line_of("--zero-angle: no fresh reading from %s for %.1f s ([t7] connect_timeout_s): the profile is unchanged",
+                                       rig.where().c_str(), patience_s));
+      }
+      continue;
+    }
+    fresh_tick = tick.tick;
     last_time_s = tick.reading.time_s;
     if (!std::isfinite(tick.reading.joint[0].angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
     sum_rad += tick.reading.joint[0].angle_rad;
@@ -182,7 +192,7 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   report["session"] = session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path());
   if (!session.path().empty()) progress << "session: " << session.path() << "\n";
   if (options.zero_angle) {
-    report["angle_zero"] = zero_the_angle(*driver, *rig, device, progress);
+    report["angle_zero"] = zero_the_angle(*driver, *rig, device, config.rig_check.zero_readings, config.t7.connect_timeout_s, config.timing.tick_s, progress);
     session.record("angle-zero", line_of("angle_zero_rad %.6f -> %.6f (the arm read %+.3f deg) in %s",
                                          report["angle_zero"]["previous_rad"].get<double>(),
                                          report["angle_zero"]["angle_zero_rad"].get<double>(),

@@ -35,6 +35,8 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   sim.swapped_chambers = options.swapped_chambers;
   sim.no_supply = options.no_supply;
   sim.silent_after_s = options.silent_after_s;
+  sim.stall_after_s = options.stall_after_s;
+  sim.stall_s = options.stall_s;
   if (!options.dead_valve.empty()) {
     for (ValveRole role : kValveRoles) {
       if (options.dead_valve == to_string(role)) sim.dead_valve = role;
@@ -47,6 +49,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (sim.dead_valve) out << "; drill: " << to_string(*sim.dead_valve) << " dead";
   if (sim.no_supply) out << "; drill: no supply";
   if (sim.silent_after_s >= 0.0) out << "; drill: silent after " << sim.silent_after_s << " s";
+  if (sim.stall_after_s >= 0.0) out << "; drill: one answer " << sim.stall_s << " s late after " << sim.stall_after_s << " s";
   out << std::endl;
   sched_param param{};
   param.sched_priority = kSimPriority;

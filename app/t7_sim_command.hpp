@@ -21,6 +21,8 @@ struct T7SimCommandOptions {
   std::string dead_valve;    // inlet_a, inlet_b, outlet_a, outlet_b
   bool no_supply = false;
   double silent_after_s = -1.0;
+  double stall_after_s = -1.0;
+  double stall_s = 0.05;
 };
 
 int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out);

@@ -93,6 +93,9 @@ bool ModbusClient::write_float(int address, double value) {
   return write(address, 2, r);
 }
 
-void ModbusClient::flush() { modbus_flush(context_); }
+bool ModbusClient::reconnect() {
+  modbus_close(context_);
+  return modbus_connect(context_) == 0 || failed();
+}
 
 }  // namespace bellows

@@ -30,8 +30,13 @@ class ModbusClient {
   bool write_u16(int address, std::uint16_t value);
   bool write_u32(int address, std::uint32_t value);
   bool write_float(int address, double value);
-  /// Drops whatever a late answer left in the socket, so the next request is not mistaken for it.
-  void flush();
+  /// After a failed request: closes the connection and opens a new one (waiting at most the
+  /// response timeout), so no answer to an older request can be taken for the next one's. False,
+  /// with last_error(), when it cannot; the next request then fails at once and may try again.
+  /// (Dropping what arrived is not enough: a server whose TCP holds an answer until the client's
+  /// next segment acknowledges the one before, as Nagle's algorithm does, hands each answer out
+  /// one request late, for good.)
+  bool reconnect();
 
   /// The last failure in words (a Modbus exception names its number).
   const std::string& last_error() const { return last_error_; }

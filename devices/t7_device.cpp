@@ -217,9 +217,6 @@ void T7Device::encode_duties(const ValveCommand& valves) {
 
 bool T7Device::exchange(const ValveCommand& valves) {
   encode_duties(valves);
-  // After a failure, an answer that came too late may still arrive: drop it before asking again,
-  // or it would be taken for the next answer.
-  if (!link_up_.load(std::memory_order_relaxed)) client_.flush();
   const double start = now_s();
   const bool ok = client_.write(t7::kDioEfConfigA(first_dio_), 2 * dio_span_, duty_registers_.data()) &&
                   client_.read(t7::kAin(0), ain_registers_, ain_buffer_.data());
@@ -227,7 +224,7 @@ bool T7Device::exchange(const ValveCommand& valves) {
   if (!ok) {
     bump(link_errors_);
     fail_link();
-    client_.flush();
+    client_.reconnect();  // a clean stream: the next request reads its own answer (or fails at once)
     return false;
   }
   record_round_trip((end - start) * 1e3);

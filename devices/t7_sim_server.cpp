@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <modbus/modbus.h>
 
@@ -144,6 +145,13 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
     status_.silent = true;  // the request is lost on the way: no answer, and the watchdog is not fed
     return;
   }
+  if (options_.stall_after_s >= 0.0 && status_.stalls == 0 && now - first_request_s_ >= options_.stall_after_s) {
+    ++status_.stalls;
+    char line[120];
+    std::snprintf(line, sizeof line, "t7-sim: this answer comes %.3f s late (drill)", options_.stall_s);
+    events(line);
+    std::this_thread::sleep_for(std::chrono::duration<double>(options_.stall_s));  // the requests meanwhile queue up
+  }
   const int header = modbus_get_header_length(context_);
   const int function = query_[static_cast<std::size_t>(header)];
   const int address = (query_[static_cast<std::size_t>(header + 1)] << 8) | query_[static_cast<std::size_t>(header + 2)];
@@ -239,12 +247,12 @@ void T7SimServer::write_status(double now, bool force) {
                 "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
                 "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
                 "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, "
-                "\"clients\": %d, \"silent\": %s, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], \"angle_rad\": %.6f, "
+                "\"clients\": %d, \"silent\": %s, \"stalls\": %d, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], \"angle_rad\": %.6f, "
                 "\"limits\": {\"pressure_ceiling_bar\": %.6f, \"angle_limit_rad\": %.6f, \"pressure_trips\": %d, \"angle_trips\": %d}}\n",
                 s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
                 s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
                 static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions), s.clients,
-                s.silent ? "true" : "false", 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1],
+                s.silent ? "true" : "false", s.stalls, 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1],
                 s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
                 s.angle_limit_trips);
   const std::string temporary = options_.status_path + ".tmp";

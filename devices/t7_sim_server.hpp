@@ -40,6 +40,8 @@ struct T7SimOptions {
   std::optional<ValveRole> dead_valve; // this valve pair never opens, whatever its line does
   bool no_supply = false;              // the supply at ambient pressure
   double silent_after_s = -1.0;        // >= 0: the link goes silent this long after the first request
+  double stall_after_s = -1.0;         // >= 0: this long after the first request, one answer comes late...
+  double stall_s = 0.05;               // ...by this long (the server stalls, as a busy network or T7 would)
   std::string status_path;             // "": no status file
   RigLimits limits;                    // the rig's own limits, enforced whatever the client writes
 };
@@ -59,6 +61,7 @@ struct T7SimStatus {
   std::uint64_t exceptions = 0;                 // answered with a Modbus exception
   int clients = 0;                              // connected now
   bool silent = false;
+  int stalls = 0;                               // answers held back by the stall drill
   std::array<double, kActuatorCount> chamber_bar{};  // the arm's true chamber pressures, A and B
   double angle_rad = 0.0;                       // the arm's true angle
   int pressure_limit_trips = 0;                 // times a chamber reached the ceiling and was vented

@@ -162,6 +162,7 @@ struct RigCheckParameters {
   double fill_s = 0.03;           // both inlets open before an outlet's test: air for the outlet to let out
   double valve_pulse_s = 0.03;    // the valve under test alone, fully open
   double min_change_bar = 0.01;   // a chamber "moved": at least this much, and this much more than the other
+  int zero_readings = 20;         // `--zero-angle` averages this many fresh readings (0.1 s at 200 Hz), the arm at rest
 };
 
 /// A LabJack T7 over Modbus TCP (docs/labjack-t7.md); the engine itself knows no Modbus.

@@ -7,13 +7,13 @@
 #include <numbers>
 
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 #include "sessions/csv_table.hpp"
 
 namespace bellows {
 namespace {
 
 // The engine's own conversion (engine/trajectory.cpp), so degrees read back bit for bit.
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // Times are k * T; a hand-edited or foreign file may round them.
 constexpr double kTimeTolerance_s = 1e-6;
 

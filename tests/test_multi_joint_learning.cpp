@@ -15,12 +15,12 @@
 #include "engine/noilc_mimo.hpp"
 #include "engine/pid_controller.hpp"
 #include "engine/trajectory.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
 
 constexpr double kSampleTime_s = 0.02;
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 /// paper2 and paper3 of ../shared/spec/multi-joint.md section 3: the shoulder 0 -> 20 -> -20 -> 20 -> 0
 /// deg with 0.3 s moves at 0.6, 2.0, 3.4, 4.8 s; the elbow the paper's trajectory; for paper3 the

@@ -13,6 +13,7 @@
 #include "sessions/iteration_files.hpp"
 #include "sessions/json_reader.hpp"
 #include "tests/test_support.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
@@ -69,7 +70,6 @@ TEST(CsvTable, AcceptsWindowsLineEndsAndSpaces) {
 }
 
 TEST(ExactDegrees, ReadBackToTheSameRadiansAndPreferShortDecimals) {
-  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
   EXPECT_EQ(degrees_for_exact_radians(30.0 * kRadPerDeg), 30.0);
   EXPECT_EQ(degrees_for_exact_radians(-28.4 * kRadPerDeg), -28.4);
   int exact = 0, total = 0;

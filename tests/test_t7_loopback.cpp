@@ -325,6 +325,26 @@ TEST(T7Loopback, ADeadLinkStopsTheReadingsAndSaysWhichLink) {
   EXPECT_GT(device.health().stale_readings, 0u);
 }
 
+// One answer comes late (a busy network or T7): its request times out, and the answers queued
+// behind it arrive in a burst. The link drops them and answers again by itself, each request with
+// its own answer. (Dropping at once, before they landed, left it one answer behind for good: every
+// answer refused for its transaction id, no fresh reading ever again; CI met it as a hung zeroing.)
+TEST(T7Loopback, ALateAnswerIsDroppedAndTheLinkAnswersAgain) {
+  T7SimOptions options;
+  options.stall_after_s = 0.2;
+  options.stall_s = 0.3;  // six of the device's response timeouts
+  SimThread sim(options);
+  T7Device device(device_options(sim.port()));
+  ASSERT_TRUE(eventually([&] { return device.health().link_errors > 0; })) << "the late answer timed out";
+  ASSERT_TRUE(eventually([&] { return device.health().connected; })) << device.link_error();
+  EXPECT_EQ(sim.status().stalls, 1);
+  const DeviceHealth after_stall = device.health();
+  const double time_s = device.read_sensors().time_s;
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > after_stall.exchanges + 50; }));
+  EXPECT_EQ(device.health().link_errors, after_stall.link_errors) << "every request reads its own answer again";
+  EXPECT_GT(device.read_sensors().time_s, time_s) << "fresh readings";
+}
+
 TEST(T7Loopback, AnAddressWhereNothingListensIsAnEnvironmentError) {
   int port = 0;
   {

@@ -311,6 +311,36 @@ TEST_F(T7Processes, ZeroingTheAngleWritesTheProfileAndTheArmThenReadsZero) {
   EXPECT_NE(builtin.err.find("--rig-profile FILE"), std::string::npos) << builtin.err;
 }
 
+// A late answer mid-zeroing (t7-sim's stall drill; CI's loaded machine met one): the link drops the
+// answers that came late and answers again, and the zeroing goes on to write the profile.
+TEST_F(T7Processes, ZeroingRidesOutALateAnswer) {
+  auto sim = start_sim({"--stall-after", "0.3", "--stall-s", "0.2"});
+  const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", paper_profile_text());
+  const std::filesystem::path config = testing::write_file(dir_, "slow-zero.toml", "[rig_check]\nzero_readings = 200\n");
+  const testing::ProcessResult r = run_cli({"rig", "check", "--zero-angle", "--json", "--device", "t7", "--t7", address_,
+                                            "--rig-profile", profile.string(), "--rt", "off", "--config", config.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["angle_zero"]["readings"], 200);
+  EXPECT_NE(r.err.find("answers again"), std::string::npos) << r.err;
+  EXPECT_NE(text_of(profile).find("# zeroed by bellows"), std::string::npos);
+  EXPECT_EQ(status()["stalls"], 1);
+}
+
+// A link that falls silent mid-zeroing ends it after [t7] connect_timeout_s without a fresh
+// reading: one line, exit 4, the profile as it was (it used to wait for ever).
+TEST_F(T7Processes, ZeroingEndsWhenTheLinkFallsSilentAndLeavesTheProfile) {
+  auto sim = start_sim({"--silent-after", "0.3"});
+  const std::string text = paper_profile_text();
+  const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", text);
+  const std::filesystem::path config = testing::write_file(
+      dir_, "endless-zero.toml", "[rig_check]\nzero_readings = 1000000\n[t7]\nconnect_timeout_s = 0.5\n");
+  const testing::ProcessResult r = run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_,
+                                            "--rig-profile", profile.string(), "--rt", "off", "--config", config.string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("--zero-angle: no fresh reading from " + address_ + " for 0.5 s"), std::string::npos) << r.err;
+  EXPECT_EQ(text_of(profile), text);
+}
+
 // `identify --write-model PROFILE`: a rig profile (it has [valves]) gets the fit in its [model],
 // which the profile then carries (the simulated arm's identification: the file path is the same
 // for every device).
