@@ -1,35 +1,74 @@
 #include "engine/control_core.hpp"
 
+#include <algorithm>
 #include <numbers>
 
 namespace bellows {
 
 ControlCore::ControlCore(const ControllerParameters& controller, const TimingParameters& timing)
-    : controller_(controller),
-      timing_(timing),
-      pid_(controller, timing.sample_s()),
-      pressure_a_(controller),
-      pressure_b_(controller) {
-  setpoints_ = map_setpoints(0.0, controller.gas.ambient_bar, controller.p_max_bar);
+    : controller_(controller), timing_(timing) {
+  loops_.reserve(kMaxJoints);
+  for (int j = 0; j < kMaxJoints; ++j) {
+    loops_.push_back(JointLoop{PidController(controller, timing.sample_s()), PressureController(controller),
+                               PressureController(controller), {}});
+    reset_loop(loops_.back());
+  }
 }
 
-void ControlCore::hold(double angle_rad) {
-  hold_rad_ = angle_rad;
+void ControlCore::reset_loop(JointLoop& l) const {
+  l.pid.reset();
+  l.pressure_a.reset();
+  l.pressure_b.reset();
+  l.setpoints = map_setpoints(0.0, controller_.gas.ambient_bar, controller_.p_max_bar);
+  l.hold_rad = l.desired_rad = l.u_total_bar = 0.0;
+}
+
+void ControlCore::use_joints(int joints) {
+  joints_ = std::clamp(joints, 1, kMaxJoints);  // callers pass 1..kMaxJoints; never index beyond
+  for (int j = joints_; j < kMaxJoints; ++j) reset_loop(loop(j));
+}
+
+void ControlCore::reset_pids() {
+  for (JointLoop& l : loops_) l.pid.reset();
+}
+
+void ControlCore::hold(double angle_rad) { hold(JointVector::Constant(1, angle_rad)); }
+
+void ControlCore::hold(const JointVector& angles_rad) {
+  use_joints(static_cast<int>(angles_rad.size()));
+  for (int j = 0; j < joints_; ++j) loop(j).hold_rad = angles_rad(j);
   trajectory_ = nullptr;
 }
 
 void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction_bar, TrialRecord& record) {
-  record.prepare(trajectory.learning_samples(), timing_.ticks_per_sample);
+  start(trajectory, correction_bar.data(), correction_bar.size(), 1, record);
+}
+
+void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::MatrixXd& correction_bar, TrialRecord& record) {
+  start(trajectory, correction_bar.data(), correction_bar.rows(), correction_bar.cols(), record);
+}
+
+void ControlCore::start(const Trajectory& trajectory, const double* correction_bar, Eigen::Index rows,
+                        Eigen::Index columns, TrialRecord& record) {
+  use_joints(trajectory.joints());
+  record.prepare(trajectory.learning_samples(), timing_.ticks_per_sample, joints_);
   trajectory_ = &trajectory;
-  correction_ = &correction_bar;
+  correction_ = correction_bar;
+  correction_rows_ = rows;
+  correction_columns_ = columns;
   record_ = &record;
   sample_ = 0;
   tick_in_sample_ = 0;
   tick_in_trial_ = 0;
 }
 
+double ControlCore::correction_bar(int sample, int joint) const {
+  if (sample >= correction_rows_ || joint >= correction_columns_) return 0.0;
+  return correction_[joint * correction_rows_ + sample];
+}
+
 void ControlCore::abort_trial() {
-  hold_rad_ = desired_rad_;
+  for (int j = 0; j < joints_; ++j) loop(j).hold_rad = loop(j).desired_rad;
   trajectory_ = nullptr;
 }
 
@@ -38,84 +77,117 @@ void ControlCore::set_controller_gains(const ControllerParameters& params) {
   controller_.k_p = params.k_p;
   controller_.k_i_per_s = params.k_i_per_s;
   controller_.k_d_s = params.k_d_s;
-  pid_.set_gains(controller_);
+  for (JointLoop& l : loops_) l.pid.set_gains(controller_);
 }
 
 ControlCore::State ControlCore::state() const {
-  return {pid_.state(), pressure_a_.state(), pressure_b_.state(), setpoints_, hold_rad_, desired_rad_, u_total_bar_,
-          tick_in_sample_};
+  const JointLoop& first = loops_.front();
+  State s{first.pid.state(), first.pressure_a.state(), first.pressure_b.state(), first.setpoints, first.hold_rad,
+          first.desired_rad, first.u_total_bar, tick_in_sample_, joints_, {}};
+  for (int j = 1; j < joints_; ++j) {
+    const JointLoop& l = loop(j);
+    s.more_joints[static_cast<std::size_t>(j - 1)] = {l.pid.state(), l.pressure_a.state(), l.pressure_b.state(),
+                                                      l.setpoints, l.hold_rad, l.desired_rad, l.u_total_bar};
+  }
+  return s;
 }
 
 void ControlCore::set_state(const State& state) {
   trajectory_ = nullptr;
-  pid_.set_state(state.pid);
-  pressure_a_.set_state(state.pressure_a);
-  pressure_b_.set_state(state.pressure_b);
-  setpoints_ = state.setpoints;
-  hold_rad_ = state.hold_rad;
-  desired_rad_ = state.desired_rad;
-  u_total_bar_ = state.u_total_bar;
+  use_joints(state.joints);
+  JointLoop& first = loops_.front();
+  first.pid.set_state(state.pid);
+  first.pressure_a.set_state(state.pressure_a);
+  first.pressure_b.set_state(state.pressure_b);
+  first.setpoints = state.setpoints;
+  first.hold_rad = state.hold_rad;
+  first.desired_rad = state.desired_rad;
+  first.u_total_bar = state.u_total_bar;
+  for (int j = 1; j < joints_; ++j) {
+    const JointState& from = state.more_joints[static_cast<std::size_t>(j - 1)];
+    JointLoop& l = loop(j);
+    l.pid.set_state(from.pid);
+    l.pressure_a.set_state(from.pressure_a);
+    l.pressure_b.set_state(from.pressure_b);
+    l.setpoints = from.setpoints;
+    l.hold_rad = from.hold_rad;
+    l.desired_rad = from.desired_rad;
+    l.u_total_bar = from.u_total_bar;
+  }
   tick_in_sample_ = state.tick_in_sample;
 }
 
 void ControlCore::run_sample(const SensorReading& reading) {
-  const double measured = reading.joint[0].angle_rad / std::numbers::pi;
-  double u_ilc = 0.0;
-  if (trajectory_ != nullptr) {
-    const int k = sample_;
-    desired_rad_ = trajectory_->angle_rad(k);
-    TrialSamples& s = record_->samples;
-    s.time_s(k) = k * trajectory_->sample_time_s;
-    s.setpoint_rad(k) = desired_rad_;
-    s.angle_rad(k) = reading.joint[0].angle_rad;
-    s.error_rad(k) = k == 0 ? 0.0 : desired_rad_ - reading.joint[0].angle_rad;
-    s.pressure_a_bar(k) = reading.joint[0].chamber_bar[0];
-    s.pressure_b_bar(k) = reading.joint[0].chamber_bar[1];
-    if (k < trajectory_->learning_samples()) u_ilc = (*correction_)(k);
-  } else {
-    desired_rad_ = hold_rad_;
-  }
-  const double u_pid = pid_.step(desired_rad_ / std::numbers::pi, measured, setpoints_.saturation_sign);
-  u_total_bar_ = u_pid + u_ilc;
-  setpoints_ = map_setpoints(u_total_bar_, controller_.gas.ambient_bar, controller_.p_max_bar);
-  if (trajectory_ != nullptr) {
-    TrialSamples& s = record_->samples;
-    s.u_pid_bar(sample_) = u_pid;
-    s.u_ilc_bar(sample_) = u_ilc;
-    s.u_total_bar(sample_) = u_total_bar_;
-    s.setpoint_a_bar(sample_) = setpoints_.a_bar;
-    s.setpoint_b_bar(sample_) = setpoints_.b_bar;
-    if (sample_ == trajectory_->learning_samples()) {
-      record_->complete = true;
-      hold(trajectory_->angle_rad(sample_));
+  const bool recording = trajectory_ != nullptr;
+  const int k = sample_;
+  for (int j = 0; j < joints_; ++j) {
+    JointLoop& c = loop(j);
+    const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
+    const double measured = r.angle_rad / std::numbers::pi;
+    double u_ilc = 0.0;
+    if (recording) {
+      c.desired_rad = trajectory_->joint_angle_rad(j)(k);
+      TrialSamples& s = record_->joint_samples(j);
+      s.time_s(k) = k * trajectory_->sample_time_s;
+      s.setpoint_rad(k) = c.desired_rad;
+      s.angle_rad(k) = r.angle_rad;
+      s.error_rad(k) = k == 0 ? 0.0 : c.desired_rad - r.angle_rad;
+      s.pressure_a_bar(k) = r.chamber_bar[0];
+      s.pressure_b_bar(k) = r.chamber_bar[1];
+      if (k < trajectory_->learning_samples()) u_ilc = correction_bar(k, j);
+    } else {
+      c.desired_rad = c.hold_rad;
     }
+    const double u_pid = c.pid.step(c.desired_rad / std::numbers::pi, measured, c.setpoints.saturation_sign);
+    c.u_total_bar = u_pid + u_ilc;
+    c.setpoints = map_setpoints(c.u_total_bar, controller_.gas.ambient_bar, controller_.p_max_bar);
+    if (recording) {
+      TrialSamples& s = record_->joint_samples(j);
+      s.u_pid_bar(k) = u_pid;
+      s.u_ilc_bar(k) = u_ilc;
+      s.u_total_bar(k) = c.u_total_bar;
+      s.setpoint_a_bar(k) = c.setpoints.a_bar;
+      s.setpoint_b_bar(k) = c.setpoints.b_bar;
+    }
+  }
+  if (recording && k == trajectory_->learning_samples()) {
+    record_->complete = true;
+    hold(trajectory_->setpoint_rad(k));
   }
 }
 
 ValveCommand ControlCore::tick(const SensorReading& reading) {
+  // A reading of another arm: nothing of it may drive these controllers (see the header).
+  if (reading.joint_count != joints_) return ValveCommand::vented(joints_);
   if (tick_in_sample_ == 0) run_sample(reading);
   const bool recording = trajectory_ != nullptr;
-  const DutyCycles a = pressure_a_.step(setpoints_.a_bar, reading.joint[0].chamber_bar[0], reading.supply_bar);
-  const DutyCycles b = pressure_b_.step(setpoints_.b_bar, reading.joint[0].chamber_bar[1], reading.supply_bar);
   ValveCommand command;
-  command.joint[0].inlet_duty = {a.inlet, b.inlet};
-  command.joint[0].outlet_duty = {a.outlet, b.outlet};
-  if (recording) {
-    TrialTicks& t = record_->ticks;
-    const int i = tick_in_trial_;
-    t.time_s(i) = i * timing_.tick_s;
-    t.angle_rad(i) = reading.joint[0].angle_rad;
-    t.pressure_a_bar(i) = reading.joint[0].chamber_bar[0];
-    t.pressure_b_bar(i) = reading.joint[0].chamber_bar[1];
-    t.supply_bar(i) = reading.supply_bar;
-    t.setpoint_a_bar(i) = setpoints_.a_bar;
-    t.setpoint_b_bar(i) = setpoints_.b_bar;
-    t.inlet_a(i) = a.inlet;
-    t.outlet_a(i) = a.outlet;
-    t.inlet_b(i) = b.inlet;
-    t.outlet_b(i) = b.outlet;
-    ++tick_in_trial_;
+  command.joint_count = joints_;
+  for (int j = 0; j < joints_; ++j) {
+    JointLoop& c = loop(j);
+    const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
+    const DutyCycles a = c.pressure_a.step(c.setpoints.a_bar, r.chamber_bar[0], reading.supply_bar);
+    const DutyCycles b = c.pressure_b.step(c.setpoints.b_bar, r.chamber_bar[1], reading.supply_bar);
+    JointValves& valves = command.joint[static_cast<std::size_t>(j)];
+    valves.inlet_duty = {a.inlet, b.inlet};
+    valves.outlet_duty = {a.outlet, b.outlet};
+    if (recording) {
+      TrialTicks& t = record_->joint_ticks(j);
+      const int i = tick_in_trial_;
+      t.time_s(i) = i * timing_.tick_s;
+      t.angle_rad(i) = r.angle_rad;
+      t.pressure_a_bar(i) = r.chamber_bar[0];
+      t.pressure_b_bar(i) = r.chamber_bar[1];
+      t.supply_bar(i) = reading.supply_bar;
+      t.setpoint_a_bar(i) = c.setpoints.a_bar;
+      t.setpoint_b_bar(i) = c.setpoints.b_bar;
+      t.inlet_a(i) = a.inlet;
+      t.outlet_a(i) = a.outlet;
+      t.inlet_b(i) = b.inlet;
+      t.outlet_b(i) = b.outlet;
+    }
   }
+  if (recording) ++tick_in_trial_;
   if (++tick_in_sample_ == timing_.ticks_per_sample) {
     tick_in_sample_ = 0;
     if (trajectory_ != nullptr) ++sample_;

@@ -57,7 +57,53 @@ void EngineCore::hand_back_trial(EventKind kind, double now_s) {
   emit(event);
   record_ = nullptr;
   correction_ = nullptr;
+  joint_correction_ = nullptr;
   if (control_.trial_running()) control_.abort_trial();
+}
+
+void EngineCore::start_control_trial() {
+  if (joint_correction_ != nullptr) {
+    control_.start_trial(*trajectory_, *joint_correction_, *record_);
+  } else {
+    control_.start_trial(*trajectory_, *correction_, *record_);
+  }
+}
+
+const char* EngineCore::trial_refusal(const EngineCommand& command) const {
+  const char* not_prepared = "the trial's trajectory, correction or record is missing or not prepared to its length";
+  const Trajectory* trajectory = command.trajectory;
+  const TrialRecord* record = command.record;
+  if (trajectory == nullptr || record == nullptr || (command.correction == nullptr) == (command.joint_correction == nullptr)) {
+    return not_prepared;
+  }
+  if (const char* why = trajectory_refusal(*trajectory)) return why;
+  const int joints = trajectory->joints();
+  const int n = trajectory->learning_samples();
+  if (command.correction != nullptr && command.correction->size() != n) return not_prepared;
+  if (command.correction != nullptr ? joints != 1
+                                    : command.joint_correction->rows() != n || command.joint_correction->cols() != joints) {
+    return "the trial's correction is not one column of N values per joint of its trajectory";
+  }
+  if (record->joints() != joints || static_cast<int>(record->more_joint_ticks.size()) != joints - 1) {
+    return "the trial's record is not prepared for the joints of its trajectory";
+  }
+  for (int j = 0; j < joints; ++j) {
+    if (record->joint_samples(j).time_s.size() != n + 1 ||
+        record->joint_ticks(j).time_s.size() != static_cast<Eigen::Index>(n) * timing_.ticks_per_sample) {
+      return not_prepared;
+    }
+  }
+  return nullptr;
+}
+
+const char* EngineCore::trajectory_refusal(const Trajectory& trajectory) {
+  if (!valid_joint_count(trajectory.joints())) return "the trajectory has more joints than bellows drives";
+  for (int j = 0; j < trajectory.joints(); ++j) {
+    if (trajectory.joint_angle_rad(j).size() != trajectory.angle_rad.size() || trajectory.angle_rad.size() == 0) {
+      return "the trajectory's joints do not all have the same number of samples";
+    }
+  }
+  return nullptr;
 }
 
 void EngineCore::hold_trajectory(const Trajectory* trajectory, double now_s) {
@@ -113,8 +159,12 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       enter_fault(FaultCode::kEmergencyStop, now_s);
       return;
     case CommandKind::kSelectTrajectory:
+      if (const char* why = command.trajectory != nullptr ? trajectory_refusal(*command.trajectory) : nullptr) {
+        refuse(why);
+        return;
+      }
       hold_trajectory(command.trajectory, now_s);
-      if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->angle_rad(0));
+      if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->setpoint_rad(0));
       return;
     case CommandKind::kSetGains: {
       ControllerParameters gains = controller_;
@@ -134,34 +184,35 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       return;
     case CommandKind::kArm: {
       manual_ = false;
-      // Fresh controllers, holding the trajectory's start (or where the arm is, without one).
-      control_.pid().reset();
-      const double hold = trajectory_ != nullptr ? trajectory_->angle_rad(0) : last_angle_rad_;
-      control_.hold(hold);
+      // Fresh controllers, holding the trajectory's start (or where the arm is, without one: one joint).
+      control_.reset_pids();
+      if (trajectory_ != nullptr) {
+        control_.hold(trajectory_->setpoint_rad(0));
+      } else {
+        control_.hold(last_angle_rad_);
+      }
       last_heartbeat_s_ = wall_s;
       break;
     }
     case CommandKind::kStartTrial:
       // The sender sizes the record (TrialRecord::prepare) so that the loop never allocates.
-      if (command.trajectory == nullptr || command.correction == nullptr || command.record == nullptr ||
-          command.correction->size() != command.trajectory->learning_samples() ||
-          command.record->samples.time_s.size() != command.trajectory->learning_samples() + 1 ||
-          command.record->ticks.time_s.size() != command.trajectory->learning_samples() * timing_.ticks_per_sample) {
-        refuse("the trial's trajectory, correction or record is missing or not prepared to its length");
+      if (const char* why = trial_refusal(command)) {
+        refuse(why);
         return;
       }
       if (manual_) {  // back from the operator's valves: fresh controllers
         manual_ = false;
-        control_.pid().reset();
+        control_.reset_pids();
       }
       hold_trajectory(command.trajectory, now_s);
       correction_ = command.correction;
+      joint_correction_ = command.joint_correction;
       record_ = command.record;
       record_->complete = false;  // the engine owns the record from now on
       trial_id_ = command.trial_id;
       settle_remaining_ = command.settle_ticks;
-      control_.hold(trajectory_->angle_rad(0));
-      if (settle_remaining_ <= 0) control_.start_trial(*trajectory_, *correction_, *record_);
+      control_.hold(trajectory_->setpoint_rad(0));
+      if (settle_remaining_ <= 0) start_control_trial();
       break;
     case CommandKind::kAbortTrial:
     case CommandKind::kDisarm:
@@ -218,6 +269,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   if (valves_live(state())) {
     GuardInputs inputs;
     inputs.p_max_bar = controller_.p_max_bar;
+    inputs.joint_count = joints();
     inputs.stale_count = stale_count_;
     inputs.missed_streak = time_follows_ticks_ ? 0 : missed_streak_;
     inputs.heartbeat_age_s = monitor_heartbeat_.load(std::memory_order_relaxed) ? wall_s - last_heartbeat_s_ : 0.0;
@@ -228,7 +280,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   ValveCommand valves = ValveCommand::vented();
   if (valves_live(state())) {
     if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
-      control_.start_trial(*trajectory_, *correction_, *record_);
+      start_control_trial();
     }
     if (manual_) {
       // The pulse's ticks, then `after`; its end is reported after `settle_ticks` of `after` (the
@@ -269,6 +321,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
       emit(event);
       record_ = nullptr;
       correction_ = nullptr;
+      joint_correction_ = nullptr;
       change_state(EngineState::kArmed, now_s, CommandKind::kStartTrial);
     }
   } else {

@@ -78,6 +78,9 @@ class EngineCore {
   /// call when the loop is not running.
   void vent_now();
 
+  /// The joints the engine drives: its trajectory's (one without a trajectory). The guards fault
+  /// on a reading of another joint count.
+  int joints() const { return trajectory_ != nullptr ? trajectory_->joints() : 1; }
   /// The control scheme (for restoring a saved state before the loop starts).
   ControlCore& control() { return control_; }
   /// Before the first tick: ARMED, the control scheme in `state` (from a saved session), as if the
@@ -93,6 +96,12 @@ class EngineCore {
   void count_missed_deadlines(int missed, double now_s);
   void hold_trajectory(const Trajectory* trajectory, double now_s);
   void hand_back_trial(EventKind kind, double now_s);
+  void start_control_trial();
+  /// Why a kStartTrial's buffers cannot run its trial (static text), or nullptr when they can.
+  const char* trial_refusal(const EngineCommand& command) const;
+  /// Why a trajectory cannot be held or run (a joint count beyond kMaxJoints, joints of unequal
+  /// length: the tick would index beyond them), or nullptr.
+  static const char* trajectory_refusal(const Trajectory& trajectory);
   void emit(const EngineEvent& event);
 
   Device& device_;
@@ -119,7 +128,8 @@ class EngineCore {
 
   // Loop-thread state.
   const Trajectory* trajectory_ = nullptr;
-  const Eigen::VectorXd* correction_ = nullptr;
+  const Eigen::VectorXd* correction_ = nullptr;        // one joint's correction, or ...
+  const Eigen::MatrixXd* joint_correction_ = nullptr;  // ... every joint's (N x J)
   TrialRecord* record_ = nullptr;
   std::uint32_t trial_id_ = 0;
   int settle_remaining_ = 0;

@@ -36,9 +36,11 @@ struct ValvePulse {
 struct EngineCommand {
   CommandKind kind = CommandKind::kHeartbeat;
   const Trajectory* trajectory = nullptr;       // kSelectTrajectory, kStartTrial
-  const Eigen::VectorXd* correction = nullptr;  // kStartTrial: u_ilc(0..N-1), bar
+  const Eigen::VectorXd* correction = nullptr;  // kStartTrial: u_ilc(0..N-1), bar (one joint)
+  const Eigen::MatrixXd* joint_correction = nullptr;  // kStartTrial instead, for J joints: N x J, bar
   TrialRecord* record = nullptr;                // kStartTrial: where the trial is written, prepared
                                                 // (TrialRecord::prepare) to the trajectory's length
+                                                // and joint count
   int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
   std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
   PidGains gains{};                             // kSetGains
@@ -56,6 +58,17 @@ struct EngineCommand {
     EngineCommand c = of(CommandKind::kStartTrial);
     c.trajectory = &trajectory;
     c.correction = &correction;
+    c.record = &record;
+    c.settle_ticks = settle_ticks;
+    c.trial_id = trial_id;
+    return c;
+  }
+  /// A trial of the trajectory's J joints, `correction` one column per joint (N x J).
+  static EngineCommand start_trial(const Trajectory& trajectory, const Eigen::MatrixXd& correction, TrialRecord& record,
+                                   int settle_ticks, std::uint32_t trial_id) {
+    EngineCommand c = of(CommandKind::kStartTrial);
+    c.trajectory = &trajectory;
+    c.joint_correction = &correction;
     c.record = &record;
     c.settle_ticks = settle_ticks;
     c.trial_id = trial_id;
@@ -107,9 +120,9 @@ struct TickRecord {
   EngineState state = EngineState::kSafe;
   FaultCode fault = FaultCode::kNone;
   SensorReading reading{};
-  double desired_angle_rad = 0.0;
-  double u_total_bar = 0.0;
-  ChamberSetpoints setpoints{};
+  double desired_angle_rad = 0.0;  // joint 1's (the reading and the valves carry every joint)
+  double u_total_bar = 0.0;        // joint 1's
+  ChamberSetpoints setpoints{};    // joint 1's
   ValveCommand valves{};
   int sample = -1;  // ILC sample of the running trial, -1 otherwise
   std::uint32_t trial_id = 0;
