@@ -10,7 +10,8 @@
 // One RK4 integration of all 5J states (angle, rate, creep and two chamber pressures per joint) at
 // the fixed internal step, the steps ending on every valve's switching edges. Deterministic for a
 // seed; state() written back with set_state() resumes bit for bit. Parameters are set up once in
-// the constructor; the step allocates nothing (fixed-capacity vectors). No Device interface yet.
+// the constructor; the step allocates nothing (fixed-capacity vectors). devices/simulated_arm_chain
+// puts it behind the engine's Device interface.
 #pragma once
 
 #include <array>

@@ -1,7 +1,10 @@
 // Proves the loop allocates nothing once running: global operator new is counted while ticks run
-// (holding, a whole trial with telemetry taps, a fault and its black box, a reset).
+// (holding, a whole trial with telemetry taps, a fault and its black box, a reset), with one joint
+// and with the three joints of the simulated arm3 chain.
 #include <gtest/gtest.h>
 
+#include "devices/simulated_arm_chain.hpp"
+#include "engine/pneumatic_arm_chain_parameters.hpp"
 #include "tests/allocation_counter.hpp"
 #include "tests/engine_fixture.hpp"
 
@@ -39,6 +42,41 @@ TEST(EngineAllocations, TicksAllocateNothing) {
     allocations = counter.allocations();
   }
   EXPECT_TRUE(record.complete);
+  EXPECT_GT(tap.read_available(), 1000u);
+  EXPECT_EQ(allocations, 0);
+}
+
+TEST(EngineAllocations, TicksOfThreeJointsAllocateNothing) {
+  const Configuration config;
+  SimulatedArmChain arm(pneumatic_chain_of(config.plant, ArmParameters{"arm3"}), 1);
+  EngineCore core(arm, config.controller, config.timing, config.safety);
+  SimulatedClock clock(core, arm);
+  TelemetryRing& tap = core.add_telemetry_tap(8192);
+  const Trajectory paper3 = library_trajectory("paper3", config.timing.sample_s());
+  const Eigen::MatrixXd correction = Eigen::MatrixXd::Constant(paper3.learning_samples(), 3, 0.01);
+  TrialRecord record;
+  record.prepare(paper3.learning_samples(), config.timing.ticks_per_sample, 3);  // sized outside the loop
+  EXPECT_TRUE(core.send(EngineCommand::select_trajectory(paper3)));
+  EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+  clock.step(10);  // warm up outside the count
+  ASSERT_EQ(core.state(), EngineState::kArmed);
+
+  const EngineCommand start = EngineCommand::start_trial(paper3, correction, record, 100, 1);
+  long allocations = 0;
+  {
+    CountAllocations counter;
+    EXPECT_TRUE(core.send(start));
+    clock.step(100 + 4 * paper3.learning_samples() + 10);  // settle, the whole trial, back to holding
+    core.request_emergency_stop();
+    clock.step(10);
+    EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kReset)));
+    EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+    clock.step(10);
+    allocations = counter.allocations();
+  }
+  EXPECT_TRUE(record.complete);
+  EXPECT_EQ(record.joints(), 3);
+  EXPECT_EQ(core.state(), EngineState::kArmed);
   EXPECT_GT(tap.read_available(), 1000u);
   EXPECT_EQ(allocations, 0);
 }
