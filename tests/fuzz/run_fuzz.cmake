@@ -1,6 +1,6 @@
-# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DBINARY=... -DSECONDS=... [-DSEEDS=dir -DDICT=file] -P run_fuzz.cmake
+# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DBINARY=... -DRUNS=... [-DSEEDS=dir -DDICT=file] -P run_fuzz.cmake
 # Fuzzes the libFuzzer target BINARY (built with -DBELLOWS_FUZZ=ON, tests/fuzz/fuzz_test.cmake) for
-# SECONDS, starting from the seeds in SEEDS (default tests/fuzz/seeds) and the corpus grown by
+# RUNS inputs, starting from the seeds in SEEDS (default tests/fuzz/seeds) and the corpus grown by
 # earlier runs in BUILD_DIR/corpus; a failing input is saved in BUILD_DIR.
 if(NOT SEEDS)
   set(SEEDS ${SOURCE_DIR}/tests/fuzz/seeds)
@@ -12,7 +12,7 @@ get_filename_component(TARGET ${BINARY} NAME)
 file(MAKE_DIRECTORY ${BUILD_DIR}/corpus/${TARGET})
 execute_process(
   COMMAND ${BINARY} ${BUILD_DIR}/corpus/${TARGET} ${SEEDS}
-          -dict=${DICT} -max_total_time=${SECONDS} -max_len=16384 -timeout=10
+          -dict=${DICT} -runs=${RUNS} -max_len=16384 -timeout=10
           -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=${BUILD_DIR}/
   RESULT_VARIABLE fuzzed)
 if(fuzzed)
