@@ -165,6 +165,8 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       }
       hold_trajectory(command.trajectory, now_s);
       if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->setpoint_rad(0));
+      // Without a trajectory the engine drives one joint: holding several would vent them all.
+      if (from == EngineState::kArmed && trajectory_ == nullptr && control_.joints() != 1) control_.hold(last_angle_rad_);
       return;
     case CommandKind::kSetGains: {
       ControllerParameters gains = controller_;
@@ -277,7 +279,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
     if (code != FaultCode::kNone) enter_fault(code, now_s);
   }
 
-  ValveCommand valves = ValveCommand::vented();
+  ValveCommand valves = ValveCommand::vented(joints());
   if (valves_live(state())) {
     if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
       start_control_trial();

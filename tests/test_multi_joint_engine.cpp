@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <numbers>
 
 #include "devices/simulated_arm_chain.hpp"
 #include "engine/arm_chain_linearization.hpp"
@@ -19,6 +20,8 @@
 
 namespace bellows {
 namespace {
+
+constexpr double kHoldTolerance_rad = 3.0 * std::numbers::pi / 180.0;  // after 8 s holding
 
 /// One trial of `trajectory` with `correction` (N values for one joint, N x J for several), after the
 /// configured settling hold. Fails the test unless the engine hands the record back complete and
@@ -76,6 +79,44 @@ Eigen::RowVectorXd joint_rms_deg(const TrialRecord& record) {
   Eigen::RowVectorXd rms(record.joints());
   for (int j = 0; j < record.joints(); ++j) rms(j) = record.joint_rms_error_deg(j);
   return rms;
+}
+
+TEST(MultiJointEngine, TheTrajectorySaysHowManyJointsTheEngineDrives) {
+  ChainEngine e("arm2");
+  // No trajectory: one joint, and a reading of two is one the guards cannot check.
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step();
+  EXPECT_EQ(e.core.state(), EngineState::kFault);
+  EXPECT_EQ(e.core.fault(), FaultCode::kSensorOutOfRange);
+  EXPECT_EQ(e.arm.chain().state().duties[1].outlet, (std::array<double, 2>{1.0, 1.0})) << "every joint vented";
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kReset)));
+  const Trajectory paper2 = library_trajectory("paper2", e.config.timing.sample_s());
+  EXPECT_TRUE(e.core.send(EngineCommand::select_trajectory(paper2)));
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  // Holding the start (0, 0) against gravity: the arm sagged while vented, the PIDs' integrators
+  // bring both joints back, closer every second (measured after 1 s: -14.9 and -4.8 deg; after 8 s:
+  // -2.2 and -0.3 deg; the integrator's time constant with the paper's gains is about 4 s).
+  JointVector previous = JointVector::Constant(2, 1e9);
+  TickRecord tick;
+  for (int second = 1; second <= 8; ++second) {
+    e.clock.step(std::lround(1.0 / e.config.timing.tick_s));
+    ASSERT_TRUE(e.core.read_snapshot(tick));
+    ASSERT_EQ(e.core.state(), EngineState::kArmed);
+    EXPECT_EQ(tick.valves.joint_count, 2);
+    for (int j = 0; j < 2; ++j) {
+      const double error_rad = std::abs(tick.reading.joint[static_cast<std::size_t>(j)].angle_rad);
+      EXPECT_LT(error_rad, previous(j)) << "joint " << j + 1 << " after " << second << " s";
+      previous(j) = error_rad;
+    }
+  }
+  EXPECT_EQ(e.core.control().joints(), 2);
+  for (int j = 0; j < 2; ++j) EXPECT_LT(previous(j), kHoldTolerance_rad) << "joint " << j + 1 << " after 8 s";
+  // Deselecting it while armed: one joint again, and the two-joint arm faults before it is driven.
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kSelectTrajectory)));  // no trajectory
+  e.clock.step();
+  EXPECT_EQ(e.core.joints(), 1);
+  EXPECT_EQ(e.core.state(), EngineState::kFault);
+  EXPECT_EQ(e.core.fault(), FaultCode::kSensorOutOfRange);
 }
 
 TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEveryJointsError) {
