@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "session_test_support.hpp"
+#include "sessions/manifest_json.hpp"
 #include "sessions/session_store.hpp"
 #include "tests/test_support.hpp"
 
@@ -218,6 +219,38 @@ TEST(SessionFixtures, EveryFixtureResumesWithOneMoreIterationAndTheEarlierOnesUn
         fixture_csv_column(copy / after["iterations"][earlier]["samples_file"].get<std::string>(), "u_ilc_bar");
     EXPECT_EQ(applied, saved_next);
   }
+}
+
+TEST(SessionVersions, AFirstFormatResumeStateIsWrittenBackAsItWasRead) {
+  const fs::path first = kFixtureRoot / "2026-11-21-1afa6a9-plain";
+  const SessionManifest read = load_manifest(first);
+  ASSERT_TRUE(read.resume && read.resume->exact());
+  EXPECT_FALSE(read.resume->clock_ticks.has_value());
+  // Rewritten (a resume records its event before its first iteration) without "exact", which
+  // would claim recorded clock ticks, and read again the same way.
+  const nlohmann::json written = nlohmann::json::parse(format_manifest(read));
+  EXPECT_FALSE(written["resume"].contains("exact"));
+  EXPECT_FALSE(written["resume"].contains("clock_ticks"));
+  const SessionManifest again = parse_manifest(format_manifest(read), "rewritten");
+  ASSERT_TRUE(again.resume && again.resume->exact());
+  EXPECT_FALSE(again.resume->clock_ticks.has_value());
+}
+
+TEST(SessionVersions, OnlyVersionsFromTheOldestToTheCurrentAreRead) {
+  nlohmann::json manifest = nlohmann::json::parse(read_text(kFixtureRoot / "2026-11-30-3060f58-plain" / "manifest.json"));
+  for (int version = kOldestSessionSchemaVersion; version <= kSessionSchemaVersion; ++version) {
+    manifest["schema_version"] = version;
+    EXPECT_EQ(parse_manifest(manifest.dump(), "m").schema_version, version);
+  }
+  manifest["schema_version"] = kSessionSchemaVersion + 1;
+  const std::string newer = testing::error_of([&] { parse_manifest(manifest.dump(), "m"); });
+  EXPECT_NE(newer.find("is not supported"), std::string::npos) << newer;
+  EXPECT_NE(newer.find("a newer bellows wrote it"), std::string::npos) << newer;
+  EXPECT_EQ(newer.find('\n'), std::string::npos) << newer;
+  manifest["schema_version"] = kOldestSessionSchemaVersion - 1;
+  const std::string older = testing::error_of([&] { parse_manifest(manifest.dump(), "m"); });
+  EXPECT_NE(older.find("is not supported"), std::string::npos) << older;
+  EXPECT_EQ(older.find("newer bellows"), std::string::npos) << older;
 }
 
 }  // namespace
