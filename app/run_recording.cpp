@@ -76,6 +76,10 @@ void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* 
         // A first-format session did not record the clock: it ticked with the arm from 0, so the
         // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
         const double arm_ticks = arm->state().time_s / m.configuration.timing.tick_s;
+        if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
+          throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
+                           ": /resume/device/time_s: expected the arm's time since it started, at least 0");
+        }
         clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
       }
       core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);

@@ -236,6 +236,19 @@ TEST(SessionVersions, AFirstFormatResumeStateIsWrittenBackAsItWasRead) {
   EXPECT_FALSE(again.resume->clock_ticks.has_value());
 }
 
+TEST(SessionVersions, AFirstFormatArmTimeThatCannotBeTheClocksIsRefusedInOneLine) {
+  TempDir dir;
+  const fs::path copy = copy_of_fixture(kFixtureRoot / "2026-11-21-1afa6a9-plain", dir);
+  nlohmann::ordered_json manifest = nlohmann::ordered_json::parse(read_text(copy / "manifest.json"));
+  manifest["resume"]["device"]["time_s"] = -0.5;
+  testing::write_text(copy / "manifest.json", manifest.dump(2));
+  const ProcessResult resumed = run_bellows({"run", "--resume", copy.string(), "--iterations", "1"});
+  EXPECT_EQ(resumed.exit_code, 2) << resumed.err;
+  EXPECT_NE(resumed.err.find("/resume/device/time_s"), std::string::npos) << resumed.err;
+  EXPECT_EQ(std::count(resumed.err.begin(), resumed.err.end(), '\n'), 1) << resumed.err;
+  EXPECT_EQ(load_manifest(copy).iterations.size(), 3u);  // nothing lost
+}
+
 TEST(SessionVersions, OnlyVersionsFromTheOldestToTheCurrentAreRead) {
   nlohmann::json manifest = nlohmann::json::parse(read_text(kFixtureRoot / "2026-11-30-3060f58-plain" / "manifest.json"));
   for (int version = kOldestSessionSchemaVersion; version <= kSessionSchemaVersion; ++version) {
