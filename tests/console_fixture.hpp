@@ -119,9 +119,11 @@ struct ConsoleFixture {
     while (!done()) {
       if (clock.now_s() - start > max_engine_s) return false;
       if (std::chrono::steady_clock::now() - wall_start > std::chrono::seconds(120)) return false;
-      // Engine time stands still while the learner works, so that runs are deterministic.
+      // Engine time stands still while the learner works or a save runs, so that runs are
+      // deterministic: a batch's next trial waits for the autosave, and on a loaded machine a save
+      // to disk can take longer than the engine time this loop would otherwise race through.
       const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning || console->state().learner_busy ||
-                           !console->state().law_ready;
+                           !console->state().law_ready || !console->saves_settled();
       if (waiting) std::this_thread::sleep_for(std::chrono::microseconds(200));
       else clock.step(5);
       console->update(clock.now_s());

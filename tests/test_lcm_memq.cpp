@@ -394,9 +394,10 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   EXPECT_LT(rms[2], rms[0]);
   const LcmDeviceStats d = device.stats();
   const RigServerStats r = rig.stats();
-  // Before it served this session the rig's states named nobody: those, and only those, are ignored.
+  // Before it served this session the rig's states named nobody: those, and only those, are ignored
+  // (how many depends on how soon the binding came, on a loaded machine later: a small part of all).
   EXPECT_EQ(d.states.ignored(), d.states.foreign);
-  EXPECT_LT(d.states.foreign, 20u);
+  EXPECT_LT(10u * d.states.foreign, d.states.accepted);
   EXPECT_EQ(r.commands.ignored(), 0u);
   EXPECT_GT(d.states.accepted, 2u * 200u);
   EXPECT_EQ(r.sessions_served, 1u);
