@@ -343,12 +343,10 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   SessionManifest m;
   m.schema_version = r["schema_version"].integer(0, 1000000);
   if (m.schema_version < kOldestSessionSchemaVersion || m.schema_version > kSessionSchemaVersion) {
-    const std::string readable = kOldestSessionSchemaVersion == kSessionSchemaVersion
-                                     ? "version " + std::to_string(kSessionSchemaVersion)
-                                     : "versions " + std::to_string(kOldestSessionSchemaVersion) + " to " +
-                                           std::to_string(kSessionSchemaVersion);
-    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) + " is not supported (this bellows reads " +
-                             readable + ")" +
+    const std::string oldest =
+        kOldestSessionSchemaVersion < kSessionSchemaVersion ? "s " + std::to_string(kOldestSessionSchemaVersion) + " to" : "";
+    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) + " is not supported (this bellows reads version" +
+                             oldest + " " + std::to_string(kSessionSchemaVersion) + ")" +
                              (m.schema_version > kSessionSchemaVersion ? ": a newer bellows wrote it" : ""));
   }
   m.program_version = r["program_version"].text();
