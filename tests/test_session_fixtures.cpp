@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "engine/safety.hpp"
 #include "session_test_support.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_store.hpp"
@@ -134,6 +135,13 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
     for (std::size_t b = 0; b < session.black_boxes.size(); ++b) {
       EXPECT_EQ(session.black_boxes[b].size(), fixture_csv_column(fixture / raw["black_boxes"][b]["file"].get<std::string>(),
                                                                   "time_s").size());
+      // The fault tick last, whether the file names the fault or gives its code (before 59907e0).
+      EXPECT_EQ(fault_name(session.black_boxes[b].back().fault), raw["black_boxes"][b]["fault"].get<std::string>());
+    }
+    if (raw.contains("first_correction")) {
+      EXPECT_EQ(nlohmann::json(session.manifest.first_correction), raw["first_correction"]);
+    } else {
+      EXPECT_TRUE(session.manifest.first_correction.is_null());
     }
   }
 }
