@@ -62,12 +62,16 @@ void restore_arm_state(SimulatedArm& arm, const nlohmann::ordered_json& json, co
   for (double pressure : s.chamber_Pa) {
     if (!(pressure > 0.0)) r["chamber_Pa"].fail("pressures must be positive");
   }
-  try {
-    s.fault = simulated_fault_from_string(r["fault"].text());
-  } catch (const InputError& error) {
-    r["fault"].fail(error.what());
+  // The first session format (1afa6a9) saved the arm before it could be given a fault: without
+  // "fault" and "fault_since_s", none is active (State's defaults).
+  if (r.has("fault") || r.has("fault_since_s")) {
+    try {
+      s.fault = simulated_fault_from_string(r["fault"].text());
+    } catch (const InputError& error) {
+      r["fault"].fail(error.what());
+    }
+    s.fault_since_s = r["fault_since_s"].number();
   }
-  s.fault_since_s = r["fault_since_s"].number();
   const double supply_Pa = r["supply_Pa"].number();
   if (!(supply_Pa > 0.0)) r["supply_Pa"].fail("must be positive");
   arm.set_state(s);

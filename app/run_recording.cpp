@@ -1,5 +1,7 @@
 #include "app/run_recording.hpp"
 
+#include <cmath>
+
 #include "app/arm_state_json.hpp"
 #include "engine/errors.hpp"
 #include "engine/iteration_numbering.hpp"
@@ -70,7 +72,16 @@ void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* 
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
     if (m.resume && m.resume->exact() && arm != nullptr) {
       restore_arm_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
-      if (clock != nullptr) clock->set_ticks(m.resume->clock_ticks);
+      if (clock != nullptr) {
+        // A first-format session did not record the clock: it ticked with the arm from 0, so the
+        // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
+        const double arm_ticks = arm->state().time_s / m.configuration.timing.tick_s;
+        if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
+          throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
+                           ": /resume/device/time_s: expected the arm's time since it started, at least 0");
+        }
+        clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
+      }
       core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
     }
     learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));

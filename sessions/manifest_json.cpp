@@ -262,9 +262,13 @@ Json manifest_head_to_json(const SessionManifest& m) {
   if (!m.model_source.empty()) out["model"]["source"] = m.model_source;  // absent: not recorded (a rig check learns nothing)
   if (!m.first_correction.is_null()) out["first_correction"] = m.first_correction;
   if (m.resume) {
-    Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}, {"exact", m.resume->exact()}};
+    Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}};
+    // A first-format state (no clock ticks) is written back as it was read: without "exact",
+    // which says the clock's ticks are recorded. The next completed iteration replaces it.
+    const bool first_format = m.resume->exact() && !m.resume->clock_ticks;
+    if (!first_format) resume["exact"] = m.resume->exact();
     if (m.resume->exact()) {
-      resume["clock_ticks"] = m.resume->clock_ticks;
+      if (m.resume->clock_ticks) resume["clock_ticks"] = *m.resume->clock_ticks;
       resume["controller"] = controller_state_to_json(*m.resume->controller);
       resume["device"] = m.resume->device;
     }
@@ -338,9 +342,12 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   }
   SessionManifest m;
   m.schema_version = r["schema_version"].integer(0, 1000000);
-  if (m.schema_version != kSessionSchemaVersion) {
-    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) +
-                             " is not supported (this bellows reads version " + std::to_string(kSessionSchemaVersion) + ")");
+  if (m.schema_version < kOldestSessionSchemaVersion || m.schema_version > kSessionSchemaVersion) {
+    const std::string oldest =
+        kOldestSessionSchemaVersion < kSessionSchemaVersion ? "s " + std::to_string(kOldestSessionSchemaVersion) + " to" : "";
+    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) + " is not supported (this bellows reads version" +
+                             oldest + " " + std::to_string(kSessionSchemaVersion) + ")" +
+                             (m.schema_version > kSessionSchemaVersion ? ": a newer bellows wrote it" : ""));
   }
   m.program_version = r["program_version"].text();
   m.name = r["name"].text();
@@ -382,10 +389,15 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
                                     std::to_string(next));
     }
     ResumeState state;
-    if (resume["exact"].boolean()) {
-      const JsonReader ticks = resume["clock_ticks"];
-      if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
-      state.clock_ticks = ticks.json().get<long long>();
+    // The first format (1afa6a9, Nov 21) always saved the controllers and the device, without
+    // "exact" and "clock_ticks": exact, the clock's ticks left to the device's own time.
+    const bool first_format = !resume.has("exact");
+    if (first_format || resume["exact"].boolean()) {
+      if (!first_format || resume.has("clock_ticks")) {
+        const JsonReader ticks = resume["clock_ticks"];
+        if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
+        state.clock_ticks = ticks.json().get<long long>();
+      }
       state.controller = controller_state_from_json(resume["controller"], m.configuration);
       resume["device"].expect_object();
       state.device = resume["device"].json();

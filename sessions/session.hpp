@@ -21,8 +21,12 @@
 
 namespace bellows {
 
-/// The manifest layout this program writes and reads. Older or newer versions are refused.
+/// The manifest layout this program writes. It reads every version from the oldest up to this one
+/// (a field an older version lacks gets its documented default: docs/session-format.md,
+/// "Versions"); a newer version is refused. Bump it when what is written changes in a way an older
+/// reader would misread, and add a fixture of the new format (tests/fixtures/sessions/README.md).
 inline constexpr int kSessionSchemaVersion = 1;
+inline constexpr int kOldestSessionSchemaVersion = 1;
 
 /// The program's version, written into every manifest.
 std::string program_version();
@@ -59,7 +63,9 @@ struct IterationEntry {
 struct ResumeState {
   std::optional<ControlCore::State> controller;
   nlohmann::ordered_json device = nlohmann::ordered_json::object();
-  long long clock_ticks = 0;
+  // The simulated clock's ticks. Unknown (empty) in sessions of the first format (Nov 21, before
+  // the simulated clock was recorded): the resume takes them from the device's own time.
+  std::optional<long long> clock_ticks;
   bool exact() const { return controller.has_value(); }
 };
 

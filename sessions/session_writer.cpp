@@ -58,7 +58,10 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   SessionLock lock(session, purpose);  // before loading: nobody changes it under us
   loaded = load_session(session);
   remove_temporary_files(session);
-  SessionWriter writer(std::move(session), loaded.manifest, std::move(lock));
+  SessionManifest manifest = loaded.manifest;
+  // What it writes is this bellows' format (what an older version lacked has its default now).
+  manifest.schema_version = kSessionSchemaVersion;
+  SessionWriter writer(std::move(session), std::move(manifest), std::move(lock));
   // Files of an iteration whose manifest update a crash prevented: not part of the session.
   const auto name_in_folder = [](const std::string& relative) { return session_layout::folder_and_name(relative).second; };
   remove_temporary_files(writer.iterations_);
