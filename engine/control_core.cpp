@@ -80,40 +80,34 @@ void ControlCore::set_controller_gains(const ControllerParameters& params) {
   for (JointLoop& l : loops_) l.pid.set_gains(controller_);
 }
 
+ControlCore::JointState ControlCore::JointLoop::state() const {
+  return {pid.state(), pressure_a.state(), pressure_b.state(), setpoints, hold_rad, desired_rad, u_total_bar};
+}
+
+void ControlCore::JointLoop::set_state(const JointState& state) {
+  pid.set_state(state.pid);
+  pressure_a.set_state(state.pressure_a);
+  pressure_b.set_state(state.pressure_b);
+  setpoints = state.setpoints;
+  hold_rad = state.hold_rad;
+  desired_rad = state.desired_rad;
+  u_total_bar = state.u_total_bar;
+}
+
 ControlCore::State ControlCore::state() const {
-  const JointLoop& first = loops_.front();
-  State s{first.pid.state(), first.pressure_a.state(), first.pressure_b.state(), first.setpoints, first.hold_rad,
-          first.desired_rad, first.u_total_bar, tick_in_sample_, joints_, {}};
-  for (int j = 1; j < joints_; ++j) {
-    const JointLoop& l = loop(j);
-    s.more_joints[static_cast<std::size_t>(j - 1)] = {l.pid.state(), l.pressure_a.state(), l.pressure_b.state(),
-                                                      l.setpoints, l.hold_rad, l.desired_rad, l.u_total_bar};
-  }
+  State s;
+  static_cast<JointState&>(s) = loops_.front().state();
+  s.tick_in_sample = tick_in_sample_;
+  s.joints = joints_;
+  for (int j = 1; j < joints_; ++j) s.more_joints[static_cast<std::size_t>(j - 1)] = loop(j).state();
   return s;
 }
 
 void ControlCore::set_state(const State& state) {
   trajectory_ = nullptr;
   use_joints(state.joints);
-  JointLoop& first = loops_.front();
-  first.pid.set_state(state.pid);
-  first.pressure_a.set_state(state.pressure_a);
-  first.pressure_b.set_state(state.pressure_b);
-  first.setpoints = state.setpoints;
-  first.hold_rad = state.hold_rad;
-  first.desired_rad = state.desired_rad;
-  first.u_total_bar = state.u_total_bar;
-  for (int j = 1; j < joints_; ++j) {
-    const JointState& from = state.more_joints[static_cast<std::size_t>(j - 1)];
-    JointLoop& l = loop(j);
-    l.pid.set_state(from.pid);
-    l.pressure_a.set_state(from.pressure_a);
-    l.pressure_b.set_state(from.pressure_b);
-    l.setpoints = from.setpoints;
-    l.hold_rad = from.hold_rad;
-    l.desired_rad = from.desired_rad;
-    l.u_total_bar = from.u_total_bar;
-  }
+  loops_.front().set_state(state);
+  for (int j = 1; j < joints_; ++j) loop(j).set_state(state.more_joints[static_cast<std::size_t>(j - 1)]);
   tick_in_sample_ = state.tick_in_sample;
 }
 

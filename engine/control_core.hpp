@@ -44,14 +44,8 @@ class ControlCore {
     double u_total_bar = 0.0;
   };
   /// Everything that evolves between ticks while holding: enough to continue a run exactly.
-  /// The first fields are joint 1's (what single-joint session files store, unchanged).
-  struct State {
-    PidController::State pid;
-    PressureController::State pressure_a, pressure_b;
-    ChamberSetpoints setpoints;
-    double hold_rad = 0.0;
-    double desired_rad = 0.0;
-    double u_total_bar = 0.0;
+  /// Its JointState fields are joint 1's (what single-joint session files store, unchanged).
+  struct State : JointState {
     int tick_in_sample = 0;
     int joints = 1;                                      // J
     std::array<JointState, kMaxJoints - 1> more_joints{};  // joints 2..J
@@ -103,6 +97,8 @@ class ControlCore {
     double hold_rad = 0.0;
     double desired_rad = 0.0;
     double u_total_bar = 0.0;
+    JointState state() const;
+    void set_state(const JointState& state);
   };
   JointLoop& loop(int joint) { return loops_[static_cast<std::size_t>(joint)]; }
   const JointLoop& loop(int joint) const { return loops_[static_cast<std::size_t>(joint)]; }

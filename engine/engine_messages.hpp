@@ -55,23 +55,15 @@ struct EngineCommand {
   }
   static EngineCommand start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction, TrialRecord& record,
                                    int settle_ticks, std::uint32_t trial_id) {
-    EngineCommand c = of(CommandKind::kStartTrial);
-    c.trajectory = &trajectory;
+    EngineCommand c = trial_of(trajectory, record, settle_ticks, trial_id);
     c.correction = &correction;
-    c.record = &record;
-    c.settle_ticks = settle_ticks;
-    c.trial_id = trial_id;
     return c;
   }
   /// A trial of the trajectory's J joints, `correction` one column per joint (N x J).
   static EngineCommand start_trial(const Trajectory& trajectory, const Eigen::MatrixXd& correction, TrialRecord& record,
                                    int settle_ticks, std::uint32_t trial_id) {
-    EngineCommand c = of(CommandKind::kStartTrial);
-    c.trajectory = &trajectory;
+    EngineCommand c = trial_of(trajectory, record, settle_ticks, trial_id);
     c.joint_correction = &correction;
-    c.record = &record;
-    c.settle_ticks = settle_ticks;
-    c.trial_id = trial_id;
     return c;
   }
   static EngineCommand valve_pulse(const ValvePulse& pulse) {
@@ -82,6 +74,17 @@ struct EngineCommand {
   static EngineCommand select_trajectory(const Trajectory& trajectory) {
     EngineCommand c = of(CommandKind::kSelectTrajectory);
     c.trajectory = &trajectory;
+    return c;
+  }
+
+ private:
+  /// A trial's command before its correction (one vector, or one column per joint) is set.
+  static EngineCommand trial_of(const Trajectory& trajectory, TrialRecord& record, int settle_ticks, std::uint32_t trial_id) {
+    EngineCommand c = of(CommandKind::kStartTrial);
+    c.trajectory = &trajectory;
+    c.record = &record;
+    c.settle_ticks = settle_ticks;
+    c.trial_id = trial_id;
     return c;
   }
 };
