@@ -79,9 +79,6 @@ struct ControllerParameters {
 /// The learning law and its parameters. Norm-optimal weights (spec section 5): M = m I, S = s I, W = w I.
 struct IlcParameters {
   std::string law = "noilc";  // which learning law runs between trials (engine/learning_law_factory)
-  // Several joints: the model of the J-joint norm-optimal update (engine/joint_learning_factory):
-  // "coupled" (the chain linearized stretched out) or "independent" (each joint's own model).
-  std::string joint_model = "coupled";
   double m = 1.0;
   double s = 0.1;
   double w = 2.0e-5;
@@ -108,6 +105,9 @@ struct IlcParameters {
   // convergence prediction before a run: grid of kappa and omega0 errors
   double prediction_model_error = 0.3;  // +-30 %
   int prediction_grid_points = 5;       // per parameter
+  // (Last, so that aggregate initializers of the fields above keep their order.) Several joints: the model of the J-joint norm-optimal update (engine/joint_learning_factory):
+  // "coupled" (the chain linearized stretched out) or "independent" (each joint's own model).
+  std::string joint_model = "coupled";
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's
