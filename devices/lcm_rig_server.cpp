@@ -56,10 +56,16 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   const io_joints_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();
   if (c.rig_id != rig_id_) return bump(not_addressed_);  // to another rig, or to none yet: not for us to count as foreign
-  if (c.joint_count != joints_) {  // meant for another arm: nothing of it is safe to apply, not even its vent's shape
+  if (c.joint_count != joints_) {  // meant for another arm: nothing of it is safe to apply, and it binds nothing
     notice(Notice::kOtherJoints, "a command for an arm of " + arm_joints_words(c.joint_count) + " but this rig's arm has " +
                                      arm_joints_words(joints_) + " (the engine's [arm] must be the rig's)");
-    return counters_.other_joints();
+    counters_.other_joints();
+    if (!c.armed) {  // but a vent only makes the rig safer, whatever arm it was meant for
+      io_joints_command_t vent = c;
+      vent.joint_count = static_cast<std::int8_t>(joints_);
+      obey_vent(vent);
+    }
+    return;
   }
   const bool outside_range = (limit_bits_ & io_state_t::FAULT_ANGLE_LIMIT) != 0;
   if (session_ == 0 && c.binding == binding_ && !c.armed && outside_range) {
@@ -82,17 +88,7 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
     pending_fresh_ = true;
     return counters_.accepted();
   }
-  if (!c.armed) {  // a vent is obeyed whatever its session or sequence number: it only makes the rig safer
-    if (!pending_fresh_ || !pending_in_sequence_) {  // never overwrite the session's own command unapplied
-      pending_ = c;
-      pending_in_sequence_ = false;
-      pending_fresh_ = true;
-    } else {
-      pending_.armed = false;  // the session's command, vented
-    }
-    bump(vents_out_of_sequence_);
-    return;
-  }
+  if (!c.armed) return obey_vent(c);  // whatever its session or sequence number: it only makes the rig safer
   if (!own) {
     notice(Notice::kForeign, session_ == 0 ? "a command of session " + std::to_string(c.session_id) + " that did not bind first"
                                             : "a command of session " + std::to_string(c.session_id) +
@@ -103,6 +99,17 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   notice(Notice::kJump, "a command of session " + std::to_string(session_) + " jumping from seq " + std::to_string(last_seq_) +
                              " to " + std::to_string(c.seq) + " (more than [lcm] seq_window)");
   counters_.out_of_order();
+}
+
+void RigServer::obey_vent(const io_joints_command_t& vent) {
+  if (!pending_fresh_ || !pending_in_sequence_) {  // never overwrite the session's own command unapplied
+    pending_ = vent;
+    pending_in_sequence_ = false;
+    pending_fresh_ = true;
+  } else {
+    pending_.armed = false;  // the session's command, vented
+  }
+  bump(vents_out_of_sequence_);
 }
 
 static_assert(kRigPressureLimitBit == io_state_t::FAULT_PRESSURE_LIMIT && kRigAngleLimitBit == io_state_t::FAULT_ANGLE_LIMIT,

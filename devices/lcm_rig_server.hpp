@@ -16,7 +16,8 @@
 // SimulatedArmChain for `[arm] preset`). With one joint it speaks io_command_t / io_state_t exactly
 // as before joints existed; with several, io_joints_command_t / io_joints_state_t. A valid command
 // for an arm of another joint count (either message type) is counted as `other_joints`, logged
-// once per binding, and never binds or drives the arm.
+// once per binding, and never binds or drives the arm (a vent addressed to this rig is obeyed, as
+// every vent is).
 #pragma once
 
 #include <atomic>
@@ -82,6 +83,7 @@ class RigServer final : public LcmEndpoint {
   // What the log reports once per binding (the refusals first).
   enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kOtherJoints, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
 
+  void obey_vent(const io_joints_command_t& vent);  // a vent addressed to this rig, outside its session's sequence
   void advance_to(double now_s);
   void apply_limits(bool write);
   void release(std::int32_t fault_bits);  // vent, drop the session, offer a new binding

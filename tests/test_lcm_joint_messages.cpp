@@ -296,6 +296,7 @@ TEST(LcmJointRig, ForgedJointCountsAreInvalidAndTodaysSingleJointCommandsAreRefu
   EXPECT_EQ(s.commands.other_joints, 3u);
   EXPECT_EQ(s.serving, 0);
   EXPECT_EQ(s.commands.accepted, 0u);
+  EXPECT_EQ(s.vents_obeyed_out_of_sequence, 2u) << "their vents only make the rig safer: obeyed";
   for (const BellowsDuties& joint : {b.arm.chain().state().duties[0], b.arm.chain().state().duties[1]}) {
     EXPECT_EQ(joint.inlet, (std::array<double, 2>{0.0, 0.0})) << "still vented";
     EXPECT_EQ(joint.outlet, (std::array<double, 2>{1.0, 1.0}));
@@ -368,7 +369,20 @@ TEST(LcmJointDevice, ArmOfTwoRefusesARigOfTodaysSingleJointMessagesInOneLineAndN
     device.service(&bus, t);
     pump(bus);
   }
+  // Forged joint states: a count of 9, and a third joint hidden in a state of two.
+  io_joints_state_t forged{};
+  forged.rig_id = 55;
+  forged.seq = 100;
+  forged.binding = 66;
+  forged.time_s = 1.0;
+  forged.joint_count = 9;
+  publish(bus, kIoStateChannel, forged);
+  forged.joint_count = 2;
+  forged.angle_rad[2] = 0.5;
+  publish(bus, kIoStateChannel, forged);
+  pump(bus);
   const LcmDeviceStats s = device.stats();
+  EXPECT_EQ(s.states.invalid, 2u);
   EXPECT_EQ(s.states.other_joints, 5u);
   EXPECT_EQ(s.states.accepted, 0u);
   EXPECT_EQ(s.rig_id, 0) << "never bound";
