@@ -123,6 +123,14 @@ TEST(LcmJointMessages, SeveralJointsTravelInTheJointMessagesRoundTrip) {
     EXPECT_EQ(back.joint[static_cast<std::size_t>(j)].chamber_bar, reading.joint[static_cast<std::size_t>(j)].chamber_bar);
   }
   EXPECT_EQ(out.angle_rad[3], 0.0);
+  // Signed like the one-joint messages: the MAC covers every byte before it.
+  std::array<std::uint8_t, kLcmKeyBytes> key_bytes{};
+  key_bytes.fill(3);
+  const LcmKey key(key_bytes);
+  const std::size_t signed_size = encode_io_state(state, key, bytes);
+  ASSERT_EQ(decode_io_state(bytes.data(), signed_size, out, &key), DecodeStatus::kOk);
+  bytes[signed_size - kLcmMacBytes - 1] ^= 1;
+  EXPECT_EQ(decode_io_state(bytes.data(), signed_size, out, &key), DecodeStatus::kUnauthenticated);
 
   ValveCommand valves = ValveCommand::vented(2);
   valves.joint[1].inlet_duty = {0.25, 0.0};
