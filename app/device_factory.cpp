@@ -170,8 +170,8 @@ DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParamete
 }
 
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind) {
-  if (!arm.preset.empty() && device_kind != "sim") {  // the rigs' links carry one joint
-    throw InputError("[arm] preset = '" + arm.preset + "': an arm of several joints runs on --device sim; --device " +
+  if (!arm.preset.empty() && device_kind != "sim" && device_kind != "lcm") {  // the T7 link carries one joint
+    throw InputError("[arm] preset = '" + arm.preset + "': an arm of several joints runs on --device sim or lcm; --device " +
                      device_kind + " drives one joint (leave [arm] out)");
   }
 }

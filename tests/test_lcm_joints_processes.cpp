@@ -1,10 +1,13 @@
 // `bellows io-sim --config arm2.toml` as its own process over UDP multicast, inside a private network
 // namespace this test makes for itself (nothing leaves it; skipped, saying why, where none can be
 // made): it serves the two-joint simulated arm in the joint messages; an LCM device of two joints
-// binds to it and reads both joints; one of one joint (today's messages) refuses it in one line.
+// binds to it and reads both joints; one of one joint (today's messages) refuses it in one line; and
+// `bellows run --device lcm` with the same [arm] learns it as the in-process arm does.
 #include <gtest/gtest.h>
 
 #include <signal.h>
+
+#include <iostream>
 
 #include <nlohmann/json.hpp>
 
@@ -89,6 +92,44 @@ TEST(LcmJointProcesses, IoSimServesArm2InTheJointMessagesAndAnEngineOfOneJointRe
   EXPECT_EQ(report["sessions_served"], 1);
   EXPECT_GT(report["commands"]["accepted"].get<int>(), 0);
   EXPECT_GT(report["not_addressed"].get<int>(), 0) << "the engine of one joint addressed no rig";
+}
+
+TEST(LcmJointProcesses, RunDrivesArm2OverLcmAndEveryJointTracksAsTheInProcessArm) {
+  const std::string why_not = testing::enter_private_network_namespace();
+  if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not;
+  setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-lcm-joints-xdg").c_str(), 1);
+  const auto dir = testing::make_temp_dir("bellows-lcm-joints-run");
+  // Learning, not deadline keeping, is compared: a loaded 2-core machine may stall a wall-clock run
+  // (the guards for that have tests of their own).
+  const std::string config = testing::write_file(dir, "arm2.toml",
+                                                 "[arm]\npreset = \"arm2\"\n[safety]\nmissed_deadline_streak = 1000\n"
+                                                 "stale_ticks = 40\n")
+                                 .string();
+  Child rig({testing::kBellows, "io-sim", "--seed", "5", "--config", config}, dir / "rig.out", dir / "rig.err");
+  ASSERT_TRUE(rig.started());
+  Child run({testing::kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "2", "--json", "--seed", "5",
+             "--trajectory", "paper2", "--config", config},
+            dir / "run.out", dir / "run.err");
+  const auto run_status = run.wait(300.0);
+  ASSERT_TRUE(run_status.has_value()) << "bellows run did not finish in 5 minutes";
+  EXPECT_EQ(*run_status, 0) << run.err();
+  rig.signal(SIGTERM);
+  ASSERT_TRUE(rig.wait(30.0).has_value());
+  const testing::ProcessResult local = testing::run_process(testing::kBellows + " run --no-save --iterations 2 --json --seed 5 --trajectory paper2 --config " + config);
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const nlohmann::json remote = nlohmann::json::parse(run.out())["iterations"];
+  const nlohmann::json in_process = nlohmann::json::parse(local.out)["iterations"];
+  ASSERT_EQ(remote.size(), 3u);  // iteration 0 (feedback only), then two learned
+  ASSERT_EQ(in_process.size(), remote.size());
+  for (std::size_t i = 0; i < remote.size(); ++i) {
+    ASSERT_EQ(remote[i]["joint_rms_deg"].size(), 2u);
+    for (std::size_t j = 0; j < 2; ++j) {
+      const double over_lcm = remote[i]["joint_rms_deg"][j].get<double>(), local_rms = in_process[i]["joint_rms_deg"][j].get<double>();
+      std::cout << "arm2/paper2 iteration " << i << ", joint " << j + 1 << ": " << over_lcm << " deg over LCM, " << local_rms
+                << " deg in process\n";
+      EXPECT_NEAR(over_lcm, local_rms, 0.15 * local_rms) << "iteration " << i << ", joint " << j + 1;
+    }
+  }
 }
 
 }  // namespace
