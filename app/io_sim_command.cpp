@@ -31,12 +31,12 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
   check_lcm_url(url, "--lcm");
 
-  // One joint: the single-joint simulated arm, as always. `[arm] preset`: the J-joint chain.
+  // One joint: the single-joint simulated arm, as always. An [arm] chain (preset or its own keys): the J-joint chain.
   std::unique_ptr<SimulatedArm> single_joint;
   std::unique_ptr<SimulatedArmChain> chain;
   int joints = 1;
   double integration_step_s = config.plant.integration_step_s;
-  if (config.arm.preset.empty()) {
+  if (!config.arm.has_chain()) {
     single_joint = std::make_unique<SimulatedArm>(config.plant, options.seed);
   } else {
     const PneumaticChainParameters chain_parameters = pneumatic_chain_of(config.plant, config.arm);
@@ -57,7 +57,7 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   LcmIoThread io(url, {&rig});
 
   io.on_open([&] {
-    const std::string which = joints == 1 ? std::string() : " '" + config.arm.preset + "' of " + std::to_string(joints) + " joints";
+    const std::string which = joints == 1 ? std::string() : " '" + config.arm.name() + "' of " + std::to_string(joints) + " joints";
     progress << "io-sim: serving the simulated arm" << which << " on " << url << " (rig " << rig.stats().rig_id << ", state every "
              << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
              << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
