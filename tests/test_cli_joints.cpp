@@ -89,8 +89,8 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   expect_refused_in_one_line("run --no-save --config " + arm_config("five", "[arm]\njoints = 5\n"), "[arm] joints = 5");
   expect_refused_in_one_line("run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
                              "[arm_joint2] mass_kg = 0");
-  expect_refused_in_one_line("run --no-save --config " + own + " --device lcm",
-                             "[arm] joints = 2: an arm of several joints runs on --device sim");
+  expect_refused_in_one_line("run --no-save --config " + own + " --device t7 --t7 127.0.0.1:1",
+                             "[arm] joints = 2: an arm of several joints runs on --device sim or lcm");
 }
 
 TEST(CliJoints, OneJointReportsItsRmsAsItsOnlyJoint) {
