@@ -58,8 +58,8 @@ class SimulatedChainDevice final : public OpenedDevice {
 
 class LcmRig final : public OpenedDevice {
  public:
-  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s)
-      : device_(session_id, std::move(key), rig_silence_s), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
+  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
+      : device_(session_id, std::move(key), rig_silence_s, joints), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
     io_.start(rt, kDeviceIoPriority);
   }
   ~LcmRig() override { io_.stop(); }
@@ -79,6 +79,8 @@ class LcmRig final : public OpenedDevice {
         if (s.states.unauthenticated > 0 && s.states.accepted == 0) {
           std::snprintf(why, sizeof why, "a rig answers on %s but its states fail authentication (%llu): a different [lcm] key_file?",
                         io_.url().c_str(), static_cast<unsigned long long>(s.states.unauthenticated));
+        } else if (s.states.other_joints > 0 && s.states.accepted == 0) {
+          std::snprintf(why, sizeof why, "%s", device_.diagnosis().c_str());  // a rig of another arm, in one line
         } else if (s.states.old_version > 0 && s.states.accepted == 0) {
           std::snprintf(why, sizeof why, "a rig answers on %s in protocol version 1, which this bellows no longer speaks: update it",
                         io_.url().c_str());
@@ -173,8 +175,8 @@ static std::string arm_setting(const ArmParameters& arm) {
 }
 
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind) {
-  if (arm.has_chain() && device_kind != "sim") {  // the rigs' links carry one joint
-    throw InputError(arm_setting(arm) + ": an arm of several joints runs on --device sim; --device " +
+  if (arm.has_chain() && device_kind != "sim" && device_kind != "lcm") {  // the T7 link carries one joint
+    throw InputError(arm_setting(arm) + ": an arm of several joints runs on --device sim or lcm; --device " +
                      device_kind + " drives one joint (leave [arm] out)");
   }
 }
@@ -191,7 +193,8 @@ std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const 
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
     return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
-                                    load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s);
+                                    load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s,
+                                    arm_joint_count(config.arm));
   }
   if (device.kind == "t7") return open_t7(device, config, rt);
   throw InputError("--device '" + device.kind + "': unknown device (known: sim, lcm, t7)");

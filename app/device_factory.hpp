@@ -73,7 +73,7 @@ class OpenedDevice {
 };
 
 /// Refuses, in one line, an arm `device_kind` cannot drive: an [arm] preset of several joints runs on
-/// the simulated arm only.
+/// the simulated arm and over LCM (the joint messages), not on a T7.
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind);
 /// Refuses, in one line, an [arm] preset for a command that handles one joint (`what`, e.g.
 /// "`bellows identify` identifies one joint").

@@ -1,7 +1,8 @@
 #include "app/io_sim_command.hpp"
 
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_rig_server.hpp"
+#include "devices/simulated_arm_chain.hpp"
 #include "engine/errors.hpp"
 
 namespace bellows {
@@ -29,7 +31,20 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   const std::string url = options.lcm_url.empty() ? kDefaultLcmUrl : options.lcm_url;
   check_lcm_url(url, "--lcm");
 
-  SimulatedArm arm(config.plant, options.seed);
+  // One joint: the single-joint simulated arm, as always. An [arm] chain (preset or its own keys): the J-joint chain.
+  std::unique_ptr<SimulatedArm> single_joint;
+  std::unique_ptr<SimulatedArmChain> chain;
+  int joints = 1;
+  double integration_step_s = config.plant.integration_step_s;
+  if (!config.arm.has_chain()) {
+    single_joint = std::make_unique<SimulatedArm>(config.plant, options.seed);
+  } else {
+    const PneumaticChainParameters chain_parameters = pneumatic_chain_of(config.plant, config.arm);
+    chain = std::make_unique<SimulatedArmChain>(chain_parameters, options.seed);
+    joints = chain->joints();
+    integration_step_s = chain_parameters.chain.integration_step_s;
+  }
+  Device& arm = single_joint ? static_cast<Device&>(*single_joint) : *chain;
   RigServerParameters params;
   params.period_s = config.timing.tick_s;
   params.command_timeout_s = config.lcm.rig_timeout_s;
@@ -38,11 +53,12 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   params.key = load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path());
   params.log = [&progress](const std::string& line) { progress << "io-sim: " << line << std::endl; };
   const bool keyed = params.key.present();
-  RigServer rig(arm, std::move(params), random_nonzero_id());
+  RigServer rig(arm, joints, integration_step_s, std::move(params), random_nonzero_id());
   LcmIoThread io(url, {&rig});
 
   io.on_open([&] {
-    progress << "io-sim: serving the simulated arm on " << url << " (rig " << rig.stats().rig_id << ", state every "
+    const std::string which = joints == 1 ? std::string() : " '" + config.arm.name() + "' of " + std::to_string(joints) + " joints";
+    progress << "io-sim: serving the simulated arm" << which << " on " << url << " (rig " << rig.stats().rig_id << ", state every "
              << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
              << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
              << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
@@ -59,12 +75,15 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   const RigServerStats s = rig.stats();
   progress << "io-sim: " << s.commands.accepted << " commands applied, " << s.commands.ignored() << " ignored ("
            << s.commands.foreign << " of other sessions, " << s.commands.out_of_order << " out of sequence, "
-           << s.commands.unauthenticated << " unauthenticated, " << s.commands.old_version << " of protocol version 1), "
+           << s.commands.unauthenticated << " unauthenticated, " << s.commands.old_version << " of protocol version 1"
+           << (s.commands.other_joints > 0 ? ", " + std::to_string(s.commands.other_joints) + " for an arm of another joint count" : "")
+           << "), "
            << s.sessions_served << " sessions, " << s.timeouts << " timeouts, " << s.pressure_limit_trips << " + "
            << s.angle_limit_trips << " pressure + angle limit trips, " << s.states_published << " states published; valves vented"
            << std::endl;
   if (options.json) {
     nlohmann::json report = {{"rig_id", s.rig_id},
+                             {"joints", joints},
                              {"url", url},
                              {"rt", io.rt_granted() ? "fifo" : "other"},
                              {"commands", receive_counts_json(s.commands)},

@@ -11,7 +11,7 @@
 namespace bellows {
 
 struct IoSimOptions {
-  std::string config_path;      // [plant], [timing] tick_s, [controller] p_max_bar, [lcm] (timeout, window, limits, key_file)
+  std::string config_path;      // [plant], [arm] preset (the arm of several joints served), [timing] tick_s, [controller] p_max_bar, [lcm] (timeout, window, limits, key_file)
   std::uint64_t seed = 1;       // of the arm's sensor noise
   std::string lcm_url;          // empty: the default bus
   RealtimeMode rt = RealtimeMode::kTry;

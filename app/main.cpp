@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
 
   bellows::IoSimOptions io_sim;
   CLI::App* io_sim_cmd = app.add_subcommand("io-sim", "Serve the simulated arm over LCM in real time, as a rig would");
-  io_sim_cmd->add_option("--config", io_sim.config_path, "TOML configuration file ([plant], [timing], [lcm])");
+  io_sim_cmd->add_option("--config", io_sim.config_path, "TOML configuration file ([plant], [arm] preset, [timing], [lcm])");
   io_sim_cmd->add_option("--seed", io_sim.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());

@@ -37,7 +37,8 @@ nlohmann::json receive_counts_json(const ReceiveCounts& c) {
             {"foreign", c.foreign},
             {"out_of_order", c.out_of_order},
             {"old_version", c.old_version},
-            {"unauthenticated", c.unauthenticated}}}};
+            {"unauthenticated", c.unauthenticated},
+            {"other_joints", c.other_joints}}}};
 }
 
 RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const Configuration& config)

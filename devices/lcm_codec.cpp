@@ -12,10 +12,11 @@
 namespace bellows {
 namespace {
 
-// The I/O messages (io_command_t, io_state_t) carry one joint's valves and sensors.
+// io_command_t and io_state_t carry one joint's valves and sensors; several joints travel in
+// io_joints_command_t and io_joints_state_t (devices/lcm_io_messages).
 std::string single_joint_protocol(const char* what, int joints) {
-  return std::string("the LCM I/O messages carry one joint: ") + what + " for " + std::to_string(joints) +
-         " joints cannot be sent (use the simulated device for an arm of several joints)";
+  return std::string("io_command_t and io_state_t carry one joint: ") + what + " for " + std::to_string(joints) +
+         " joints goes in io_joints_command_t / io_joints_state_t";
 }
 
 }  // namespace
@@ -83,6 +84,7 @@ ReceiveCounts ReceiveCounters::snapshot() const {
   c.out_of_order = out_of_order_.load(relaxed);
   c.old_version = old_version_.load(relaxed);
   c.unauthenticated = unauthenticated_.load(relaxed);
+  c.other_joints = other_joints_.load(relaxed);
   return c;
 }
 

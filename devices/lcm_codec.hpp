@@ -13,6 +13,8 @@
 
 #include <bellows/engine_event_t.hpp>
 #include <bellows/io_command_t.hpp>
+#include <bellows/io_joints_command_t.hpp>
+#include <bellows/io_joints_state_t.hpp>
 #include <bellows/io_state_t.hpp>
 #include <bellows/telemetry_t.hpp>
 #include <bellows/trial_summary_t.hpp>
@@ -50,8 +52,10 @@ struct ReceiveCounts {
   std::uint64_t out_of_order = 0;  // sequence number or time not after the last accepted one, or a jump
   std::uint64_t old_version = 0;   // an earlier protocol version's message
   std::uint64_t unauthenticated = 0;  // MAC missing or wrong (only with a key)
+  std::uint64_t other_joints = 0;  // valid, but for an arm of another joint count than this one's
   std::uint64_t ignored() const {
-    return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version + unauthenticated;
+    return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version + unauthenticated +
+           other_joints;
   }
 };
 
@@ -63,11 +67,13 @@ class ReceiveCounters {
   void invalid() { bump(invalid_); }
   void foreign() { bump(foreign_); }
   void out_of_order() { bump(out_of_order_); }
+  void other_joints() { bump(other_joints_); }
   ReceiveCounts snapshot() const;
 
  private:
   std::atomic<std::uint64_t> accepted_{0}, truncated_{0}, wrong_type_{0}, too_large_{0}, malformed_{0};
   std::atomic<std::uint64_t> invalid_{0}, foreign_{0}, out_of_order_{0}, old_version_{0}, unauthenticated_{0};
+  std::atomic<std::uint64_t> other_joints_{0};
 };
 
 namespace detail {
@@ -91,6 +97,15 @@ template <>
 inline std::int64_t previous_version_hash<io_state_t>() {
   return bellows_v1::io_state_t::getHash();
 }
+// A version-1 peer is refused as such by an arm of several joints too.
+template <>
+inline std::int64_t previous_version_hash<io_joints_command_t>() {
+  return bellows_v1::io_command_t::getHash();
+}
+template <>
+inline std::int64_t previous_version_hash<io_joints_state_t>() {
+  return bellows_v1::io_state_t::getHash();
+}
 
 /// Encoded size of a message type with no variable-length field.
 template <typename Message>
@@ -109,6 +124,12 @@ inline SizeRange size_range(const io_command_t&, const std::uint8_t*, std::size_
 }
 inline SizeRange size_range(const io_state_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<io_state_t>(), fixed_size<io_state_t>()};
+}
+inline SizeRange size_range(const io_joints_command_t&, const std::uint8_t*, std::size_t) {
+  return {fixed_size<io_joints_command_t>(), fixed_size<io_joints_command_t>()};
+}
+inline SizeRange size_range(const io_joints_state_t&, const std::uint8_t*, std::size_t) {
+  return {fixed_size<io_joints_state_t>(), fixed_size<io_joints_state_t>()};
 }
 inline SizeRange size_range(const telemetry_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<telemetry_t>(), fixed_size<telemetry_t>()};
@@ -190,7 +211,8 @@ bool valid_state(const io_state_t& state);
 
 /// What the rig applies: the duties when armed, else the vented state (one joint: the messages
 /// carry one). fill_command and fill_state throw InputError for a command or reading of another
-/// joint count than one: today's messages cannot carry it, and nothing of it is sent.
+/// joint count than one: these messages cannot carry it (devices/lcm_io_messages: the messages of
+/// an arm of several joints, which endpoints use).
 ValveCommand to_valves(const io_command_t& command);
 void fill_command(const ValveCommand& valves, bool armed, io_command_t& command);
 /// The sensor values of a state (time_s is the rig's; the device replaces it by its own clock).

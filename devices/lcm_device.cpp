@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "devices/lcm_channels.hpp"
+#include "engine/errors.hpp"
 
 namespace bellows {
 namespace {
@@ -19,10 +20,13 @@ constexpr double kLinkAlive_s = 0.1;
 
 }  // namespace
 
-LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s)
-    : session_id_(session_id), key_(key), rig_silence_s_(rig_silence_s) {
+LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
+    : session_id_(session_id), key_(key), rig_silence_s_(rig_silence_s), joints_(joints) {
+  if (!valid_joint_count(joints_)) {
+    throw InputError("an LCM rig of " + std::to_string(joints_) + " joints: the messages carry 1 to " + std::to_string(kMaxJoints));
+  }
   command_.session_id = session_id_;
-  buffer_.resize(static_cast<std::size_t>(command_.getEncodedSize()));
+  buffer_.resize(max_io_message_bytes());
   // Nothing goes out before the engine's first tick: a rig serving nobody takes the first session
   // that commands it, and would time out (and serve nobody again) if that session then fell silent.
 }
@@ -37,28 +41,37 @@ SensorReading LcmDevice::read_sensors() {
 void LcmDevice::write_valves(const ValveCommand& command) {
   Outgoing out;
   out.armed = true;
-  // The messages carry one joint: a command for another joint count goes out vented (fill_command
-  // would refuse it on the I/O thread), and the engine's guard faults on the one-joint readings.
-  const JointValves valves = single_joint_valves(command);
-  for (int i = 0; i < kActuatorCount; ++i) {  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
-    const double inlet = valves.inlet_duty[i], outlet = valves.outlet_duty[i];
-    out.valves.joint[0].inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
-    out.valves.joint[0].outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
+  // A command for another joint count than the arm's is meant for another arm: every joint goes
+  // out vented, and the engine's guard faults on readings of the arm's joint count.
+  out.valves = ValveCommand::vented(joints_);
+  if (command.joint_count != joints_) return outbox_.write(out);
+  for (int j = 0; j < joints_; ++j) {
+    const JointValves& valves = command.joint[static_cast<std::size_t>(j)];
+    JointValves& sent = out.valves.joint[static_cast<std::size_t>(j)];
+    for (int i = 0; i < kActuatorCount; ++i) {  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
+      const double inlet = valves.inlet_duty[i], outlet = valves.outlet_duty[i];
+      sent.inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
+      sent.outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
+    }
   }
   outbox_.write(out);
 }
 
-void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(), false}); }
+void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(joints_), false}); }
 
 // ---- I/O thread ----
 
 void LcmDevice::attach(lcm::LCM& bus) { subscribe(bus, kIoStateChannel); }
 
-void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  // io_state_t only
-  const DecodeStatus status = decode_checked(data, size, received_, key_.present() ? &key_ : nullptr);
+void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  // io_state_t or io_joints_state_t
+  const DecodeStatus status = decode_io_state(data, size, received_, key_.present() ? &key_ : nullptr);
   if (status != DecodeStatus::kOk) return counters_.count(status);
-  const io_state_t& s = received_;
+  const io_joints_state_t& s = received_;
   if (!valid_state(s)) return counters_.invalid();
+  if (s.joint_count != joints_) {  // a rig of another arm: never bound to, whatever it offers
+    last_other_joints_.store(s.joint_count, std::memory_order_relaxed);
+    return counters_.other_joints();
+  }
   const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
   if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
   if (s.session_id == 0) {  // a free rig's offer
@@ -125,7 +138,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
 
 void LcmDevice::finish(lcm::LCM* bus, double now_s) {
   // Leave the rig vented, whatever the engine last asked for.
-  if (bus != nullptr) publish(*bus, Outgoing{ValveCommand::vented(), false}, now_s);
+  if (bus != nullptr) publish(*bus, Outgoing{ValveCommand::vented(joints_), false}, now_s);
 }
 
 void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
@@ -136,7 +149,7 @@ void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   command_.utime = static_cast<std::int64_t>(now_s * 1e6);
   fill_command(outgoing.valves, outgoing.armed, command_);
   last_armed_ = outgoing.armed;
-  const std::size_t size = encode_signed(command_, key_, buffer_);
+  const std::size_t size = encode_io_command(command_, key_, buffer_);
   if (bus.publish(kIoCommandChannel, buffer_.data(), static_cast<unsigned int>(size)) != 0) {
     bump(publish_errors_);
     return;
@@ -151,7 +164,7 @@ DeviceHealth LcmDevice::health() const {
   h.connected = connected() && monotonic_s() - last_state_s() < kLinkAlive_s;
   round_trips_.summarize(h);
   const ReceiveCounts c = counters_.snapshot();
-  h.link_errors = c.truncated + c.wrong_type + c.too_large + c.malformed + c.invalid + c.foreign + c.out_of_order +
+  h.link_errors = c.truncated + c.wrong_type + c.too_large + c.malformed + c.invalid + c.foreign + c.out_of_order + c.other_joints +
                   rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
   h.stale_readings = stale_reads_.load(std::memory_order_relaxed);
   return h;
@@ -166,6 +179,8 @@ LcmDeviceStats LcmDevice::stats() const {
   s.rig_fault_states = rig_fault_states_.load(relaxed);
   s.last_fault_bits = last_fault_bits_.load(relaxed);
   s.last_foreign_session = last_foreign_session_.load(relaxed);
+  s.joints = joints_;
+  s.last_other_joints = last_other_joints_.load(relaxed);
   s.commands_sent = commands_sent_.load(relaxed);
   s.vent_commands_sent = vent_commands_sent_.load(relaxed);
   s.publish_errors = publish_errors_.load(relaxed);
@@ -186,6 +201,11 @@ std::string LcmDevice::diagnosis() const {
   if (s.states.unauthenticated > 0) {
     return "another sender publishes rig states on this bus: " + std::to_string(s.states.unauthenticated) +
            " failed authentication and were ignored (or the rig has a different [lcm] key_file)";
+  }
+  if (s.states.other_joints > 0) {
+    return "a rig on this bus serves an arm of " + arm_joints_words(s.last_other_joints) + " but this arm has " +
+           arm_joints_words(s.joints) + ": " + std::to_string(s.states.other_joints) +
+           " states ignored (the engine's [arm] must be the rig's: docs/lcm-protocol.md)";
   }
   if (s.states.old_version > 0) {
     return "a rig on this bus speaks protocol version 1: " + std::to_string(s.states.old_version) +

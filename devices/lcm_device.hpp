@@ -7,6 +7,10 @@
 //   each new valve state as an io_command_t with the next sequence number, and checks every
 //   io_state_t received before handing it to the engine.
 //
+// Joints: an arm of one joint speaks io_command_t / io_state_t, one of several io_joints_command_t /
+// io_joints_state_t (devices/lcm_io_messages). A state of a rig of another joint count is counted
+// (`other_joints`) and never bound to; diagnosis() says so in one line.
+//
 // Binding: commands are addressed to one rig (`rig_id`) and echo its binding offer. Until a free
 // rig's offer is seen they are addressed to none (rig_id 0) and every rig ignores them; the engine
 // vents until a rig serves it, so the command that binds is a vent. A new offer (the rig restarted,
@@ -27,6 +31,7 @@
 #include <vector>
 
 #include "devices/lcm_codec.hpp"
+#include "devices/lcm_io_messages.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/round_trip_stats.hpp"
 #include "engine/device.hpp"
@@ -41,6 +46,8 @@ struct LcmDeviceStats {
   std::uint64_t rig_fault_states = 0;    // states of this session carrying rig fault bits
   std::int32_t last_fault_bits = 0;
   std::int64_t last_foreign_session = 0; // the session a rig served when it was not this one
+  int joints = 1;                        // this arm's
+  int last_other_joints = 0;             // a rig's joint count when it was not this arm's, 0: none heard
   std::uint64_t commands_sent = 0;
   std::uint64_t vent_commands_sent = 0;  // of which armed = false
   std::uint64_t publish_errors = 0;
@@ -54,7 +61,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
  public:
   /// `session_id`: nonzero, unique per run (random_session_id()).
   /// `rig_silence_s`: a rig silent this long is gone ([lcm] rig_timeout_s): another may be bound.
-  explicit LcmDevice(std::int64_t session_id, LcmKey key = {}, double rig_silence_s = 0.05);
+  /// `joints`: the arm's joint count, 1..kMaxJoints (InputError otherwise), the rig's must match.
+  explicit LcmDevice(std::int64_t session_id, LcmKey key = {}, double rig_silence_s = 0.05, int joints = 1);
 
   /// A random nonzero session id.
   static std::int64_t random_session_id() { return random_nonzero_id(); }
@@ -75,6 +83,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   // ---- any thread ----
   std::int64_t session_id() const { return session_id_; }
+  int joints() const { return joints_; }
   /// Whether a valid state of this session has arrived: a rig has served this engine.
   bool connected() const { return connected_.load(std::memory_order_acquire); }
   /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
@@ -99,12 +108,13 @@ class LcmDevice final : public Device, public LcmEndpoint {
   const std::int64_t session_id_;
   const LcmKey key_;
   const double rig_silence_s_;
+  const int joints_;
   LatestValue<Outgoing> outbox_;        // engine -> I/O
   LatestValue<SensorReading> inbox_;    // I/O -> engine
   SensorReading reading_{};             // engine thread's copy
 
   // I/O thread state.
-  io_state_t received_{};
+  io_joints_state_t received_{};
   SensorReading pending_{};
   bool pending_fresh_ = false;
   std::int64_t rig_id_ = 0;        // the rig addressed, 0: none yet
@@ -119,7 +129,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   double origin_s_ = -1.0;
   std::int64_t seq_ = 0;
   bool last_armed_ = false;
-  io_command_t command_{};
+  io_joints_command_t command_{};
   std::vector<std::uint8_t> buffer_;
 
   ReceiveCounters counters_;
@@ -129,6 +139,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<std::uint64_t> rig_fault_states_{0};
   std::atomic<std::int32_t> last_fault_bits_{0};
   std::atomic<std::int64_t> last_foreign_session_{0};
+  std::atomic<int> last_other_joints_{0};
   std::atomic<std::uint64_t> commands_sent_{0};
   std::atomic<std::uint64_t> vent_commands_sent_{0};
   std::atomic<std::uint64_t> publish_errors_{0};

@@ -13,7 +13,14 @@ namespace {
 }  // namespace
 
 RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id)
-    : arm_(arm), params_(std::move(params)), rig_id_(rig_id) {
+    : RigServer(arm, 1, arm.parameters().integration_step_s, std::move(params), rig_id) {}
+
+RigServer::RigServer(Device& arm, int joints, double integration_step_s, RigServerParameters params, std::int64_t rig_id)
+    : arm_(arm), joints_(joints), integration_step_s_(integration_step_s), params_(std::move(params)), rig_id_(rig_id) {
+  if (!valid_joint_count(joints_)) {
+    throw InputError("a rig of " + std::to_string(joints_) + " joints: the LCM messages carry 1 to " + std::to_string(kMaxJoints));
+  }
+  if (!(integration_step_s_ > 0.0)) throw InputError("the rig's integration step must be positive");
   if (!(params_.period_s > 0.0) || !(params_.command_timeout_s > 0.0)) {
     throw InputError("the rig's period and command timeout must be positive");
   }
@@ -22,7 +29,8 @@ RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t
   binding_ = random_nonzero_id();
   binding_shown_.store(binding_, std::memory_order_relaxed);
   state_.rig_id = rig_id_;
-  buffer_.resize(static_cast<std::size_t>(state_.getEncodedSize()));
+  commanded_ = ValveCommand::vented(joints_);
+  buffer_.resize(max_io_message_bytes());
 }
 
 void RigServer::attach(lcm::LCM& bus) { subscribe(bus, kIoCommandChannel); }
@@ -37,17 +45,28 @@ void RigServer::notice(Notice kind, const std::string& line) {
   reported = true;
 }
 
-void RigServer::on_message(const char*, const void* data, std::size_t size) {  // io_command_t only
-  const DecodeStatus status = decode_checked(data, size, received_, params_.key.present() ? &params_.key : nullptr);
+void RigServer::on_message(const char*, const void* data, std::size_t size) {  // io_command_t or io_joints_command_t
+  const DecodeStatus status = decode_io_command(data, size, received_, params_.key.present() ? &params_.key : nullptr);
   if (status != DecodeStatus::kOk) {
     counters_.count(status);
     if (status == DecodeStatus::kOldVersion) notice(Notice::kOldVersion, std::string("a command ") + explain(status));
     if (status == DecodeStatus::kUnauthenticated) notice(Notice::kUnauthenticated, std::string("a command ") + explain(status));
     return;
   }
-  const io_command_t& c = received_;
+  const io_joints_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();
   if (c.rig_id != rig_id_) return bump(not_addressed_);  // to another rig, or to none yet: not for us to count as foreign
+  if (c.joint_count != joints_) {  // meant for another arm: nothing of it is safe to apply, and it binds nothing
+    notice(Notice::kOtherJoints, "a command for an arm of " + arm_joints_words(c.joint_count) + " but this rig's arm has " +
+                                     arm_joints_words(joints_) + " (the engine's [arm] must be the rig's)");
+    counters_.other_joints();
+    if (!c.armed) {  // but a vent only makes the rig safer, whatever arm it was meant for
+      io_joints_command_t vent = c;
+      vent.joint_count = static_cast<std::int8_t>(joints_);
+      obey_vent(vent);
+    }
+    return;
+  }
   const bool outside_range = (limit_bits_ & io_state_t::FAULT_ANGLE_LIMIT) != 0;
   if (session_ == 0 && c.binding == binding_ && !c.armed && outside_range) {
     notice(Notice::kForeign, "session " + std::to_string(c.session_id) + " tried to bind while the arm is beyond the rig's angle range");
@@ -69,17 +88,7 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
     pending_fresh_ = true;
     return counters_.accepted();
   }
-  if (!c.armed) {  // a vent is obeyed whatever its session or sequence number: it only makes the rig safer
-    if (!pending_fresh_ || !pending_in_sequence_) {  // never overwrite the session's own command unapplied
-      pending_ = c;
-      pending_in_sequence_ = false;
-      pending_fresh_ = true;
-    } else {
-      pending_.armed = false;  // the session's command, vented
-    }
-    bump(vents_out_of_sequence_);
-    return;
-  }
+  if (!c.armed) return obey_vent(c);  // whatever its session or sequence number: it only makes the rig safer
   if (!own) {
     notice(Notice::kForeign, session_ == 0 ? "a command of session " + std::to_string(c.session_id) + " that did not bind first"
                                             : "a command of session " + std::to_string(c.session_id) +
@@ -90,6 +99,17 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   notice(Notice::kJump, "a command of session " + std::to_string(session_) + " jumping from seq " + std::to_string(last_seq_) +
                              " to " + std::to_string(c.seq) + " (more than [lcm] seq_window)");
   counters_.out_of_order();
+}
+
+void RigServer::obey_vent(const io_joints_command_t& vent) {
+  if (!pending_fresh_ || !pending_in_sequence_) {  // never overwrite the session's own command unapplied
+    pending_ = vent;
+    pending_in_sequence_ = false;
+    pending_fresh_ = true;
+  } else {
+    pending_.armed = false;  // the session's command, vented
+  }
+  bump(vents_out_of_sequence_);
 }
 
 static_assert(kRigPressureLimitBit == io_state_t::FAULT_PRESSURE_LIMIT && kRigAngleLimitBit == io_state_t::FAULT_ANGLE_LIMIT,
@@ -112,7 +132,7 @@ void RigServer::apply_limits(bool write) {
                                     (session_ != 0 ? ", session " + std::to_string(session_) + " dropped" : std::string()));
   }
   if (limited.angle_exceeded) {
-    commanded_ = ValveCommand::vented();
+    commanded_ = ValveCommand::vented(joints_);
     if (session_ != 0) release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT});
   }
   // Written only when something changed: every write starts a new PWM period.
@@ -121,7 +141,7 @@ void RigServer::apply_limits(bool write) {
 
 void RigServer::release(std::int32_t fault_bits) {
   arm_.vent();
-  commanded_ = ValveCommand::vented();
+  commanded_ = ValveCommand::vented(joints_);
   session_ = 0;
   serving_.store(0, std::memory_order_relaxed);
   applied_seq_ = 0;
@@ -133,7 +153,7 @@ void RigServer::release(std::int32_t fault_bits) {
 
 void RigServer::advance_to(double now_s) {
   // The limits are checked at every integration step, as a driver checks them at every sensor read.
-  const double step_s = arm_.parameters().integration_step_s;
+  const double step_s = integration_step_s_;
   const double target_s = now_s - origin_s_;
   while (target_s > device_time_s_) {
     const double dt = std::min(step_s, target_s - device_time_s_);
@@ -192,9 +212,9 @@ void RigServer::publish_state(lcm::LCM& bus, double now_s) {
   state_.fault_bits = fault_bits_ | limit_bits_ | limit_bits_since_state_;  // a limit that acted between two states too
   limit_bits_since_state_ = 0;
   const ReceiveCounts c = counters_.snapshot();
-  state_.foreign_commands = static_cast<std::int64_t>(c.foreign + c.out_of_order + c.old_version);
+  state_.foreign_commands = static_cast<std::int64_t>(c.foreign + c.out_of_order + c.old_version + c.other_joints);
   state_.unauthenticated_commands = static_cast<std::int64_t>(c.unauthenticated);
-  const std::size_t size = encode_signed(state_, params_.key, buffer_);
+  const std::size_t size = encode_io_state(state_, params_.key, buffer_);
   if (bus.publish(kIoStateChannel, buffer_.data(), static_cast<unsigned int>(size)) == 0) bump(states_published_);
 }
 

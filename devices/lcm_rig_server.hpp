@@ -11,6 +11,13 @@
 // the session and offers a new binding. A chamber above the rig's ceiling is vented whatever the
 // command. With a key, a command whose MAC does not match is counted and ignored, and every state
 // is signed. Everything refused is counted, in the states and in the log.
+//
+// Joints: it serves any Device of J joints (the single-joint SimulatedArm, or the J-joint
+// SimulatedArmChain for `[arm] preset`). With one joint it speaks io_command_t / io_state_t exactly
+// as before joints existed; with several, io_joints_command_t / io_joints_state_t. A valid command
+// for an arm of another joint count (either message type) is counted as `other_joints`, logged
+// once per binding, and never binds or drives the arm (a vent addressed to this rig is obeyed, as
+// every vent is).
 #pragma once
 
 #include <atomic>
@@ -21,6 +28,7 @@
 
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_codec.hpp"
+#include "devices/lcm_io_messages.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/lcm_rig_limits.hpp"
 #include "devices/simulated_arm.hpp"
@@ -55,8 +63,13 @@ struct RigServerStats {
 
 class RigServer final : public LcmEndpoint {
  public:
-  /// `rig_id`: nonzero, unique per start (random_nonzero_id()).
+  /// `rig_id`: nonzero, unique per start (random_nonzero_id()). The single-joint simulated arm.
   RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id);
+  /// Any in-process arm of `joints` joints (1..kMaxJoints, InputError otherwise) whose physics is
+  /// advanced in steps of at most `integration_step_s` (the limits are checked after each).
+  RigServer(Device& arm, int joints, double integration_step_s, RigServerParameters params, std::int64_t rig_id);
+
+  int joints() const { return joints_; }
 
   void attach(lcm::LCM& bus) override;
   void on_message(const char* channel, const void* data, std::size_t size) override;
@@ -68,8 +81,9 @@ class RigServer final : public LcmEndpoint {
 
  private:
   // What the log reports once per binding (the refusals first).
-  enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
+  enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kOtherJoints, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
 
+  void obey_vent(const io_joints_command_t& vent);  // a vent addressed to this rig, outside its session's sequence
   void advance_to(double now_s);
   void apply_limits(bool write);
   void release(std::int32_t fault_bits);  // vent, drop the session, offer a new binding
@@ -77,13 +91,15 @@ class RigServer final : public LcmEndpoint {
   void say(const std::string& line) const;
   void publish_state(lcm::LCM& bus, double now_s);
 
-  SimulatedArm& arm_;
+  Device& arm_;
+  const int joints_;
+  const double integration_step_s_;
   const RigServerParameters params_;
   const std::int64_t rig_id_;
 
   // I/O thread state.
-  io_command_t received_{};
-  io_command_t pending_{};
+  io_joints_command_t received_{};
+  io_joints_command_t pending_{};
   bool pending_fresh_ = false;
   bool pending_in_sequence_ = false;  // the session's own command (else a vent obeyed out of sequence)
   ValveCommand commanded_ = ValveCommand::vented();  // the session's latest, before the limits
@@ -100,7 +116,7 @@ class RigServer final : public LcmEndpoint {
   double last_command_s_ = 0.0;
   double next_publish_s_ = 0.0;
   std::int64_t state_seq_ = 0;
-  io_state_t state_{};
+  io_joints_state_t state_{};
   std::vector<std::uint8_t> buffer_;
 
   ReceiveCounters counters_;

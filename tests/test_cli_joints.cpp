@@ -89,8 +89,8 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   expect_refused_in_one_line("run --no-save --config " + arm_config("five", "[arm]\njoints = 5\n"), "[arm] joints = 5");
   expect_refused_in_one_line("run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
                              "[arm_joint2] mass_kg = 0");
-  expect_refused_in_one_line("run --no-save --config " + own + " --device lcm",
-                             "[arm] joints = 2: an arm of several joints runs on --device sim");
+  expect_refused_in_one_line("run --no-save --config " + own + " --device t7 --t7 127.0.0.1:1",
+                             "[arm] joints = 2: an arm of several joints runs on --device sim or lcm");
 }
 
 TEST(CliJoints, OneJointReportsItsRmsAsItsOnlyJoint) {
@@ -111,7 +111,7 @@ TEST(CliJoints, WhatCannotDriveTheArmIsRefusedInOneLine) {
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --trajectory paper3",
                              "trajectory 'paper3' has 3 joints; the arm has 2 (arm2)");
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
-                             "an arm of several joints runs on --device sim; --device t7 drives one joint");
+                             "an arm of several joints runs on --device sim or lcm; --device t7 drives one joint");
   expect_refused_in_one_line("run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
                              "[ilc] joint_model = 'rigid': unknown (known: coupled, independent)");
   expect_refused_in_one_line("identify --config " + arm2, "`bellows identify` identifies the model of one joint");

@@ -83,7 +83,7 @@ TEST(DeviceFactory, ARigRefusesAnArmOfSeveralJointsInOneLine) {
     open_device(resolve_device({"t7", "", "127.0.0.1:1", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
     FAIL() << "a T7 link must not silently drive one joint of arm2";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': an arm of several joints runs on --device sim; --device t7 drives one "
+    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': an arm of several joints runs on --device sim or lcm; --device t7 drives one "
                            "joint (leave [arm] out)");
   }
 }
