@@ -13,6 +13,7 @@
 // its snapshot and one telemetry tap. Tests drive it with a simulated clock.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -93,7 +94,7 @@ class ConsoleController {
  private:
   struct InFlight {  // a trial the engine owns until it hands it back
     std::shared_ptr<const Trajectory> trajectory;
-    Eigen::VectorXd correction_bar;
+    Eigen::MatrixXd correction_bar;  // N x J
     TrialRecord record;
     std::uint32_t id = 0;
     std::string origin;
@@ -203,7 +204,9 @@ class ConsoleController {
   bool begin_after_save_ = false;    // a trial waits for the autosave
   bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
-  std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate
+  void export_strip();  // the selected joint's ring into state_.strip
+  std::vector<double> strip_time_;  // ring at the ILC rate; angles and set points of every joint
+  std::vector<std::array<double, kMaxJoints>> strip_angle_, strip_setpoint_;
   std::size_t strip_next_ = 0, strip_count_ = 0;
   std::uint64_t strip_revision_ = 0, strip_exported_ = 0;
 
@@ -214,7 +217,7 @@ class ConsoleController {
     bool warning = false;
   };
   BackgroundTask<BuiltLaw> law_build_;
-  BackgroundTask<Eigen::VectorXd> law_update_;
+  BackgroundTask<Eigen::MatrixXd> law_update_;
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::string> rename_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;

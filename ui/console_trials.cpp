@@ -8,6 +8,7 @@
 #include "engine/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
+#include "ui/joint_view.hpp"
 
 namespace bellows::ui {
 
@@ -63,7 +64,7 @@ void ConsoleController::poll_tasks() {
   }
   if (law_update_.ready()) {
     try {
-      Eigen::VectorXd next = law_update_.take();
+      Eigen::MatrixXd next = law_update_.take();
       const int from = state_.experiment.trials.back().iteration;
       state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from));
       log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
@@ -106,7 +107,7 @@ void ConsoleController::begin_trial() {
   auto trial = std::make_unique<InFlight>();
   trial->trajectory = e.trajectory;
   trial->correction_bar = e.next_correction_bar;
-  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample);
+  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample, e.joints());
   trial->id = ++last_trial_id_;
   trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
   const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
@@ -129,8 +130,13 @@ void ConsoleController::finish_trial(double time_s) {
   trial.correction_bar = std::move(in_flight_->correction_bar);
   trial.record = std::move(in_flight_->record);
   trial.origin = in_flight_->origin;
-  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
+  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar.col(0),
                                   env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
+  for (int j = 0; j < trial.record.joints(); ++j) trial.joint_rms_deg.push_back(trial.record.joint_rms_error_deg(j));
+  if (trial.record.joints() > 1) {  // the RMS over every joint and sample; the largest correction of any joint
+    trial.summary.rms_deg = overall_rms_deg(trial.joint_rms_deg);
+    trial.summary.max_abs_correction_bar = trial.correction_bar.size() > 0 ? trial.correction_bar.cwiseAbs().maxCoeff() : 0.0;
+  }
   in_flight_.reset();
   const bool follow = state_.inspector.trial == static_cast<int>(e.trials.size()) - 1;
   e.add_trial(std::move(trial));
@@ -154,7 +160,17 @@ void ConsoleController::finish_trial(double time_s) {
                diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
         true, time_s);
   }
-  set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  if (e.trials.back().joint_rms_deg.size() > 1) {
+    std::string per_joint;
+    for (double r : e.trials.back().joint_rms_deg) {
+      if (!per_joint.empty()) per_joint += ' ';
+      per_joint += format("%.3f", r);
+    }
+    log(LogSource::kEngine, format("iteration %d: RMS per joint %s deg", s.iteration, per_joint.c_str()), false, time_s);
+    set_status(format("iteration %d: RMS %.3f deg (per joint %s)", s.iteration, s.rms_deg, per_joint.c_str()));
+  } else {
+    set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  }
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;
   continue_run();
@@ -204,13 +220,19 @@ void ConsoleController::step() {
   }
   const Trial& last = e.trials.back();
   state_.run.phase = RunProgress::Phase::kLearning;
-  const Eigen::Index n = last.correction_bar.size();
+  const Eigen::Index n = last.correction_bar.rows();
   const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
-  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error(),
-                     feedback = Eigen::VectorXd(last.record.samples.u_pid_bar.head(n)), input_limit_bar] {
-    law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
-    Eigen::VectorXd next(u.size());
-    law->update(u, error, next);
+  Eigen::MatrixXd feedback(n, last.correction_bar.cols());
+  for (Eigen::Index j = 0; j < feedback.cols(); ++j) {
+    feedback.col(j) = last.record.joint_samples(static_cast<int>(j)).u_pid_bar.head(n);
+  }
+  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_joint_errors(),
+                     feedback = std::move(feedback), input_limit_bar] {
+    Eigen::MatrixXd next(u.rows(), u.cols());
+    for (Eigen::Index j = 0; j < u.cols(); ++j) {
+      law->set_input_context(feedback.col(j), input_limit_bar);  // laws that respect the pressure limits use it
+      law->update(u.col(j), error.col(j), next.col(j));
+    }
     return next;
   });
   ++revision_;
