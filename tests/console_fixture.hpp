@@ -78,12 +78,12 @@ class MemorySessions final : public ui::SessionGateway {
 struct ConsoleFixture {
   /// `gateway`: where sessions go (default: `sessions`, in memory). `device`: the engine drives it
   /// instead of `arm` (a test's own device). `write_figures`: the figure key's writer (default:
-  /// none, the key says so). `trajectory`: the library trajectory it starts with (`paper2` for an
+  /// none, the key says so). `start_trajectory`: the library trajectory it starts with (`paper2` for an
   /// arm2 device and configuration).
   explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
                           ui::SessionGateway* gateway = nullptr, Device* device = nullptr,
                           std::function<std::string(const ui::SessionSnapshot&)> write_figures = {},
-                          const std::string& trajectory = "paper")
+                          const std::string& start_trajectory = "paper")
       : config(c),
         arm(c.plant, 1),
         core(device != nullptr ? *device : arm, c.controller, c.timing, c.safety),
@@ -101,7 +101,7 @@ struct ConsoleFixture {
     env.stop_after_rises = stop_after_rises;
     env.write_figures = std::move(write_figures);
     env.clock_text = [] { return std::string("12:00:00"); };
-    console = std::make_unique<ui::ConsoleController>(env, library_trajectory(trajectory, c.timing.sample_s()), false);
+    console = std::make_unique<ui::ConsoleController>(env, library_trajectory(start_trajectory, c.timing.sample_s()), false);
     console->resize(120, 40);
     console->start(clock.now_s());
   }

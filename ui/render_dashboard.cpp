@@ -159,10 +159,8 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     options.y_min = 0.0;
     options.y_format = "%.2f";
     std::vector<PlotSeries> series;
-    if (joints > 1) {
-      const RmsSeries joint = rms_series(s.experiment, selected_joint(s));
-      series.push_back({joint.iteration, joint.rms_deg, Role::kSeries2, '.'});
-    }
+    const RmsSeries joint = joints > 1 ? rms_series(s.experiment, selected_joint(s)) : RmsSeries{};  // the series refer to it
+    if (joints > 1) series.push_back({joint.iteration, joint.rms_deg, Role::kSeries2, '.'});
     series.push_back({data.iteration, data.rms_deg, Role::kSeries1, '*'});
     draw_plot(c, plot, series, options);
   }
