@@ -91,6 +91,16 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   for (int j = 0; j < 2; ++j) EXPECT_GT(e.trials[2].correction_bar.col(j).cwiseAbs().maxCoeff(), 0.0) << j;
   for (int j = 0; j < 2; ++j) EXPECT_LT(e.trials[2].joint_rms_deg[static_cast<std::size_t>(j)], e.trials[0].joint_rms_deg[static_cast<std::size_t>(j)]) << j;
   EXPECT_TRUE(f.logged("iteration 2: RMS per joint"));
+  {  // At 80x24 the header keeps the joint beside the state, trajectory, iteration and RMS.
+    ConsoleState small = f.state();
+    small.width = kMinWidth;
+    small.height = kMinHeight;
+    const std::string header = render_lines(small)[0];
+    EXPECT_NE(header.find("ARMED"), std::string::npos) << header;
+    EXPECT_NE(header.find("paper2"), std::string::npos) << header;
+    EXPECT_NE(header.find("1/2 shoulder"), std::string::npos) << header;
+    EXPECT_NE(header.find(format("%.3f", e.trials.back().summary.rms_deg)), std::string::npos) << header;
+  }
 
   // The dashboard lists every iteration's overall RMS and each joint's.
   const std::string screen = screen_text(f.state());
