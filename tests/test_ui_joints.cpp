@@ -72,12 +72,12 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   const Experiment& e = f.state().experiment;
   ASSERT_EQ(e.trials.size(), 3u);
   for (const Trial& t : e.trials) {
-    ASSERT_EQ(t.joint_rms_deg.size(), 2u);
+    ASSERT_EQ(t.summary.joint_rms_deg.size(), 2);
     ASSERT_EQ(t.record.joints(), 2);
     double squares = 0.0;
     for (int j = 0; j < 2; ++j) {
-      EXPECT_DOUBLE_EQ(t.joint_rms_deg[static_cast<std::size_t>(j)], t.record.joint_rms_error_deg(j));
-      EXPECT_GT(t.joint_rms_deg[static_cast<std::size_t>(j)], 0.0);
+      EXPECT_DOUBLE_EQ(t.summary.joint_rms_deg(j), t.record.joint_rms_error_deg(j));
+      EXPECT_GT(t.summary.joint_rms_deg(j), 0.0);
       squares += t.record.joint_rms_error_deg(j) * t.record.joint_rms_error_deg(j);
       // The engine applied this trial's correction to each joint.
       ASSERT_EQ(t.correction_bar.cols(), 2);
@@ -89,7 +89,7 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   // Iteration 0 ran with no correction; 1 and 2 with learned ones, on both joints.
   EXPECT_TRUE(e.trials[0].correction_bar.isZero());
   for (int j = 0; j < 2; ++j) EXPECT_GT(e.trials[2].correction_bar.col(j).cwiseAbs().maxCoeff(), 0.0) << j;
-  for (int j = 0; j < 2; ++j) EXPECT_LT(e.trials[2].joint_rms_deg[static_cast<std::size_t>(j)], e.trials[0].joint_rms_deg[static_cast<std::size_t>(j)]) << j;
+  for (int j = 0; j < 2; ++j) EXPECT_LT(e.trials[2].summary.joint_rms_deg(j), e.trials[0].summary.joint_rms_deg(j)) << j;
   EXPECT_TRUE(f.logged("iteration 2: RMS per joint"));
   {  // At 80x24 the header keeps the joint beside the state, trajectory, iteration and RMS.
     ConsoleState small = f.state();
@@ -107,7 +107,7 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   EXPECT_NE(screen.find("it     all      j1     j2"), std::string::npos) << screen;
   const Trial& last = e.trials.back();
   const std::string row = format("%4d %7.3f", last.iteration, last.summary.rms_deg);
-  const std::string joints = format("%7.3f%7.3f", last.joint_rms_deg[0], last.joint_rms_deg[1]);
+  const std::string joints = format("%7.3f%7.3f", last.summary.joint_rms_deg(0), last.summary.joint_rms_deg(1));
   EXPECT_TRUE(std::regex_search(screen, std::regex(std::regex_replace(row, std::regex("\\."), "\\.") + ".?" +
                                                    std::regex_replace(joints, std::regex("\\."), "\\."))))
       << row << joints << "\n" << screen;
@@ -129,7 +129,7 @@ TEST(UiJoints, TheInspectorAndTheLiveStripShowTheSelectedJoint) {
   const int k = f.state().inspector.sample;
   const std::string screen = screen_text(f.state());
   EXPECT_NE(screen.find("joint 2/2 elbow"), std::string::npos) << screen;
-  EXPECT_NE(screen.find(format("(joint 2 %.3f)", t.joint_rms_deg[1])), std::string::npos) << screen;
+  EXPECT_NE(screen.find(format("(joint 2 %.3f)", t.summary.joint_rms_deg(1))), std::string::npos) << screen;
   const auto readout = [](double deg) { return format("%.2f deg", deg); };
   const double elbow_deg = t.record.joint_samples(1).angle_rad(k) * 180.0 / std::numbers::pi;
   const double shoulder_deg = t.record.joint_samples(0).angle_rad(k) * 180.0 / std::numbers::pi;

@@ -22,7 +22,7 @@
 
 #include "engine/arm_model.hpp"
 #include "engine/engine_core.hpp"
-#include "engine/learning_law.hpp"
+#include "engine/joint_learning.hpp"
 #include "engine/realtime_loop.hpp"
 #include "engine/valve_test.hpp"
 #include "ui/background_task.hpp"
@@ -184,8 +184,8 @@ class ConsoleController {
   std::unique_ptr<InFlight> in_flight_;
   std::uint32_t last_trial_id_ = 0;
 
-  // The law; never touched while a background update uses it.
-  std::unique_ptr<LearningLaw> law_;
+  // The learning (every joint's); never touched while a background update uses it.
+  std::unique_ptr<JointLearning> law_;
   bool rebuild_pending_ = false;
   int law_samples_ = 0;
   std::function<void()> pending_discard_action_;
@@ -212,7 +212,7 @@ class ConsoleController {
 
   // Declared last: destroyed (joined) first, before the law and the state they use.
   struct BuiltLaw {
-    std::unique_ptr<LearningLaw> law;
+    std::unique_ptr<JointLearning> law;
     std::string convergence;
     bool warning = false;
   };

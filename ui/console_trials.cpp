@@ -4,7 +4,7 @@
 
 #include "engine/convergence.hpp"
 #include "engine/errors.hpp"
-#include "engine/learning_law_factory.hpp"
+#include "engine/joint_learning_factory.hpp"
 #include "engine/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
@@ -21,10 +21,12 @@ void ConsoleController::rebuild_law() {
   state_.law_ready = false;
   law_samples_ = state_.experiment.samples();
   state_.law_name = state_.config.ilc.law;
-  law_build_.start([config = state_.config, model = model_, samples = law_samples_] {
+  law_build_.start([config = state_.config, model = model_, samples = law_samples_, joints = state_.experiment.joints()] {
     BuiltLaw built;
-    built.law = make_learning_law(config, model, samples);
-    const ConvergencePrediction p = predict_convergence(*built.law, config, samples);
+    built.law = make_joint_learning(config, model, joints, samples);
+    // Predicted for one joint's law (the single-joint model); several joints learn without one.
+    const LearningLaw* single = built.law->single_joint_law();
+    const ConvergencePrediction p = single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
     if (p.available) {
       built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
                                  "off by up to %.0f %%",
@@ -32,7 +34,8 @@ void ConsoleController::rebuild_law() {
       built.warning = !p.warning.empty();
       if (built.warning) built.convergence = p.warning;
     } else {
-      built.convergence = "no convergence prediction for this law";
+      built.convergence = single != nullptr ? "no convergence prediction for this law"
+                                            : "no convergence prediction for several joints";
     }
     return built;
   });
@@ -45,9 +48,10 @@ void ConsoleController::poll_tasks() {
     try {
       BuiltLaw built = law_build_.take();
       law_ = std::move(built.law);
-      if (law_->samples() != state_.experiment.samples()) rebuild_pending_ = true;
+      if (law_->samples() != state_.experiment.samples() || law_->joints() != state_.experiment.joints()) rebuild_pending_ = true;
       state_.law_ready = !rebuild_pending_;
       if (state_.law_ready) {
+        if (law_->joints() > 1) state_.law_name = law_->name();  // how the joints are modelled, too
         state_.convergence = built.convergence;
         state_.convergence_warning = built.warning;
         log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
@@ -130,13 +134,9 @@ void ConsoleController::finish_trial(double time_s) {
   trial.correction_bar = std::move(in_flight_->correction_bar);
   trial.record = std::move(in_flight_->record);
   trial.origin = in_flight_->origin;
-  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar.col(0),
+  // The RMS over every joint and sample, each joint's, the largest correction of any joint.
+  trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
                                   env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
-  for (int j = 0; j < trial.record.joints(); ++j) trial.joint_rms_deg.push_back(trial.record.joint_rms_error_deg(j));
-  if (trial.record.joints() > 1) {  // the RMS over every joint and sample; the largest correction of any joint
-    trial.summary.rms_deg = overall_rms_deg(trial.joint_rms_deg);
-    trial.summary.max_abs_correction_bar = trial.correction_bar.size() > 0 ? trial.correction_bar.cwiseAbs().maxCoeff() : 0.0;
-  }
   in_flight_.reset();
   const bool follow = state_.inspector.trial == static_cast<int>(e.trials.size()) - 1;
   e.add_trial(std::move(trial));
@@ -160,9 +160,9 @@ void ConsoleController::finish_trial(double time_s) {
                diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
         true, time_s);
   }
-  if (e.trials.back().joint_rms_deg.size() > 1) {
+  if (s.joint_rms_deg.size() > 1) {
     std::string per_joint;
-    for (double r : e.trials.back().joint_rms_deg) {
+    for (double r : s.joint_rms_deg) {
       if (!per_joint.empty()) per_joint += ' ';
       per_joint += format("%.3f", r);
     }
@@ -228,11 +228,9 @@ void ConsoleController::step() {
   }
   law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_joint_errors(),
                      feedback = std::move(feedback), input_limit_bar] {
+    law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
     Eigen::MatrixXd next(u.rows(), u.cols());
-    for (Eigen::Index j = 0; j < u.cols(); ++j) {
-      law->set_input_context(feedback.col(j), input_limit_bar);  // laws that respect the pressure limits use it
-      law->update(u.col(j), error.col(j), next.col(j));
-    }
+    law->update(u, error, next);
     return next;
   });
   ++revision_;

@@ -69,8 +69,8 @@ std::vector<double> Experiment::joint_rms_history_deg(int joint) const {
   std::vector<double> rms;
   rms.reserve(trials.size());
   for (const Trial& t : trials) {
-    const bool known = joint >= 0 && joint < static_cast<int>(t.joint_rms_deg.size());
-    rms.push_back(known ? t.joint_rms_deg[static_cast<std::size_t>(joint)] : (joint == 0 ? t.summary.rms_deg : std::numeric_limits<double>::quiet_NaN()));
+    const bool known = joint >= 0 && joint < t.summary.joint_rms_deg.size();
+    rms.push_back(known ? t.summary.joint_rms_deg(joint) : (joint == 0 ? t.summary.rms_deg : std::numeric_limits<double>::quiet_NaN()));
   }
   return rms;
 }

@@ -23,8 +23,7 @@ struct Trial {
   Eigen::MatrixXd correction_bar;  // u_ilc(0..N-1) the trial applied, one column per joint (N x J);
                                    // empty once released
   TrialRecord record;              // empty once released (saved, and older than the kept window)
-  IterationSummary summary;        // rms_deg over every joint and sample
-  std::vector<double> joint_rms_deg;  // each joint's RMS (deg); one entry with one joint
+  IterationSummary summary;        // rms_deg over every joint and sample, joint_rms_deg per joint
   std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
 
   /// False once its record and correction were released: they are in the session on disk only.

@@ -24,13 +24,6 @@ double tick_desired_rad(const TickRecord& tick, int joint) {
   return tick.more_desired_rad[static_cast<std::size_t>(joint - 1)];
 }
 
-double overall_rms_deg(const std::vector<double>& joint_rms_deg) {
-  if (joint_rms_deg.empty()) return 0.0;
-  double sum = 0.0;
-  for (double r : joint_rms_deg) sum += r * r;
-  return std::sqrt(sum / static_cast<double>(joint_rms_deg.size()));
-}
-
 std::string fault_location(FaultCode code, const TickRecord& tick, const Configuration& config) {
   const int joints = tick.reading.joint_count;
   if (joints < 2 || joints > kMaxJoints) return {};

@@ -1,5 +1,5 @@
 // The joints of the arm as the console names and shows them (issue 14): the selected joint's
-// label, its signals in a tick, the RMS over every joint, and which joint a guard fired on. With
+// label, its set point in a tick, and which joint a guard fired on. With
 // one joint nothing here adds to the screen (it looks as it did before joints were counted).
 #pragma once
 
@@ -21,9 +21,6 @@ std::string joint_label(int joints, int joint);
 
 /// Joint `joint`'s set point in a tick (joint 1's is desired_angle_rad).
 double tick_desired_rad(const TickRecord& tick, int joint);
-
-/// The RMS over every joint and sample (deg) from each joint's RMS over the same samples.
-double overall_rms_deg(const std::vector<double>& joint_rms_deg);
 
 /// Where a guard fired on a J-joint arm, in words ("joint 2 (elbow): angle 97.3 deg beyond the
 /// limit of 95 deg"), read from the tick that faulted; "" for one joint, for a fault that is not

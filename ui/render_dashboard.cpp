@@ -145,7 +145,7 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     std::string line = joints > 1 ? format("%4d %7.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : " ")
                                   : format("%4d %9.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : "");
     for (int j = 0; joints > 1 && j < joints; ++j) {
-      line += j < static_cast<int>(t.joint_rms_deg.size()) ? format("%7.3f", t.joint_rms_deg[static_cast<std::size_t>(j)])
+      line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j))
                                                             : std::string("      -");
     }
     c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1);

@@ -47,8 +47,8 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   if (t.record.joints() > 1) x = c.put(x + 2, body.y, joint_label(t.record.joints(), joint), Role::kNormal, true);
   x = c.put(x + 2, body.y, "(" + t.origin + ")", Role::kDim);
   x = c.put(x + 2, body.y, format("RMS %.3f deg", t.summary.rms_deg), Role::kNormal, true);
-  if (joint < static_cast<int>(t.joint_rms_deg.size()) && t.record.joints() > 1) {
-    x = c.put(x + 1, body.y, format("(joint %d %.3f)", joint + 1, t.joint_rms_deg[static_cast<std::size_t>(joint)]), Role::kNormal);
+  if (joint < t.summary.joint_rms_deg.size() && t.record.joints() > 1) {
+    x = c.put(x + 1, body.y, format("(joint %d %.3f)", joint + 1, t.summary.joint_rms_deg(joint)), Role::kNormal);
   }
   if (s.inspector.chosen >= 0) c.put(x + 2, body.y, format("overlay: it %d", s.inspector.chosen), Role::kSeries3);
 
