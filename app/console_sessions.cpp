@@ -141,10 +141,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const ui::Experiment& e = snapshot.experiment;
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
-  if (e.trajectory->joints() > 1) {  // the session files hold one joint: joint 1 alone would reopen on the wrong arm
-    throw InputError("sessions store one joint so far: trajectory '" + e.trajectory->name + "' has " +
-                     std::to_string(e.trajectory->joints()) + " joints (its trials are in this console only)");
-  }
+  if (const std::string why = joints_refusal(e.trajectory->joints()); !why.empty()) throw InputError(why);
   const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
@@ -197,6 +194,12 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   }
   return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
+}
+
+std::string StoreSessionGateway::joints_refusal(int joints) const {
+  // The session files hold one joint so far: joint 1 alone would reopen on the wrong arm.
+  if (joints <= 1) return {};
+  return "sessions store one joint so far (this arm has " + std::to_string(joints) + "): the trials stay in this console";
 }
 
 std::string StoreSessionGateway::rename(const std::string& name) {
