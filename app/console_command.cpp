@@ -98,6 +98,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   if (opened_session) {
     setup.session = sessions.open(options.session_dir);  // this gateway saves into it from now on
     setup.trajectory = *setup.session->experiment.trajectory;
+    require_driven_joints(setup.trajectory, config.arm);  // a session of another arm: one line, nothing driven
   } else {
     setup.trajectory = load_trajectory(options.trajectory);
   }

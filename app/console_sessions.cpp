@@ -89,9 +89,15 @@ ui::SessionSnapshot snapshot_of(Session& loaded, const std::filesystem::path& di
   for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
     ui::Trial trial;
     trial.iteration = static_cast<int>(i);
-    trial.correction_bar = loaded.iterations[i].record.samples.u_ilc_bar.head(n);
-    trial.record = std::move(loaded.iterations[i].record);
+    const TrialRecord& record = loaded.iterations[i].record;
+    trial.correction_bar.resize(n, record.joints());
+    for (int j = 0; j < record.joints(); ++j) trial.correction_bar.col(j) = record.joint_samples(j).u_ilc_bar.head(n);
     trial.summary = loaded.manifest.iterations[i].summary;
+    if (trial.summary.joint_rms_deg.size() != record.joints()) {  // each joint's RMS, from its record
+      trial.summary.joint_rms_deg.resize(record.joints());
+      for (int j = 0; j < record.joints(); ++j) trial.summary.joint_rms_deg(j) = record.joint_rms_error_deg(j);
+    }
+    trial.record = std::move(loaded.iterations[i].record);
     trial.origin = "saved";
     e.trials.push_back(std::move(trial));
   }
@@ -135,6 +141,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const ui::Experiment& e = snapshot.experiment;
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
+  if (const std::string why = joints_refusal(e.trajectory->joints()); !why.empty()) throw InputError(why);
   const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
@@ -160,7 +167,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
     // Learned (or chosen) after the last saved trial: on disk before the next trial starts.
     if (first_trial == end && first_trial > first && e.next_unsaved) {
-      writer_->update_next_correction(trial_at(end - 1).record, e.next_correction_bar);
+      writer_->update_next_correction(trial_at(end - 1).record, e.next_correction_bar.col(0));
     }
   } else {
     if (first != 0) throw std::logic_error("StoreSessionGateway::save: a new session needs every iteration");
@@ -178,15 +185,21 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
   }
   for (std::size_t i = first_trial; i < end; ++i) {
-    const Eigen::VectorXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
+    const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
     // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
-    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, ResumeState{});
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next.col(0), ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
   return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
+}
+
+std::string StoreSessionGateway::joints_refusal(int joints) const {
+  // The session files hold one joint so far: joint 1 alone would reopen on the wrong arm.
+  if (joints <= 1) return {};
+  return "sessions store one joint so far (this arm has " + std::to_string(joints) + "): the trials stay in this console";
 }
 
 std::string StoreSessionGateway::rename(const std::string& name) {

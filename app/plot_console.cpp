@@ -33,8 +33,8 @@ std::string write_console_figures(const ui::SessionSnapshot& snapshot, const fs:
     IterationSummary summary = trial.summary;
     summary.iteration = static_cast<int>(i);
     session.manifest.iterations.push_back({summary, {}});
-    const Eigen::VectorXd& next = i + 1 < e.trials.size() ? e.trials[i + 1].correction_bar : e.next_correction_bar;
-    session.iterations.push_back({trial.record, next});
+    const Eigen::MatrixXd& next = i + 1 < e.trials.size() ? e.trials[i + 1].correction_bar : e.next_correction_bar;
+    session.iterations.push_back({trial.record, next.col(0)});  // the figures draw joint 1
   }
   FigureRequest request;
   if (session.manifest.trajectory_name == "paper") {

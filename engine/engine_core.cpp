@@ -337,6 +337,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   tick.fault = fault();
   tick.reading = reading;
   tick.desired_angle_rad = control_.desired_angle_rad();
+  for (int j = 1; j < control_.joints(); ++j) tick.more_desired_rad[static_cast<std::size_t>(j - 1)] = control_.desired_angle_rad(j);
   tick.u_total_bar = control_.last_u_total_bar();
   tick.setpoints = control_.setpoints();
   tick.valves = valves;

@@ -3,6 +3,7 @@
 // allocating.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include <Eigen/Dense>
@@ -124,6 +125,7 @@ struct TickRecord {
   FaultCode fault = FaultCode::kNone;
   SensorReading reading{};
   double desired_angle_rad = 0.0;  // joint 1's (the reading and the valves carry every joint)
+  std::array<double, kMaxJoints - 1> more_desired_rad{};  // joints 2..J's (the console's live strip per joint)
   double u_total_bar = 0.0;        // joint 1's
   ChamberSetpoints setpoints{};    // joint 1's
   ValveCommand valves{};

@@ -78,10 +78,12 @@ class MemorySessions final : public ui::SessionGateway {
 struct ConsoleFixture {
   /// `gateway`: where sessions go (default: `sessions`, in memory). `device`: the engine drives it
   /// instead of `arm` (a test's own device). `write_figures`: the figure key's writer (default:
-  /// none, the key says so).
+  /// none, the key says so). `start_trajectory`: the library trajectory it starts with (`paper2` for an
+  /// arm2 device and configuration).
   explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
                           ui::SessionGateway* gateway = nullptr, Device* device = nullptr,
-                          std::function<std::string(const ui::SessionSnapshot&)> write_figures = {})
+                          std::function<std::string(const ui::SessionSnapshot&)> write_figures = {},
+                          const std::string& start_trajectory = "paper")
       : config(c),
         arm(c.plant, 1),
         core(device != nullptr ? *device : arm, c.controller, c.timing, c.safety),
@@ -90,7 +92,7 @@ struct ConsoleFixture {
     env.core = &core;
     env.telemetry = &core.add_telemetry_tap(4096);
     env.config = config;
-    env.load_trajectory = [c](const std::string& name) {  // as app/console_command's: one joint so far
+    env.load_trajectory = [c](const std::string& name) {  // as app/console_command's
       Trajectory trajectory = resolve_trajectory(name, c.timing.sample_s(), c.trajectory);
       require_driven_joints(trajectory, c.arm);
       return trajectory;
@@ -99,7 +101,7 @@ struct ConsoleFixture {
     env.stop_after_rises = stop_after_rises;
     env.write_figures = std::move(write_figures);
     env.clock_text = [] { return std::string("12:00:00"); };
-    console = std::make_unique<ui::ConsoleController>(env, library_trajectory("paper", c.timing.sample_s()), false);
+    console = std::make_unique<ui::ConsoleController>(env, library_trajectory(start_trajectory, c.timing.sample_s()), false);
     console->resize(120, 40);
     console->start(clock.now_s());
   }

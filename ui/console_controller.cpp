@@ -10,6 +10,7 @@
 
 #include "engine/errors.hpp"
 #include "ui/canvas.hpp"
+#include "ui/joint_view.hpp"
 
 namespace bellows::ui {
 namespace {
@@ -50,11 +51,17 @@ ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajecto
   state_.sessions_unavailable_reason =
       env_.sessions != nullptr ? env_.sessions->unavailable_reason() : "no session store in this build";
   auto shared = std::make_shared<const Trajectory>(std::move(trajectory));
+  if (state_.sessions_available) {
+    if (std::string why = env_.sessions->joints_refusal(shared->joints()); !why.empty()) {
+      state_.sessions_available = false;
+      state_.sessions_unavailable_reason = std::move(why);
+    }
+  }
   state_.experiment = Experiment::start(shared);
   const auto strip_size = static_cast<std::size_t>(std::lround(kStripSeconds / env_.config.timing.sample_s()));
   strip_time_.assign(strip_size, 0.0);
-  strip_angle_.assign(strip_size, 0.0);
-  strip_setpoint_.assign(strip_size, 0.0);
+  strip_angle_.assign(strip_size, {});
+  strip_setpoint_.assign(strip_size, {});
 }
 
 ConsoleController::~ConsoleController() = default;
@@ -104,6 +111,9 @@ void ConsoleController::start(double now_s) {
   log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
                                    env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
   if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
+  if (env_.sessions != nullptr && !env_.sessions->joints_refusal(state_.experiment.joints()).empty()) {
+    log(LogSource::kSession, "not saving: " + state_.sessions_unavailable_reason, true);
+  }
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
 
@@ -143,6 +153,13 @@ void ConsoleController::update(double now_s) {
   if (black_box_pending_ && env_.core->black_box().frozen()) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
     black_box_pending_ = false;
+    if (!state_.fault_view.black_box.empty()) {
+      state_.fault_view.where = fault_location(state_.fault_view.code, state_.fault_view.black_box.back(), state_.config);
+      if (!state_.fault_view.where.empty()) {
+        log(LogSource::kEngine, format("%s fired on %s", fault_name(state_.fault_view.code), state_.fault_view.where.c_str()),
+            true, state_.fault_view.time_s);
+      }
+    }
     if (!state_.fault_view.black_box.empty()) {  // kept for the session, saved with the next save
       state_.experiment.faults.push_back(
           {fault_name(state_.fault_view.code), state_.experiment.next_iteration(), state_.fault_view.black_box});
@@ -225,7 +242,7 @@ void ConsoleController::on_event(const EngineEvent& event) {
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
-      state_.fault_view = FaultView{event.fault, event.time_s, {}};
+      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}};
       black_box_pending_ = true;
       log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), fault_message(event.fault)), true, event.time_s);
       set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);
@@ -304,29 +321,36 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
     env_.telemetry->consume_all([&](const TickRecord& t) {
       if (per_sample > 0 && t.tick % static_cast<std::uint64_t>(per_sample) != 0) return;
       strip_time_[strip_next_] = t.time_s;
-      strip_angle_[strip_next_] = t.reading.joint[0].angle_rad * 180.0 / std::numbers::pi;
-      // Vented, the engine's last set point is none (the plot leaves the gap).
-      strip_setpoint_[strip_next_] =
-          valves_live(t.state) ? t.desired_angle_rad * 180.0 / std::numbers::pi : std::numeric_limits<double>::quiet_NaN();
+      for (int j = 0; j < kMaxJoints; ++j) {
+        const auto i = static_cast<std::size_t>(j);
+        strip_angle_[strip_next_][i] = t.reading.joint[i].angle_rad * 180.0 / std::numbers::pi;
+        // Vented, the engine's last set point is none (the plot leaves the gap).
+        strip_setpoint_[strip_next_][i] = valves_live(t.state) ? tick_desired_rad(t, j) * 180.0 / std::numbers::pi
+                                                               : std::numeric_limits<double>::quiet_NaN();
+      }
       strip_next_ = (strip_next_ + 1) % strip_time_.size();
       strip_count_ = std::min(strip_count_ + 1, strip_time_.size());
       ++strip_revision_;
     });
-    if (strip_revision_ != strip_exported_) {
-      strip_exported_ = strip_revision_;
-      LiveStrip& s = state_.strip;
-      s.time_s.resize(strip_count_);
-      s.angle_deg.resize(strip_count_);
-      s.setpoint_deg.resize(strip_count_);
-      const std::size_t first = (strip_next_ + strip_time_.size() - strip_count_) % strip_time_.size();
-      const double newest_s = strip_time_[(strip_next_ + strip_time_.size() - 1) % strip_time_.size()];
-      for (std::size_t i = 0; i < strip_count_; ++i) {
-        const std::size_t j = (first + i) % strip_time_.size();
-        s.time_s[i] = strip_time_[j] - newest_s;  // seconds before now
-        s.angle_deg[i] = strip_angle_[j];
-        s.setpoint_deg[i] = strip_setpoint_[j];
-      }
-    }
+    if (strip_revision_ != strip_exported_) export_strip();
+  }
+}
+
+void ConsoleController::export_strip() {
+  strip_exported_ = strip_revision_;
+  const auto joint = static_cast<std::size_t>(std::clamp(state_.joint, 0, kMaxJoints - 1));
+  LiveStrip& s = state_.strip;
+  s.time_s.resize(strip_count_);
+  s.angle_deg.resize(strip_count_);
+  s.setpoint_deg.resize(strip_count_);
+  if (strip_count_ == 0) return;
+  const std::size_t first = (strip_next_ + strip_time_.size() - strip_count_) % strip_time_.size();
+  const double newest_s = strip_time_[(strip_next_ + strip_time_.size() - 1) % strip_time_.size()];
+  for (std::size_t i = 0; i < strip_count_; ++i) {
+    const std::size_t j = (first + i) % strip_time_.size();
+    s.time_s[i] = strip_time_[j] - newest_s;  // seconds before now
+    s.angle_deg[i] = strip_angle_[j][joint];
+    s.setpoint_deg[i] = strip_setpoint_[j][joint];
   }
 }
 

@@ -13,6 +13,7 @@
 // its snapshot and one telemetry tap. Tests drive it with a simulated clock.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -21,7 +22,7 @@
 
 #include "engine/arm_model.hpp"
 #include "engine/engine_core.hpp"
-#include "engine/learning_law.hpp"
+#include "engine/joint_learning.hpp"
 #include "engine/realtime_loop.hpp"
 #include "engine/valve_test.hpp"
 #include "ui/background_task.hpp"
@@ -93,7 +94,7 @@ class ConsoleController {
  private:
   struct InFlight {  // a trial the engine owns until it hands it back
     std::shared_ptr<const Trajectory> trajectory;
-    Eigen::VectorXd correction_bar;
+    Eigen::MatrixXd correction_bar;  // N x J
     TrialRecord record;
     std::uint32_t id = 0;
     std::string origin;
@@ -183,8 +184,8 @@ class ConsoleController {
   std::unique_ptr<InFlight> in_flight_;
   std::uint32_t last_trial_id_ = 0;
 
-  // The law; never touched while a background update uses it.
-  std::unique_ptr<LearningLaw> law_;
+  // The learning (every joint's); never touched while a background update uses it.
+  std::unique_ptr<JointLearning> law_;
   bool rebuild_pending_ = false;
   int law_samples_ = 0;
   std::function<void()> pending_discard_action_;
@@ -203,18 +204,20 @@ class ConsoleController {
   bool begin_after_save_ = false;    // a trial waits for the autosave
   bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
-  std::vector<double> strip_time_, strip_angle_, strip_setpoint_;  // ring at the ILC rate
+  void export_strip();  // the selected joint's ring into state_.strip
+  std::vector<double> strip_time_;  // ring at the ILC rate; angles and set points of every joint
+  std::vector<std::array<double, kMaxJoints>> strip_angle_, strip_setpoint_;
   std::size_t strip_next_ = 0, strip_count_ = 0;
   std::uint64_t strip_revision_ = 0, strip_exported_ = 0;
 
   // Declared last: destroyed (joined) first, before the law and the state they use.
   struct BuiltLaw {
-    std::unique_ptr<LearningLaw> law;
+    std::unique_ptr<JointLearning> law;
     std::string convergence;
     bool warning = false;
   };
   BackgroundTask<BuiltLaw> law_build_;
-  BackgroundTask<Eigen::VectorXd> law_update_;
+  BackgroundTask<Eigen::MatrixXd> law_update_;
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::string> rename_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;

@@ -6,6 +6,7 @@
 
 #include "engine/errors.hpp"
 #include "ui/console_controller.hpp"
+#include "ui/joint_view.hpp"
 #include "ui/keys.hpp"
 #include "ui/render.hpp"
 #include "ui/text_input.hpp"
@@ -331,6 +332,13 @@ void ConsoleController::perform(Action action) {
       log(LogSource::kOperator, format("heartbeat drill: heartbeats withheld; the engine must vent within %.1f s",
                                        env_.config.safety.heartbeat_timeout_s));
       return;
+    case Action::kJoint: {
+      const int joints = state_.experiment.joints();
+      state_.joint = (std::clamp(state_.joint, 0, joints - 1) + 1) % joints;
+      export_strip();
+      set_status("showing " + joint_label(joints, state_.joint) + " (j: the next joint)");
+      return;
+    }
     case Action::kMain: state_.screen = Screen::kMain; return;
   }
 }

@@ -136,7 +136,12 @@ struct FaultView {
   FaultCode code = FaultCode::kNone;
   double time_s = 0.0;
   std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
+  std::string where;                  // on a J-joint arm: the joint (and chamber) the guard fired on
 };
+
+struct ConsoleState;
+/// The joint shown (0-based), within the experiment's joints.
+int selected_joint(const ConsoleState& s);
 
 struct ConsoleState {
   // The terminal.
@@ -165,6 +170,7 @@ struct ConsoleState {
   // The learning.
   Configuration config;        // current gains and weights included
   Experiment experiment;
+  int joint = 0;               // the joint the live strip, plots and inspector show (0-based; j selects)
   std::string law_name;
   bool law_ready = false;
   std::string convergence;        // the law's predicted contraction per trial, in words
@@ -186,5 +192,9 @@ struct ConsoleState {
   bool sessions_available = false;
   std::string sessions_unavailable_reason;
 };
+
+inline int selected_joint(const ConsoleState& s) {
+  return s.joint < 0 || s.joint >= s.experiment.joints() ? 0 : s.joint;
+}
 
 }  // namespace bellows::ui

@@ -109,6 +109,7 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
 // The controller's side: remembering what was taught, offering, taking the offer.
 
 void ConsoleController::remember_taught() {
+  if (state_.experiment.joints() > 1) return;  // transfers learn one joint's dynamics
   TransferSource source = transfer_source_of(state_.experiment, env_.config);
   if (source.trials.empty()) return;
   taught_.push_back(std::move(source));
@@ -119,6 +120,7 @@ void ConsoleController::remember_taught() {
 void ConsoleController::offer_transfer() {
   transfer_offer_ = TransferOffer{};
   if (!state_.experiment.trials.empty() || state_.experiment.next_correction_bar.cwiseAbs().maxCoeff() > 0.0) return;
+  if (state_.experiment.joints() > 1) return;  // transfers learn one joint's dynamics
   if (transfer_task_.busy()) {  // one at a time: ask again when the running one is done
     transfer_wanted_ = true;
     return;

@@ -4,10 +4,11 @@
 
 #include "engine/convergence.hpp"
 #include "engine/errors.hpp"
-#include "engine/learning_law_factory.hpp"
+#include "engine/joint_learning_factory.hpp"
 #include "engine/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
+#include "ui/joint_view.hpp"
 
 namespace bellows::ui {
 
@@ -20,10 +21,12 @@ void ConsoleController::rebuild_law() {
   state_.law_ready = false;
   law_samples_ = state_.experiment.samples();
   state_.law_name = state_.config.ilc.law;
-  law_build_.start([config = state_.config, model = model_, samples = law_samples_] {
+  law_build_.start([config = state_.config, model = model_, samples = law_samples_, joints = state_.experiment.joints()] {
     BuiltLaw built;
-    built.law = make_learning_law(config, model, samples);
-    const ConvergencePrediction p = predict_convergence(*built.law, config, samples);
+    built.law = make_joint_learning(config, model, joints, samples);
+    // Predicted for one joint's law (the single-joint model); several joints learn without one.
+    const LearningLaw* single = built.law->single_joint_law();
+    const ConvergencePrediction p = single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
     if (p.available) {
       built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
                                  "off by up to %.0f %%",
@@ -31,7 +34,8 @@ void ConsoleController::rebuild_law() {
       built.warning = !p.warning.empty();
       if (built.warning) built.convergence = p.warning;
     } else {
-      built.convergence = "no convergence prediction for this law";
+      built.convergence = single != nullptr ? "no convergence prediction for this law"
+                                            : "no convergence prediction for several joints";
     }
     return built;
   });
@@ -44,9 +48,10 @@ void ConsoleController::poll_tasks() {
     try {
       BuiltLaw built = law_build_.take();
       law_ = std::move(built.law);
-      if (law_->samples() != state_.experiment.samples()) rebuild_pending_ = true;
+      if (law_->samples() != state_.experiment.samples() || law_->joints() != state_.experiment.joints()) rebuild_pending_ = true;
       state_.law_ready = !rebuild_pending_;
       if (state_.law_ready) {
+        if (law_->joints() > 1) state_.law_name = law_->name();  // how the joints are modelled, too
         state_.convergence = built.convergence;
         state_.convergence_warning = built.warning;
         log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
@@ -63,7 +68,7 @@ void ConsoleController::poll_tasks() {
   }
   if (law_update_.ready()) {
     try {
-      Eigen::VectorXd next = law_update_.take();
+      Eigen::MatrixXd next = law_update_.take();
       const int from = state_.experiment.trials.back().iteration;
       state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from));
       log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
@@ -106,7 +111,7 @@ void ConsoleController::begin_trial() {
   auto trial = std::make_unique<InFlight>();
   trial->trajectory = e.trajectory;
   trial->correction_bar = e.next_correction_bar;
-  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample);
+  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample, e.joints());
   trial->id = ++last_trial_id_;
   trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
   const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
@@ -129,6 +134,7 @@ void ConsoleController::finish_trial(double time_s) {
   trial.correction_bar = std::move(in_flight_->correction_bar);
   trial.record = std::move(in_flight_->record);
   trial.origin = in_flight_->origin;
+  // The RMS over every joint and sample, each joint's, the largest correction of any joint.
   trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
                                   env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
   in_flight_.reset();
@@ -154,7 +160,17 @@ void ConsoleController::finish_trial(double time_s) {
                diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
         true, time_s);
   }
-  set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  if (s.joint_rms_deg.size() > 1) {
+    std::string per_joint;
+    for (double r : s.joint_rms_deg) {
+      if (!per_joint.empty()) per_joint += ' ';
+      per_joint += format("%.3f", r);
+    }
+    log(LogSource::kEngine, format("iteration %d: RMS per joint %s deg", s.iteration, per_joint.c_str()), false, time_s);
+    set_status(format("iteration %d: RMS %.3f deg (per joint %s)", s.iteration, s.rms_deg, per_joint.c_str()));
+  } else {
+    set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
+  }
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;
   continue_run();
@@ -204,12 +220,16 @@ void ConsoleController::step() {
   }
   const Trial& last = e.trials.back();
   state_.run.phase = RunProgress::Phase::kLearning;
-  const Eigen::Index n = last.correction_bar.size();
+  const Eigen::Index n = last.correction_bar.rows();
   const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
-  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_error(),
-                     feedback = Eigen::VectorXd(last.record.samples.u_pid_bar.head(n)), input_limit_bar] {
+  Eigen::MatrixXd feedback(n, last.correction_bar.cols());
+  for (Eigen::Index j = 0; j < feedback.cols(); ++j) {
+    feedback.col(j) = last.record.joint_samples(static_cast<int>(j)).u_pid_bar.head(n);
+  }
+  law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_joint_errors(),
+                     feedback = std::move(feedback), input_limit_bar] {
     law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
-    Eigen::VectorXd next(u.size());
+    Eigen::MatrixXd next(u.rows(), u.cols());
     law->update(u, error, next);
     return next;
   });

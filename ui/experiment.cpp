@@ -1,6 +1,7 @@
 #include "ui/experiment.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -9,7 +10,7 @@ namespace bellows::ui {
 Experiment Experiment::start(std::shared_ptr<const Trajectory> trajectory) {
   Experiment e;
   e.trajectory = std::move(trajectory);
-  e.next_correction_bar = Eigen::VectorXd::Zero(e.samples());
+  e.next_correction_bar = Eigen::MatrixXd::Zero(e.samples(), e.joints());
   return e;
 }
 
@@ -36,7 +37,7 @@ void Experiment::add_trial(Trial trial) {
   next_tried = true;
 }
 
-void Experiment::set_next(Eigen::VectorXd correction_bar, std::string origin) {
+void Experiment::set_next(Eigen::MatrixXd correction_bar, std::string origin) {
   next_correction_bar = std::move(correction_bar);
   next_origin = std::move(origin);
   next_tried = false;
@@ -50,7 +51,7 @@ void Experiment::release_saved_history() {
     Trial& t = trials[static_cast<std::size_t>(i)];
     if (!t.in_memory()) continue;
     t.record = TrialRecord{};
-    t.correction_bar = Eigen::VectorXd();
+    t.correction_bar = Eigen::MatrixXd();
   }
   for (int i = 0; i < std::min(saved_faults, static_cast<int>(faults.size())); ++i) {
     std::vector<TickRecord>().swap(faults[static_cast<std::size_t>(i)].ticks);
@@ -61,6 +62,16 @@ std::vector<double> Experiment::rms_history_deg() const {
   std::vector<double> rms;
   rms.reserve(trials.size());
   for (const Trial& t : trials) rms.push_back(t.summary.rms_deg);
+  return rms;
+}
+
+std::vector<double> Experiment::joint_rms_history_deg(int joint) const {
+  std::vector<double> rms;
+  rms.reserve(trials.size());
+  for (const Trial& t : trials) {
+    const bool known = joint >= 0 && joint < t.summary.joint_rms_deg.size();
+    rms.push_back(known ? t.summary.joint_rms_deg(joint) : (joint == 0 ? t.summary.rms_deg : std::numeric_limits<double>::quiet_NaN()));
+  }
   return rms;
 }
 

@@ -20,9 +20,10 @@ namespace bellows::ui {
 
 struct Trial {
   int iteration = 0;
-  Eigen::VectorXd correction_bar;  // u_ilc(0..N-1) the trial applied; empty once released
+  Eigen::MatrixXd correction_bar;  // u_ilc(0..N-1) the trial applied, one column per joint (N x J);
+                                   // empty once released
   TrialRecord record;              // empty once released (saved, and older than the kept window)
-  IterationSummary summary;
+  IterationSummary summary;        // rms_deg over every joint and sample, joint_rms_deg per joint
   std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
 
   /// False once its record and correction were released: they are in the session on disk only.
@@ -60,7 +61,7 @@ struct Experiment {
 
   std::shared_ptr<const Trajectory> trajectory;
   std::vector<Trial> trials;
-  Eigen::VectorXd next_correction_bar;  // what the next trial applies
+  Eigen::MatrixXd next_correction_bar;  // what the next trial applies, N x J
   std::string next_origin = "feedback only";
   bool next_tried = false;              // a trial already ran with it: a step learns first
   int saved_trials = 0;                 // trials already in the saved session
@@ -78,6 +79,7 @@ struct Experiment {
   static Experiment start(std::shared_ptr<const Trajectory> trajectory);
 
   int samples() const { return trajectory ? trajectory->learning_samples() : 0; }
+  int joints() const { return trajectory ? trajectory->joints() : 1; }
   int next_iteration() const { return static_cast<int>(trials.size()); }
   bool unsaved() const {
     return static_cast<int>(trials.size()) > saved_trials || static_cast<int>(faults.size()) > saved_faults ||
@@ -92,9 +94,12 @@ struct Experiment {
   /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
   void add_trial(Trial trial);
   /// The correction the next trial applies, from `origin`.
-  void set_next(Eigen::VectorXd correction_bar, std::string origin);
-  /// RMS per trial, in order.
+  void set_next(Eigen::MatrixXd correction_bar, std::string origin);
+  /// RMS per trial, in order (over every joint).
   std::vector<double> rms_history_deg() const;
+  /// Joint `joint`'s RMS per trial, in order (0-based; with one joint the same as rms_history_deg();
+  /// NaN where a trial's per-joint RMS is not known).
+  std::vector<double> joint_rms_history_deg(int joint) const;
   /// Lowest RMS so far; negative without trials.
   double best_rms_deg() const;
   /// True when each of the last `count` trials had a higher RMS than the one before it.

@@ -45,6 +45,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
+      {Action::kJoint, 'j', key::kNone, "j", "Joint", "next joint: the live strip, plots and inspector show it (arms with several joints)"},
       {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
   };
   return bindings;
@@ -119,6 +120,9 @@ Availability availability(Action action, const ConsoleState& s) {
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
       if (!run_idle(s) || valves_live(s.engine_state)) return no("disarm first (d): opening replaces the session");
       return {};
+    case Action::kJoint:
+      if (s.experiment.joints() < 2) return no("the arm has one joint");
+      return {};
     case Action::kHeartbeatDrill: {
       Availability a = needs_armed_idle(s);
       if (a.available && s.heartbeat_drill) return no("the drill is running");
@@ -133,15 +137,15 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
   if (s.engine_state == EngineState::kFault) {
     candidates = {Action::kReset, Action::kFaultView, Action::kLog, Action::kTrajectory, Action::kHelp, Action::kQuit};
   } else if (!run_idle(s) || s.engine_state == EngineState::kRunning) {
-    candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kInspector, Action::kLog,
-                  Action::kHelp};
+    candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kJoint, Action::kInspector,
+                  Action::kLog, Action::kHelp};
   } else if (s.engine_state == EngineState::kArmed) {
     candidates = {Action::kEmergencyStop, Action::kRunTrial, Action::kNextIteration, Action::kRunIterations,
-                  Action::kDisarm, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
+                  Action::kDisarm, Action::kJoint, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
                   Action::kHelp, Action::kQuit};
   } else {
-    candidates = {Action::kArm, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave, Action::kOpen,
-                  Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
+    candidates = {Action::kArm, Action::kJoint, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave,
+                  Action::kOpen, Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
   }
   if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
     const bool stop_first = candidates.front() == Action::kEmergencyStop;

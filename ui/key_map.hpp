@@ -31,6 +31,7 @@ enum class Action {
   kQuit,
   kHeartbeatDrill,
   kRig,
+  kJoint,
   kMain,
 };
 

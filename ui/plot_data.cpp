@@ -7,40 +7,40 @@
 namespace bellows::ui {
 namespace {
 
-std::vector<double> to_vector(const Eigen::VectorXd& v, double scale, Eigen::Index count) {
+std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v, double scale, Eigen::Index count) {
   std::vector<double> out(static_cast<std::size_t>(count));
   for (Eigen::Index i = 0; i < count; ++i) out[static_cast<std::size_t>(i)] = v(i) * scale;
   return out;
 }
 }  // namespace
 
-TrialSeries trial_series(const TrialRecord& record) {
-  const Eigen::Index n = record.samples.time_s.size();
-  return {to_vector(record.samples.time_s, 1.0, n), to_vector(record.samples.angle_rad, kDegPerRad, n),
-          to_vector(record.samples.setpoint_rad, kDegPerRad, n)};
+TrialSeries trial_series(const TrialRecord& record, int joint) {
+  const TrialSamples& s = joint > 0 && joint < record.joints() ? record.joint_samples(joint) : record.samples;
+  const Eigen::Index n = s.time_s.size();
+  return {to_vector(s.time_s, 1.0, n), to_vector(s.angle_rad, kDegPerRad, n), to_vector(s.setpoint_rad, kDegPerRad, n)};
 }
 
-RmsSeries rms_series(const Experiment& experiment) {
+RmsSeries rms_series(const Experiment& experiment, int joint) {
   RmsSeries out;
-  for (const Trial& t : experiment.trials) {
-    out.iteration.push_back(t.iteration);
-    out.rms_deg.push_back(t.summary.rms_deg);
-  }
+  out.rms_deg = joint < 0 ? experiment.rms_history_deg() : experiment.joint_rms_history_deg(joint);
+  for (const Trial& t : experiment.trials) out.iteration.push_back(t.iteration);
   return out;
 }
 
-CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chosen) {
+CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chosen, int joint) {
   CorrectionOverlay out;
   const int n = e.samples();
   if (n <= 0 || !e.trajectory) return out;
   const int trials = static_cast<int>(e.trials.size());
   out.time_s.resize(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) out.time_s[static_cast<std::size_t>(k)] = k * e.trajectory->sample_time_s;
-  const auto correction_of = [&](int i) -> const Eigen::VectorXd& {
+  const auto matrix_of = [&](int i) -> const Eigen::MatrixXd& {
     return i < 0 ? e.next_correction_bar : e.trials[static_cast<std::size_t>(i)].correction_bar;
   };
+  // Released corrections (on disk only) and a joint a correction does not have show nothing.
+  const auto in_memory = [&](int i) { return matrix_of(i).rows() >= n && matrix_of(i).cols() > joint; };
+  const auto correction_of = [&](int i) { return matrix_of(i).col(joint); };
   const auto label_of = [&](int i) { return i < 0 ? std::string("next") : "it " + std::to_string(i); };
-  const auto in_memory = [&](int i) { return i < 0 || correction_of(i).size() >= n; };  // released: on disk only
   const int previous = primary < 0 ? trials - 1 : primary - 1;
   if (previous >= 0 && in_memory(previous)) out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
   if (chosen >= 0 && chosen < trials && chosen != primary && chosen != previous && in_memory(chosen)) {
@@ -49,7 +49,7 @@ CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chose
   if (primary < trials && in_memory(primary)) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
   // A transferred start stays in view beside what was learned from it.
   if (trials > 0 && in_memory(0) && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 && previous != 0 && chosen != 0) {
-    out.series.insert(out.series.begin(), {"transferred", Role::kSeries3, '+', to_vector(e.trials.front().correction_bar, 1.0, n)});
+    out.series.insert(out.series.begin(), {"transferred", Role::kSeries3, '+', to_vector(correction_of(0), 1.0, n)});
   }
   return out;
 }
@@ -59,7 +59,7 @@ CorrectionOverlay correction_overlay(const ConsoleState& s) {
   const bool untouched = e.trials.empty() && (e.next_correction_bar.size() == 0 || e.next_correction_bar.isZero());
   if (untouched) return {};
   const int primary = e.next_tried && !e.trials.empty() ? static_cast<int>(e.trials.size()) - 1 : -1;
-  return correction_overlay(e, primary, s.inspector.chosen);
+  return correction_overlay(e, primary, s.inspector.chosen, s.joint);
 }
 
 }  // namespace bellows::ui

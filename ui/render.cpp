@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "ui/joint_view.hpp"
 #include "ui/key_map.hpp"
 #include "ui/render_parts.hpp"
 
@@ -102,6 +103,8 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
     out.push_back({labels ? 0 : 2, format("%s (%.1f s)", e.trajectory->name.c_str(), e.trajectory->duration_s()),
                    Role::kNormal, true});
   }
+  // The joint the screens show, on an arm with several (j selects it).
+  if (e.joints() > 1) out.push_back({2, joint_label(e.joints(), selected_joint(s)), Role::kNormal, true});
   // The newest iteration run, whose RMS follows (docs/iterations.md); "-" before the first.
   out.push_back({2, labels ? "iteration " : "it ", Role::kDim, false});
   out.push_back({0, e.trials.empty() ? std::string("-") : format("%d", e.trials.back().iteration), Role::kNormal, true});

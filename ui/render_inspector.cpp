@@ -2,6 +2,7 @@
 // guard that fired and the black box around it): the two screens that read recorded signals.
 #include <algorithm>
 
+#include "ui/joint_view.hpp"
 #include "ui/plot.hpp"
 #include "ui/plot_data.hpp"
 #include "ui/render_parts.hpp"
@@ -35,14 +36,20 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
           Role::kDim, false, body.right());
     return;
   }
-  const TrialSamples& samples = t.record.samples;
+  // The selected joint's signals (j selects; joint 1 of a record that has fewer joints).
+  const int joint = selected_joint(s) < t.record.joints() ? selected_joint(s) : 0;
+  const TrialSamples& samples = t.record.joint_samples(joint);
   const int k = std::clamp(s.inspector.sample, 0, static_cast<int>(samples.time_s.size()) - 1);
   const double cursor_s = samples.time_s(k);
 
   int x = c.put(body.x + 1, body.y, format("Iteration %d", t.iteration), Role::kTitle, true);
   x = c.put(x, body.y, format(" of 0..%d", e.trials.back().iteration), Role::kDim);
+  if (t.record.joints() > 1) x = c.put(x + 2, body.y, joint_label(t.record.joints(), joint), Role::kNormal, true);
   x = c.put(x + 2, body.y, "(" + t.origin + ")", Role::kDim);
   x = c.put(x + 2, body.y, format("RMS %.3f deg", t.summary.rms_deg), Role::kNormal, true);
+  if (joint < t.summary.joint_rms_deg.size() && t.record.joints() > 1) {
+    x = c.put(x + 1, body.y, format("(joint %d %.3f)", joint + 1, t.summary.joint_rms_deg(joint)), Role::kNormal);
+  }
   if (s.inspector.chosen >= 0) c.put(x + 2, body.y, format("overlay: it %d", s.inspector.chosen), Role::kSeries3);
 
   constexpr int kReadoutWidth = 30;
@@ -57,7 +64,7 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   options.cursor_x = cursor_s;
 
   c.frame(top, g, "Correction u_ilc (bar)");
-  const CorrectionOverlay overlay = correction_overlay(e, s.inspector.trial, s.inspector.chosen);
+  const CorrectionOverlay overlay = correction_overlay(e, s.inspector.trial, s.inspector.chosen, joint);
   std::vector<LegendItem> items;
   std::vector<PlotSeries> series;
   for (const auto& o : overlay.series) {
@@ -70,7 +77,7 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
 
   c.frame(bottom, g, "Angle and set point (deg)");
   legend(c, bottom, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
-  const TrialSeries data = trial_series(t.record);
+  const TrialSeries data = trial_series(t.record, joint);
   options.y_format = "%.1f";
   draw_plot(c, inner(bottom),
             {{data.time_s, data.setpoint_deg, Role::kSeries2, '.'}, {data.time_s, data.angle_deg, Role::kSeries1, '*'}},
@@ -110,6 +117,9 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   for (const std::string& line : wrap(fault_message(f.code), body.right() - x - 2)) {
     c.put(x + 1, y++, line, Role::kWarning, true);
   }
+  if (!f.where.empty()) {  // which joint (and chamber), on an arm with several
+    for (const std::string& line : wrap("on " + f.where, body.right() - x - 2)) c.put(x + 1, y++, line, Role::kWarning, true);
+  }
   const bool latched = s.engine_state == EngineState::kFault;
   const std::string when = format("vented at engine time %.3f s, in the tick the fault was seen; %s", f.time_s,
                                   latched ? "latched: R resets to SAFE, then a arms again." : "reset since then.");
@@ -121,16 +131,21 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     return;
   }
   const std::size_t n = f.black_box.size();
+  // The selected joint's signals on an arm with several joints (j selects).
+  const int joint = std::clamp(selected_joint(s), 0, std::max(1, f.black_box.back().reading.joint_count) - 1);
+  const auto ji = static_cast<std::size_t>(joint);
   std::vector<double> time(n), angle(n), desired(n), pa(n), pb(n), supply(n);
   for (std::size_t i = 0; i < n; ++i) {
     const TickRecord& t = f.black_box[i];
     time[i] = t.time_s - f.time_s;
-    angle[i] = to_deg(t.reading.joint[0].angle_rad);
-    desired[i] = to_deg(t.desired_angle_rad);
-    pa[i] = t.reading.joint[0].chamber_bar[0];
-    pb[i] = t.reading.joint[0].chamber_bar[1];
+    angle[i] = to_deg(t.reading.joint[ji].angle_rad);
+    desired[i] = to_deg(tick_desired_rad(t, joint));
+    pa[i] = t.reading.joint[ji].chamber_bar[0];
+    pb[i] = t.reading.joint[ji].chamber_bar[1];
     supply[i] = t.reading.supply_bar;
   }
+  const int joints = f.black_box.back().reading.joint_count;
+  const std::string of_joint = joints > 1 ? ", " + joint_label(joints, joint) : std::string();
   constexpr int kTableRows = 8;
   const int plot_height = std::max(6, body.bottom() - y - (kTableRows + 3));
   const Rect left{body.x, y, body.width / 2, plot_height};
@@ -138,17 +153,17 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   PlotOptions options;
   options.braille = s.unicode;
   options.x_unit = "s";
-  c.frame(left, g, format("Black box: last %.1f s, angle (deg)", time.back() - time.front()));
+  c.frame(left, g, format("Black box: last %.1f s, angle (deg)%s", time.back() - time.front(), of_joint.c_str()));
   legend(c, left, {{"angle", Role::kSeries1, '*'}, {"set pt", Role::kSeries2, '.'}}, g);
   draw_plot(c, inner(left), {{time, desired, Role::kSeries2, '.'}, {time, angle, Role::kSeries1, '*'}}, options);
-  c.frame(right, g, "Pressures (bar)");
+  c.frame(right, g, "Pressures (bar)" + of_joint);
   legend(c, right, {{"A", Role::kSeries1, 'a'}, {"B", Role::kSeries2, 'b'}, {"supply", Role::kSeries3, 's'}}, g);
   options.y_format = "%.2f";
   draw_plot(c, inner(right),
             {{time, supply, Role::kSeries3, 's'}, {time, pb, Role::kSeries2, 'b'}, {time, pa, Role::kSeries1, 'a'}}, options);
 
   const Rect table{body.x, left.bottom(), body.width, body.bottom() - left.bottom()};
-  c.frame(table, g, "Last ticks before the fault");
+  c.frame(table, g, "Last ticks before the fault" + of_joint);
   const Rect in = inner(table);
   c.put(in.x + 1, in.y, "  time s   state      angle deg  p A bar  p B bar  supply  in A  out A  in B  out B", Role::kDim);
   const std::size_t rows = static_cast<std::size_t>(std::max(in.height - 1, 0));
@@ -157,8 +172,8 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
     const TickRecord& t = f.black_box[i];
     c.put(in.x + 1, in.y + 1 + static_cast<int>(i - first),
           format("%8.3f   %-9s %9.2f %8.3f %8.3f %7.3f %5.2f %6.2f %5.2f %6.2f", t.time_s - f.time_s, to_string(t.state),
-                 to_deg(t.reading.joint[0].angle_rad), t.reading.joint[0].chamber_bar[0], t.reading.joint[0].chamber_bar[1], t.reading.supply_bar,
-                 t.valves.joint[0].inlet_duty[0], t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1], t.valves.joint[0].outlet_duty[1]),
+                 to_deg(t.reading.joint[ji].angle_rad), t.reading.joint[ji].chamber_bar[0], t.reading.joint[ji].chamber_bar[1], t.reading.supply_bar,
+                 t.valves.joint[ji].inlet_duty[0], t.valves.joint[ji].outlet_duty[0], t.valves.joint[ji].inlet_duty[1], t.valves.joint[ji].outlet_duty[1]),
           t.state == EngineState::kFault ? Role::kFault : Role::kNormal, false, in.right());
   }
 }

@@ -1,0 +1,30 @@
+// The joints of the arm as the console names and shows them (issue 14): the selected joint's
+// label, its set point in a tick, and which joint a guard fired on. With
+// one joint nothing here adds to the screen (it looks as it did before joints were counted).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "engine/configuration.hpp"
+#include "engine/engine_messages.hpp"
+
+namespace bellows::ui {
+
+/// The spec's names of a chain's joints (shoulder, elbow, wrist for arm2 / arm3); "" for one joint
+/// or a joint the presets do not name.
+std::string joint_name(int joints, int joint);
+/// "joint 2/2 elbow" (joint is 0-based); "" for one joint.
+std::string joint_label(int joints, int joint);
+
+/// Joint `joint`'s set point in a tick (joint 1's is desired_angle_rad).
+double tick_desired_rad(const TickRecord& tick, int joint);
+
+/// Where a guard fired on a J-joint arm, in words ("joint 2 (elbow): angle 97.3 deg beyond the
+/// limit of 95 deg"), read from the tick that faulted; "" for one joint, for a fault that is not
+/// a joint's (supply, heartbeat, stop) or when the tick shows nothing beyond a limit.
+std::string fault_location(FaultCode code, const TickRecord& tick, const Configuration& config);
+
+}  // namespace bellows::ui
