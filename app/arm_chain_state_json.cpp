@@ -73,7 +73,7 @@ void restore_chain_state(SimulatedArmChain& arm, const Json& json, const std::st
     r["joints"].fail("the session's arm has " + std::to_string(r["joints"].json().get<int>()) + " joints, this arm " +
                      std::to_string(joints));
   }
-  PneumaticArmChain::State s;
+  PneumaticArmChain::State s = arm.chain().state();  // the slots beyond the arm's joints as they are
   s.time_s = r["time_s"].number();
   s.angle_rad = joint_values_from(r, "angle_rad", joints);
   s.velocity_rad_per_s = joint_values_from(r, "velocity_rad_per_s", joints);

@@ -406,10 +406,14 @@ TEST(JointSessionDamage, LiesAboutTheJointsAreRefusedInOneLine) {
   };
   expect_one_line(with_manifest([](Json& m) { m["trajectory"]["joints"] = 9; }),
                   "manifest.json: /trajectory/joints: expected a whole number in [1, 4], found 9");
-  // A manifest claiming 3 joints of 2-joint files: the trajectory file is refused first.
+  // A manifest claiming 3 joints of 2-joint files: the resume state lacks joint 3's controllers...
+  expect_one_line(with_manifest([](Json& m) { m["trajectory"]["joints"] = 3; }),
+                  "/resume/controller/more_joints: expected 2 entries (joints 2 to 3 of the session's 3), found 1");
+  // ...and given them, the trajectory file has two joints' columns.
   expect_one_line(with_manifest([](Json& m) {
                     m["trajectory"]["joints"] = 3;
-                    m["trajectory"].erase("sha256");
+                    Json& more = m["resume"]["controller"]["more_joints"];
+                    more.push_back(more[0]);
                   }),
                   "trajectory.csv: line 1: the header must be 'time_s,q1_deg,q2_deg,q3_deg'");
   // The resume state without joint 2's controllers.
