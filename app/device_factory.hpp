@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "devices/simulated_arm.hpp"
+#include "devices/simulated_arm_chain.hpp"
 #include "engine/configuration.hpp"
 #include "engine/device.hpp"
 #include "engine/realtime_loop.hpp"
@@ -44,6 +45,8 @@ class OpenedDevice {
   virtual Device& device() = 0;
   /// The simulated arm (sim only), else null.
   virtual SimulatedArm* simulated_arm() { return nullptr; }
+  /// The simulated arm of several joints (sim with an [arm] preset), else null.
+  virtual SimulatedArmChain* simulated_arm_chain() { return nullptr; }
   /// A real rig's time passes on its own: only the wall clock at speed 1 can drive it.
   virtual bool needs_real_time() const { return true; }
   /// Waits (the engine loop running) until the rig serves this engine; "" when it does, else why
@@ -69,8 +72,12 @@ class OpenedDevice {
   virtual void stop() {}
 };
 
-/// Refuses, in one line, an arm the engine does not drive yet (an [arm] preset of several joints).
-void require_driven_arm(const ArmParameters& arm);
+/// Refuses, in one line, an arm `device_kind` cannot drive: an [arm] preset of several joints runs on
+/// the simulated arm only.
+void require_driven_arm(const ArmParameters& arm, const std::string& device_kind);
+/// Refuses, in one line, an [arm] preset for a command that handles one joint (`what`, e.g.
+/// "`bellows identify` identifies one joint").
+void require_single_joint_arm(const ArmParameters& arm, const std::string& what);
 
 /// Opens the device `device` names. `seed`: the simulated arm's noise; `rt`: the I/O thread's
 /// scheduling; `session_id`: the LCM session (0: a random one); `config_dir`: where a relative

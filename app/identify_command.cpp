@@ -110,6 +110,7 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  require_single_joint_arm(config.arm, "`bellows identify` identifies the model of one joint");
   std::string plant_source = options.config_path.empty() ? "the default plant" : "the plant of " + options.config_path;
   // --write-model FILE: a rig profile (it has [valves]) gets the model identified on its rig; a
   // configuration gets its [model]. Either must be valid before any trial runs.

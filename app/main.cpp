@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
 
   bellows::RunOptions run;
   CLI::App* run_cmd = app.add_subcommand("run", "Run trials headless (simulated time on the simulated arm, real time on a rig), learning between them");
-  run_cmd->add_option("--trajectory", run.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
+  run_cmd->add_option("--trajectory", run.trajectory, "Library name: " + bellows::trajectory_library_summary() +
+                      "; or a CSV file (an [arm] preset of J joints: paperJ by default)")
       ->capture_default_str();
   run_cmd->add_option("--iterations", run.iterations, "K: iteration 0 (feedback only), then K learning iterations: 0..K "
                       "(with --resume: K after the newest)")
@@ -294,6 +295,7 @@ int main(int argc, char** argv) {
   try {
     run.lcm_log = lcm_log->count() > 0;
     run.speed_given = run_cmd->get_option("--speed")->count() > 0;
+    run.trajectory_given = run_cmd->get_option("--trajectory")->count() > 0;
     run.progress_on_terminal = isatty(run.json ? STDERR_FILENO : STDOUT_FILENO) == 1;
     if (completion_cmd->parsed()) {
       std::cout << bellows::bash_completion(app);

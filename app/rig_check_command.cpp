@@ -142,6 +142,7 @@ void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession
 
 int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ostream& out, std::ostream& progress) {
   const Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
+  require_single_joint_arm(config.arm, "`bellows rig check` tests the valves of one joint's rig");
   const DeviceParameters device = resolve_device(options.device, config.device);
   if (options.zero_angle && (device.kind != "t7" || device.rig_profile.empty())) {  // before anything opens
     throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "

@@ -14,6 +14,7 @@ namespace bellows {
 
 struct RunOptions {
   std::string trajectory = "paper";
+  bool trajectory_given = false;  // --trajectory on the command line; else an [arm] preset of J joints runs paperJ
   int iterations = 30;  // learning iterations after the feedback-only iteration 0 (docs/iterations.md)
   std::string config_path;
   std::uint64_t seed = 1;

@@ -8,11 +8,23 @@
 namespace bellows {
 namespace {
 
+/// "  joints 9.608 / 15.038": each joint's RMS after the overall one; nothing for one joint.
+std::string joints_text(const IterationSummary& s) {
+  if (s.joint_rms_deg.size() < 2) return "";
+  std::string text = "  joints";
+  char value[32];
+  for (Eigen::Index j = 0; j < s.joint_rms_deg.size(); ++j) {
+    std::snprintf(value, sizeof value, "%s%.3f", j == 0 ? " " : " / ", s.joint_rms_deg(j));
+    text += value;
+  }
+  return text;
+}
+
 std::string per_iteration_line(const IterationSummary& s) {
   char line[160];
   std::snprintf(line, sizeof line, "iteration %3d  rms %7.3f deg  max error %7.3f deg  max correction %6.4f bar",
                 s.iteration, s.rms_deg, s.max_abs_error_deg, s.max_abs_correction_bar);
-  return line;
+  return line + joints_text(s);
 }
 
 /// "0.4 s", "42 s", "3 min 05 s", "2 h 07 min": coarse enough to read at a glance.
@@ -59,8 +71,8 @@ void RunProgressReport::iteration(const IterationSummary& s) {
   const int done = s.iteration - first_iteration_ + 1;
   const int left = last_iteration_ - s.iteration;
   char line[160];
-  std::snprintf(line, sizeof line, "iteration %d of %d..%d  rms %.3f deg  %s", s.iteration, first_iteration_, last_iteration_,
-                s.rms_deg,
+  std::snprintf(line, sizeof line, "iteration %d of %d..%d  rms %.3f deg%s  %s", s.iteration, first_iteration_, last_iteration_,
+                s.rms_deg, joints_text(s).c_str(),
                 left > 0 ? ("ETA " + duration_text(elapsed_s / std::max(done, 1) * left)).c_str()
                          : ("done in " + duration_text(elapsed_s)).c_str());
   out_ << '\r' << line << "\x1b[K" << std::flush;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "app/device_factory.hpp"
+#include "engine/arm_chain_parameters.hpp"
 #include "engine/errors.hpp"
 #include "engine/units.hpp"
 #include "engine/printable_text.hpp"
@@ -125,9 +126,11 @@ Trajectory parse_trajectory_csv(const std::string& text, const std::string& sour
 }
 
 void require_driven_joints(const Trajectory& trajectory, const ArmParameters& arm) {
-  require_driven_arm(arm);  // an [arm] preset first: its joints are what the operator asked for
-  constexpr int kDrivenJoints = 1;  // the engine's loop, readings and records are single-joint today
-  require_trajectory_joints(trajectory, kDrivenJoints, "[arm] preset");
+  if (arm.preset.empty()) {
+    require_trajectory_joints(trajectory, 1, "[arm] preset");
+  } else {
+    require_trajectory_joints(trajectory, chain_preset(arm.preset).joints, arm.preset);
+  }
 }
 
 std::string trajectory_csv(const Trajectory& trajectory) {

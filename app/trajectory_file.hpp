@@ -21,9 +21,9 @@ Trajectory load_trajectory_file(const std::string& path, double sample_time_s, c
 /// A library name ("paper") or a path to a CSV file (anything with '/' or ending in ".csv").
 Trajectory resolve_trajectory(const std::string& name_or_path, double sample_time_s, const TrajectoryLimits& limits);
 
-/// `bellows run` and the console drive one joint until the J-joint loop lands: a trajectory of
-/// several joints is refused with one line ("trajectory 'paper2' has 2 joints; the arm has 1
-/// ([arm] preset)") rather than one of its columns used in silence. Throws InputError.
+/// The trajectory must have the arm's joints: one without an [arm] preset, else the preset's. Refused
+/// with one line ("trajectory 'paper2' has 2 joints; the arm has 1 ([arm] preset)") rather than one
+/// of its columns used in silence, or a joint left without set points. Throws InputError.
 void require_driven_joints(const Trajectory& trajectory, const ArmParameters& arm);
 
 /// The CSV text parse_trajectory_csv reads back: `time_s,angle_deg` for one joint, else

@@ -11,6 +11,14 @@
 #include <benchmark/benchmark.h>
 
 #include "devices/simulated_arm.hpp"
+#include "devices/simulated_arm_chain.hpp"
+#include "engine/configuration.hpp"
+#include "engine/engine_core.hpp"
+#include "engine/engine_driver.hpp"
+#include "engine/joint_learning_factory.hpp"
+#include "engine/learning_session.hpp"
+#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/trajectory.hpp"
 #include "engine/arm_chain.hpp"
 #include "engine/arm_chain_linearization.hpp"
 #include "engine/arm_model.hpp"
@@ -202,6 +210,30 @@ void BM_ArmChainLinearization(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(linearize_chain(arm, pose, kSampleTime_s).A.data());
 }
 BENCHMARK(BM_ArmChainLinearization)->Unit(benchmark::kMicrosecond);
+
+/// `bellows run --config arm3.toml --trajectory paper3 --iterations 30 --no-save` without the process:
+/// 31 trials of the 3-joint simulated arm on the simulated clock (each settling, then 8 s of paper3)
+/// and the coupled J-joint update between them. Wall time per run of 30 iterations.
+void BM_Arm3ThirtyIterationsHeadless(benchmark::State& state) {
+  Configuration config;
+  config.arm.preset = "arm3";
+  const Trajectory paper3 = library_trajectory("paper3", config.timing.sample_s());
+  const auto learning = make_joint_learning(config, discretize_arm_model(config.model, config.timing.sample_s()), 3,
+                                            paper3.learning_samples());
+  double last_rms_deg = 0.0;
+  for (auto _ : state) {
+    SimulatedArmChain arm(pneumatic_chain_of(config.plant, config.arm), 1);
+    EngineCore core(arm, config.controller, config.timing, config.safety);
+    SimulatedClock clock(core, arm);
+    LearningSession session(clock, *learning, paper3, config.timing, config.controller);
+    for (int i = 0; i <= 30; ++i) {
+      last_rms_deg = session.run_trial().rms_deg;
+      session.learn();
+    }
+  }
+  state.counters["rms_deg_at_30"] = last_rms_deg;
+}
+BENCHMARK(BM_Arm3ThirtyIterationsHeadless)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
 }  // namespace
 }  // namespace bellows

@@ -163,7 +163,11 @@ std::vector<ParameterBinding> make_bindings() {
   const ParameterBinding law = name("ilc", "law", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
                                     [](C& c) { return &c.ilc.law; });
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
-  b.insert(first_ilc, law);
+  const auto after_law = b.insert(first_ilc, law) + 1;
+  b.insert(after_law, name("ilc", "joint_model",
+                           "several joints: the model of the norm-optimal update, coupled (the chain linearized stretched out) or "
+                           "independent (each joint's own single-joint model)",
+                           [](C& c) { return &c.ilc.joint_model; }));
   const ParameterBinding signal = name("identify", "signal", "excitation of the identification trial: chirp or steps",
                                        [](C& c) { return &c.identify.signal; });
   const auto first_identify = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "identify"; });
@@ -275,6 +279,9 @@ void validate_configuration(const Configuration& config) {
     std::string known;
     for (const std::string& law : laws) known += (known.empty() ? "" : ", ") + law;
     throw InputError("[ilc] law = '" + config.ilc.law + "': unknown learning law (known: " + known + ")");
+  }
+  if (std::find(kJointModels.begin(), kJointModels.end(), config.ilc.joint_model) == kJointModels.end()) {
+    throw InputError("[ilc] joint_model = '" + config.ilc.joint_model + "': unknown (known: coupled, independent)");
   }
   validation_signal(config.identify.signal);  // throws for anything but chirp and steps
   // The Q-filters of the law in use; the other laws' keys may hold anything in range.

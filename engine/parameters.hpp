@@ -79,6 +79,9 @@ struct ControllerParameters {
 /// The learning law and its parameters. Norm-optimal weights (spec section 5): M = m I, S = s I, W = w I.
 struct IlcParameters {
   std::string law = "noilc";  // which learning law runs between trials (engine/learning_law_factory)
+  // Several joints: the model of the J-joint norm-optimal update (engine/joint_learning_factory):
+  // "coupled" (the chain linearized stretched out) or "independent" (each joint's own model).
+  std::string joint_model = "coupled";
   double m = 1.0;
   double s = 0.1;
   double w = 2.0e-5;
@@ -154,6 +157,8 @@ struct ArmParameters {
 
 /// The chains engine/arm_chain_parameters knows by name (chain_preset).
 inline constexpr std::array<std::string_view, 2> kArmPresets = {"arm2", "arm3"};
+/// The `[ilc] joint_model` names: how the learning of several joints models the arm.
+inline constexpr std::array<std::string_view, 2> kJointModels = {"coupled", "independent"};
 
 /// The valve test of the first day at the bench (`bellows rig check`, the console's Rig screen):
 /// each valve opened alone for `valve_pulse_s`, the chamber pressures compared before and after.

@@ -62,15 +62,29 @@ TEST(DeviceFactory, TheSimulatedArmRecordsItsSeed) {
   EXPECT_FALSE(opened->device().health().has_link);
 }
 
-TEST(DeviceFactory, AnArmOfSeveralJointsIsRefusedUntilTheEngineRunsIt) {
+TEST(DeviceFactory, AnArmPresetOpensTheSimulatedArmOfSeveralJoints) {
+  Configuration c;
+  c.arm.preset = "arm3";
+  const auto opened = open_device(resolve_device({"sim", "", "", ""}, c.device), c, 7, RealtimeMode::kOff, 0);
+  EXPECT_STREQ(opened->device().name(), "sim");
+  EXPECT_EQ(opened->simulated_arm(), nullptr) << "not the single-joint arm";
+  ASSERT_NE(opened->simulated_arm_chain(), nullptr);
+  EXPECT_EQ(opened->simulated_arm_chain()->joints(), 3);
+  EXPECT_EQ(opened->device().read_sensors().joint_count, 3);
+  EXPECT_FALSE(opened->needs_real_time());
+  EXPECT_EQ(opened->session_info().at("seed"), 7);
+  EXPECT_EQ(opened->session_info().at("arm"), "arm3");
+}
+
+TEST(DeviceFactory, ARigRefusesAnArmOfSeveralJointsInOneLine) {
   Configuration c;
   c.arm.preset = "arm2";
   try {
-    open_device(resolve_device({"sim", "", "", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
-    FAIL() << "arm2 must not silently run one joint";
+    open_device(resolve_device({"t7", "", "127.0.0.1:1", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
+    FAIL() << "a T7 link must not silently drive one joint of arm2";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': arms of several joints do not run in the engine yet (issue 14); "
-                           "leave [arm] out for one joint");
+    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': an arm of several joints runs on --device sim; --device t7 drives one "
+                           "joint (leave [arm] out)");
   }
 }
 

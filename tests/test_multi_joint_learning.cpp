@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "engine/arm_chain_linearization.hpp"
+#include "engine/joint_learning_factory.hpp"
 #include "engine/arm_model.hpp"
 #include "engine/noilc_mimo.hpp"
 #include "engine/pid_controller.hpp"
@@ -111,16 +112,7 @@ std::string table(const std::vector<JointRms>& rms) {
 
 /// Each joint's own single-joint model from its row of the spec's table (kappa, w0 straight, delta).
 MultiJointModel independent_joints(const ChainParameters& chain) {
-  std::vector<DiscreteArmModel> joints;
-  for (int i = 0; i < chain.joints; ++i) {
-    const ChainLink& l = chain.links[static_cast<std::size_t>(i)];
-    ModelParameters p;
-    p.kappa_rad_per_bar = l.kappa_rad_per_bar;
-    p.omega0_rad_per_s = l.omega0_straight_rad_per_s;
-    p.damping = l.damping_ratio;
-    joints.push_back(discretize_arm_model(p, kSampleTime_s));
-  }
-  return block_diagonal_model(joints);
+  return block_diagonal_model(independent_joint_models(chain, kSampleTime_s));
 }
 
 /// The bar for every joint: iteration 30 at most 1/8 of iteration 0, and no iteration to

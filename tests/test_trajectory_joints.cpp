@@ -113,16 +113,16 @@ TEST(TrajectoryJoints, JointCountsOutsideOneToFourAreRefused) {
   EXPECT_NE(testing::error_of([&] { validate_trajectory(ragged, {}); }).find("joint 2: has 10 samples"), std::string::npos);
 }
 
-TEST(TrajectoryJoints, ASingleJointConsumerRefusesSeveralJoints) {
+TEST(TrajectoryJoints, TheTrajectoryMustHaveTheArmsJoints) {
   EXPECT_NO_THROW(require_driven_joints(library_trajectory("paper", kSample_s), ArmParameters{}));
+  EXPECT_NO_THROW(require_driven_joints(library_trajectory("paper2", kSample_s), ArmParameters{"arm2"}));
+  EXPECT_NO_THROW(require_driven_joints(library_trajectory("paper3", kSample_s), ArmParameters{"arm3"}));
   EXPECT_EQ(testing::error_of([] { require_driven_joints(library_trajectory("paper2", kSample_s), ArmParameters{}); }),
             "trajectory 'paper2' has 2 joints; the arm has 1 ([arm] preset)");
-  // An [arm] preset is named first: it is what the operator asked for, with any trajectory.
-  for (const char* name : {"paper", "paper2"}) {
-    EXPECT_EQ(testing::error_of([name] { require_driven_joints(library_trajectory(name, kSample_s), ArmParameters{"arm2"}); }),
-              "[arm] preset = 'arm2': arms of several joints do not run in the engine yet (issue 14); leave [arm] out for "
-              "one joint");
-  }
+  EXPECT_EQ(testing::error_of([] { require_driven_joints(library_trajectory("paper", kSample_s), ArmParameters{"arm2"}); }),
+            "trajectory 'paper' has 1 joint; the arm has 2 (arm2)");
+  EXPECT_EQ(testing::error_of([] { require_driven_joints(library_trajectory("paper2", kSample_s), ArmParameters{"arm3"}); }),
+            "trajectory 'paper2' has 2 joints; the arm has 3 (arm3)");
   EXPECT_EQ(testing::error_of([] { require_trajectory_joints(library_trajectory("paper", kSample_s), 3, "arm3"); }),
             "trajectory 'paper' has 1 joint; the arm has 3 (arm3)");
 }

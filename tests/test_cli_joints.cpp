@@ -1,0 +1,92 @@
+// `bellows run` with an arm of several joints (issue 14) as a user runs it: `[arm] preset` chooses the
+// simulated chain, the trajectory must have its joints (paperJ when --trajectory is left out), every
+// iteration reports the overall RMS and each joint's, and the rigs, which carry one joint, refuse it.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/process_runner.hpp"
+
+namespace bellows {
+namespace {
+
+using testing::expect_refused_in_one_line;
+
+nlohmann::json joints_run_json(const std::string& args) {
+  const auto result = testing::run_process(testing::kBellows + " run --json --quiet --no-save " + args);
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  return nlohmann::json::parse(result.out);
+}
+
+std::string arm_config(const std::string& name, const std::string& toml) {
+  static const auto dir = testing::make_temp_dir("bellows-cli-arms");
+  return testing::write_file(dir, name + ".toml", toml).string();
+}
+
+TEST(CliJoints, Arm2ReportsEveryJointsRmsAndLearns) {
+  const std::string arm2 = arm_config("arm2", "[arm]\npreset = \"arm2\"\n");
+  const nlohmann::json report = joints_run_json("--config " + arm2 + " --iterations 3");
+  EXPECT_EQ(report.at("trajectory"), "paper2") << "the arm's paper trajectory when --trajectory is left out";
+  EXPECT_EQ(report.at("joints"), 2);
+  EXPECT_EQ(report.at("arm").at("preset"), "arm2");
+  EXPECT_EQ(report.at("arm").at("joint_model"), "coupled");
+  ASSERT_EQ(report.at("iterations").size(), 4u);
+  std::vector<double> previous = {1e9, 1e9};
+  for (const nlohmann::json& it : report.at("iterations")) {
+    const std::vector<double> joints = it.at("joint_rms_deg").get<std::vector<double>>();
+    ASSERT_EQ(joints.size(), 2u);
+    // The overall RMS is over every joint and sample: with N samples each, the joints' RMS combined.
+    EXPECT_NEAR(it.at("rms_deg").get<double>(), std::sqrt((joints[0] * joints[0] + joints[1] * joints[1]) / 2.0), 1e-9);
+    EXPECT_GE(it.at("max_abs_error_deg").get<double>(), std::max(joints[0], joints[1]));
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_LT(joints[j], previous[j]) << "joint " << j + 1 << " at iteration " << it.at("iteration");
+      previous[j] = joints[j];
+    }
+  }
+  const std::vector<double> first = report["iterations"][0]["joint_rms_deg"].get<std::vector<double>>();
+  EXPECT_GT(first[0], 5.0) << "the shoulder's feedback-only error";
+  EXPECT_GT(first[1], 10.0) << "the elbow's: the paper arm's (15 deg)";
+  EXPECT_LT(previous[0], 0.6 * first[0]);
+  EXPECT_LT(previous[1], 0.6 * first[1]);
+}
+
+TEST(CliJoints, Arm3RunsPaper3WithIndependentJointsToo) {
+  const std::string arm3 = arm_config("arm3i", "[arm]\npreset = \"arm3\"\n[ilc]\njoint_model = \"independent\"\n");
+  const nlohmann::json report = joints_run_json("--config " + arm3 + " --trajectory paper3 --iterations 1");
+  EXPECT_EQ(report.at("arm").at("joint_model"), "independent");
+  for (const nlohmann::json& it : report.at("iterations")) EXPECT_EQ(it.at("joint_rms_deg").size(), 3u);
+  const auto rms = [&](int iteration, int joint) { return report["iterations"][iteration]["joint_rms_deg"][joint].get<double>(); };
+  for (int j = 0; j < 3; ++j) EXPECT_LT(rms(1, j), rms(0, j)) << "joint " << j + 1;
+}
+
+TEST(CliJoints, OneJointReportsItsRmsAsItsOnlyJoint) {
+  const nlohmann::json report = joints_run_json("--iterations 1");
+  EXPECT_EQ(report.at("trajectory"), "paper");
+  EXPECT_EQ(report.at("joints"), 1);
+  EXPECT_FALSE(report.contains("arm"));
+  for (const nlohmann::json& it : report.at("iterations")) {
+    ASSERT_EQ(it.at("joint_rms_deg").size(), 1u);
+    EXPECT_EQ(it.at("joint_rms_deg")[0].get<double>(), it.at("rms_deg").get<double>());
+  }
+}
+
+TEST(CliJoints, WhatCannotDriveTheArmIsRefusedInOneLine) {
+  const std::string arm2 = arm_config("arm2r", "[arm]\npreset = \"arm2\"\n");
+  expect_refused_in_one_line("run --no-save --config " + arm2 + " --trajectory paper",
+                             "trajectory 'paper' has 1 joint; the arm has 2 (arm2)");
+  expect_refused_in_one_line("run --no-save --config " + arm2 + " --trajectory paper3",
+                             "trajectory 'paper3' has 3 joints; the arm has 2 (arm2)");
+  expect_refused_in_one_line("run --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
+                             "an arm of several joints runs on --device sim; --device t7 drives one joint");
+  expect_refused_in_one_line("run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
+                             "[ilc] joint_model = 'rigid': unknown (known: coupled, independent)");
+  expect_refused_in_one_line("identify --config " + arm2, "`bellows identify` identifies the model of one joint");
+  expect_refused_in_one_line("rig check --config " + arm2, "`bellows rig check` tests the valves of one joint's rig");
+  expect_refused_in_one_line("run --no-save --config " + arm2 + " --transfer-from nowhere",
+                             "--transfer-from learns one joint's correction; trajectory 'paper2' has 2");
+}
+
+}  // namespace
+}  // namespace bellows
