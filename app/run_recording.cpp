@@ -97,17 +97,27 @@ void RunRecording::record_resumption() {
 
 void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
   if (!resuming_) return;
-  require_joints(1, "the single-joint arm");
+  require_joints(learning.joints(), "an arm");
   const SessionManifest& m = resumed_.manifest;
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
     if (m.resume && m.resume->exact() && arm != nullptr) {
       restore_arm_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
       restore_clock_and_core(arm->state().time_s, core, clock);
     }
-    learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));
+    learning.set_correction(resumed_corrections_bar(), static_cast<int>(m.iterations.size()));
     learning.set_history(resumed_history());
   }
   record_resumption();
+}
+
+void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
+  if (!resuming_) return;
+  require_joints(learning.joints(), "an arm");
+  restore(arm, core, clock);
+  if (!resumed_.iterations.empty()) {
+    learning.set_correction(resumed_corrections_bar(), static_cast<int>(resumed_.manifest.iterations.size()));
+    learning.set_history(resumed_history());
+  }
 }
 
 void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock) {
@@ -142,7 +152,12 @@ void RunRecording::save(const LearningSession& learning, const IterationSummary&
     resume.device = arm_state_to_json(*arm);
     resume.clock_ticks = clock->ticks();
   }
-  writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(), std::move(resume));
+  writer_->save_iteration(learning.last_record(), summary, learning.joint_corrections_bar(), std::move(resume));
+}
+
+void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArmChain* arm,
+                        EngineCore& core, const SimulatedClock* clock) {
+  save(learning.last_record(), learning.joint_corrections_bar(), summary, arm, core, clock);
 }
 
 void RunRecording::save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar, const IterationSummary& summary,
