@@ -39,21 +39,21 @@ class SimulatedDevice final : public OpenedDevice {
   std::uint64_t seed_;
 };
 
-// The simulated arm of several joints ([arm] preset), in-process like the single-joint one.
+// The simulated arm of several joints ([arm] preset or its own keys), in-process like the single-joint one.
 class SimulatedChainDevice final : public OpenedDevice {
  public:
   SimulatedChainDevice(const Configuration& config, std::uint64_t seed)
-      : arm_(pneumatic_chain_of(config.plant, config.arm), seed), seed_(seed), preset_(config.arm.preset) {}
+      : arm_(pneumatic_chain_of(config.plant, config.arm), seed), seed_(seed), arm_name_(config.arm.name()) {}
   Device& device() override { return arm_; }
   SimulatedArmChain* simulated_arm_chain() override { return &arm_; }
   bool needs_real_time() const override { return false; }
-  nlohmann::ordered_json session_info() const override { return {{"seed", seed_}, {"arm", preset_}}; }
+  nlohmann::ordered_json session_info() const override { return {{"seed", seed_}, {"arm", arm_name_}}; }
   std::string where() const override { return "in-process"; }
 
  private:
   SimulatedArmChain arm_;
   std::uint64_t seed_;
-  std::string preset_;
+  std::string arm_name_;
 };
 
 class LcmRig final : public OpenedDevice {
@@ -167,22 +167,27 @@ DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParamete
   return d;
 }
 
+/// "[arm] preset = 'arm2'" or "[arm] joints = 3": what the operator wrote.
+static std::string arm_setting(const ArmParameters& arm) {
+  return !arm.preset.empty() ? "[arm] preset = '" + arm.preset + "'" : arm.name();
+}
+
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind) {
-  if (!arm.preset.empty() && device_kind != "sim") {  // the rigs' links carry one joint
-    throw InputError("[arm] preset = '" + arm.preset + "': an arm of several joints runs on --device sim; --device " +
+  if (arm.has_chain() && device_kind != "sim") {  // the rigs' links carry one joint
+    throw InputError(arm_setting(arm) + ": an arm of several joints runs on --device sim; --device " +
                      device_kind + " drives one joint (leave [arm] out)");
   }
 }
 
 void require_single_joint_arm(const ArmParameters& arm, const std::string& what) {
-  if (!arm.preset.empty()) throw InputError("[arm] preset = '" + arm.preset + "': " + what + " (leave [arm] out)");
+  if (arm.has_chain()) throw InputError(arm_setting(arm) + ": " + what + " (leave [arm] out)");
 }
 
 std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const Configuration& config,
                                           std::uint64_t seed, RealtimeMode rt, std::int64_t session_id,
                                           const std::filesystem::path& config_dir) {
   require_driven_arm(config.arm, device.kind);
-  if (device.kind == "sim" && !config.arm.preset.empty()) return std::make_unique<SimulatedChainDevice>(config, seed);
+  if (device.kind == "sim" && config.arm.has_chain()) return std::make_unique<SimulatedChainDevice>(config, seed);
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
     return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),

@@ -64,8 +64,8 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
 
 /// --trajectory, or without it the paper's trajectory for the arm's joints (paper, paper2, paper3).
 std::string trajectory_name(const RunOptions& options, const ArmParameters& arm) {
-  if (options.trajectory_given || arm.preset.empty()) return options.trajectory;
-  return "paper" + std::to_string(chain_preset(arm.preset).joints);
+  if (options.trajectory_given || !arm.has_chain()) return options.trajectory;
+  return "paper" + std::to_string(arm_joint_count(arm));
 }
 
 }  // namespace
@@ -259,7 +259,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
                              {"session", recording.directory().empty() ? nlohmann::json(nullptr)
                                                                        : nlohmann::json(recording.directory().string())},
                              {"iterations", iterations}};
-    if (trajectory.joints() > 1) report["arm"] = {{"preset", config.arm.preset}, {"joint_model", config.ilc.joint_model}};
+    if (trajectory.joints() > 1) report["arm"] = {{"name", config.arm.name()}, {"joint_model", config.ilc.joint_model}};
     if (transfer) report["transfer"] = transfer_json(*transfer);
     if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
     report["dropped_events"] = core.dropped_events();

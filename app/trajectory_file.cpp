@@ -126,10 +126,10 @@ Trajectory parse_trajectory_csv(const std::string& text, const std::string& sour
 }
 
 void require_driven_joints(const Trajectory& trajectory, const ArmParameters& arm) {
-  if (arm.preset.empty()) {
+  if (!arm.has_chain()) {
     require_trajectory_joints(trajectory, 1, "[arm] preset");
   } else {
-    require_trajectory_joints(trajectory, chain_preset(arm.preset).joints, arm.preset);
+    require_trajectory_joints(trajectory, arm_joint_count(arm), arm.name());
   }
 }
 

@@ -1,5 +1,7 @@
 #include "engine/arm_chain_parameters.hpp"
 
+#include <tuple>
+
 #include <cmath>
 #include <string>
 
@@ -74,5 +76,25 @@ void validate_chain(const ChainParameters& chain) {
     throw InputError("arm: gravity_m_per_s2 and the hard stops' stiffness and damping must be >= 0, integration_step_s > 0");
   }
 }
+
+ChainParameters chain_of(const ArmParameters& arm) {
+  static_assert(std::tuple_size_v<decltype(ArmParameters::joint)> == kMaxJoints);
+  if (!arm.preset.empty()) return chain_preset(arm.preset);
+  if (arm.joints < 2 || arm.joints > kMaxJoints) {
+    throw InputError("an arm of several joints needs [arm] preset (arm2 or arm3) or [arm] joints (2 to 4)");
+  }
+  ChainParameters chain;
+  chain.joints = arm.joints;
+  chain.gravity = arm.gravity != 0;
+  for (int j = 0; j < arm.joints; ++j) {
+    const ArmJointParameters& p = arm.joint[static_cast<std::size_t>(j)];
+    chain.links[static_cast<std::size_t>(j)] =
+        preset_link(p.mass_kg, p.length_m, p.center_of_mass_m, p.inertia_kg_m2, p.tip_mass_kg, p.stiffness_Nm_per_rad,
+                    p.kappa_rad_per_bar, p.omega0_straight_rad_per_s, p.damping_ratio);
+  }
+  return chain;
+}
+
+int arm_joint_count(const ArmParameters& arm) { return arm.has_chain() ? chain_of(arm).joints : 1; }
 
 }  // namespace bellows

@@ -44,6 +44,12 @@ struct ChainParameters {
 /// InputError naming the known presets otherwise.
 ChainParameters chain_preset(std::string_view name);
 
+/// The chain `[arm]` describes: its preset's, or the chain of its own keys ([arm] joints,
+/// [arm] gravity, [arm_joint1] ..). InputError when the arm is one joint (no chain) or unknown.
+ChainParameters chain_of(const ArmParameters& arm);
+/// The joints of `arm`: its chain's, or 1 without one.
+int arm_joint_count(const ArmParameters& arm);
+
 /// Throws InputError naming the joint and the value when a chain cannot be simulated: joint count
 /// outside 1..kMaxJoints, a negative or non-finite mass, length or inertia, K, w0, tau_z or the
 /// integration step not positive, a negative damping ratio or creep gain. (ArmChain also refuses a

@@ -168,6 +168,35 @@ std::vector<ParameterBinding> make_bindings() {
                            "several joints: the model of the norm-optimal update, coupled (the chain linearized stretched out) or "
                            "independent (each joint's own single-joint model)",
                            [](C& c) { return &c.ilc.joint_model; }));
+  // [arm] joints and [arm_joint1] .. [arm_joint4]: a chain of its own keys, after [arm] preset.
+  auto after_preset = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "preset"; }) + 1;
+  after_preset = b.insert(after_preset, whole("arm", "joints", "a chain of its own keys: this many joints (2..4) from [arm_joint1] on; 0: none ([arm] preset, or one joint)",
+                                              Range{0.0, 4.0, false, false}, [](C& c) { return &c.arm.joints; })) + 1;
+  after_preset = b.insert(after_preset, whole("arm", "gravity", "that chain: 1 in a vertical plane (gravity), 0 in the horizontal plane",
+                                              Range{0.0, 1.0, false, false}, [](C& c) { return &c.arm.gravity; })) + 1;
+  using Joint = ArmJointParameters;
+  const auto joint_key = [](std::string key, std::string unit, std::string meaning, Range range, double Joint::*member) {
+    return std::make_tuple(std::move(key), std::move(unit), std::move(meaning), range, member);
+  };
+  const std::array joint_keys = {
+      joint_key("mass_kg", "kg", "link mass m", pos(100.0), &Joint::mass_kg),
+      joint_key("length_m", "m", "link length l, joint to the next joint", pos(10.0), &Joint::length_m),
+      joint_key("center_of_mass_m", "m", "link centre of mass c, from the joint", upto(10.0), &Joint::center_of_mass_m),
+      joint_key("inertia_kg_m2", "kg m^2", "link inertia I about its centre of mass", upto(100.0), &Joint::inertia_kg_m2),
+      joint_key("tip_mass_kg", "kg", "point mass m_a at the link's end (the next joint's bellows)", upto(100.0), &Joint::tip_mass_kg),
+      joint_key("stiffness_Nm_per_rad", "N m/rad", "joint stiffness K (the bellows' retraction)", pos(1.0e4), &Joint::stiffness_Nm_per_rad),
+      joint_key("kappa_rad_per_bar", "rad/bar", "gain kappa: the torque per bar is K kappa", pos(100.0), &Joint::kappa_rad_per_bar),
+      joint_key("omega0_straight_rad_per_s", "rad/s", "natural frequency w0 with the arm straight (damping 2 delta w0 M_ii)", pos(1000.0), &Joint::omega0_straight_rad_per_s),
+      joint_key("damping_ratio", "", "damping ratio delta", upto(10.0), &Joint::damping_ratio),
+      joint_key("bellows_scale", "", "the paper's bellows volume and valve conductance times this", pos(100.0), &Joint::bellows_scale),
+  };
+  for (std::size_t j = 0; j < ArmParameters{}.joint.size(); ++j) {
+    const std::string section = "arm_joint" + std::to_string(j + 1);
+    for (const auto& [key, unit, meaning, range, member] : joint_keys) {
+      after_preset = b.insert(after_preset, number(section, key, unit, "[arm] joints: joint " + std::to_string(j + 1) + "'s " + meaning, range,
+                                                   [j, member = member](C& c) { return &(c.arm.joint[j].*member); })) + 1;
+    }
+  }
   const ParameterBinding signal = name("identify", "signal", "excitation of the identification trial: chirp or steps",
                                        [](C& c) { return &c.identify.signal; });
   const auto first_identify = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "identify"; });
@@ -251,6 +280,10 @@ void validate_configuration(const Configuration& config) {
     std::string known;
     for (std::string_view preset : kArmPresets) known += (known.empty() ? "" : ", ") + std::string(preset);
     throw InputError("[arm] preset = '" + config.arm.preset + "': unknown arm (known: " + known + "; empty: one joint)");
+  }
+  if (config.arm.joints == 1) throw InputError("[arm] joints = 1: a chain has 2 to 4 joints (leave [arm] out for one joint)");
+  if (config.arm.joints > 0 && !config.arm.preset.empty()) {
+    throw InputError("[arm] preset and [arm] joints both name the arm: keep one");
   }
   if (config.lcm.seq_window > 1000000) {
     throw InputError("[lcm] seq_window = " + std::to_string(config.lcm.seq_window) + ": must be at most 1000000");

@@ -131,18 +131,13 @@ MultiJointModel joint_learning_model(const ChainParameters& chain, const std::st
   throw InputError("[ilc] joint_model = '" + joint_model + "': unknown (known: coupled, independent)");
 }
 
-ChainParameters configured_chain(const Configuration& config) {
-  if (config.arm.preset.empty()) throw InputError("an arm of several joints needs [arm] preset (arm2 or arm3)");
-  return chain_preset(config.arm.preset);
-}
-
 std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model, int joints,
                                                    int samples) {
-  if (joints == 1 && config.arm.preset.empty()) return std::make_unique<OwnedSingleJointLearning>(make_learning_law(config, model, samples));
-  const ChainParameters chain = configured_chain(config);
+  if (joints == 1 && !config.arm.has_chain()) return std::make_unique<OwnedSingleJointLearning>(make_learning_law(config, model, samples));
+  const ChainParameters chain = chain_of(config.arm);
   if (chain.joints != joints) {
     throw InputError("the trajectory has " + std::to_string(joints) + " joints; the arm has " + std::to_string(chain.joints) +
-                     " ([arm] preset = '" + config.arm.preset + "')");
+                     " (" + config.arm.name() + ")");
   }
   const std::string& law = config.ilc.law;
   const double sample_s = config.timing.sample_s();

@@ -25,9 +25,6 @@ std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& ch
 /// the block-diagonal model of independent_joint_models.
 MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s);
 
-/// The chain `[arm]` describes (one joint when [arm] is absent: then J must be 1).
-ChainParameters configured_chain(const Configuration& config);
-
 /// The learning for `joints` joints of `samples` samples. `model` is the single-joint model (one
 /// joint only). Throws InputError for a law, model or weights that cannot be used, or a joint count
 /// other than the [arm]'s.

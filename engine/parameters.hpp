@@ -151,8 +151,31 @@ struct DeviceParameters {
 
 /// Which simulated arm (`[arm]`): the single joint of [plant], or a chain of several joints from
 /// ../shared/spec/multi-joint.md (engine/pneumatic_arm_chain_parameters: pneumatic_chain_of).
+/// One link of a chain given by its own keys (`[arm_joint1]` .. `[arm_joint4]`), in the spec's
+/// terms (multi-joint.md section 1). Each joint defaults to a paper-type joint (the elbow of `arm2`).
+struct ArmJointParameters {
+  double mass_kg = 0.10;                    // m_i
+  double length_m = 0.30;                   // l_i, joint to the next joint
+  double center_of_mass_m = 0.15;           // c_i, from the joint
+  double inertia_kg_m2 = 7.5e-4;            // I_i, about the link's centre of mass
+  double tip_mass_kg = 0.0;                 // m_a,i, at the distal end (the next joint's bellows)
+  double stiffness_Nm_per_rad = 0.60;       // K_i
+  double kappa_rad_per_bar = 7.91;          // torque per bar K_i kappa_i
+  double omega0_straight_rad_per_s = 14.14; // w0 with the arm straight (damping D_i = 2 delta w0 M_ii(0))
+  double damping_ratio = 0.31;              // delta
+  double bellows_scale = 1.0;               // the paper's bellows volume and valve conductance times this
+};
+
 struct ArmParameters {
-  std::string preset;  // "" (absent): one joint; else one of kArmPresets
+  std::string preset;  // "" (absent): one joint or the chain's own keys; else one of kArmPresets
+  int joints = 0;      // a chain of the [arm_jointK] keys (2..kMaxJoints joints); 0: none
+  int gravity = 1;     // that chain: 1 in a vertical plane, 0 in the horizontal plane
+  std::array<ArmJointParameters, 4> joint{};  // [arm_joint1] .. [arm_joint4] (kMaxJoints)
+
+  /// Whether the arm is a chain of several joints (a preset or its own keys), not [plant]'s joint.
+  bool has_chain() const { return !preset.empty() || joints > 0; }
+  /// "arm2", or "[arm] joints = 3" for a chain of its own keys; "" for one joint.
+  std::string name() const { return !preset.empty() ? preset : joints > 0 ? "[arm] joints = " + std::to_string(joints) : ""; }
 };
 
 /// The chains engine/arm_chain_parameters knows by name (chain_preset).

@@ -47,8 +47,19 @@ PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant) {
 }
 
 PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant, const ArmParameters& arm) {
-  if (arm.preset.empty()) return pneumatic_chain_of(plant);
-  PneumaticChainParameters parameters = pneumatic_chain_preset(arm.preset);
+  if (!arm.has_chain()) return pneumatic_chain_of(plant);
+  PneumaticChainParameters parameters;
+  if (!arm.preset.empty()) {
+    parameters = pneumatic_chain_preset(arm.preset);
+  } else {
+    parameters.chain = chain_of(arm);
+    for (int j = 0; j < arm.joints; ++j) {
+      const double scale = arm.joint[static_cast<std::size_t>(j)].bellows_scale;
+      BellowsParameters& bellows = parameters.bellows[static_cast<std::size_t>(j)];
+      bellows.volume_l *= scale;
+      bellows.valve_conductance_m3_per_sPa *= scale;
+    }
+  }
   const PneumaticChainParameters shared = pneumatic_chain_of(plant);
   parameters.supply_bar = shared.supply_bar;
   parameters.encoder_resolution_deg = shared.encoder_resolution_deg;

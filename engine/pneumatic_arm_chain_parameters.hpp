@@ -31,8 +31,9 @@ PneumaticChainParameters pneumatic_chain_preset(std::string_view name);
 /// integration step the plant's. Fault settings are not part of the chain.
 PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant);
 
-/// The simulated arm `[arm] preset` names: "" gives pneumatic_chain_of(plant); a preset gives its
-/// links and bellows with [plant]'s supply, sensors, PWM period, gas, integration step and hard-stop
+/// The simulated arm `[arm]` names: one joint gives pneumatic_chain_of(plant); a preset gives its
+/// links and bellows (a chain of its own keys: its links, each joint the paper's bellows times its
+/// bellows_scale) with [plant]'s supply, sensors, PWM period, gas, integration step and hard-stop
 /// stiffness and damping. InputError for an unknown preset.
 PneumaticChainParameters pneumatic_chain_of(const PlantParameters& plant, const ArmParameters& arm);
 

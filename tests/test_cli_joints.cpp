@@ -30,7 +30,7 @@ TEST(CliJoints, Arm2ReportsEveryJointsRmsAndLearns) {
   const nlohmann::json report = joints_run_json("--config " + arm2 + " --iterations 3");
   EXPECT_EQ(report.at("trajectory"), "paper2") << "the arm's paper trajectory when --trajectory is left out";
   EXPECT_EQ(report.at("joints"), 2);
-  EXPECT_EQ(report.at("arm").at("preset"), "arm2");
+  EXPECT_EQ(report.at("arm").at("name"), "arm2");
   EXPECT_EQ(report.at("arm").at("joint_model"), "coupled");
   ASSERT_EQ(report.at("iterations").size(), 4u);
   std::vector<double> previous = {1e9, 1e9};
@@ -59,6 +59,38 @@ TEST(CliJoints, Arm3RunsPaper3WithIndependentJointsToo) {
   for (const nlohmann::json& it : report.at("iterations")) EXPECT_EQ(it.at("joint_rms_deg").size(), 3u);
   const auto rms = [&](int iteration, int joint) { return report["iterations"][iteration]["joint_rms_deg"][joint].get<double>(); };
   for (int j = 0; j < 3; ++j) EXPECT_LT(rms(1, j), rms(0, j)) << "joint " << j + 1;
+}
+
+TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
+  // arm2 written out key by key (multi-joint.md section 2; the shoulder's bellows twice the paper's):
+  // the same arm, so the same run to the last bit.
+  const std::string own = arm_config("own2",
+                                     "[arm]\njoints = 2\n"
+                                     "[arm_joint1]\nmass_kg = 0.40\nlength_m = 0.25\ncenter_of_mass_m = 0.125\ninertia_kg_m2 = 2.08e-3\n"
+                                     "tip_mass_kg = 0.30\nstiffness_Nm_per_rad = 2.81\nkappa_rad_per_bar = 5.0\n"
+                                     "omega0_straight_rad_per_s = 8.0\nbellows_scale = 2.0\n");
+  const std::string arm2 = arm_config("arm2same", "[arm]\npreset = \"arm2\"\n");
+  const nlohmann::json by_keys = joints_run_json("--config " + own + " --iterations 2");
+  const nlohmann::json by_preset = joints_run_json("--config " + arm2 + " --iterations 2");
+  EXPECT_EQ(by_keys.at("arm").at("name"), "[arm] joints = 2");
+  EXPECT_EQ(by_keys.at("trajectory"), "paper2");
+  ASSERT_EQ(by_keys.at("iterations").size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(by_keys["iterations"][i]["joint_rms_deg"], by_preset["iterations"][i]["joint_rms_deg"]) << "iteration " << i;
+  }
+  // Another shoulder is another arm.
+  const std::string light = arm_config("light2", "[arm]\njoints = 2\n[arm_joint1]\nbellows_scale = 2.0\n");
+  EXPECT_NE(joints_run_json("--config " + light + " --iterations 0")["iterations"][0]["joint_rms_deg"],
+            by_preset["iterations"][0]["joint_rms_deg"]);
+  expect_refused_in_one_line("run --no-save --config " + arm_config("one", "[arm]\njoints = 1\n"),
+                             "[arm] joints = 1: a chain has 2 to 4 joints (leave [arm] out for one joint)");
+  expect_refused_in_one_line("run --no-save --config " + arm_config("both", "[arm]\njoints = 3\npreset = \"arm2\"\n"),
+                             "[arm] preset and [arm] joints both name the arm: keep one");
+  expect_refused_in_one_line("run --no-save --config " + arm_config("five", "[arm]\njoints = 5\n"), "[arm] joints = 5");
+  expect_refused_in_one_line("run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
+                             "[arm_joint2] mass_kg = 0");
+  expect_refused_in_one_line("run --no-save --config " + own + " --device lcm",
+                             "[arm] joints = 2: an arm of several joints runs on --device sim");
 }
 
 TEST(CliJoints, OneJointReportsItsRmsAsItsOnlyJoint) {

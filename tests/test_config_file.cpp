@@ -91,7 +91,19 @@ TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
   EXPECT_EQ(c.arm.preset, "arm2");
   expect_config_refused("[arm]\npreset = \"arm7\"\n", "[arm] preset = 'arm7': unknown arm (known: arm2, arm3; empty: one joint)");
   expect_config_refused("[arm]\npreset = 2\n", "[arm] preset");
-  expect_config_refused("[arm]\njoints = 2\n", "unknown key");
+  expect_config_refused("[arm]\nlinks = 2\n", "unknown key");
+  // A chain of its own keys: the joints, each link's keys in its own section.
+  Configuration own;
+  apply_config_toml("[arm]\njoints = 3\ngravity = 0\n[arm_joint3]\nmass_kg = 0.06\nbellows_scale = 1.5\n", "own.toml", own);
+  EXPECT_EQ(own.arm.joints, 3);
+  EXPECT_EQ(own.arm.gravity, 0);
+  EXPECT_EQ(own.arm.joint[2].mass_kg, 0.06);
+  EXPECT_EQ(own.arm.joint[2].bellows_scale, 1.5);
+  EXPECT_EQ(own.arm.joint[1].mass_kg, ArmJointParameters{}.mass_kg);
+  EXPECT_EQ(own.arm.name(), "[arm] joints = 3");
+  expect_config_refused("[arm_joint5]\nmass_kg = 1\n", "unknown section [arm_joint5]");
+  expect_config_refused("[arm_joint1]\nmass_kg = -1\n", "[arm_joint1] mass_kg");
+  expect_config_refused("[arm]\ngravity = 2\n", "[arm] gravity");
 }
 
 TEST(ConfigFile, RoundTripsThroughToml) {

@@ -125,9 +125,9 @@ TEST(JointLearning, WhatDoesNotFitTheArmIsRefusedInOneLine) {
   const Configuration arm2 = arm_configuration("arm2", "noilc");
   const DiscreteArmModel model = discretize_arm_model(arm2.model, arm2.timing.sample_s());
   EXPECT_EQ(testing::error_of([&] { make_joint_learning(arm2, model, 3, kLearningSamples); }),
-            "the trajectory has 3 joints; the arm has 2 ([arm] preset = 'arm2')");
+            "the trajectory has 3 joints; the arm has 2 (arm2)");
   EXPECT_EQ(testing::error_of([&] { make_joint_learning(Configuration{}, model, 2, kLearningSamples); }),
-            "an arm of several joints needs [arm] preset (arm2 or arm3)");
+            "an arm of several joints needs [arm] preset (arm2 or arm3) or [arm] joints (2 to 4)");
   Configuration bad = arm2;
   bad.ilc.joint_model = "rigid";
   EXPECT_EQ(testing::error_of([&] { make_joint_learning(bad, model, 2, kLearningSamples); }),
