@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "app/arm_chain_state_json.hpp"
 #include "app/arm_state_json.hpp"
 #include "engine/errors.hpp"
 #include "engine/iteration_numbering.hpp"
@@ -66,31 +67,80 @@ void RunRecording::start(const Configuration& config, const Trajectory& trajecto
                                         kPurpose));
 }
 
+void RunRecording::require_joints(int joints, const std::string& arm) const {
+  if (resumed_.manifest.joints != joints) {
+    throw InputError("session " + resumed_.directory.string() + " was recorded with an arm of " +
+                     std::to_string(resumed_.manifest.joints) + " joint" + (resumed_.manifest.joints == 1 ? "" : "s") +
+                     "; this run drives " + arm + " of " + std::to_string(joints) + " (its [arm] preset must be the session's)");
+  }
+}
+
+void RunRecording::restore_clock_and_core(double arm_time_s, EngineCore& core, SimulatedClock* clock) {
+  const SessionManifest& m = resumed_.manifest;
+  if (clock != nullptr) {
+    // A first-format session did not record the clock: it ticked with the arm from 0, so the
+    // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
+    const double arm_ticks = arm_time_s / m.configuration.timing.tick_s;
+    if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
+      throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
+                       ": /resume/device/time_s: expected the arm's time since it started, at least 0");
+    }
+    clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
+  }
+  core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
+}
+
+void RunRecording::record_resumption() {
+  writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
+                                      " more iterations");
+}
+
 void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
   if (!resuming_) return;
+  require_joints(learning.joints(), "an arm");
   const SessionManifest& m = resumed_.manifest;
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
     if (m.resume && m.resume->exact() && arm != nullptr) {
       restore_arm_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
-      if (clock != nullptr) {
-        // A first-format session did not record the clock: it ticked with the arm from 0, so the
-        // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
-        const double arm_ticks = arm->state().time_s / m.configuration.timing.tick_s;
-        if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
-          throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
-                           ": /resume/device/time_s: expected the arm's time since it started, at least 0");
-        }
-        clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
-      }
-      core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
+      restore_clock_and_core(arm->state().time_s, core, clock);
     }
-    learning.set_correction(resumed_.iterations.back().next_correction_bar, static_cast<int>(m.iterations.size()));
-    std::vector<IterationSummary> history;
-    for (const IterationEntry& entry : m.iterations) history.push_back(entry.summary);
-    learning.set_history(std::move(history));
+    learning.set_correction(resumed_corrections_bar(), static_cast<int>(m.iterations.size()));
+    learning.set_history(resumed_history());
   }
-  writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
-                                      " more iterations");
+  record_resumption();
+}
+
+void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
+  if (!resuming_) return;
+  require_joints(learning.joints(), "an arm");
+  restore(arm, core, clock);
+  if (!resumed_.iterations.empty()) {
+    learning.set_correction(resumed_corrections_bar(), static_cast<int>(resumed_.manifest.iterations.size()));
+    learning.set_history(resumed_history());
+  }
+}
+
+void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock) {
+  if (!resuming_) return;
+  const SessionManifest& m = resumed_.manifest;
+  if (arm != nullptr) require_joints(arm->joints(), "a simulated arm");
+  if (!resumed_.iterations.empty() && m.resume && m.resume->exact() && arm != nullptr) {
+    restore_chain_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+    restore_clock_and_core(arm->chain().state().time_s, core, clock);
+  }
+  record_resumption();
+}
+
+Eigen::MatrixXd RunRecording::resumed_corrections_bar() const {
+  if (!resuming_ || resumed_.iterations.empty()) return {};
+  return resumed_.iterations.back().next_corrections_bar();
+}
+
+std::vector<IterationSummary> RunRecording::resumed_history() const {
+  std::vector<IterationSummary> history;
+  if (!resuming_) return history;
+  for (const IterationEntry& entry : resumed_.manifest.iterations) history.push_back(entry.summary);
+  return history;
 }
 
 void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm* arm,
@@ -102,7 +152,24 @@ void RunRecording::save(const LearningSession& learning, const IterationSummary&
     resume.device = arm_state_to_json(*arm);
     resume.clock_ticks = clock->ticks();
   }
-  writer_->save_iteration(learning.last_record(), summary, learning.correction_bar(), std::move(resume));
+  writer_->save_iteration(learning.last_record(), summary, learning.joint_corrections_bar(), std::move(resume));
+}
+
+void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArmChain* arm,
+                        EngineCore& core, const SimulatedClock* clock) {
+  save(learning.last_record(), learning.joint_corrections_bar(), summary, arm, core, clock);
+}
+
+void RunRecording::save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar, const IterationSummary& summary,
+                        const SimulatedArmChain* arm, EngineCore& core, const SimulatedClock* clock) {
+  if (!writer_) return;
+  ResumeState resume;
+  if (clock != nullptr && arm != nullptr) {  // as above: between trials, on the engine's thread
+    resume.controller = core.control().state();
+    resume.device = chain_state_to_json(*arm);
+    resume.clock_ticks = clock->ticks();
+  }
+  writer_->save_iteration(record, summary, corrections_bar, std::move(resume));
 }
 
 void RunRecording::fault(const std::string& what) noexcept {

@@ -10,6 +10,7 @@
 
 #include "app/run_command.hpp"
 #include "devices/simulated_arm.hpp"
+#include "devices/simulated_arm_chain.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/engine_driver.hpp"
 #include "engine/learning_session.hpp"
@@ -40,13 +41,39 @@ class RunRecording {
   /// A resumed run, before the engine's first tick: puts the arm, the engine (armed, with its
   /// controllers' state), the clock and the learning where the session stopped, and records the
   /// resumption. Nothing for a fresh run. `clock` is null on the wall clock; `arm` is null for a rig
-  /// over LCM (whose sessions are not resumed).
+  /// over LCM (whose sessions are not resumed) and for the J-joint arm (use the SimulatedArmChain
+  /// overload below to restore it exactly). Every joint's correction goes to the learning;
+  /// InputError when the session's joints are not the learning's.
   void restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
   /// After a trial and the learning from it. On the wall clock (`clock` null) the loop thread owns
   /// the arm and the controllers, so their state is not captured: such a session resumes with the
-  /// correction and freshly armed controllers. `arm` is null for a rig over LCM.
+  /// correction and freshly armed controllers. `arm` is null for a rig over LCM. Every joint's
+  /// correction is saved (N x J); the arm's state only with `arm` (the SimulatedArmChain overload
+  /// below saves the J-joint arm's).
   void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm* arm, EngineCore& core,
             const SimulatedClock* clock);
+  /// A resumed run of J joints (the simulated arm chain of `[arm] preset`), before the engine's
+  /// first tick: puts the chain, the engine (armed, every joint's controllers) and the clock where
+  /// the session stopped, and records the resumption; nothing for a fresh run. InputError when the
+  /// session's joints are not the arm's. The learning is the caller's to set, from
+  /// resumed_corrections_bar() and resumed_history(). `clock` null: the wall clock; `arm` null: a
+  /// rig over LCM (whose state is not restored).
+  void restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock);
+  /// The same, and the learning continues with every joint's saved correction and the history.
+  void restore(SimulatedArmChain* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning);
+  /// Every joint's correction learned from the resumed session's last iteration, N x J (one column
+  /// per joint); 0 x 0 when it completed none (or for a fresh run).
+  Eigen::MatrixXd resumed_corrections_bar() const;
+  /// The resumed session's iterations, for the learning's history (empty for a fresh run).
+  std::vector<IterationSummary> resumed_history() const;
+  /// After a trial of a J-joint run and the learning from it: `record` is the trial's (J joints),
+  /// `corrections_bar` the correction learned from it for the next trial (N x J). On the wall clock
+  /// (`clock` null) the state of the chain and the controllers is not captured, as for one joint.
+  void save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar, const IterationSummary& summary,
+            const SimulatedArmChain* arm, EngineCore& core, const SimulatedClock* clock);
+  /// The same with the learning's last record and every joint's correction (N x J).
+  void save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArmChain* arm,
+            EngineCore& core, const SimulatedClock* clock);
   /// Records a fault; never throws (the fault itself is what the caller reports).
   void fault(const std::string& what) noexcept;
   /// Records an engine fault and keeps its black box (the engine's frozen record, if any).
@@ -59,6 +86,13 @@ class RunRecording {
   std::filesystem::path directory() const;
 
  private:
+  /// The clock and the controllers where the session stopped (`arm_time_s`: the arm's own time,
+  /// for a first-format session without the clock's ticks).
+  void restore_clock_and_core(double arm_time_s, EngineCore& core, SimulatedClock* clock);
+  void record_resumption();
+  /// Throws InputError unless the resumed session has `joints` joints (`arm` says which arm).
+  void require_joints(int joints, const std::string& arm) const;
+
   const RunOptions& options_;
   bool resuming_ = false;
   Session resumed_;

@@ -197,6 +197,7 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                          {"updated_utc", m.updated_utc},
                          {"trajectory",
                           {{"name", m.trajectory_name},
+                           {"joints", m.joints},
                            {"learning_samples", m.trajectory_samples},
                            {"sample_time_s", c.timing.sample_s()}}},
                          {"model", {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
@@ -218,8 +219,9 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
       << "started      " << shown(m.started_utc) << "\n"
       << "updated      " << shown(m.updated_utc) << "\n"
       << "integrity    " << integrity_line(session.integrity) << "\n"
-      << "trajectory   " << shown(m.trajectory_name) << ": " << m.trajectory_samples << " samples every " << c.timing.sample_s()
-      << " s (" << m.trajectory_samples * c.timing.sample_s() << " s)\n"
+      << "trajectory   " << shown(m.trajectory_name) << ": "
+      << (m.joints > 1 ? std::to_string(m.joints) + " joints, " : std::string()) << m.trajectory_samples
+      << " samples every " << c.timing.sample_s() << " s (" << m.trajectory_samples * c.timing.sample_s() << " s)\n"
       << "model        kappa " << format("%g", c.model.kappa_rad_per_bar) << " rad/bar, omega0 "
       << format("%g", c.model.omega0_rad_per_s) << " 1/s, damping " << format("%g", c.model.damping)
       << (m.model_source.empty() ? std::string() : " (from the " + shown(m.model_source) + ")") << "\n"

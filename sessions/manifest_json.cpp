@@ -169,7 +169,11 @@ Configuration configuration_from_json(const JsonReader& reader) {
   return config;
 }
 
-Json controller_state_to_json(const ControlCore::State& s) {
+namespace {
+
+/// One joint's controllers: joint 1's fields of "controller" (as every session saved them), and
+/// each entry of its "more_joints".
+Json joint_state_to_json(const ControlCore::JointState& s) {
   return {{"pid", {{"integral_s", s.pid.integral_s}, {"previous_output", s.pid.previous_output},
                    {"has_previous", s.pid.has_previous}}},
           {"pressure_a", pressure_state_to_json(s.pressure_a)},
@@ -178,12 +182,10 @@ Json controller_state_to_json(const ControlCore::State& s) {
                          {"saturation_sign", s.setpoints.saturation_sign}}},
           {"hold_rad", s.hold_rad},
           {"desired_rad", s.desired_rad},
-          {"u_total_bar", s.u_total_bar},
-          {"tick_in_sample", s.tick_in_sample}};
+          {"u_total_bar", s.u_total_bar}};
 }
 
-ControlCore::State controller_state_from_json(const JsonReader& r, const Configuration& config) {
-  ControlCore::State s;
+void joint_state_from_json(const JsonReader& r, const Configuration& config, ControlCore::JointState& s) {
   const JsonReader pid = r["pid"];
   s.pid.integral_s = pid["integral_s"].number();
   s.pid.previous_output = pid["previous_output"].number();
@@ -197,7 +199,35 @@ ControlCore::State controller_state_from_json(const JsonReader& r, const Configu
   s.hold_rad = r["hold_rad"].number();
   s.desired_rad = r["desired_rad"].number();
   s.u_total_bar = r["u_total_bar"].number();
+}
+
+}  // namespace
+
+Json controller_state_to_json(const ControlCore::State& s) {
+  Json out = joint_state_to_json(s);
+  out["tick_in_sample"] = s.tick_in_sample;
+  if (s.joints > 1) {  // absent: one joint (every session saved before joints were counted)
+    Json& more = out["more_joints"] = Json::array();
+    for (int joint = 1; joint < s.joints; ++joint) more.push_back(joint_state_to_json(s.more_joints[static_cast<std::size_t>(joint - 1)]));
+  }
+  return out;
+}
+
+ControlCore::State controller_state_from_json(const JsonReader& r, const Configuration& config, int joints) {
+  ControlCore::State s;
+  joint_state_from_json(r, config, s);
   s.tick_in_sample = r["tick_in_sample"].integer(0, config.timing.ticks_per_sample - 1);
+  s.joints = joints;
+  if (joints > 1 || r.has("more_joints")) {
+    const JsonReader more = r["more_joints"];
+    if (more.size() != static_cast<std::size_t>(joints - 1)) {
+      more.fail("expected " + std::to_string(joints - 1) + " entries (joints 2 to " + std::to_string(joints) +
+                " of the session's " + std::to_string(joints) + "), found " + std::to_string(more.size()));
+    }
+    for (int joint = 1; joint < joints; ++joint) {
+      joint_state_from_json(more[static_cast<std::size_t>(joint - 1)], config, s.more_joints[static_cast<std::size_t>(joint - 1)]);
+    }
+  }
   return s;
 }
 
@@ -234,6 +264,7 @@ Json manifest_head_to_json(const SessionManifest& m) {
                      {"sample_time_s", sample_s},
                      {"duration_s", m.trajectory_samples * sample_s}};
   put_digest(trajectory, "sha256", m.trajectory_sha256);
+  if (m.joints > 1) trajectory["joints"] = m.joints;  // absent: one joint (and the files as they always were)
   Json out = {
       {"format", kFormat},
       {"schema_version", m.schema_version},
@@ -367,6 +398,7 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
     trajectory["learning_samples"].fail(error.what());
   }
   m.trajectory_sha256 = digest_from_json(trajectory, "sha256");
+  if (trajectory.has("joints")) m.joints = trajectory["joints"].integer(1, kMaxJoints);  // absent: one joint
   const JsonReader iterations = r["iterations"];
   for (std::size_t i = 0; i < iterations.size(); ++i) {
     m.iterations.push_back(summary_from_json(iterations[i], static_cast<int>(i), m.trajectory_samples));
@@ -398,7 +430,7 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
         if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
         state.clock_ticks = ticks.json().get<long long>();
       }
-      state.controller = controller_state_from_json(resume["controller"], m.configuration);
+      state.controller = controller_state_from_json(resume["controller"], m.configuration, m.joints);
       resume["device"].expect_object();
       state.device = resume["device"].json();
     }

@@ -41,7 +41,8 @@ nlohmann::ordered_json configuration_to_json(const Configuration& config);
 Configuration configuration_from_json(const JsonReader& reader);
 
 nlohmann::ordered_json controller_state_to_json(const ControlCore::State& state);
-/// Checks the ranges the configuration implies (filter length, ticks per sample).
-ControlCore::State controller_state_from_json(const JsonReader& reader, const Configuration& config);
+/// Checks the ranges the configuration implies (filter length, ticks per sample) and that
+/// "more_joints" holds joints 2..`joints` (absent for one joint).
+ControlCore::State controller_state_from_json(const JsonReader& reader, const Configuration& config, int joints = 1);
 
 }  // namespace bellows

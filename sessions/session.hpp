@@ -56,7 +56,8 @@ struct IterationEntry {
   std::string telemetry_sha256 = {};  // were kept
 };
 
-/// What continuing the run exactly needs beyond the correction: the controllers' state, the
+/// What continuing the run exactly needs beyond the correction: the controllers' state (every
+/// joint's: ControlCore::State's more_joints are saved as "more_joints" when J > 1), the
 /// device's own state (which only the device's owner understands, kept here as JSON) and the
 /// simulated clock. Only a run on a simulated clock can be captured exactly; after a wall-clock
 /// run `controller` is empty and a resume starts from freshly armed controllers.
@@ -74,6 +75,9 @@ struct SessionManifest {
   std::string program_version;
   std::string name;
   std::string device;                                      // Device::name(), e.g. "sim"
+  // The arm's joints J: every iteration file holds J joints' columns, the trajectory J columns.
+  // Written only when J > 1 (a one-joint manifest is what it always was); absent: one joint.
+  int joints = 1;
   nlohmann::ordered_json device_info = nlohmann::ordered_json::object();  // e.g. {"seed": 1}
   std::string started_utc;
   std::string updated_utc;
@@ -95,9 +99,18 @@ struct SessionManifest {
 };
 
 /// One iteration's signals: the trial record and the correction learned from it for the next trial.
+/// Joint 1's correction is `next_correction_bar` (the only one of a single-joint session), joints
+/// 2..J's are `more_joint_next_correction_bar`, as TrialRecord keeps its joints.
 struct IterationData {
   TrialRecord record;
-  Eigen::VectorXd next_correction_bar;  // N values
+  Eigen::VectorXd next_correction_bar;  // N values, joint 1
+  std::vector<Eigen::VectorXd> more_joint_next_correction_bar = {};  // joints 2..J; empty: one joint
+
+  int joints() const { return 1 + static_cast<int>(more_joint_next_correction_bar.size()); }
+  /// Every joint's correction, N x J (one column per joint): what a J-joint learning takes.
+  Eigen::MatrixXd next_corrections_bar() const;
+  /// Sets every joint's correction from N x J.
+  void set_next_corrections(const Eigen::MatrixXd& corrections_bar);
 };
 
 /// How many of a loaded session's files the manifest's digests vouch for. A file whose digest does

@@ -21,6 +21,7 @@
 #include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
+#include "sessions/record_columns.hpp"
 #include "sessions/session_layout.hpp"
 
 namespace bellows {
@@ -30,29 +31,32 @@ std::string describe_session(const fs::path& directory) { return "session " + pr
 
 namespace {
 
-void check_finite(const Eigen::VectorXd& values, int index, const char* what) {
-  for (Eigen::Index k = 0; k < values.size(); ++k) {
-    if (!std::isfinite(values(k))) {
-      throw InputError("iteration " + std::to_string(index) + ": " + what + " at index " + std::to_string(k) +
-                       " is not a finite number; it cannot be saved");
+/// A column for people: "angle_deg" -> "angle", "u_pid_bar_j2" -> "joint 2 u_pid".
+std::string column_label(std::string name) {
+  std::string joint;
+  if (const std::size_t suffix = name.rfind("_j"); suffix != std::string::npos && suffix + 2 < name.size() &&
+                                                   name.find_first_not_of("0123456789", suffix + 2) == std::string::npos) {
+    joint = "joint " + name.substr(suffix + 2) + " ";
+    name.resize(suffix);
+  }
+  for (const std::string unit : {"_deg", "_bar", "_s"}) {
+    if (name.size() > unit.size() && name.compare(name.size() - unit.size(), unit.size(), unit) == 0) {
+      name.resize(name.size() - unit.size());
+      break;
     }
   }
+  return joint + name;
 }
 
-void check_record(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar, int index) {
-  const TrialSamples& s = record.samples;
-  for (const auto& [values, what] :
-       {std::pair{&s.time_s, "time"}, {&s.setpoint_rad, "angle set point"}, {&s.angle_rad, "angle"},
-        {&s.error_rad, "error"}, {&s.u_pid_bar, "u_pid"}, {&s.u_ilc_bar, "u_ilc"}, {&s.u_total_bar, "u_tot"},
-        {&s.pressure_a_bar, "pressure A"}, {&s.pressure_b_bar, "pressure B"}, {&s.setpoint_a_bar, "pressure A set point"},
-        {&s.setpoint_b_bar, "pressure B set point"}, {&next_correction_bar, "next correction"}}) {
-    check_finite(*values, index, what);
-  }
-  const TrialTicks& t = record.ticks;
-  for (const Eigen::VectorXd* values : {&t.time_s, &t.angle_rad, &t.pressure_a_bar, &t.pressure_b_bar, &t.supply_bar,
-                                        &t.setpoint_a_bar, &t.setpoint_b_bar, &t.inlet_a, &t.outlet_a, &t.inlet_b,
-                                        &t.outlet_b}) {
-    check_finite(*values, index, "telemetry");
+/// Refuses a value a CSV file cannot hold (a NaN): before anything is written.
+void check_finite(const std::vector<Eigen::VectorXd>& columns, const std::vector<std::string>& names, int index) {
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    for (Eigen::Index k = 0; k < columns[c].size(); ++k) {
+      if (!std::isfinite(columns[c](k))) {
+        throw InputError("iteration " + std::to_string(index) + ": " + column_label(names[c]) + " at index " +
+                         std::to_string(k) + " is not a finite number; it cannot be saved");
+      }
+    }
   }
 }
 
@@ -74,7 +78,7 @@ void write_all_iteration_files(const DirectoryHandle& folder, const std::vector<
     try {
       for (std::size_t i = next++; i < iterations.size(); i = next++) {
         const IterationDigests digests = write_iteration_files(folder, static_cast<int>(i), iterations[i].record,
-                                                               iterations[i].next_correction_bar);
+                                                               iterations[i].next_corrections_bar());
         entries[i].samples_sha256 = digests.samples_sha256;
         entries[i].telemetry_sha256 = digests.telemetry_sha256;
       }
@@ -110,11 +114,16 @@ std::string write_black_box_file(const DirectoryHandle& session, int index, cons
 }
 
 IterationDigests write_iteration_files(const DirectoryHandle& iterations, int index, const TrialRecord& record,
-                                       const Eigen::VectorXd& next_correction_bar) {
-  check_record(record, next_correction_bar, index);
+                                       const Eigen::MatrixXd& next_corrections_bar) {
+  const std::vector<std::string> samples_names = samples_header(record.joints());
+  const std::vector<std::string> telemetry_names = telemetry_header(record.joints());
+  const std::vector<Eigen::VectorXd> samples = samples_file_values(record, next_corrections_bar);
+  const std::vector<Eigen::VectorXd> telemetry = telemetry_file_values(record);
+  check_finite(samples, samples_names, index);
+  check_finite(telemetry, telemetry_names, index);
   IterationDigests digests;
   digests.samples_sha256 = write_layout_file(iterations, session_layout::samples_file(index),
-                                             format_samples_csv(record, next_correction_bar), DirectorySync::kLater);
+                                             format_samples_csv(record, next_corrections_bar), DirectorySync::kLater);
   digests.telemetry_sha256 = write_layout_file(iterations, session_layout::telemetry_file(index),
                                                format_telemetry_csv(record), DirectorySync::kLater);
   return digests;
@@ -131,6 +140,9 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
                                         const std::vector<std::vector<TickRecord>>& black_boxes) {
   if (iterations.size() != manifest.iterations.size()) {
     throw std::invalid_argument("create_session_directory: the manifest lists a different number of iterations");
+  }
+  if (trajectory.joints() != manifest.joints) {
+    throw std::invalid_argument("create_session_directory: the manifest's joints are not the trajectory's");
   }
   if (black_boxes.size() != manifest.black_boxes.size()) {
     throw std::invalid_argument("create_session_directory: the manifest lists a different number of black boxes");

@@ -47,9 +47,10 @@ struct IterationDigests {
 };
 
 /// Writes iteration `index`'s samples and telemetry files into the session's `iterations` folder
-/// (durable once the caller syncs it). Throws InputError for a value that is not finite.
+/// (durable once the caller syncs it), every joint of the record (`next_corrections_bar` N x J).
+/// Throws InputError for a value that is not finite.
 IterationDigests write_iteration_files(const DirectoryHandle& iterations, int index, const TrialRecord& record,
-                                       const Eigen::VectorXd& next_correction_bar);
+                                       const Eigen::MatrixXd& next_corrections_bar);
 
 /// Writes black box `index` into the session's faults folder (created if needed), synced; returns
 /// its digest.

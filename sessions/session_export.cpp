@@ -72,12 +72,15 @@ std::vector<fs::path> export_session_csv(const Session& session, const fs::path&
   check_export_targets(session, paths, ".csv", force);
   std::vector<std::string> samples, telemetry;
   for (const IterationData& data : session.iterations) {
-    samples.push_back(format_samples_csv(data.record, data.next_correction_bar));
+    samples.push_back(format_samples_csv(data.record, data.next_corrections_bar()));
     telemetry.push_back(format_telemetry_csv(data.record));
   }
-  if (samples.empty()) {  // the header alone
-    samples.push_back(format_samples_csv(TrialRecord{}, Eigen::VectorXd{}));
-    telemetry.push_back(format_telemetry_csv(TrialRecord{}));
+  if (samples.empty()) {  // the header alone, of every joint
+    TrialRecord empty;  // no rows: every joint's columns empty
+    empty.more_joint_samples.resize(static_cast<std::size_t>(session.manifest.joints - 1));
+    empty.more_joint_ticks.resize(empty.more_joint_samples.size());
+    samples.push_back(format_samples_csv(empty, Eigen::MatrixXd{}));
+    telemetry.push_back(format_telemetry_csv(empty));
   }
   std::string summary = "iteration,rms_deg,max_abs_error_deg,max_abs_correction_bar,saturated_samples\n";
   for (const IterationEntry& entry : session.manifest.iterations) {

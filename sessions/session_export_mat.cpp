@@ -17,6 +17,7 @@
 #include "sessions/black_box_file.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
+#include "sessions/record_columns.hpp"
 #include "sessions/session_export.hpp"
 
 namespace bellows {
@@ -68,31 +69,19 @@ void set_field(matvar_t* parent, const std::string& field, size_t index, MatVar 
   Mat_VarSetStructFieldByName(parent, field.c_str(), index, value.release());  // the parent owns it now
 }
 
-MatVar columns_struct(const std::vector<std::string_view>& names, const std::vector<const Eigen::VectorXd*>& values) {
-  std::vector<std::string> fields(names.begin(), names.end());
+/// A struct of one column vector per field: a file's columns by their names (record_columns.hpp).
+MatVar columns_struct(const std::vector<std::string>& fields, const std::vector<Eigen::VectorXd>& values) {
   MatVar out = structure(fields);
-  for (std::size_t i = 0; i < fields.size(); ++i) set_field(out.get(), fields[i], 0, column(*values[i]));
+  for (std::size_t i = 0; i < fields.size(); ++i) set_field(out.get(), fields[i], 0, column(values[i]));
   return out;
 }
 
 MatVar samples_struct(const IterationData& data) {
-  const TrialSamples& s = data.record.samples;
-  const Eigen::VectorXd setpoint = degrees_of(s.setpoint_rad), angle = degrees_of(s.angle_rad),
-                        error = degrees_of(s.error_rad);
-  const Eigen::VectorXd time_s = rounded_times(s.time_s);
-  Eigen::VectorXd next = Eigen::VectorXd::Zero(s.time_s.size());
-  next.head(data.next_correction_bar.size()) = data.next_correction_bar;
-  return columns_struct(samples_columns(), {&time_s, &setpoint, &angle, &error, &s.u_pid_bar, &s.u_ilc_bar,
-                                            &s.u_total_bar, &s.pressure_a_bar, &s.pressure_b_bar, &s.setpoint_a_bar,
-                                            &s.setpoint_b_bar, &next});
+  return columns_struct(samples_header(data.record.joints()), samples_file_values(data.record, data.next_corrections_bar()));
 }
 
-MatVar telemetry_struct(const TrialTicks& t) {
-  const Eigen::VectorXd angle = degrees_of(t.angle_rad);
-  const Eigen::VectorXd time_s = rounded_times(t.time_s);
-  return columns_struct(telemetry_columns(), {&time_s, &angle, &t.pressure_a_bar, &t.pressure_b_bar, &t.supply_bar,
-                                              &t.setpoint_a_bar, &t.setpoint_b_bar, &t.inlet_a, &t.outlet_a,
-                                              &t.inlet_b, &t.outlet_b});
+MatVar telemetry_struct(const TrialRecord& record) {
+  return columns_struct(telemetry_header(record.joints()), telemetry_file_values(record));
 }
 
 MatVar configuration_struct(const Configuration& config) {
@@ -125,13 +114,16 @@ MatVar session_struct(const Session& session) {
   set_field(out.get(), "updated_utc", 0, text(m.updated_utc));
   set_field(out.get(), "configuration", 0, configuration_struct(m.configuration));
 
+  // The trajectory file's columns: time_s, angle_deg (one joint) or time_s, q1_deg, ... (several).
   const Trajectory& trajectory = session.trajectory;
-  Eigen::VectorXd times(trajectory.angle_rad.size());
-  for (Eigen::Index k = 0; k < times.size(); ++k) times(k) = static_cast<double>(k) * trajectory.sample_time_s;
-  MatVar trajectory_var = structure({"name", "time_s", "angle_deg"});
+  std::vector<std::string> trajectory_fields = trajectory_header(trajectory.joints());
+  const std::vector<Eigen::VectorXd> trajectory_values = trajectory_file_values(trajectory);
+  trajectory_fields.insert(trajectory_fields.begin(), "name");
+  MatVar trajectory_var = structure(trajectory_fields);
   set_field(trajectory_var.get(), "name", 0, text(trajectory.name));
-  set_field(trajectory_var.get(), "time_s", 0, column(rounded_times(times)));
-  set_field(trajectory_var.get(), "angle_deg", 0, column(degrees_of(trajectory.angle_rad)));
+  for (std::size_t c = 0; c < trajectory_values.size(); ++c) {
+    set_field(trajectory_var.get(), trajectory_fields[c + 1], 0, column(trajectory_values[c]));
+  }
   set_field(out.get(), "trajectory", 0, std::move(trajectory_var));
 
   const auto n = static_cast<Eigen::Index>(m.iterations.size());
@@ -146,7 +138,7 @@ MatVar session_struct(const Session& session) {
   }
   set_field(out.get(), "summary", 0,
             columns_struct({"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples"},
-                           {&iteration, &rms, &max_error, &max_correction, &saturated}));
+                           {iteration, rms, max_error, max_correction, saturated}));
 
   MatVar events = structure({"time_utc", "iteration", "kind", "message"}, m.events.size());
   for (std::size_t e = 0; e < m.events.size(); ++e) {
@@ -173,7 +165,7 @@ MatVar iterations_struct(const Session& session) {
     set_field(out.get(), "saturated_samples", i, scalar(entry.summary.saturated_samples));
     set_field(out.get(), "completed_utc", i, text(entry.completed_utc));
     set_field(out.get(), "samples", i, samples_struct(session.iterations[i]));
-    set_field(out.get(), "telemetry", i, telemetry_struct(session.iterations[i].record.ticks));
+    set_field(out.get(), "telemetry", i, telemetry_struct(session.iterations[i].record));
   }
   return out;
 }

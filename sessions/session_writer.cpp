@@ -31,6 +31,7 @@ SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string&
   if (header.started_utc.empty()) header.started_utc = utc_now();
   header.trajectory_name = trajectory.name;
   header.trajectory_samples = trajectory.learning_samples();
+  header.joints = trajectory.joints();
   if (!name.empty()) {
     validate_session_name(name);
     header.name = name;
@@ -79,17 +80,32 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   return writer;
 }
 
+void SessionWriter::check_fits(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar,
+                               const char* what) const {
+  if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
+      next_corrections_bar.rows() != manifest_.trajectory_samples) {
+    throw std::invalid_argument(std::string("SessionWriter::") + what + ": the record does not match the session's trajectory");
+  }
+  if (record.joints() != manifest_.joints || next_corrections_bar.cols() != manifest_.joints) {
+    throw std::invalid_argument(std::string("SessionWriter::") + what + ": the session has " +
+                                std::to_string(manifest_.joints) + " joints, the record " + std::to_string(record.joints()) +
+                                " and the correction " + std::to_string(next_corrections_bar.cols()));
+  }
+}
+
 void SessionWriter::save_iteration(const TrialRecord& record, const IterationSummary& summary,
                                    const Eigen::VectorXd& next_correction_bar, ResumeState resume) {
+  save_iteration(record, summary, Eigen::MatrixXd(next_correction_bar), std::move(resume));
+}
+
+void SessionWriter::save_iteration(const TrialRecord& record, const IterationSummary& summary,
+                                   const Eigen::MatrixXd& next_corrections_bar, ResumeState resume) {
   if (summary.iteration != next_iteration()) {
     throw std::invalid_argument("SessionWriter::save_iteration: expected iteration " + std::to_string(next_iteration()) +
                                 ", got " + std::to_string(summary.iteration));
   }
-  if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
-      next_correction_bar.size() != manifest_.trajectory_samples) {
-    throw std::invalid_argument("SessionWriter::save_iteration: the record does not match the session's trajectory");
-  }
-  const IterationDigests digests = write_iteration_files(iterations_, summary.iteration, record, next_correction_bar);
+  check_fits(record, next_corrections_bar, "save_iteration");
+  const IterationDigests digests = write_iteration_files(iterations_, summary.iteration, record, next_corrections_bar);
   sync(iterations_);
   std::optional<ResumeState> previous_resume = std::move(manifest_.resume);
   manifest_.iterations.push_back({summary, utc_now(), digests.samples_sha256, digests.telemetry_sha256});
@@ -114,13 +130,14 @@ void SessionWriter::rewrite_manifest(const std::function<void()>& undo) {
 }
 
 void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar) {
+  update_next_correction(record, Eigen::MatrixXd(next_correction_bar));
+}
+
+void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::MatrixXd& next_correction_bar) {
   if (manifest_.iterations.empty()) {
     throw std::invalid_argument("SessionWriter::update_next_correction: no iteration saved yet");
   }
-  if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
-      next_correction_bar.size() != manifest_.trajectory_samples) {
-    throw std::invalid_argument("SessionWriter::update_next_correction: the record does not match the session's trajectory");
-  }
+  check_fits(record, next_correction_bar, "update_next_correction");
   // The rewritten samples file gets its new digest in the manifest, or a resume would refuse it.
   const int iteration = next_iteration() - 1;
   const std::string contents = format_samples_csv(record, next_correction_bar);

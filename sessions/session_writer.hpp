@@ -36,10 +36,15 @@ class SessionWriter {
   /// the correction learned from it and the state to continue from.
   void save_iteration(const TrialRecord& record, const IterationSummary& summary,
                       const Eigen::VectorXd& next_correction_bar, ResumeState resume);
+  /// The same for a J-joint session: `record` of J joints, `next_corrections_bar` N x J (one
+  /// column per joint). A one-joint session takes N x 1 alike.
+  void save_iteration(const TrialRecord& record, const IterationSummary& summary,
+                      const Eigen::MatrixXd& next_corrections_bar, ResumeState resume);
   /// The correction learned from the last saved iteration changed (learning ran after the save, or
   /// the operator chose another): rewrites that iteration's samples file (`record` is its record)
   /// atomically, so the learned correction is on disk before the next trial starts.
   void update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar);
+  void update_next_correction(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar);
   /// Keeps a fault's black box (`ticks` oldest first, ending with the fault tick): writes its file,
   /// then lists it in the manifest. Throws std::invalid_argument when `ticks` is empty.
   void save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks);
@@ -51,6 +56,8 @@ class SessionWriter {
  private:
   SessionWriter(DirectoryHandle directory, SessionManifest manifest, SessionLock lock);
   int next_iteration() const { return static_cast<int>(manifest_.iterations.size()); }
+  /// Throws std::invalid_argument unless `record` and the corrections fit the session (`what` names the caller).
+  void check_fits(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar, const char* what) const;
 
   DirectoryHandle directory_;  // every file is written relative to it, never through a link
   DirectoryHandle iterations_;

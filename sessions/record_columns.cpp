@@ -1,0 +1,175 @@
+#include "sessions/record_columns.hpp"
+
+#include <utility>
+
+#include "engine/units.hpp"
+#include "sessions/iteration_files.hpp"
+
+namespace bellows {
+namespace {
+
+using S = TrialSamples;
+using T = TrialTicks;
+constexpr ColumnScale kAsIs = ColumnScale::kAsIs, kDegrees = ColumnScale::kDegrees, kTime = ColumnScale::kTime;
+constexpr ColumnScope kJoint = ColumnScope::kPerJoint, kShared = ColumnScope::kShared;
+
+Eigen::VectorXd written(const Eigen::VectorXd& values, ColumnScale scale) {
+  switch (scale) {
+    case ColumnScale::kDegrees: return degrees_of(values);
+    case ColumnScale::kTime: return rounded_times(values);
+    case ColumnScale::kAsIs: break;
+  }
+  return values;
+}
+
+Eigen::VectorXd read_back(Eigen::VectorXd&& values, ColumnScale scale) {
+  if (scale == ColumnScale::kDegrees) return values * kRadPerDeg;  // the engine's own conversion
+  return std::move(values);
+}
+
+template <typename Record>
+std::vector<std::string> header_of(const std::vector<RecordColumn<Record>>& table, int joints) {
+  std::vector<std::string> names;
+  for (int joint = 0; joint < joints; ++joint) {
+    for (const RecordColumn<Record>& column : table) {
+      if (joint == 0 || column.scope == ColumnScope::kPerJoint) names.push_back(joint_column_name(column.name, joint));
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
+const std::vector<RecordColumn<TrialSamples>>& samples_record_columns() {
+  static const std::vector<RecordColumn<TrialSamples>> columns = {
+      {"time_s", "s", "k T", kTime, kShared, &S::time_s},
+      {"angle_setpoint_deg", "deg", "desired angle yD(k)", kDegrees, kJoint, &S::setpoint_rad},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &S::angle_rad},
+      {"error_deg", "deg", "yD(k) - y(k); 0 at k = 0", kDegrees, kJoint, &S::error_rad},
+      {"u_pid_bar", "bar", "PID + feed-forward output", kAsIs, kJoint, &S::u_pid_bar},
+      {"u_ilc_bar", "bar", "learned correction applied at sample k (0 at k = N)", kAsIs, kJoint, &S::u_ilc_bar},
+      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, &S::u_total_bar},
+      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &S::pressure_a_bar},
+      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &S::pressure_b_bar},
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint, &S::setpoint_a_bar},
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint, &S::setpoint_b_bar},
+      {"u_ilc_next_bar", "bar", "correction learned from this iteration, applied in the next (0 at k = N)", kAsIs,
+       kJoint, nullptr},
+  };
+  return columns;
+}
+
+const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns() {
+  static const std::vector<RecordColumn<TrialTicks>> columns = {
+      {"time_s", "s", "i tick_s", kTime, kShared, &T::time_s},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &T::angle_rad},
+      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &T::pressure_a_bar},
+      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &T::pressure_b_bar},
+      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared, &T::supply_bar},
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A in force", kAsIs, kJoint, &T::setpoint_a_bar},
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B in force", kAsIs, kJoint, &T::setpoint_b_bar},
+      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint, &T::inlet_a},
+      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint, &T::outlet_a},
+      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint, &T::inlet_b},
+      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint, &T::outlet_b},
+  };
+  return columns;
+}
+
+std::string joint_column_name(std::string_view name, int joint) {
+  std::string out(name);
+  if (joint > 0) out.append("_j").append(std::to_string(joint + 1));  // by appends: GCC 12 warns falsely (-Wrestrict) on "_j" + string
+  return out;
+}
+
+std::vector<std::string> samples_header(int joints) { return header_of(samples_record_columns(), joints); }
+std::vector<std::string> telemetry_header(int joints) { return header_of(telemetry_record_columns(), joints); }
+
+std::vector<std::string> trajectory_header(int joints) {
+  if (joints == 1) return {"time_s", "angle_deg"};
+  std::vector<std::string> names = {"time_s"};
+  for (int joint = 1; joint <= joints; ++joint) names.push_back(std::string("q").append(std::to_string(joint)).append("_deg"));
+  return names;
+}
+
+std::vector<std::string_view> header_views(const std::vector<std::string>& names) {
+  return {names.begin(), names.end()};
+}
+
+std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar) {
+  std::vector<Eigen::VectorXd> values;
+  for (int joint = 0; joint < record.joints(); ++joint) {
+    const TrialSamples& samples = record.joint_samples(joint);
+    for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) continue;
+      if (column.member != nullptr) {
+        values.push_back(written(samples.*column.member, column.scale));
+        continue;
+      }
+      Eigen::VectorXd next = Eigen::VectorXd::Zero(samples.time_s.size());
+      const Eigen::Index learned = std::min(next.size(), next_corrections_bar.rows());
+      if (joint < next_corrections_bar.cols()) next.head(learned) = next_corrections_bar.col(joint).head(learned);
+      values.push_back(std::move(next));
+    }
+  }
+  return values;
+}
+
+std::vector<Eigen::VectorXd> telemetry_file_values(const TrialRecord& record) {
+  std::vector<Eigen::VectorXd> values;
+  for (int joint = 0; joint < record.joints(); ++joint) {
+    for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) continue;
+      values.push_back(written(record.joint_ticks(joint).*column.member, column.scale));
+    }
+  }
+  return values;
+}
+
+std::vector<Eigen::VectorXd> trajectory_file_values(const Trajectory& trajectory) {
+  const Eigen::Index rows = trajectory.angle_rad.size();
+  Eigen::VectorXd times(rows);
+  for (Eigen::Index k = 0; k < rows; ++k) times(k) = static_cast<double>(k) * trajectory.sample_time_s;
+  std::vector<Eigen::VectorXd> values = {rounded_times(times)};
+  for (int joint = 0; joint < trajectory.joints(); ++joint) values.push_back(degrees_of(trajectory.joint_angle_rad(joint)));
+  return values;
+}
+
+Eigen::MatrixXd samples_from_file_values(std::vector<Eigen::VectorXd>& columns, int joints, TrialRecord& record) {
+  record.more_joint_samples.resize(static_cast<std::size_t>(joints - 1));
+  if (record.more_joint_ticks.size() != record.more_joint_samples.size()) {
+    record.more_joint_ticks.resize(record.more_joint_samples.size());
+  }
+  const Eigen::Index rows = columns.empty() ? 0 : columns.front().size();
+  Eigen::MatrixXd next(rows, joints);
+  std::size_t at = 0;
+  for (int joint = 0; joint < joints; ++joint) {
+    TrialSamples& samples = record.joint_samples(joint);
+    for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) {
+        samples.*column.member = record.samples.*column.member;  // joint 1's, read first
+        continue;
+      }
+      Eigen::VectorXd& values = columns[at++];
+      if (column.member == nullptr) next.col(joint) = values;
+      else samples.*column.member = read_back(std::move(values), column.scale);
+    }
+  }
+  return next;
+}
+
+void telemetry_from_file_values(std::vector<Eigen::VectorXd>& columns, TrialRecord& record) {
+  std::size_t at = 0;
+  for (int joint = 0; joint < record.joints(); ++joint) {
+    TrialTicks& ticks = record.joint_ticks(joint);
+    for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) {
+        ticks.*column.member = record.ticks.*column.member;  // joint 1's, read first
+        continue;
+      }
+      ticks.*column.member = read_back(std::move(columns[at++]), column.scale);
+    }
+  }
+}
+
+}  // namespace bellows
