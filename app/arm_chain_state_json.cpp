@@ -4,12 +4,12 @@
 
 #include "engine/errors.hpp"
 #include "sessions/json_reader.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
 
 using Json = nlohmann::ordered_json;
-constexpr double kPaPerBar = 1e5;
 
 Json joint_values(const JointVector& values) {
   Json out = Json::array();

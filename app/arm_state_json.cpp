@@ -2,10 +2,10 @@
 
 #include "engine/errors.hpp"
 #include "sessions/json_reader.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
-constexpr double kPaPerBar = 1e5;
 
 template <std::size_t Size>
 nlohmann::ordered_json pair_to_json(const std::array<double, Size>& values) {

@@ -27,9 +27,9 @@ namespace bellows {
 
 namespace {
 
-// A session reopens on the device it was recorded on (unless --device names one): its [device]
-// section and its manifest's device. Says why when that device cannot be driven from here.
-void take_device_of_session(const std::string& session_dir, const ConsoleOptions& options, Configuration& config) {
+// A session reopens on the device and the arm it was recorded on (unless --device names one): its [device]
+// and [arm] sections and its manifest's device. Says why when that device cannot be driven from here.
+void take_rig_of_session(const std::string& session_dir, const ConsoleOptions& options, Configuration& config) {
   std::filesystem::path data_dir;
   try {
     data_dir = default_data_dir();
@@ -45,6 +45,14 @@ void take_device_of_session(const std::string& session_dir, const ConsoleOptions
   }
   config.device = manifest.configuration.device;
   config.device.kind = manifest.device;
+  // The arm too: a session of arm2 continues on arm2 (its trajectory and corrections have its joints).
+  const ArmParameters& recorded = manifest.configuration.arm;
+  if (config.arm.has_chain() && config.arm.name() != recorded.name()) {
+    throw InputError("session " + directory.string() + " was recorded on the arm '" +
+                     (recorded.has_chain() ? recorded.name() : std::string("of one joint")) + "'; --config names '" +
+                     config.arm.name() + "' (leave [arm] out to reopen it on its own arm)");
+  }
+  config.arm = recorded;
 }
 
 }  // namespace
@@ -54,7 +62,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   if (options.exit_after_s < 0.0) throw InputError("--exit-after must not be negative");
   const double speed = parse_speed(options.speed);
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
-  if (!options.session_dir.empty()) take_device_of_session(options.session_dir, options, config);
+  if (!options.session_dir.empty()) take_rig_of_session(options.session_dir, options, config);
   config.device = resolve_device(options.device, config.device);
   // The model the learning uses: the rig profile's identified one, if it has one (a reopened session
   // too: it keeps its gains and law, the model is the rig's as it is now).

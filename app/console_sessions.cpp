@@ -141,7 +141,6 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const ui::Experiment& e = snapshot.experiment;
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
-  if (const std::string why = joints_refusal(e.trajectory->joints()); !why.empty()) throw InputError(why);
   const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
@@ -167,7 +166,7 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
     // Learned (or chosen) after the last saved trial: on disk before the next trial starts.
     if (first_trial == end && first_trial > first && e.next_unsaved) {
-      writer_->update_next_correction(trial_at(end - 1).record, e.next_correction_bar.col(0));
+      writer_->update_next_correction(trial_at(end - 1).record, e.next_correction_bar);
     }
   } else {
     if (first != 0) throw std::logic_error("StoreSessionGateway::save: a new session needs every iteration");
@@ -187,19 +186,13 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   for (std::size_t i = first_trial; i < end; ++i) {
     const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
     // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
-    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next.col(0), ResumeState{});
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
   return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
-}
-
-std::string StoreSessionGateway::joints_refusal(int joints) const {
-  // The session files hold one joint so far: joint 1 alone would reopen on the wrong arm.
-  if (joints <= 1) return {};
-  return "sessions store one joint so far (this arm has " + std::to_string(joints) + "): the trials stay in this console";
 }
 
 std::string StoreSessionGateway::rename(const std::string& name) {
@@ -266,7 +259,7 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   if (seed != m.device_info.end() && seed->is_number_unsigned()) snapshot.seed = seed->get<std::uint64_t>();
   ui::Experiment& e = snapshot.experiment;
   if (!loaded.iterations.empty()) {
-    e.next_correction_bar = loaded.iterations.back().next_correction_bar;
+    e.next_correction_bar = loaded.iterations.back().next_corrections_bar();
     e.next_origin = "saved with the session";
     // The correction the last trial ran with again: the next step learns first.
     e.next_tried = e.next_correction_bar.isApprox(e.trials.back().correction_bar) ||

@@ -30,7 +30,6 @@ class StoreSessionGateway final : public ui::SessionGateway {
 
   bool available() const override { return !data_dir_.empty(); }
   std::string unavailable_reason() const override { return reason_; }
-  std::string joints_refusal(int joints) const override;
   std::string save(const ui::SessionSnapshot& snapshot) override;
   std::vector<ui::SessionListing> list() override;
   ui::SessionSnapshot open(const std::string& location) override;

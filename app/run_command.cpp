@@ -122,9 +122,6 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
   const std::unique_ptr<JointLearning> law = make_joint_learning(config, model, trajectory.joints(), trajectory.learning_samples());
-  if (trajectory.joints() > 1 && !options.no_save) {  // until sessions store every joint: nothing saved by halves
-    throw InputError("sessions of an arm of several joints are not saved yet: add --no-save");
-  }
   const std::optional<TransferReport> transfer = transfer_for(options, config, trajectory, resumed != nullptr);
 
   RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
@@ -148,7 +145,9 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
-  recording.restore(arm, core, clock, session);  // before the first tick
+  SimulatedArmChain* chain = io.simulated_arm_chain();  // the simulated arm of several joints, or null
+  if (chain != nullptr) recording.restore(chain, core, clock, session);  // before the first tick
+  else recording.restore(arm, core, clock, session);
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
@@ -198,7 +197,9 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
       const IterationSummary s = session.run_trial();
       io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
-      recording.save(session, s, arm, core, clock);  // on disk before the line says it is done
+      // On disk before the line says it is done.
+      if (chain != nullptr) recording.save(session, s, chain, core, clock);
+      else recording.save(session, s, arm, core, clock);
       said.iteration(s);
       nlohmann::json iteration = to_json(s);
       iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));

@@ -67,6 +67,7 @@ RunIo::~RunIo() { stop(); }
 Device& RunIo::device() { return device_->device(); }
 
 SimulatedArm* RunIo::simulated_arm() { return device_->simulated_arm(); }
+SimulatedArmChain* RunIo::simulated_arm_chain() { return device_->simulated_arm_chain(); }
 
 void RunIo::add_telemetry_tap(EngineCore& core) {
   if (!telemetry_) return;

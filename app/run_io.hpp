@@ -15,6 +15,7 @@
 #include "bridge/telemetry_publisher.hpp"
 #include "devices/lcm_device.hpp"
 #include "devices/simulated_arm.hpp"
+#include "devices/simulated_arm_chain.hpp"
 #include "engine/configuration.hpp"
 #include "engine/engine_core.hpp"
 #include "engine/engine_driver.hpp"
@@ -40,6 +41,8 @@ class RunIo {
   Device& device();
   /// The simulated arm, or null for a rig.
   SimulatedArm* simulated_arm();
+  /// The simulated arm of several joints ([arm] chain on sim), or null.
+  SimulatedArmChain* simulated_arm_chain();
   /// The device as opened (its session record, its name).
   const OpenedDevice& opened() const { return *device_; }
   const DeviceParameters& device_parameters() const { return device_parameters_; }

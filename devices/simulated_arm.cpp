@@ -11,7 +11,6 @@
 
 namespace bellows {
 namespace {
-constexpr double kPaPerBar = 1e5;
 }  // namespace
 
 const char* to_string(SimulatedFault fault) {

@@ -12,12 +12,12 @@
 #include "engine/arm_model.hpp"
 #include "engine/errors.hpp"
 #include "engine/valve_flow.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
 
 constexpr int kMaxIterations = 100;
-constexpr double kPaPerBar = 1e5;
 constexpr double kRelativeCostTolerance = 1e-12;
 constexpr double kArxMinimumStep_s = 0.02;  // equation error is fitted no faster than this: less noise bias
 

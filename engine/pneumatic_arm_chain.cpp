@@ -7,11 +7,11 @@
 
 #include "engine/arm_chain_kernel.hpp"
 #include "engine/errors.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
 namespace {
 
-constexpr double kPaPerBar = 1e5;
 constexpr double kBarPerPa = 1e-5;  // a product: a division here was the step's slowest instruction
 
 /// Calls f(std::integral_constant<int, J>) for the chain's joint count.

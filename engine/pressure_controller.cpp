@@ -5,12 +5,9 @@
 
 #include "engine/errors.hpp"
 #include "engine/valve_flow.hpp"
+#include "engine/units.hpp"
 
 namespace bellows {
-namespace {
-constexpr double kPaPerBar = 1e5;
-}
-
 PressureController::PressureController(const ControllerParameters& params) : params_(params) {
   if (params.filter_samples < 1 || params.filter_samples > kMaxFilterSamples) {
     throw InputError("controller.filter_samples must be between 1 and " + std::to_string(kMaxFilterSamples));

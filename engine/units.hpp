@@ -8,5 +8,6 @@ namespace bellows {
 
 inline constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+inline constexpr double kPaPerBar = 1e5;
 
 }  // namespace bellows

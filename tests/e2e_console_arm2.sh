@@ -2,7 +2,7 @@
 # The console drives arm2 end to end (issue 14): `[arm] preset = "arm2"` on the simulated chain with
 # `paper2`; arm, run iterations 0..3 and read each joint's RMS and the overall one off the screen,
 # inspect the correction of joint 2 (the elbow), emergency stop with the elbow's black box, quit
-# without saving (sessions hold one joint so far: the console says so).
+# (saved as it went), reopen the session: the same per-joint history, joint 2 inspected again.
 source "$(dirname "$0")/e2e_console_lib.sh"
 
 # The dashboard's RMS list on an arm with two joints, as "iteration all j1 j2" lines.
@@ -59,18 +59,29 @@ e2e_wait_for 'Last ticks before the fault, joint 2/2 elbow'
 e2e_keys R
 e2e_wait_for 'Bellows +SAFE '
 
-# Saving: the session files hold one joint so far (the sessions library's J-joint format is not
-# on main yet), so the console runs arm2 without saving and says so in one line, everywhere it
-# matters: the log at start, the name key, and the quit question.
+# Saved as it went: quit does not ask; the closing report names the session.
 e2e_keys Escape
 e2e_wait_for 'it +all +j1 +j2'
-e2e_keys s
-e2e_wait_for 'Name: sessions store one joint so far \(this arm has 2\)'
-e2e_keys q
-e2e_wait_for 'Quit\?'
-e2e_wait_for 'Saving is not available: sessions store one joint so far'
+for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
 e2e_keys q
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has 'bellows console: .* iterations 0\.\.3, best RMS .*valves vented'
+e2e_output_has 'session: /.* \(saved as it went\)'
+session="$(e2e_history | grep -oE '^session: /[^ ]+' | head -1 | cut -c10-)"
+[ -f "$session/manifest.json" ] || e2e_fail "no session at '$session'"
+shown="$("$BELLOWS" sessions show "$session")"
+grep -q '2 joints' <<<"$shown" || e2e_fail "sessions show does not say 2 joints: $shown"
+
+# Reopened: the arm of the session (arm2), the same per-joint RMS history, joint 2 inspected again.
+e2e_start 120 40 -- console --speed max --session "$session"
+e2e_wait_for 'trajectory paper2 \(8\.0 s\)  joint 1/2 shoulder'
+e2e_wait_for 'it +all +j1 +j2'
+[ "$(arm2_rms_list)" = "$rms" ] || e2e_fail "RMS history after reopening: $(arm2_rms_list | tr '\n' ';') vs $(echo "$rms" | tr '\n' ';')"
+e2e_keys c
+e2e_wait_for 'At the cursor'
+e2e_keys j
+e2e_wait_for "Iteration 3 of 0\.\.3  joint 2/2 elbow .*\(joint 2 $elbow\)"
+e2e_keys Escape q
+[ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after reopening"
 echo "ok: $(echo "$rms" | tr '\n' ';')"

@@ -51,12 +51,6 @@ ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajecto
   state_.sessions_unavailable_reason =
       env_.sessions != nullptr ? env_.sessions->unavailable_reason() : "no session store in this build";
   auto shared = std::make_shared<const Trajectory>(std::move(trajectory));
-  if (state_.sessions_available) {
-    if (std::string why = env_.sessions->joints_refusal(shared->joints()); !why.empty()) {
-      state_.sessions_available = false;
-      state_.sessions_unavailable_reason = std::move(why);
-    }
-  }
   state_.experiment = Experiment::start(shared);
   const auto strip_size = static_cast<std::size_t>(std::lround(kStripSeconds / env_.config.timing.sample_s()));
   strip_time_.assign(strip_size, 0.0);
@@ -111,9 +105,6 @@ void ConsoleController::start(double now_s) {
   log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
                                    env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
   if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
-  if (env_.sessions != nullptr && !env_.sessions->joints_refusal(state_.experiment.joints()).empty()) {
-    log(LogSource::kSession, "not saving: " + state_.sessions_unavailable_reason, true);
-  }
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
 

@@ -56,9 +56,6 @@ class SessionGateway {
   virtual bool available() const = 0;
   /// Why save and open are not available (shown to the operator).
   virtual std::string unavailable_reason() const { return "saving sessions is not available in this build"; }
-  /// Why sessions of an arm of `joints` joints cannot be saved here; empty when they can. The console
-  /// then runs its trials without saving and says so, rather than saving part of each trial.
-  virtual std::string joints_refusal(int /*joints*/) const { return {}; }
   /// Saves `snapshot`: a new session, or, when `experiment.session_location` is the session this
   /// gateway opened or saved last, what was added since: trials, black boxes, log entries
   /// (`experiment.saved_events`), changed settings and a changed next correction. The console
