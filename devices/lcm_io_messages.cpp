@@ -61,34 +61,49 @@ std::size_t max_io_message_bytes() {
                    detail::fixed_size<io_joints_command_t>()});
 }
 
+namespace {
+
+// The fields the one-joint and the joint messages share, listed once for both directions.
+template <typename From, typename To>
+void copy_state_header(const From& from, To& to) {
+  to.rig_id = from.rig_id;
+  to.seq = from.seq;
+  to.binding = from.binding;
+  to.session_id = from.session_id;
+  to.command_seq = from.command_seq;
+  to.utime = from.utime;
+  to.time_s = from.time_s;
+  to.supply_bar = from.supply_bar;
+  to.temperature_K = from.temperature_K;
+  to.fault_bits = from.fault_bits;
+  to.foreign_commands = from.foreign_commands;
+  to.unauthenticated_commands = from.unauthenticated_commands;
+}
+
+template <typename From, typename To>
+void copy_command_header(const From& from, To& to) {
+  to.session_id = from.session_id;
+  to.seq = from.seq;
+  to.utime = from.utime;
+  to.rig_id = from.rig_id;
+  to.binding = from.binding;
+  to.armed = from.armed;
+}
+
+}  // namespace
+
 io_joints_state_t widen(const io_state_t& s) {
   io_joints_state_t w{};
-  w.rig_id = s.rig_id;
-  w.seq = s.seq;
-  w.binding = s.binding;
-  w.session_id = s.session_id;
-  w.command_seq = s.command_seq;
-  w.utime = s.utime;
-  w.time_s = s.time_s;
+  copy_state_header(s, w);
   w.joint_count = 1;
   w.angle_rad[0] = s.angle_rad;
   for (int i = 0; i < kActuatorCount; ++i) w.chamber_bar[0][i] = s.chamber_bar[i];
-  w.supply_bar = s.supply_bar;
-  w.temperature_K = s.temperature_K;
-  w.fault_bits = s.fault_bits;
-  w.foreign_commands = s.foreign_commands;
-  w.unauthenticated_commands = s.unauthenticated_commands;
   return w;
 }
 
 io_joints_command_t widen(const io_command_t& c) {
   io_joints_command_t w{};
-  w.session_id = c.session_id;
-  w.seq = c.seq;
-  w.utime = c.utime;
-  w.rig_id = c.rig_id;
-  w.binding = c.binding;
-  w.armed = c.armed;
+  copy_command_header(c, w);
   w.joint_count = 1;
   for (int i = 0; i < kActuatorCount; ++i) {
     w.inlet_duty[0][i] = c.inlet_duty[i];
@@ -99,31 +114,15 @@ io_joints_command_t widen(const io_command_t& c) {
 
 io_state_t narrow(const io_joints_state_t& w) {
   io_state_t s{};
-  s.rig_id = w.rig_id;
-  s.seq = w.seq;
-  s.binding = w.binding;
-  s.session_id = w.session_id;
-  s.command_seq = w.command_seq;
-  s.utime = w.utime;
-  s.time_s = w.time_s;
+  copy_state_header(w, s);
   s.angle_rad = w.angle_rad[0];
   for (int i = 0; i < kActuatorCount; ++i) s.chamber_bar[i] = w.chamber_bar[0][i];
-  s.supply_bar = w.supply_bar;
-  s.temperature_K = w.temperature_K;
-  s.fault_bits = w.fault_bits;
-  s.foreign_commands = w.foreign_commands;
-  s.unauthenticated_commands = w.unauthenticated_commands;
   return s;
 }
 
 io_command_t narrow(const io_joints_command_t& w) {
   io_command_t c{};
-  c.session_id = w.session_id;
-  c.seq = w.seq;
-  c.utime = w.utime;
-  c.rig_id = w.rig_id;
-  c.binding = w.binding;
-  c.armed = w.armed;
+  copy_command_header(w, c);
   for (int i = 0; i < kActuatorCount; ++i) {
     c.inlet_duty[i] = w.inlet_duty[0][i];
     c.outlet_duty[i] = w.outlet_duty[0][i];
