@@ -28,9 +28,13 @@ void check_joint_count(const char* what, int joints) {
 
 }  // namespace
 
-DecodeStatus decode_io_state(const void* data, std::size_t size, io_joints_state_t& out, const LcmKey* key) {
-  if (fingerprint(data, size) == io_state_t::getHash()) {
-    io_state_t one{};
+namespace {
+
+// A message of either kind, by its fingerprint: today's one-joint message is widened.
+template <typename OneJoint, typename Joints>
+DecodeStatus decode_either(const void* data, std::size_t size, Joints& out, const LcmKey* key) {
+  if (fingerprint(data, size) == OneJoint::getHash()) {
+    OneJoint one{};
     const DecodeStatus status = decode_checked(data, size, one, key);
     if (status == DecodeStatus::kOk) out = widen(one);
     return status;
@@ -38,14 +42,14 @@ DecodeStatus decode_io_state(const void* data, std::size_t size, io_joints_state
   return decode_checked(data, size, out, key);
 }
 
+}  // namespace
+
+DecodeStatus decode_io_state(const void* data, std::size_t size, io_joints_state_t& out, const LcmKey* key) {
+  return decode_either<io_state_t>(data, size, out, key);
+}
+
 DecodeStatus decode_io_command(const void* data, std::size_t size, io_joints_command_t& out, const LcmKey* key) {
-  if (fingerprint(data, size) == io_command_t::getHash()) {
-    io_command_t one{};
-    const DecodeStatus status = decode_checked(data, size, one, key);
-    if (status == DecodeStatus::kOk) out = widen(one);
-    return status;
-  }
-  return decode_checked(data, size, out, key);
+  return decode_either<io_command_t>(data, size, out, key);
 }
 
 std::size_t encode_io_state(const io_joints_state_t& state, const LcmKey& key, std::vector<std::uint8_t>& buffer) {
