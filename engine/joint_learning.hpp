@@ -33,9 +33,11 @@ class JointLearning {
 };
 
 /// One joint: `law` on the only column, exactly as the single-joint product has always learned.
+/// Borrows the law, or owns it when given one.
 class SingleJointLearning final : public JointLearning {
  public:
   explicit SingleJointLearning(LearningLaw& law) : law_(law) {}
+  explicit SingleJointLearning(std::unique_ptr<LearningLaw> law) : owned_(std::move(law)), law_(*owned_) {}
   void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
               Eigen::Ref<Eigen::MatrixXd> u_next) override;
   std::string name() const override { return law_.name(); }
@@ -45,6 +47,7 @@ class SingleJointLearning final : public JointLearning {
   const LearningLaw* single_joint_law() const override { return &law_; }
 
  private:
+  std::unique_ptr<LearningLaw> owned_;  // null when borrowed
   LearningLaw& law_;
 };
 

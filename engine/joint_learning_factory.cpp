@@ -89,27 +89,6 @@ class PerJointLearning final : public JointLearning {
   std::vector<std::unique_ptr<LearningLaw>> laws_;
 };
 
-/// Owns the single-joint law it adapts.
-class OwnedSingleJointLearning final : public JointLearning {
- public:
-  explicit OwnedSingleJointLearning(std::unique_ptr<LearningLaw> law) : law_(std::move(law)), adapter_(*law_) {}
-  void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
-              Eigen::Ref<Eigen::MatrixXd> u_next) override {
-    adapter_.update(u_j, e_j, u_next);
-  }
-  void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) override {
-    adapter_.set_input_context(feedback_bar, input_limit_bar);
-  }
-  std::string name() const override { return adapter_.name(); }
-  int samples() const override { return adapter_.samples(); }
-  int joints() const override { return 1; }
-  const LearningLaw* single_joint_law() const override { return law_.get(); }
-
- private:
-  std::unique_ptr<LearningLaw> law_;
-  SingleJointLearning adapter_;
-};
-
 }  // namespace
 
 std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s) {
@@ -133,7 +112,7 @@ MultiJointModel joint_learning_model(const ChainParameters& chain, const std::st
 
 std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model, int joints,
                                                    int samples) {
-  if (joints == 1 && !config.arm.has_chain()) return std::make_unique<OwnedSingleJointLearning>(make_learning_law(config, model, samples));
+  if (joints == 1 && !config.arm.has_chain()) return std::make_unique<SingleJointLearning>(make_learning_law(config, model, samples));
   const ChainParameters chain = chain_of(config.arm);
   if (chain.joints != joints) {
     throw InputError("the trajectory has " + std::to_string(joints) + " joints; the arm has " + std::to_string(chain.joints) +
