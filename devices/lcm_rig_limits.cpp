@@ -21,6 +21,7 @@ LimitedValves enforce_rig_limits(const ValveCommand& commanded, const SensorRead
       out.valves = ValveCommand::vented(commanded.joint_count);  // any joint out of range vents the whole arm
       out.fault_bits |= kRigAngleLimitBit;
       out.angle_exceeded = true;
+      if (out.angle_joint < 0) out.angle_joint = j;
     }
   }
   for (int j = 0; j < joints; ++j) {

@@ -27,6 +27,7 @@ struct LimitedValves {
   ValveCommand valves;          // what to drive
   std::int32_t fault_bits = 0;  // kRigPressureLimitBit / kRigAngleLimitBit
   bool angle_exceeded = false;  // the rig must vent and drop its session
+  int angle_joint = -1;         // the first joint (0-based) beyond the range, -1: none
 };
 
 /// `commanded` with every chamber above the ceiling vented (inlet closed, outlet open), and

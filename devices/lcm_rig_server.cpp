@@ -128,7 +128,8 @@ void RigServer::apply_limits(bool write) {
   }
   if (rising(io_state_t::FAULT_ANGLE_LIMIT)) {
     bump(angle_trips_);
-    notice(Notice::kAngleLimit, "the arm beyond the rig's angle range: vented" +
+    const std::string which = joints_ > 1 ? "joint " + std::to_string(limited.angle_joint + 1) : std::string("the arm");
+    notice(Notice::kAngleLimit, which + " beyond the rig's angle range: vented" +
                                     (session_ != 0 ? ", session " + std::to_string(session_) + " dropped" : std::string()));
   }
   if (limited.angle_exceeded) {

@@ -192,10 +192,16 @@ std::vector<ParameterBinding> make_bindings() {
   };
   for (std::size_t j = 0; j < ArmParameters{}.joint.size(); ++j) {
     const std::string section = "arm_joint" + std::to_string(j + 1);
+    const std::string joint = "joint " + std::to_string(j + 1);
     for (const auto& [key, unit, meaning, range, member] : joint_keys) {
-      after_preset = b.insert(after_preset, number(section, key, unit, "[arm] joints: joint " + std::to_string(j + 1) + "'s " + meaning, range,
+      after_preset = b.insert(after_preset, number(section, key, unit, "[arm] joints: " + joint + "'s " + meaning, range,
                                                    [j, member = member](C& c) { return &(c.arm.joint[j].*member); })) + 1;
     }
+    // The guard's limit is every arm's (a preset's, a chain of its own keys, the one joint of [plant]).
+    after_preset = b.insert(after_preset, number(section, "angle_limit_deg", "deg",
+                                                 "any arm: the engine's guard faults when " + joint +
+                                                     " goes beyond this angle; 0: [safety] angle_limit_deg",
+                                                 upto(180.0), [j](C& c) { return &c.safety.joint_angle_limit_deg[j]; })) + 1;
   }
   const ParameterBinding signal = name("identify", "signal", "excitation of the identification trial: chirp or steps",
                                        [](C& c) { return &c.identify.signal; });
@@ -272,6 +278,20 @@ void validate_configuration(const Configuration& config) {
   }
   if (config.trajectory.max_abs_angle_deg >= config.safety.angle_limit_deg) {
     throw InputError("[trajectory] max_abs_angle_deg must be below [safety] angle_limit_deg");
+  }
+  // Each joint's own limit obeys the same rules as [safety] angle_limit_deg: above every trajectory
+  // (none may be built that crosses a guard), within the rig's range (the engine's guard acts first).
+  for (std::size_t j = 0; j < config.safety.joint_angle_limit_deg.size(); ++j) {
+    const double limit_deg = config.safety.joint_angle_limit_deg[j];
+    if (limit_deg == 0.0) continue;
+    const std::string key = "[arm_joint" + std::to_string(j + 1) + "] angle_limit_deg = " + format_number(limit_deg);
+    if (config.trajectory.max_abs_angle_deg >= limit_deg) {
+      throw InputError(key + ": must be above [trajectory] max_abs_angle_deg = " + format_number(config.trajectory.max_abs_angle_deg));
+    }
+    if (limit_deg > config.lcm.rig_angle_limit_deg) {
+      throw InputError(key + ": must not be above [lcm] rig_angle_limit_deg = " + format_number(config.lcm.rig_angle_limit_deg) +
+                       ": the engine's guard acts first");
+    }
   }
   if (config.device.kind != "sim" && config.device.kind != "lcm" && config.device.kind != "t7") {
     throw InputError("[device] kind = '" + config.device.kind + "': unknown device (known: sim, lcm, t7)");

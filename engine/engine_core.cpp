@@ -117,7 +117,8 @@ void EngineCore::hold_trajectory(const Trajectory* trajectory, double now_s) {
   emit(event);
 }
 
-void EngineCore::enter_fault(FaultCode code, double now_s) {
+void EngineCore::enter_fault(FaultCode code, double now_s, int joint) {
+  fault_joint_ = joint;
   fault_.store(code, std::memory_order_release);
   manual_ = false;
   device_.vent();
@@ -129,6 +130,7 @@ void EngineCore::enter_fault(FaultCode code, double now_s) {
   event.kind = EventKind::kFault;
   event.time_s = now_s;
   event.fault = code;
+  event.fault_joint = joint;
   event.from = event.to = EngineState::kFault;
   emit(event);
 }
@@ -227,6 +229,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
         return;
       }
       fault_.store(FaultCode::kNone, std::memory_order_release);
+      fault_joint_ = -1;
       black_box_.clear();
       break;
   }
@@ -275,8 +278,8 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
     inputs.stale_count = stale_count_;
     inputs.missed_streak = time_follows_ticks_ ? 0 : missed_streak_;
     inputs.heartbeat_age_s = monitor_heartbeat_.load(std::memory_order_relaxed) ? wall_s - last_heartbeat_s_ : 0.0;
-    const FaultCode code = check_guards(reading, inputs, safety_);
-    if (code != FaultCode::kNone) enter_fault(code, now_s);
+    const GuardFault fired = find_guard_fault(reading, inputs, safety_);
+    if (fired.code != FaultCode::kNone) enter_fault(fired.code, now_s, fired.joint);
   }
 
   ValveCommand valves = ValveCommand::vented(joints());
@@ -335,6 +338,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   tick.time_s = now_s;
   tick.state = state();
   tick.fault = fault();
+  tick.fault_joint = fault_joint_;
   tick.reading = reading;
   tick.desired_angle_rad = control_.desired_angle_rad();
   for (int j = 1; j < control_.joints(); ++j) tick.more_desired_rad[static_cast<std::size_t>(j - 1)] = control_.desired_angle_rad(j);

@@ -92,7 +92,8 @@ class EngineCore {
  private:
   void apply(const EngineCommand& command, double now_s, double wall_s);
   void change_state(EngineState next, double now_s, CommandKind cause, FaultCode fault_cause = FaultCode::kNone);
-  void enter_fault(FaultCode code, double now_s);
+  /// `joint`: the joint (0-based) the guard fired on, -1 when the fault is no joint's.
+  void enter_fault(FaultCode code, double now_s, int joint = -1);
   void count_missed_deadlines(int missed, double now_s);
   void hold_trajectory(const Trajectory* trajectory, double now_s);
   void hand_back_trial(EventKind kind, double now_s);
@@ -136,6 +137,7 @@ class EngineCore {
   double last_reading_time_s_ = -1.0;
   double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;
+  int fault_joint_ = -1;  // the joint the latched fault fired on (-1: none, or no joint's)
   int missed_streak_ = 0;
   const bool time_follows_ticks_;  // the device's, read once: missed deadlines warn instead of fault
   double last_heartbeat_s_ = 0.0;

@@ -110,6 +110,7 @@ struct EngineEvent {
   CommandKind command = CommandKind::kHeartbeat;  // the command concerned, if any
   const char* refusal = "";                       // kCommandRefused: why (static text)
   FaultCode fault = FaultCode::kNone;
+  int fault_joint = -1;                           // kFault: the joint (0-based) the guard fired on; -1: no joint's
   TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
   const Trajectory* trajectory = nullptr;         // kTrajectorySelected
   std::uint32_t trial_id = 0;
@@ -123,6 +124,7 @@ struct TickRecord {
   double time_s = 0.0;
   EngineState state = EngineState::kSafe;
   FaultCode fault = FaultCode::kNone;
+  int fault_joint = -1;            // the joint (0-based) the latched fault fired on; -1: none or no joint's
   SensorReading reading{};
   double desired_angle_rad = 0.0;  // joint 1's (the reading and the valves carry every joint)
   std::array<double, kMaxJoints - 1> more_desired_rad{};  // joints 2..J's (the console's live strip per joint)

@@ -106,6 +106,28 @@ TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
   expect_config_refused("[arm]\ngravity = 2\n", "[arm] gravity");
 }
 
+TEST(ConfigFile, EachJointHasItsOwnAngleLimitDefaultingToTheSafetyLimit) {
+  Configuration c;
+  // A joint guarded more tightly than the others: every trajectory's range below it.
+  apply_config_toml("[arm]\npreset = \"arm2\"\n[safety]\nangle_limit_deg = 92\n[trajectory]\nmax_abs_angle_deg = 60\n"
+                    "[arm_joint2]\nangle_limit_deg = 70\n",
+                    "arm2.toml", c);
+  EXPECT_EQ(c.safety.angle_limit_deg_of(0), 92.0) << "no key of its own: [safety] angle_limit_deg";
+  EXPECT_EQ(c.safety.angle_limit_deg_of(1), 70.0);
+  // One joint ([plant]'s) is joint 1: its own limit too.
+  Configuration one;
+  apply_config_toml("[arm_joint1]\nangle_limit_deg = 93.5\n", "one.toml", one);
+  EXPECT_EQ(one.safety.angle_limit_deg_of(0), 93.5);
+  // The same rules as [safety] angle_limit_deg: above every trajectory, within the rig's range.
+  expect_config_refused("[arm_joint2]\nangle_limit_deg = 90\n",
+                        "[arm_joint2] angle_limit_deg = 90: must be above [trajectory] max_abs_angle_deg = 90");
+  expect_config_refused("[arm_joint3]\nangle_limit_deg = 120\n",
+                        "[arm_joint3] angle_limit_deg = 120: must not be above [lcm] rig_angle_limit_deg = 100");
+  expect_config_refused("[arm_joint1]\nangle_limit_deg = -5\n", "[arm_joint1] angle_limit_deg = -5: must be in [0, 180]");
+  apply_config_toml("[lcm]\nrig_angle_limit_deg = 130\n[arm_joint4]\nangle_limit_deg = 120\n", "wide.toml", c);
+  EXPECT_EQ(c.safety.angle_limit_deg_of(3), 120.0);
+}
+
 TEST(ConfigFile, RoundTripsThroughToml) {
   Configuration c;
   c.plant.kappa_rad_per_bar = 6.5;

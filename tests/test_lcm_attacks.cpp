@@ -120,9 +120,11 @@ TEST(LcmRigLimits, ActJointByJoint) {
   EXPECT_EQ(out.valves.joint[1].inlet_duty[0], 1.0) << "only that chamber";
   EXPECT_EQ(out.valves.joint[0].inlet_duty[1], 0.5) << "the other joint untouched";
   r.joint[1].chamber_bar = {1.2, 1.2};
+  EXPECT_EQ(out.angle_joint, -1);
   r.joint[1].angle_rad = -1.8;  // the second joint beyond the range: the whole arm vents
   out = enforce_rig_limits(open, r, limits);
   EXPECT_TRUE(out.angle_exceeded);
+  EXPECT_EQ(out.angle_joint, 1) << "the joint beyond the range is named";
   EXPECT_EQ(out.valves.joint_count, 2);
   EXPECT_TRUE(vented(out.valves));
 }

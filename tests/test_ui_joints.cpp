@@ -26,7 +26,8 @@ Configuration arm2_config() {
 
 /// The arm2 chain first (the engine holds a reference to it), then the console over it.
 struct Arm2Console {
-  Configuration config = arm2_config();
+  explicit Arm2Console(const Configuration& c = arm2_config()) : config(c) {}
+  Configuration config;
   SimulatedArmChain chain{pneumatic_chain_of(config.plant, config.arm)};
   ConsoleFixture f{config, 3, nullptr, &chain, {}, "paper2"};
 };
@@ -156,15 +157,44 @@ TEST(UiJoints, AGuardNamesTheJointAndTheChamberItFiredOn) {
   tick.reading.joint_count = 2;
   for (JointReading& j : tick.reading.joint) j.chamber_bar = {1.2, 1.2};
   tick.reading.joint[1].angle_rad = 100.0 * std::numbers::pi / 180.0;
-  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, tick, c), "joint 2 (elbow): angle 100.0 deg beyond the limit of 95 deg");
+  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, c), "joint 2 (elbow): angle 100.0 deg beyond its limit of 95 deg");
+  Configuration own = c;
+  own.safety.joint_angle_limit_deg[1] = 99.5;  // the elbow's own limit, not [safety] angle_limit_deg
+  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, own), "joint 2 (elbow): angle 100.0 deg beyond its limit of 99.5 deg");
   tick.reading.joint[1].angle_rad = 0.0;
   tick.reading.joint[0].chamber_bar[1] = 3.0;
-  EXPECT_EQ(fault_location(FaultCode::kOverpressure, tick, c),
+  EXPECT_EQ(fault_location(FaultCode::kOverpressure, 0, tick, c),
             format("joint 1 (shoulder) chamber B: 3.000 bar above p_max plus the margin (%.3f bar)",
                    c.controller.p_max_bar + c.safety.pressure_margin_bar));
-  EXPECT_EQ(fault_location(FaultCode::kSupplyLow, tick, c), "");  // the supply is every joint's
+  EXPECT_EQ(fault_location(FaultCode::kSupplyLow, -1, tick, c), "");  // the supply is every joint's
   tick.reading.joint_count = 1;
-  EXPECT_EQ(fault_location(FaultCode::kOverpressure, tick, c), "");  // one joint: nothing to name
+  EXPECT_EQ(fault_location(FaultCode::kOverpressure, 0, tick, c), "");  // one joint: nothing to name
+}
+
+TEST(UiJoints, AJointsOwnAngleLimitFaultsTheConsoleNamingThatJointAndItsLimit) {
+  Configuration config = arm2_config();
+  // Below paper2's elbow (+-30 deg), so that the first trial crosses it. (A configuration file keeps
+  // every joint's limit above [trajectory] max_abs_angle_deg: validate_configuration refuses this.)
+  config.safety.joint_angle_limit_deg[1] = 25.0;
+  Arm2Console a(config);
+  ConsoleFixture& f = a.f;
+  f.arm_valves();
+  f.key('N');
+  f.key(key::kBackspace);
+  f.key(key::kBackspace);
+  f.type("1");
+  f.key(key::kEnter);
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.where.empty(); }));
+  EXPECT_EQ(f.state().fault, FaultCode::kAngleLimit);
+  EXPECT_EQ(f.state().fault_view.joint, 1);
+  const std::string& where = f.state().fault_view.where;
+  EXPECT_TRUE(std::regex_match(where, std::regex("joint 2 \\(elbow\\): angle -?(2[5-9]|3[0-9])\\.[0-9] deg beyond its limit of 25 deg")))
+      << where;
+  const double shoulder_deg = f.state().fault_view.black_box.back().reading.joint[0].angle_rad * 180.0 / std::numbers::pi;
+  EXPECT_LT(std::abs(shoulder_deg), 25.0) << "the shoulder stayed inside 25 deg";
+  EXPECT_TRUE(f.logged("angle-limit fired on joint 2 (elbow)"));
+  const std::string screen = screen_text(f.state());
+  EXPECT_NE(screen.find("on joint 2 (elbow)"), std::string::npos) << screen;
 }
 
 TEST(UiJoints, AnEmergencyStopOnArm2ShowsTheSelectedJointsBlackBox) {

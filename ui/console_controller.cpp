@@ -145,7 +145,8 @@ void ConsoleController::update(double now_s) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
     black_box_pending_ = false;
     if (!state_.fault_view.black_box.empty()) {
-      state_.fault_view.where = fault_location(state_.fault_view.code, state_.fault_view.black_box.back(), state_.config);
+      state_.fault_view.where = fault_location(state_.fault_view.code, state_.fault_view.joint, state_.fault_view.black_box.back(),
+                                              state_.config);
       if (!state_.fault_view.where.empty()) {
         log(LogSource::kEngine, format("%s fired on %s", fault_name(state_.fault_view.code), state_.fault_view.where.c_str()),
             true, state_.fault_view.time_s);
@@ -233,7 +234,7 @@ void ConsoleController::on_event(const EngineEvent& event) {
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
-      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}};
+      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint};
       black_box_pending_ = true;
       log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), fault_message(event.fault)), true, event.time_s);
       set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);

@@ -137,6 +137,7 @@ struct FaultView {
   double time_s = 0.0;
   std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
   std::string where;                  // on a J-joint arm: the joint (and chamber) the guard fired on
+  int joint = -1;                     // the joint the engine named (0-based); -1: no joint's
 };
 
 struct ConsoleState;

@@ -24,57 +24,51 @@ double tick_desired_rad(const TickRecord& tick, int joint) {
   return tick.more_desired_rad[static_cast<std::size_t>(joint - 1)];
 }
 
-std::string fault_location(FaultCode code, const TickRecord& tick, const Configuration& config) {
+std::string fault_location(FaultCode code, int joint, const TickRecord& tick, const Configuration& config) {
   const int joints = tick.reading.joint_count;
-  if (joints < 2 || joints > kMaxJoints) return {};
+  if (joints < 2 || joints > kMaxJoints || joint < 0 || joint >= joints) return {};
   const SafetyParameters& limits = config.safety;
   const double p_limit_bar = config.controller.p_max_bar + limits.pressure_margin_bar;
-  const auto where = [joints](int j) {
-    const std::string name = joint_name(joints, j);
-    return format("joint %d", j + 1) + (name.empty() ? "" : " (" + name + ")");
-  };
+  const std::string name = joint_name(joints, joint);
+  const std::string where = format("joint %d", joint + 1) + (name.empty() ? "" : " (" + name + ")");
+  const JointReading& r = tick.reading.joint[static_cast<std::size_t>(joint)];
   constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-  for (int j = 0; j < joints; ++j) {
-    const JointReading& r = tick.reading.joint[static_cast<std::size_t>(j)];
-    const double angle_deg = r.angle_rad * kDegPerRad;
-    switch (code) {
-      case FaultCode::kAngleLimit:
-        if (std::abs(angle_deg) > limits.angle_limit_deg) {
-          return format("%s: angle %.1f deg beyond the limit of %g deg", where(j).c_str(), angle_deg, limits.angle_limit_deg);
+  const double angle_deg = r.angle_rad * kDegPerRad;
+  const auto chamber = [](int c) { return c == 0 ? 'A' : 'B'; };
+  switch (code) {
+    case FaultCode::kAngleLimit:
+      return format("%s: angle %.1f deg beyond its limit of %g deg", where.c_str(), angle_deg, limits.angle_limit_deg_of(joint));
+    case FaultCode::kOverpressure:
+      for (int c = 0; c < kActuatorCount; ++c) {
+        if (r.chamber_bar[static_cast<std::size_t>(c)] > p_limit_bar) {
+          return format("%s chamber %c: %.3f bar above p_max plus the margin (%.3f bar)", where.c_str(), chamber(c),
+                        r.chamber_bar[static_cast<std::size_t>(c)], p_limit_bar);
         }
-        break;
-      case FaultCode::kOverpressure:
-        for (int c = 0; c < kActuatorCount; ++c) {
-          if (r.chamber_bar[static_cast<std::size_t>(c)] > p_limit_bar) {
-            return format("%s chamber %c: %.3f bar above p_max plus the margin (%.3f bar)", where(j).c_str(), c == 0 ? 'A' : 'B',
-                          r.chamber_bar[static_cast<std::size_t>(c)], p_limit_bar);
-          }
+      }
+      break;
+    case FaultCode::kSensorNotANumber:
+      if (!std::isfinite(r.angle_rad)) return where + ": the angle is not a number";
+      for (int c = 0; c < kActuatorCount; ++c) {
+        if (!std::isfinite(r.chamber_bar[static_cast<std::size_t>(c)])) {
+          return format("%s chamber %c: the pressure is not a number", where.c_str(), chamber(c));
         }
-        break;
-      case FaultCode::kSensorNotANumber:
-        if (!std::isfinite(r.angle_rad)) return where(j) + ": the angle is not a number";
-        for (int c = 0; c < kActuatorCount; ++c) {
-          if (!std::isfinite(r.chamber_bar[static_cast<std::size_t>(c)])) {
-            return format("%s chamber %c: the pressure is not a number", where(j).c_str(), c == 0 ? 'A' : 'B');
-          }
+      }
+      break;
+    case FaultCode::kSensorOutOfRange:
+      if (std::abs(angle_deg) > limits.sensor_max_angle_deg) {
+        return format("%s: angle %.1f deg outside the encoder's range", where.c_str(), angle_deg);
+      }
+      for (int c = 0; c < kActuatorCount; ++c) {
+        const double p = r.chamber_bar[static_cast<std::size_t>(c)];
+        if (p < limits.sensor_min_bar || p > limits.sensor_max_bar) {
+          return format("%s chamber %c: %.3f bar outside the sensor's range", where.c_str(), chamber(c), p);
         }
-        break;
-      case FaultCode::kSensorOutOfRange:
-        if (std::abs(angle_deg) > limits.sensor_max_angle_deg) {
-          return format("%s: angle %.1f deg outside the encoder's range", where(j).c_str(), angle_deg);
-        }
-        for (int c = 0; c < kActuatorCount; ++c) {
-          const double p = r.chamber_bar[static_cast<std::size_t>(c)];
-          if (p < limits.sensor_min_bar || p > limits.sensor_max_bar) {
-            return format("%s chamber %c: %.3f bar outside the sensor's range", where(j).c_str(), c == 0 ? 'A' : 'B', p);
-          }
-        }
-        break;
-      default:
-        return {};
-    }
+      }
+      break;
+    default:
+      return {};
   }
-  return {};
+  return where;  // the engine named the joint; the tick recorded no value beyond a limit
 }
 
 }  // namespace bellows::ui

@@ -22,9 +22,10 @@ std::string joint_label(int joints, int joint);
 /// Joint `joint`'s set point in a tick (joint 1's is desired_angle_rad).
 double tick_desired_rad(const TickRecord& tick, int joint);
 
-/// Where a guard fired on a J-joint arm, in words ("joint 2 (elbow): angle 97.3 deg beyond the
-/// limit of 95 deg"), read from the tick that faulted; "" for one joint, for a fault that is not
-/// a joint's (supply, heartbeat, stop) or when the tick shows nothing beyond a limit.
-std::string fault_location(FaultCode code, const TickRecord& tick, const Configuration& config);
+/// Where a guard fired on a J-joint arm, in words ("joint 2 (elbow): angle 97.3 deg beyond its
+/// limit of 95 deg"): the joint the engine named (`joint`, 0-based, the kFault event's fault_joint),
+/// with its values from the tick that faulted; "" for one joint and for a fault that is no joint's
+/// (supply, heartbeat, stop: `joint` < 0).
+std::string fault_location(FaultCode code, int joint, const TickRecord& tick, const Configuration& config);
 
 }  // namespace bellows::ui
