@@ -340,10 +340,11 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   tick.fault = fault();
   tick.fault_joint = fault_joint_;
   tick.reading = reading;
-  tick.desired_angle_rad = control_.desired_angle_rad();
-  for (int j = 1; j < control_.joints(); ++j) tick.more_desired_rad[static_cast<std::size_t>(j - 1)] = control_.desired_angle_rad(j);
-  tick.u_total_bar = control_.last_u_total_bar();
-  tick.setpoints = control_.setpoints();
+  for (int j = 0; j < control_.joints(); ++j) {  // every joint's, for the black box and the telemetry
+    tick.joint_desired_rad(j) = control_.desired_angle_rad(j);
+    tick.joint_u_total_bar(j) = control_.last_u_total_bar(j);
+    tick.joint_setpoints(j) = control_.setpoints(j);
+  }
   tick.valves = valves;
   tick.sample = control_.sample_index();
   tick.trial_id = trial_id_;

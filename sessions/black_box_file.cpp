@@ -1,6 +1,7 @@
 #include "sessions/black_box_file.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 #include "engine/safety.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
+#include "sessions/record_columns.hpp"
 
 namespace bellows {
 namespace {
@@ -99,16 +101,6 @@ std::string joined_header(const std::vector<std::string_view>& names) {
 
 }  // namespace
 
-const std::vector<std::string_view>& black_box_columns() {
-  static const std::vector<std::string_view> columns = {
-      "tick",          "time_s",        "sensor_time_s", "state",         "fault",
-      "angle_deg",     "angle_setpoint_deg", "pressure_a_bar", "pressure_b_bar",
-      "supply_bar",    "u_tot_bar",     "pressure_a_setpoint_bar", "pressure_b_setpoint_bar",
-      "inlet_a_duty",  "outlet_a_duty", "inlet_b_duty",  "outlet_b_duty",
-      "sample",        "trial_id"};
-  return columns;
-}
-
 const std::vector<std::string_view>& legacy_black_box_columns() {
   static const std::vector<std::string_view> columns = {
       "tick",          "time_s",        "sensor_time_s", "state",         "fault",
@@ -119,27 +111,22 @@ const std::vector<std::string_view>& legacy_black_box_columns() {
   return columns;
 }
 
+int black_box_joints(const std::vector<TickRecord>& ticks) {
+  int joints = 1;
+  for (const TickRecord& t : ticks) joints = std::max(joints, std::min(t.reading.joint_count, kMaxJoints));
+  return joints;
+}
+
 std::vector<Eigen::VectorXd> black_box_values(const std::vector<TickRecord>& ticks) {
-  const auto rows = static_cast<Eigen::Index>(ticks.size());
-  std::vector<Eigen::VectorXd> c(black_box_columns().size(), Eigen::VectorXd(rows));
-  for (Eigen::Index k = 0; k < rows; ++k) {
-    const TickRecord& t = ticks[static_cast<std::size_t>(k)];
-    const double values[] = {static_cast<double>(t.tick), t.time_s, t.reading.time_s, static_cast<double>(t.state),
-                             static_cast<double>(t.fault), degrees_for_exact_radians(t.reading.joint[0].angle_rad),
-                             degrees_for_exact_radians(t.desired_angle_rad), t.reading.joint[0].chamber_bar[0],
-                             t.reading.joint[0].chamber_bar[1], t.reading.supply_bar, t.u_total_bar, t.setpoints.a_bar,
-                             t.setpoints.b_bar, t.valves.joint[0].inlet_duty[0], t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1],
-                             t.valves.joint[0].outlet_duty[1], static_cast<double>(t.sample), static_cast<double>(t.trial_id)};
-    for (std::size_t i = 0; i < c.size(); ++i) c[i](k) = values[i];
-  }
-  return c;
+  return black_box_file_values(ticks, black_box_joints(ticks));
 }
 
 std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
   if (ticks.empty()) throw std::invalid_argument("format_black_box_csv: no ticks");
   const std::vector<Eigen::VectorXd> c = black_box_values(ticks);
+  const std::vector<std::string> header = black_box_header(black_box_joints(ticks));
   std::vector<CsvColumn> columns;
-  for (std::size_t i = 0; i < c.size(); ++i) columns.push_back({black_box_columns()[i], &c[i]});
+  for (std::size_t i = 0; i < c.size(); ++i) columns.push_back({header[i], &c[i]});
   std::string numeric;
   append_csv(numeric, columns);
   return with_named_fields_replaced(numeric, [](std::size_t column, std::string_view field, std::size_t) {
@@ -151,11 +138,17 @@ std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
 std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::string& source, int expected_ticks) {
   std::string_view header = text.substr(0, text.find('\n'));
   while (!header.empty() && (header.back() == '\r' || header.back() == ' ' || header.back() == '\t')) header.remove_suffix(1);
+  int joints = 0;  // from the header: the one of 1..kMaxJoints joints it is
+  for (int j = 1; j <= kMaxJoints && joints == 0; ++j) {
+    if (header == joined_header(header_views(black_box_header(j)))) joints = j;
+  }
   std::vector<Eigen::VectorXd> c;
   if (header == joined_header(legacy_black_box_columns())) {
+    joints = 1;
     c = parse_csv(text, legacy_black_box_columns(), source, NonFinite::kAccept);
-  } else if (header != joined_header(black_box_columns())) {
-    c = parse_csv(text, black_box_columns(), source, NonFinite::kAccept);  // refuses the header, naming the current one
+  } else if (joints == 0) {
+    // Refuses the header, naming the one-joint one.
+    c = parse_csv(text, header_views(black_box_header(1)), source, NonFinite::kAccept);
   } else {
     // Names back to codes, then the strict numeric reader checks everything else.
     const std::string numeric =
@@ -164,39 +157,32 @@ std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::st
                      ? std::to_string(code_of(field, kLastState, state_name, source, line, "state"))
                      : std::to_string(code_of(field, kLastFault, fault_name_of, source, line, "fault"));
         });
-    c = parse_csv(numeric, black_box_columns(), source, NonFinite::kAccept);
+    c = parse_csv(numeric, header_views(black_box_header(joints)), source, NonFinite::kAccept);
   }
   if (c[0].size() != expected_ticks) {
     throw InputError(source + ": expected " + std::to_string(expected_ticks) + " rows (the ticks the manifest lists), found " +
                      std::to_string(c[0].size()));
   }
-  std::vector<TickRecord> ticks(static_cast<std::size_t>(expected_ticks));
+  // The whole-number columns (joint 1's block: the same positions in every header) before any is cast.
+  const std::vector<TickColumn>& table = black_box_record_columns();
+  const auto column = [&](std::string_view name) -> const Eigen::VectorXd& {
+    const auto found = std::find_if(table.begin(), table.end(), [&](const TickColumn& t) { return t.name == name; });
+    return c[static_cast<std::size_t>(found - table.begin())];
+  };
+  constexpr double kMostTicks = 9007199254740992.0;  // 2^53: every tick count a double holds exactly
   for (Eigen::Index k = 0; k < c[0].size(); ++k) {
-    TickRecord& t = ticks[static_cast<std::size_t>(k)];
-    constexpr double kMostTicks = 9007199254740992.0;  // 2^53: every tick count a double holds exactly
-    t.tick = static_cast<std::uint64_t>(whole_at(c[0], k, 0.0, kMostTicks, source, "tick"));
-    if (k > 0 && t.tick <= ticks[static_cast<std::size_t>(k - 1)].tick) {
-      throw InputError(source + ": line " + std::to_string(k + 2) + ": tick " + std::to_string(t.tick) +
-                       " does not follow tick " + std::to_string(ticks[static_cast<std::size_t>(k - 1)].tick) +
+    const double tick = whole_at(column("tick"), k, 0.0, kMostTicks, source, "tick");
+    if (k > 0 && tick <= column("tick")(k - 1)) {
+      throw InputError(source + ": line " + std::to_string(k + 2) + ": tick " + std::to_string(static_cast<std::uint64_t>(tick)) +
+                       " does not follow tick " + std::to_string(static_cast<std::uint64_t>(column("tick")(k - 1))) +
                        " (ticks increase row by row)");
     }
-    t.time_s = c[1](k);
-    t.state = static_cast<EngineState>(whole_at(c[3], k, 0, kLastState, source, "state"));
-    t.fault = static_cast<FaultCode>(whole_at(c[4], k, 0, kLastFault, source, "fault"));
-    t.reading.joint[0].angle_rad = radians_from_degrees(c[5](k));
-    t.reading.time_s = c[2](k);
-    t.desired_angle_rad = radians_from_degrees(c[6](k));
-    t.reading.joint[0].chamber_bar = {c[7](k), c[8](k)};
-    t.reading.supply_bar = c[9](k);
-    t.u_total_bar = c[10](k);
-    t.setpoints.a_bar = c[11](k);
-    t.setpoints.b_bar = c[12](k);
-    t.valves.joint[0].inlet_duty = {c[13](k), c[15](k)};
-    t.valves.joint[0].outlet_duty = {c[14](k), c[16](k)};
-    t.sample = static_cast<int>(whole_at(c[17], k, -1, std::numeric_limits<int>::max(), source, "sample"));
-    t.trial_id = static_cast<std::uint32_t>(whole_at(c[18], k, 0, std::numeric_limits<std::uint32_t>::max(), source, "trial_id"));
+    whole_at(column("state"), k, 0, kLastState, source, "state");
+    whole_at(column("fault"), k, 0, kLastFault, source, "fault");
+    whole_at(column("sample"), k, -1, std::numeric_limits<int>::max(), source, "sample");
+    whole_at(column("trial_id"), k, 0, std::numeric_limits<std::uint32_t>::max(), source, "trial_id");
   }
-  return ticks;
+  return black_box_from_file_values(c, joints);
 }
 
 }  // namespace bellows

@@ -13,6 +13,8 @@ using T = TrialTicks;
 constexpr ColumnScale kAsIs = ColumnScale::kAsIs, kDegrees = ColumnScale::kDegrees, kTime = ColumnScale::kTime;
 constexpr ColumnScope kJoint = ColumnScope::kPerJoint, kShared = ColumnScope::kShared;
 
+std::size_t at(int joint) { return static_cast<std::size_t>(joint); }
+
 Eigen::VectorXd written(const Eigen::VectorXd& values, ColumnScale scale) {
   switch (scale) {
     case ColumnScale::kDegrees: return degrees_of(values);
@@ -27,11 +29,11 @@ Eigen::VectorXd read_back(Eigen::VectorXd&& values, ColumnScale scale) {
   return std::move(values);
 }
 
-template <typename Record>
-std::vector<std::string> header_of(const std::vector<RecordColumn<Record>>& table, int joints) {
+template <typename Column>
+std::vector<std::string> header_of(const std::vector<Column>& table, int joints) {
   std::vector<std::string> names;
   for (int joint = 0; joint < joints; ++joint) {
-    for (const RecordColumn<Record>& column : table) {
+    for (const Column& column : table) {
       if (joint == 0 || column.scope == ColumnScope::kPerJoint) names.push_back(joint_column_name(column.name, joint));
     }
   }
@@ -76,6 +78,51 @@ const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns() {
   return columns;
 }
 
+const std::vector<TickColumn>& black_box_record_columns() {
+  using Tick = TickRecord;
+  static const std::vector<TickColumn> columns = {
+      {"tick", "", "the engine's tick count", kAsIs, kShared, [](const Tick& t, int) { return static_cast<double>(t.tick); },
+       [](Tick& t, int, double v) { t.tick = static_cast<std::uint64_t>(v); }},
+      {"time_s", "s", "engine time of the tick", kAsIs, kShared, [](const Tick& t, int) { return t.time_s; },
+       [](Tick& t, int, double v) { t.time_s = v; }},
+      {"sensor_time_s", "s", "time of the reading the tick used", kAsIs, kShared, [](const Tick& t, int) { return t.reading.time_s; },
+       [](Tick& t, int, double v) { t.reading.time_s = v; }},
+      {"state", "", "engine state (SAFE, ARMED, RUNNING, FAULT)", kAsIs, kShared,
+       [](const Tick& t, int) { return static_cast<double>(t.state); }, [](Tick& t, int, double v) { t.state = static_cast<EngineState>(v); }},
+      {"fault", "", "the latched fault (none, angle-limit, ...)", kAsIs, kShared,
+       [](const Tick& t, int) { return static_cast<double>(t.fault); }, [](Tick& t, int, double v) { t.fault = static_cast<FaultCode>(v); }},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, [](const Tick& t, int j) { return t.reading.joint[at(j)].angle_rad; },
+       [](Tick& t, int j, double v) { t.reading.joint[at(j)].angle_rad = v; }},
+      {"angle_setpoint_deg", "deg", "desired angle", kDegrees, kJoint, [](const Tick& t, int j) { return t.joint_desired_rad(j); },
+       [](Tick& t, int j, double v) { t.joint_desired_rad(j) = v; }},
+      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[0]; }, [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[0] = v; }},
+      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[1]; }, [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[1] = v; }},
+      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared, [](const Tick& t, int) { return t.reading.supply_bar; },
+       [](Tick& t, int, double v) { t.reading.supply_bar = v; }},
+      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint_u_total_bar(j); },
+       [](Tick& t, int j, double v) { t.joint_u_total_bar(j) = v; }},
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint_setpoints(j).a_bar; },
+       [](Tick& t, int j, double v) { t.joint_setpoints(j).a_bar = v; }},
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint_setpoints(j).b_bar; },
+       [](Tick& t, int j, double v) { t.joint_setpoints(j).b_bar = v; }},
+      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[0]; },
+       [](Tick& t, int j, double v) { t.valves.joint[at(j)].inlet_duty[0] = v; }},
+      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[0]; },
+       [](Tick& t, int j, double v) { t.valves.joint[at(j)].outlet_duty[0] = v; }},
+      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[1]; },
+       [](Tick& t, int j, double v) { t.valves.joint[at(j)].inlet_duty[1] = v; }},
+      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[1]; },
+       [](Tick& t, int j, double v) { t.valves.joint[at(j)].outlet_duty[1] = v; }},
+      {"sample", "", "ILC sample of the running trial, -1 when none runs", kAsIs, kShared,
+       [](const Tick& t, int) { return static_cast<double>(t.sample); }, [](Tick& t, int, double v) { t.sample = static_cast<int>(v); }},
+      {"trial_id", "", "the running trial's id", kAsIs, kShared, [](const Tick& t, int) { return static_cast<double>(t.trial_id); },
+       [](Tick& t, int, double v) { t.trial_id = static_cast<std::uint32_t>(v); }},
+  };
+  return columns;
+}
+
 std::string joint_column_name(std::string_view name, int joint) {
   std::string out(name);
   if (joint > 0) out.append("_j").append(std::to_string(joint + 1));  // by appends: GCC 12 warns falsely (-Wrestrict) on "_j" + string
@@ -84,6 +131,7 @@ std::string joint_column_name(std::string_view name, int joint) {
 
 std::vector<std::string> samples_header(int joints) { return header_of(samples_record_columns(), joints); }
 std::vector<std::string> telemetry_header(int joints) { return header_of(telemetry_record_columns(), joints); }
+std::vector<std::string> black_box_header(int joints) { return header_of(black_box_record_columns(), joints); }
 
 std::vector<std::string> trajectory_header(int joints) {
   if (joints == 1) return {"time_s", "angle_deg"};
@@ -121,6 +169,23 @@ std::vector<Eigen::VectorXd> telemetry_file_values(const TrialRecord& record) {
     for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
       if (joint > 0 && column.scope == ColumnScope::kShared) continue;
       values.push_back(written(record.joint_ticks(joint).*column.member, column.scale));
+    }
+  }
+  return values;
+}
+
+std::vector<Eigen::VectorXd> black_box_file_values(const std::vector<TickRecord>& ticks, int joints) {
+  const auto rows = static_cast<Eigen::Index>(ticks.size());
+  std::vector<Eigen::VectorXd> values;
+  for (int joint = 0; joint < joints; ++joint) {
+    for (const TickColumn& column : black_box_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) continue;
+      Eigen::VectorXd v(rows);
+      for (Eigen::Index k = 0; k < rows; ++k) {
+        const double value = column.value(ticks[static_cast<std::size_t>(k)], joint);
+        v(k) = column.scale == ColumnScale::kDegrees ? degrees_for_exact_radians(value) : value;
+      }
+      values.push_back(std::move(v));
     }
   }
   return values;
@@ -170,6 +235,24 @@ void telemetry_from_file_values(std::vector<Eigen::VectorXd>& columns, TrialReco
       ticks.*column.member = read_back(std::move(columns[at++]), column.scale);
     }
   }
+}
+
+std::vector<TickRecord> black_box_from_file_values(const std::vector<Eigen::VectorXd>& columns, int joints) {
+  const Eigen::Index rows = columns.empty() ? 0 : columns.front().size();
+  std::vector<TickRecord> ticks(static_cast<std::size_t>(rows));
+  for (TickRecord& tick : ticks) tick.reading.joint_count = tick.valves.joint_count = joints;
+  std::size_t at = 0;
+  for (int joint = 0; joint < joints; ++joint) {
+    for (const TickColumn& column : black_box_record_columns()) {
+      if (joint > 0 && column.scope == ColumnScope::kShared) continue;  // joint 1's, read first
+      const Eigen::VectorXd& values = columns[at++];
+      for (Eigen::Index k = 0; k < rows; ++k) {
+        const double value = column.scale == ColumnScale::kDegrees ? radians_from_degrees(values(k)) : values(k);
+        column.set(ticks[static_cast<std::size_t>(k)], joint, value);
+      }
+    }
+  }
+  return ticks;
 }
 
 }  // namespace bellows

@@ -1,5 +1,6 @@
 // The record types as files store them, described once: for every column of an iteration's samples
-// (TrialSamples plus the correction learned) and telemetry (TrialTicks) its name, unit, meaning,
+// (TrialSamples plus the correction learned), telemetry (TrialTicks) and a fault's black box (the
+// engine's TickRecords) its name, unit, meaning,
 // how its values are written (radians as degrees, times rounded to the nanosecond) and which member
 // of the record holds it. The session's CSV writer and reader, the consistency checks and the
 // CSV/JSON/MAT exports all take their columns from here (docs/session-format.md lists the same).
@@ -16,6 +17,7 @@
 
 #include <Eigen/Dense>
 
+#include "engine/engine_messages.hpp"
 #include "engine/trajectory.hpp"
 #include "engine/trial_record.hpp"
 
@@ -42,6 +44,20 @@ const std::vector<RecordColumn<TrialSamples>>& samples_record_columns();
 /// An iteration's tick-rate telemetry, N x ticks_per_sample rows, in file order.
 const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns();
 
+/// A column of a fault's black box: one value per tick, read from and written into a TickRecord
+/// (which keeps joint 1's values apart from joints 2..J's: hence functions, not a member).
+struct TickColumn {
+  std::string_view name;
+  std::string_view unit;
+  std::string_view meaning;
+  ColumnScale scale;  // kDegrees for angles; never kTime (a black box keeps the engine's times as they are)
+  ColumnScope scope;
+  double (*value)(const TickRecord& tick, int joint);
+  void (*set)(TickRecord& tick, int joint, double value);
+};
+/// A black box's ticks, one row per tick, in file order (docs/session-format.md).
+const std::vector<TickColumn>& black_box_record_columns();
+
 /// `name` of joint `joint` (0 = joint 1: the name itself; else name + "_j" + (joint + 1)).
 std::string joint_column_name(std::string_view name, int joint);
 
@@ -49,6 +65,7 @@ std::string joint_column_name(std::string_view name, int joint);
 /// order, then each further joint's per-joint columns.
 std::vector<std::string> samples_header(int joints);
 std::vector<std::string> telemetry_header(int joints);
+std::vector<std::string> black_box_header(int joints);
 /// The trajectory file's header: `time_s,angle_deg` for one joint (as always), else
 /// `time_s,q1_deg,...,qJ_deg` (the format `bellows run --trajectory FILE.csv` reads).
 std::vector<std::string> trajectory_header(int joints);
@@ -59,6 +76,8 @@ std::vector<std::string_view> header_views(const std::vector<std::string>& names
 /// `next_corrections_bar` is N x J (a missing row or column is 0); the last row's is 0.
 std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar);
 std::vector<Eigen::VectorXd> telemetry_file_values(const TrialRecord& record);
+/// Every column of black_box_header(joints), one row per tick, angles in degrees as written.
+std::vector<Eigen::VectorXd> black_box_file_values(const std::vector<TickRecord>& ticks, int joints);
 std::vector<Eigen::VectorXd> trajectory_file_values(const Trajectory& trajectory);
 
 /// The record's samples (prepared for `joints` joints) from the columns of samples_header(joints)
@@ -66,5 +85,7 @@ std::vector<Eigen::VectorXd> trajectory_file_values(const Trajectory& trajectory
 Eigen::MatrixXd samples_from_file_values(std::vector<Eigen::VectorXd>& columns, int joints, TrialRecord& record);
 /// The record's ticks from the columns of telemetry_header(record.joints()) as read.
 void telemetry_from_file_values(std::vector<Eigen::VectorXd>& columns, TrialRecord& record);
+/// Ticks (one per row) of `joints` joints from the columns of black_box_header(joints) as read.
+std::vector<TickRecord> black_box_from_file_values(const std::vector<Eigen::VectorXd>& columns, int joints);
 
 }  // namespace bellows

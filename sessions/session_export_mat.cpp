@@ -196,7 +196,7 @@ MatVar black_boxes_struct(const Session& session) {
     set_field(out.get(), "iteration", b, scalar(entry.iteration));
     set_field(out.get(), "time_utc", b, text(entry.time_utc));
     const std::vector<Eigen::VectorXd> values = black_box_values(session.black_boxes[b]);
-    std::vector<std::string> fields(black_box_columns().begin(), black_box_columns().end());
+    const std::vector<std::string> fields = black_box_header(black_box_joints(session.black_boxes[b]));
     MatVar ticks = structure(fields);
     for (std::size_t c = 0; c < fields.size(); ++c) {
       if (c == kBlackBoxStateColumn || c == kBlackBoxFaultColumn) {

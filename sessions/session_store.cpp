@@ -200,7 +200,7 @@ Session load_session(const DirectoryHandle& directory) {
   for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
     const BlackBoxEntry& entry = m.black_boxes[i];
     const std::string file = session_layout::black_box_file(static_cast<int>(i));
-    const std::size_t limit = csv_size_limit(black_box_columns(), static_cast<std::size_t>(entry.ticks));
+    const std::size_t limit = csv_size_limit(header_views(black_box_header(m.joints)), static_cast<std::size_t>(entry.ticks));
     session.black_boxes.push_back(
         parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity), where + file, entry.ticks));
   }

@@ -9,6 +9,7 @@
 
 #include "engine/errors.hpp"
 #include "sessions/black_box_file.hpp"
+#include "sessions/record_columns.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/session_export.hpp"
@@ -123,8 +124,9 @@ TEST_F(SessionExport, ReadsLegacyBlackBoxesWithNumericCodes) {
                        "supply_bar,u_total_bar,pressure_a_setpoint_bar,pressure_b_setpoint_bar,inlet_a_duty,"
                        "outlet_a_duty,inlet_b_duty,outlet_b_duty,sample,trial_id\n";
   const std::vector<Eigen::VectorXd> values = black_box_values(box);
+  const std::vector<std::string> header = black_box_header(1);
   std::vector<CsvColumn> columns;
-  for (std::size_t c = 0; c < values.size(); ++c) columns.push_back({black_box_columns()[c], &values[c]});
+  for (std::size_t c = 0; c < values.size(); ++c) columns.push_back({header[c], &values[c]});
   std::string numeric;
   append_csv(numeric, columns);
   legacy += numeric.substr(numeric.find('\n') + 1);
