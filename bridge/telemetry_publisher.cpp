@@ -3,6 +3,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -15,6 +16,20 @@ namespace {
 // How often the ring is drained: 40 ticks at 200 Hz, far below what a person watching notices,
 // far above what fills the ring.
 constexpr double kDrainPeriod_s = 0.02;
+
+// The fields telemetry_t and telemetry_joints_t share, listed once.
+template <typename Message>
+void copy_shared_fields(const TickRecord& tick, Message& t) {
+  t.tick = static_cast<std::int64_t>(tick.tick);
+  t.time_s = tick.time_s;
+  t.state = state_code(tick.state);
+  t.fault = fault_code(tick.fault);
+  t.trial_id = static_cast<std::int32_t>(tick.trial_id);
+  t.sample = tick.sample;
+  t.reading_time_s = tick.reading.time_s;
+  t.supply_bar = tick.reading.supply_bar;
+  t.temperature_K = tick.reading.temperature_K;
+}
 
 std::int64_t realtime_us() {
   timespec now{};
@@ -49,6 +64,7 @@ TelemetryPublisher::TelemetryPublisher(TelemetryRing& ring, std::int64_t session
   }
   log_epoch_us_ = realtime_us();
   telemetry_.session_id = session_id_;
+  joints_telemetry_.session_id = session_id_;
   event_.session_id = session_id_;
   buffer_.resize(4096);
 }
@@ -103,33 +119,57 @@ void TelemetryPublisher::emit_event(lcm::LCM* bus, const TickRecord& tick, std::
   emit(bus, kEventChannel, event_, events_);
 }
 
+void TelemetryPublisher::publish_joints(lcm::LCM* bus, const TickRecord& tick, int joints) {
+  telemetry_joints_t& t = joints_telemetry_;
+  copy_shared_fields(tick, t);
+  t.fault_joint = static_cast<std::int8_t>(tick.fault != FaultCode::kNone && tick.fault_joint >= 0 ? tick.fault_joint + 1 : 0);
+  t.joint_count = static_cast<std::int8_t>(joints);
+  for (int j = 0; j < kMaxJoints; ++j) {
+    const bool used = j < joints;  // rows beyond the arm's joints stay zero
+    const auto ji = static_cast<std::size_t>(j);
+    const JointReading& r = tick.reading.joint[ji];
+    const JointValves& v = tick.valves.joint[ji];
+    t.angle_rad[j] = used ? r.angle_rad : 0.0;
+    t.desired_angle_rad[j] = used ? tick.joint_desired_rad(j) : 0.0;
+    t.u_total_bar[j] = used ? tick.joint_u_total_bar(j) : 0.0;
+    t.saturation[j] = static_cast<std::int8_t>(used ? tick.joint_setpoints(j).saturation_sign : 0);
+    t.setpoint_bar[j][0] = used ? tick.joint_setpoints(j).a_bar : 0.0;
+    t.setpoint_bar[j][1] = used ? tick.joint_setpoints(j).b_bar : 0.0;
+    for (int i = 0; i < kActuatorCount; ++i) {
+      t.chamber_bar[j][i] = used ? r.chamber_bar[static_cast<std::size_t>(i)] : 0.0;
+      t.inlet_duty[j][i] = used ? v.inlet_duty[static_cast<std::size_t>(i)] : 0.0;
+      t.outlet_duty[j][i] = used ? v.outlet_duty[static_cast<std::size_t>(i)] : 0.0;
+    }
+  }
+  t.dropped_ticks = static_cast<std::int64_t>(dropped_ticks_.load(std::memory_order_relaxed));
+  emit(bus, kTelemetryChannel, t, ticks_);
+}
+
 void TelemetryPublisher::on_tick(lcm::LCM* bus, const TickRecord& tick) {
   if (have_previous_ && tick.tick > previous_.tick + 1) bump(dropped_ticks_, tick.tick - previous_.tick - 1);
   latest_time_s_ = tick.time_s;
 
-  telemetry_t& t = telemetry_;
-  t.tick = static_cast<std::int64_t>(tick.tick);
-  t.time_s = tick.time_s;
-  t.state = state_code(tick.state);
-  t.fault = fault_code(tick.fault);
-  t.trial_id = static_cast<std::int32_t>(tick.trial_id);
-  t.sample = tick.sample;
-  t.reading_time_s = tick.reading.time_s;
-  t.angle_rad = tick.reading.joint[0].angle_rad;
-  t.desired_angle_rad = tick.desired_angle_rad;
-  for (int i = 0; i < kActuatorCount; ++i) {
-    t.chamber_bar[i] = tick.reading.joint[0].chamber_bar[i];
-    t.inlet_duty[i] = tick.valves.joint[0].inlet_duty[i];
-    t.outlet_duty[i] = tick.valves.joint[0].outlet_duty[i];
+  // The arm's joints as the reading carries them: one speaks telemetry_t, several telemetry_joints_t.
+  const int joints = std::clamp(tick.reading.joint_count, 1, kMaxJoints);
+  if (joints > 1) {
+    publish_joints(bus, tick, joints);
+  } else {
+    telemetry_t& t = telemetry_;
+    copy_shared_fields(tick, t);
+    t.angle_rad = tick.reading.joint[0].angle_rad;
+    t.desired_angle_rad = tick.desired_angle_rad;
+    for (int i = 0; i < kActuatorCount; ++i) {
+      t.chamber_bar[i] = tick.reading.joint[0].chamber_bar[i];
+      t.inlet_duty[i] = tick.valves.joint[0].inlet_duty[i];
+      t.outlet_duty[i] = tick.valves.joint[0].outlet_duty[i];
+    }
+    t.u_total_bar = tick.u_total_bar;
+    t.setpoint_bar[0] = tick.setpoints.a_bar;
+    t.setpoint_bar[1] = tick.setpoints.b_bar;
+    t.saturation = static_cast<std::int8_t>(tick.setpoints.saturation_sign);
+    t.dropped_ticks = static_cast<std::int64_t>(dropped_ticks_.load(std::memory_order_relaxed));
+    emit(bus, kTelemetryChannel, t, ticks_);
   }
-  t.supply_bar = tick.reading.supply_bar;
-  t.temperature_K = tick.reading.temperature_K;
-  t.u_total_bar = tick.u_total_bar;
-  t.setpoint_bar[0] = tick.setpoints.a_bar;
-  t.setpoint_bar[1] = tick.setpoints.b_bar;
-  t.saturation = static_cast<std::int8_t>(tick.setpoints.saturation_sign);
-  t.dropped_ticks = static_cast<std::int64_t>(dropped_ticks_.load(std::memory_order_relaxed));
-  emit(bus, kTelemetryChannel, t, ticks_);
 
   // Events, from what changed since the previous tick (before the first: the engine's initial
   // state, SAFE, no fault, no trial).

@@ -2,7 +2,8 @@
 //
 // Runs as an endpoint of its own, non-real-time LcmIoThread, fed by one engine telemetry tap (an
 // SPSC ring the engine fills every tick): the loop never calls LCM, never writes files. Per tick
-// it publishes a telemetry_t; from consecutive ticks it derives engine events (state changes,
+// it publishes a telemetry_t (one joint, as always) or a telemetry_joints_t (an arm of several
+// joints: every joint's values, on the same channel); from consecutive ticks it derives engine events (state changes,
 // faults, trials started and ended); the operator thread posts a trial summary after every
 // completed trial. Every message published also goes into the log, written with lcm::LogFile in
 // LCM's own format, so lcm-logplayer replays it and any LCM tool reads it. Log timestamps are the
@@ -60,6 +61,7 @@ class TelemetryPublisher final : public LcmEndpoint {
  private:
   void drain(lcm::LCM* bus);
   void on_tick(lcm::LCM* bus, const TickRecord& tick);
+  void publish_joints(lcm::LCM* bus, const TickRecord& tick, int joints);
   void emit_event(lcm::LCM* bus, const TickRecord& tick, std::int8_t kind, const std::string& text);
   template <typename Message>
   void emit(lcm::LCM* bus, const char* channel, const Message& message, std::atomic<std::uint64_t>& counter);
@@ -75,6 +77,7 @@ class TelemetryPublisher final : public LcmEndpoint {
   bool have_previous_ = false;
   double latest_time_s_ = 0.0;
   telemetry_t telemetry_{};
+  telemetry_joints_t joints_telemetry_{};
   engine_event_t event_{};
   std::vector<std::uint8_t> buffer_;
 

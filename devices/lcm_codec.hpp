@@ -16,6 +16,7 @@
 #include <bellows/io_joints_command_t.hpp>
 #include <bellows/io_joints_state_t.hpp>
 #include <bellows/io_state_t.hpp>
+#include <bellows/telemetry_joints_t.hpp>
 #include <bellows/telemetry_t.hpp>
 #include <bellows/trial_summary_t.hpp>
 #include <bellows_v1/io_command_t.hpp>
@@ -133,6 +134,9 @@ inline SizeRange size_range(const io_joints_state_t&, const std::uint8_t*, std::
 }
 inline SizeRange size_range(const telemetry_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<telemetry_t>(), fixed_size<telemetry_t>()};
+}
+inline SizeRange size_range(const telemetry_joints_t&, const std::uint8_t*, std::size_t) {
+  return {fixed_size<telemetry_joints_t>(), fixed_size<telemetry_joints_t>()};
 }
 inline SizeRange size_range(const engine_event_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<engine_event_t>(), kMaxEventBytes};  // the empty text is the shortest
