@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "engine/safety.hpp"
+#include "engine/control/safety.hpp"
 #include "session_test_support.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_store.hpp"
