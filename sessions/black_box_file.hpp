@@ -13,7 +13,7 @@
 
 #include <Eigen/Dense>
 
-#include "engine/engine_messages.hpp"
+#include "engine/rt/engine_messages.hpp"
 
 namespace bellows {
 

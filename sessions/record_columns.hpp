@@ -17,9 +17,9 @@
 
 #include <Eigen/Dense>
 
-#include "engine/engine_messages.hpp"
-#include "engine/trajectory.hpp"
-#include "engine/trial_record.hpp"
+#include "engine/rt/engine_messages.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/trial/trial_record.hpp"
 
 namespace bellows {
 

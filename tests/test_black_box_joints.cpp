@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/record_columns.hpp"
 #include "sessions/session_export.hpp"

@@ -9,10 +9,10 @@
 #include <optional>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 
 namespace bellows {
 namespace {

@@ -10,9 +10,9 @@
 #include "devices/lcm_channels.hpp"
 #include "devices/simulated_arm.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/lcm_bench.hpp"
 
 namespace bellows {
