@@ -1,17 +1,22 @@
 // libFuzzer target for the rig's command decoder and protocol (devices/lcm_rig_server, what
-// `bellows io-sim` runs): the input is a sequence of io_command_t messages (2-byte little-endian
-// length, then the bytes) delivered to a RigServer driving the simulated arm, with time passing
-// between them. The first byte's bits: 1 the rig has a key (messages of the right size are then
-// signed with it when bit 4 is set), 2 messages of the right size are addressed to the rig and its
-// current binding (so that the fuzzer reaches the bound states). Whatever arrives: no crash, no
-// exception, a rig serving nobody holds its valves vented, and no chamber ever passes the rig's
-// pressure ceiling.
+// `bellows io-sim` runs): the input is a sequence of command messages (2-byte little-endian length,
+// then the bytes) delivered to a RigServer driving a simulated arm, with time passing between them.
+// The first byte's bits: 1 the rig has a key (messages of the right size are then signed with it
+// when bit 4 is set), 2 messages of the right size are addressed to the rig and its current binding
+// (so that the fuzzer reaches the bound states), 8 the rig serves the two-joint arm `arm2` (the
+// simulated chain, speaking io_joints_command_t / io_joints_state_t) instead of the one joint
+// (io_command_t). "The right size" is that of the message the rig's arm speaks. Whatever arrives:
+// no crash, no exception, a rig serving nobody holds every joint's valves vented, and no chamber of
+// any joint ever passes the rig's pressure ceiling.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "devices/lcm_rig_server.hpp"
+#include "devices/simulated_arm_chain.hpp"
 #include "engine/config/configuration.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 
 namespace {
 
@@ -30,18 +35,37 @@ bool vented(const bellows::JointValves& c) {  // the simulated arm's one joint
   return c.inlet_duty[0] == 0.0 && c.inlet_duty[1] == 0.0 && c.outlet_duty[0] == 1.0 && c.outlet_duty[1] == 1.0;
 }
 
+bool vented(const bellows::BellowsDuties& d) {  // one joint of the chain
+  return d.inlet[0] == 0.0 && d.inlet[1] == 0.0 && d.outlet[0] == 1.0 && d.outlet[1] == 1.0;
+}
+
+/// arm2's parameters, once (the chain validates them at every construction).
+const bellows::PneumaticChainParameters& arm2(const bellows::Configuration& config) {
+  static const bellows::PneumaticChainParameters parameters = [&] {
+    bellows::ArmParameters arm;
+    arm.preset = "arm2";
+    return bellows::pneumatic_chain_of(config.plant, arm);
+  }();
+  return parameters;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   static const bellows::Configuration config;
-  static const std::size_t command_size = bellows::detail::fixed_size<bellows::io_command_t>();
+  const std::uint8_t flags = data[0];
+  const bool joints = (flags & 8) != 0;
+  const std::size_t command_size = joints ? bellows::detail::fixed_size<bellows::io_joints_command_t>()
+                                          : bellows::detail::fixed_size<bellows::io_command_t>();
   std::array<std::uint8_t, bellows::kLcmKeyBytes> key_bytes{};
   key_bytes.fill(0x5a);
   const bellows::LcmKey key(key_bytes);
-  const std::uint8_t flags = data[0];
 
-  bellows::SimulatedArm arm(config.plant, 1);
+  std::optional<bellows::SimulatedArm> arm;
+  std::optional<bellows::SimulatedArmChain> chain;
+  if (joints) chain.emplace(arm2(config), 1);
+  else arm.emplace(config.plant, 1);
   bellows::RigServerParameters params;
   params.period_s = config.timing.tick_s;
   params.command_timeout_s = config.lcm.rig_timeout_s;
@@ -49,7 +73,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   params.limits = bellows::RigLimits::from(config);
   if ((flags & 1) != 0) params.key = key;
   const double ceiling_Pa = params.limits.pressure_ceiling_bar * 1e5;
-  bellows::RigServer rig(arm, params, kRigId);
+  std::optional<bellows::RigServer> server;
+  if (joints) server.emplace(*chain, chain->joints(), arm2(config).chain.integration_step_s, params, kRigId);
+  else server.emplace(*arm, params, kRigId);
+  bellows::RigServer& rig = *server;
   double t = 1.0;
   rig.service(nullptr, t);
 
@@ -68,10 +95,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     rig.on_message("BELLOWS_IO_COMMAND", message.data(), message.size());
     t += 0.0005 * static_cast<double>(1 + (length % 16));  // up to 8 ms: timeouts happen too
     rig.service(nullptr, t);
-    const bellows::SimulatedArm::State state = arm.state();
-    if (rig.stats().serving == 0 && !vented(state.command)) __builtin_trap();
+    const bool serving = rig.stats().serving != 0;
     // Checked every 0.1 ms integration step; 10 mbar is far more than one step's rise.
-    if (state.chamber_Pa[0] > ceiling_Pa + 1e3 || state.chamber_Pa[1] > ceiling_Pa + 1e3) __builtin_trap();
+    if (joints) {
+      const bellows::PneumaticArmChain::State& state = chain->chain().state();
+      for (int j = 0; j < chain->joints(); ++j) {
+        const auto ji = static_cast<std::size_t>(j);
+        if (!serving && !vented(state.duties[ji])) __builtin_trap();
+        if (state.chamber_Pa[ji][0] > ceiling_Pa + 1e3 || state.chamber_Pa[ji][1] > ceiling_Pa + 1e3) __builtin_trap();
+      }
+    } else {
+      const bellows::SimulatedArm::State state = arm->state();
+      if (!serving && !vented(state.command)) __builtin_trap();
+      if (state.chamber_Pa[0] > ceiling_Pa + 1e3 || state.chamber_Pa[1] > ceiling_Pa + 1e3) __builtin_trap();
+    }
   }
   return 0;
 }
