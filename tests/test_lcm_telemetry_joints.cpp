@@ -116,7 +116,7 @@ TEST_P(JointTelemetry, EveryTickCarriesEveryJoint) {
   EXPECT_EQ(compared, box.size());
   // The last joint moves on its own: its values are not joint 1's.
   const telemetry_joints_t running = decode<telemetry_joints_t>(messages[box.front().tick + box.size() / 2]);
-  EXPECT_EQ(running.state, telemetry_t::STATE_RUNNING);
+  EXPECT_EQ(running.state, std::int8_t{telemetry_t::STATE_RUNNING});
   EXPECT_NE(running.u_total_bar[joints - 1], running.u_total_bar[0]);
   EXPECT_NE(running.angle_rad[joints - 1], running.angle_rad[0]);
   const telemetry_joints_t last = decode<telemetry_joints_t>(messages.back());
@@ -137,10 +137,16 @@ TEST(JointTelemetryFault, NamesTheJointTheGuardFiredOn) {
   bench.run(false);
   const std::vector<Recorded> messages = bench.published();
   ASSERT_FALSE(messages.empty());
+  std::size_t fault_tick = 0;  // the first tick with the fault: the elbow beyond its limit there
+  while (fault_tick < messages.size() && decode<telemetry_joints_t>(messages[fault_tick]).fault == 0) ++fault_tick;
+  ASSERT_LT(fault_tick, messages.size());
+  const telemetry_joints_t first = decode<telemetry_joints_t>(messages[fault_tick]);
+  EXPECT_EQ(first.fault, fault_code(FaultCode::kAngleLimit));
+  EXPECT_EQ(first.fault_joint, 2);
+  EXPECT_GT(std::abs(first.angle_rad[1]), 25.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(decode<telemetry_joints_t>(messages[fault_tick - 1]).fault_joint, 0) << "before the fault: no joint";
   const telemetry_joints_t last = decode<telemetry_joints_t>(messages.back());
-  EXPECT_EQ(last.fault, fault_code(FaultCode::kAngleLimit));
-  EXPECT_EQ(last.fault_joint, 2);
-  EXPECT_GT(std::abs(last.angle_rad[1]), 25.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(last.fault_joint, 2) << "latched with the fault";
 }
 
 TEST(JointTelemetryFault, OneJointStillSpeaksTelemetryT) {
