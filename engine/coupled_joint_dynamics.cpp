@@ -37,6 +37,45 @@ CoupledJointDynamics independent_dynamics(std::span<const ModelParameters> joint
   return d;
 }
 
+CoupledJointDynamics identified_dynamics(const IdentifiedArmParameters& identified, int joints) {
+  if (!valid_joint_count(joints)) throw InputError("identified model: 1 to " + std::to_string(kMaxJoints) + " joints");
+  CoupledJointDynamics d;
+  d.per_angle.setZero(joints, joints);
+  d.per_velocity.setZero(joints, joints);
+  d.per_bar.setZero(joints, joints);
+  for (int i = 0; i < joints; ++i) {
+    const IdentifiedJointRow& row = identified.joint[static_cast<std::size_t>(i)];
+    for (int k = 0; k < joints; ++k) {
+      const auto at = static_cast<std::size_t>(k);
+      d.per_angle(i, k) = row.per_angle_per_s2[at];
+      d.per_velocity(i, k) = row.per_velocity_per_s[at];
+      d.per_bar(i, k) = row.per_bar_rad_per_s2[at];
+    }
+    if (d.per_bar.row(i).isZero(0.0)) {
+      throw InputError("[identified_joint" + std::to_string(i + 1) +
+                       "] holds no identified model (bellows identify --config FILE --write-model FILE writes it)");
+    }
+  }
+  if (Eigen::MatrixXd(d.per_angle).fullPivLu().rank() < joints) {
+    throw InputError("[identified_joint1.." + std::to_string(joints) + "] per_angle: a singular matrix is no arm (identify again)");
+  }
+  return d;
+}
+
+IdentifiedArmParameters identified_parameters(const CoupledJointDynamics& dynamics) {
+  IdentifiedArmParameters p;
+  for (int i = 0; i < dynamics.joints(); ++i) {
+    IdentifiedJointRow& row = p.joint[static_cast<std::size_t>(i)];
+    for (int k = 0; k < dynamics.joints(); ++k) {
+      const auto at = static_cast<std::size_t>(k);
+      row.per_angle_per_s2[at] = dynamics.per_angle(i, k);
+      row.per_velocity_per_s[at] = dynamics.per_velocity(i, k);
+      row.per_bar_rad_per_s2[at] = dynamics.per_bar(i, k);
+    }
+  }
+  return p;
+}
+
 void continuous_joint_model(const CoupledJointDynamics& dynamics, Eigen::MatrixXd& Ac, Eigen::MatrixXd& Bc) {
   const int J = dynamics.joints();
   Ac = Eigen::MatrixXd::Zero(2 * J, 2 * J);

@@ -34,6 +34,12 @@ struct CoupledJointDynamics {
 /// than kMaxJoints models.
 CoupledJointDynamics independent_dynamics(std::span<const ModelParameters> joints);
 
+/// The first `joints` rows of `[identified_joint1..4]`. InputError when they hold no model (a row
+/// without any per_bar entry) or do not describe an arm (a singular per_angle).
+CoupledJointDynamics identified_dynamics(const IdentifiedArmParameters& identified, int joints);
+/// The dynamics as `[identified_jointK]` values (the rows beyond its joints zero).
+IdentifiedArmParameters identified_parameters(const CoupledJointDynamics& dynamics);
+
 /// Continuous-time Ac (2J x 2J), Bc (2J x J) in the normalized coordinates above.
 void continuous_joint_model(const CoupledJointDynamics& dynamics, Eigen::MatrixXd& Ac, Eigen::MatrixXd& Bc);
 

@@ -21,9 +21,11 @@ namespace bellows {
 /// straight, delta), the rest of the chain held still.
 std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s);
 
-/// The model the J-joint norm-optimal update uses: the chain linearized stretched out (coupled), or
-/// the block-diagonal model of independent_joint_models.
-MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s);
+/// The model the J-joint norm-optimal update uses: the chain linearized stretched out (coupled), the
+/// block-diagonal model of independent_joint_models (independent), or the coupled model `bellows
+/// identify` fitted (identified: `identified`'s first J rows, InputError when they hold none).
+MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s,
+                                     const IdentifiedArmParameters& identified = {});
 
 /// The learning for `joints` joints of `samples` samples. `model` is the single-joint model (one
 /// joint only). Throws InputError for a law, model or weights that cannot be used, or a joint count
