@@ -1,7 +1,7 @@
 // `bellows identify` on an arm of several joints (an [arm] chain; docs/rig-bring-up.md, "Identify an
 // arm of several joints"): per joint k, a trial with joint k's reference excited (the [identify]
 // signal) while every other joint's PID holds its start angle, then the same with the held-out
-// signal. From those trials (engine/coupled_identification):
+// signal. From those trials (engine/operator/coupled_identification):
 //  - each joint's single-joint model (kappa, omega0, delta) by the single-joint fit on its trial;
 //  - the coupled model (2J states: the chain linearization's structure and order), from the J
 //    identification trials together, every joint's response to every joint's excitation;
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "app/identify_command.hpp"
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 
 namespace bellows {
 

@@ -1,7 +1,7 @@
-// The coupled model's identification (engine/coupled_identification): from trials simulated with a
+// The coupled model's identification (engine/operator/coupled_identification): from trials simulated with a
 // known coupled model (arm2's and arm3's linearization), the output-error fit recovers that model
 // from the independent joints' diagonal; the chain's linearization is the same description
-// (engine/coupled_joint_dynamics) as the single-joint nominal model on its diagonal.
+// (engine/model/coupled_joint_dynamics) as the single-joint nominal model on its diagonal.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,11 +9,11 @@
 #include <random>
 #include <vector>
 
-#include "engine/arm_chain_linearization.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/coupled_identification.hpp"
-#include "engine/errors.hpp"
-#include "engine/joint_learning_factory.hpp"
+#include "engine/model/arm_chain_linearization.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/operator/coupled_identification.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/joint_learning_factory.hpp"
 
 namespace bellows {
 namespace {

@@ -2,10 +2,10 @@
 // finishing it (summary, diagnostics, log), and the run modes (one trial, a step, K iterations).
 #include <cmath>
 
-#include "engine/convergence.hpp"
-#include "engine/errors.hpp"
-#include "engine/joint_learning_factory.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/config/convergence.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/joint_learning_factory.hpp"
+#include "engine/operator/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/joint_view.hpp"

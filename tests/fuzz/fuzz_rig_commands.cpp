@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "devices/lcm_rig_server.hpp"
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 
 namespace {
 
