@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "engine/model/arm_chain_linearization.hpp"
@@ -121,6 +122,26 @@ TEST(CoupledJointDynamics, TheLinearizationDiscretizesAsTheSingleJointModelOnIts
   const ChainParameters arm2 = chain_preset("arm2");
   const MultiJointModel blocks = joint_learning_model(arm2, "independent", kIlcSample_s);
   EXPECT_LT(markov_gap(discretize_joint_dynamics(table_dynamics(arm2), kIlcSample_s), blocks, 100), 1e-12);
+}
+
+TEST(CoupledJointDynamics, IdentifiedKeysCarryTheModelToTheLearning) {
+  const ChainParameters arm3 = chain_preset("arm3");
+  const CoupledJointDynamics linearized = chain_dynamics(ArmChain(arm3), JointVector::Zero(3));
+  const IdentifiedArmParameters keys = identified_parameters(linearized);
+  EXPECT_EQ(keys.joint[3].per_bar_rad_per_s2[0], 0.0);  // rows beyond the arm's joints stay empty
+  EXPECT_EQ(keys.joint[1].per_angle_per_s2[2], linearized.per_angle(1, 2));
+  const MultiJointModel learned = joint_learning_model(arm3, "identified", kIlcSample_s, keys);
+  EXPECT_LT(markov_gap(learned, joint_learning_model(arm3, "coupled", kIlcSample_s), 200), 1e-12);
+  try {
+    joint_learning_model(arm3, "identified", kIlcSample_s, IdentifiedArmParameters{});
+    ADD_FAILURE() << "no identified model, yet learned";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("[ilc] joint_model = 'identified': [identified_joint1] holds no identified model"),
+              std::string::npos) << error.what();
+  }
+  IdentifiedArmParameters singular = keys;
+  for (double& entry : singular.joint[2].per_angle_per_s2) entry = 0.0;
+  EXPECT_THROW(identified_dynamics(singular, 3), InputError);
 }
 
 TEST(CoupledIdentification, RefusesDataThatCannotBeFitted) {

@@ -2,7 +2,8 @@
 // joints, `[ilc] joint_model` and the `[arm]` chain (docs/learning-laws.md, "Several joints").
 //  - one joint: today's single-joint law (make_learning_law) on `model`, unchanged;
 //  - noilc, noilc-constrained: the J-joint norm-optimal update (engine/learning/noilc_mimo*) with the chain
-//    linearized stretched out (`coupled`) or each joint's own single-joint model (`independent`);
+//    linearized stretched out (`coupled`), each joint's own single-joint model (`independent`) or
+//    the coupled model `bellows identify` fitted (`identified`, [identified_joint1..J]);
 //  - the other laws: one single-joint law per joint, each on its joint's own model.
 #pragma once
 
