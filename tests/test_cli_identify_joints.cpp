@@ -62,7 +62,8 @@ TEST(CliIdentifyJoints, TheIdentifiedCoupledModelIsWhatARunLearnsWith) {
   const std::string arm2 = identify_arm_config("arm2w", "# my arm\n[arm]\npreset = \"arm2\"\n");
   const auto identified = testing::run_process(testing::kBellows + " identify --no-save --config " + arm2 + " --write-model " + arm2);
   ASSERT_EQ(identified.exit_code, 0) << identified.err;
-  EXPECT_NE(identified.err.find("wrote [identified_joint1..2] and [ilc] joint_model = \"identified\""), std::string::npos);
+  // Without --json the progress lines go to stdout with the results.
+  EXPECT_NE(identified.out.find("wrote [identified_joint1..2] and [ilc] joint_model = \"identified\""), std::string::npos) << identified.out;
   std::stringstream text;
   text << std::ifstream(arm2).rdbuf();
   for (const char* expected : {"# my arm", "[identified_joint1]", "[identified_joint2]", "per_bar_j2_rad_per_s2", "joint_model = \"identified\""}) {
