@@ -3,6 +3,7 @@
 // compared with the chain's linearization; --write-model hands the coupled model to `bellows run`
 // (`[ilc] joint_model = "identified"`), and what still cannot work is refused in one line.
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -23,7 +24,9 @@ std::vector<double> numbers(const nlohmann::json& array) { return array.get<std:
 
 TEST(CliIdentifyJoints, Arm2FitsEveryJointAndTheCoupledModelAndComparesItWithTheLinearization) {
   const std::string arm2 = identify_arm_config("arm2", "[arm]\npreset = \"arm2\"\n");
-  const auto result = testing::run_process(testing::kBellows + " identify --json --no-save --config " + arm2);
+  const auto data_dir = testing::make_temp_dir("bellows-cli-identify-sessions");
+  const auto result = testing::run_process(testing::kBellows + " identify --json --config " + arm2 + " --data-dir " +
+                                           data_dir.string() + " --name arm2-identified");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   for (const char* line : {"joint 1 of 2: identification trial (chirp", "joint 2 of 2: held-out trial (steps",
                            "fitting the coupled model (4 states)"}) {
@@ -56,6 +59,18 @@ TEST(CliIdentifyJoints, Arm2FitsEveryJointAndTheCoupledModelAndComparesItWithThe
   const double gap = report.at("linearization_gap").at("markov_relative").get<double>();
   EXPECT_GT(gap, 0.02);
   EXPECT_LT(gap, 0.5);
+  // The session: joint 1's trial as iteration 0 (of both joints), every trial, fit and the gap as events.
+  ASSERT_EQ(report.at("session"), (data_dir / "arm2-identified").string());
+  std::stringstream manifest_text;
+  manifest_text << std::ifstream(data_dir / "arm2-identified" / "manifest.json").rdbuf();
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_text.str());
+  std::map<std::string, int> kinds;
+  for (const nlohmann::json& event : manifest.at("events")) ++kinds[event.at("kind").get<std::string>()];
+  EXPECT_EQ(kinds["identify-trial"], 4);  // 2 joints x (identification, held-out)
+  EXPECT_EQ(kinds["identify-fit"], 3);    // each joint, then the coupled model
+  EXPECT_EQ(kinds["identify-gap"], 1);
+  EXPECT_EQ(kinds["finish"], 1);
+  EXPECT_EQ(manifest.at("iterations").size(), 1u);
 }
 
 TEST(CliIdentifyJoints, TheIdentifiedCoupledModelIsWhatARunLearnsWith) {
