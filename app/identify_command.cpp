@@ -12,6 +12,7 @@
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
+#include "app/identify_chain.hpp"
 #include "app/identify_session.hpp"
 #include "app/rig_profile_file.hpp"
 #include "app/rig_profile_write.hpp"
@@ -110,7 +111,6 @@ std::string with_model_section(const std::string& toml_text, const std::string& 
 
 int identify_command(const IdentifyOptions& options, std::ostream& out, std::ostream& progress) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
-  require_single_joint_arm(config.arm, "`bellows identify` identifies the model of one joint");
   std::string plant_source = options.config_path.empty() ? "the default plant" : "the plant of " + options.config_path;
   // --write-model FILE: a rig profile (it has [valves]) gets the model identified on its rig; a
   // configuration gets its [model]. Either must be valid before any trial runs.
@@ -126,13 +126,20 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
       Configuration written;
       apply_config_toml(existing_text, options.write_model_path, written);
       // The file whose model is fitted describes the arm: without --config, its [plant] is the one fitted.
-      if (options.config_path.empty() && toml::parse(existing_text).contains("plant")) {
+      if (options.config_path.empty() && (toml::parse(existing_text).contains("plant") || written.arm.has_chain())) {
         config = written;
         plant_source = "the plant of " + options.write_model_path;
       }
     }
   }
   if (!options.signal.empty()) config.identify.signal = options.signal;
+  if (config.arm.has_chain()) {  // every joint, and the coupled model (app/identify_chain)
+    if (into_profile) {
+      throw InputError("--write-model " + options.write_model_path + ": a rig profile holds one joint's [model]; the coupled model of " +
+                       config.arm.name() + " goes into its configuration");
+    }
+    return identify_chain_command(options, config, existing_text, out, progress);
+  }
   const std::string estimation_signal = config.identify.signal;
   const std::string held_out_signal = validation_signal(estimation_signal);
 

@@ -35,11 +35,19 @@ void IdentifySession::begin(const Configuration& config, const std::string& devi
   header.device_info = device_info;
   header.configuration = config;
   char line[400];
-  std::snprintf(line, sizeof line,
-                "%s: an identification trial (%s, +-%g deg, %g s), then a held-out %s trial; fitting kappa, omega0 and "
-                "damping from %s",
-                kPurpose, excitation.name.c_str(), config.identify.amplitude_deg, config.identify.duration_s,
-                validation_signal.c_str(), model_text(config.model).c_str());
+  if (excitation.joints() > 1) {  // app/identify_chain: a trial per joint and signal
+    std::snprintf(line, sizeof line,
+                  "%s: for each of %d joints an identification trial (%s, +-%g deg, %g s) with the others held, then a "
+                  "held-out %s trial each; fitting each joint's kappa, omega0 and damping and the coupled model of %s",
+                  kPurpose, excitation.joints(), config.identify.signal.c_str(), config.identify.amplitude_deg,
+                  config.identify.duration_s, validation_signal.c_str(), config.arm.name().c_str());
+  } else {
+    std::snprintf(line, sizeof line,
+                  "%s: an identification trial (%s, +-%g deg, %g s), then a held-out %s trial; fitting kappa, omega0 and "
+                  "damping from %s",
+                  kPurpose, excitation.name.c_str(), config.identify.amplitude_deg, config.identify.duration_s,
+                  validation_signal.c_str(), model_text(config.model).c_str());
+  }
   header.events.push_back({utc_now(), 0, "start", line});
   const std::filesystem::path data_dir = data_dir_.empty() ? default_data_dir() : std::filesystem::path(data_dir_);
   writer_.emplace(SessionWriter::create(data_dir, name_, std::move(header), excitation, kPurpose));
@@ -47,13 +55,14 @@ void IdentifySession::begin(const Configuration& config, const std::string& devi
 
 void IdentifySession::save_estimation_trial(const Configuration& config, const std::string& signal, const TrialRecord& record) {
   if (!writer_) return;
-  const Eigen::VectorXd no_correction = Eigen::VectorXd::Zero(record.learning_samples);
+  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(record.learning_samples, record.joints());  // N x J
   const IterationSummary summary =
       summarize_trial(0, record, no_correction, config.controller.gas.ambient_bar, config.controller.p_max_bar);
   writer_->save_iteration(record, summary, no_correction, ResumeState{});
   char line[200];
-  std::snprintf(line, sizeof line, "identification trial (%s): %d samples, tracking RMS %.3f deg; iteration 0 holds it",
-                signal.c_str(), record.learning_samples, summary.rms_deg);
+  std::snprintf(line, sizeof line, "identification trial (%s): %d samples, tracking RMS %.3f deg; iteration 0 holds it%s",
+                signal.c_str(), record.learning_samples, summary.rms_deg,
+                record.joints() > 1 ? " (joint 1 excited; the other joints' trials are in the events)" : "");
   writer_->record_event("identify-trial", line);
 }
 

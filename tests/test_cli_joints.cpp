@@ -116,8 +116,7 @@ TEST(CliJoints, WhatCannotDriveTheArmIsRefusedInOneLine) {
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
                              "an arm of several joints runs on --device sim or lcm; --device t7 drives one joint");
   expect_refused_in_one_line("run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
-                             "[ilc] joint_model = 'rigid': unknown (known: coupled, independent)");
-  expect_refused_in_one_line("identify --config " + arm2, "`bellows identify` identifies the model of one joint");
+                             "[ilc] joint_model = 'rigid': unknown (known: coupled, independent, identified)");
   expect_refused_in_one_line("rig check --config " + arm2, "`bellows rig check` tests the valves of one joint's rig");
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --transfer-from nowhere",
                              "--transfer-from learns one joint's correction; trajectory 'paper2' has 2");

@@ -131,7 +131,7 @@ TEST(JointLearning, WhatDoesNotFitTheArmIsRefusedInOneLine) {
   Configuration bad = arm2;
   bad.ilc.joint_model = "rigid";
   EXPECT_EQ(testing::error_of([&] { make_joint_learning(bad, model, 2, kLearningSamples); }),
-            "[ilc] joint_model = 'rigid': unknown (known: coupled, independent)");
+            "[ilc] joint_model = 'rigid': unknown (known: coupled, independent, identified)");
   const auto learning = make_joint_learning(arm2, model, 2, kLearningSamples);
   Eigen::MatrixXd u = Eigen::MatrixXd::Zero(kLearningSamples, 2), next(kLearningSamples, 2);
   Eigen::MatrixXd e = Eigen::MatrixXd::Zero(kLearningSamples, 2);

@@ -178,10 +178,23 @@ struct ArmParameters {
   std::string name() const { return !preset.empty() ? preset : joints > 0 ? "[arm] joints = " + std::to_string(joints) : ""; }
 };
 
+/// The coupled model `bellows identify` fitted on an arm of several joints (`[identified_joint1]` ..
+/// `[identified_joint4]`, written by `identify --write-model`; engine/model/coupled_joint_dynamics): joint
+/// i's row of q_ddot = per_angle q + per_velocity q_dot + per_bar dp, entry k for joint k + 1.
+/// `[ilc] joint_model = "identified"` learns with it. All zero: none identified.
+struct IdentifiedJointRow {
+  std::array<double, 4> per_angle_per_s2{};      // d q_ddot_i / d q_k
+  std::array<double, 4> per_velocity_per_s{};    // d q_ddot_i / d q_dot_k
+  std::array<double, 4> per_bar_rad_per_s2{};    // d q_ddot_i / d dp_k (rad/s^2 per bar)
+};
+struct IdentifiedArmParameters {
+  std::array<IdentifiedJointRow, 4> joint{};  // (kMaxJoints)
+};
+
 /// The chains engine/model/arm_chain_parameters knows by name (chain_preset).
 inline constexpr std::array<std::string_view, 2> kArmPresets = {"arm2", "arm3"};
 /// The `[ilc] joint_model` names: how the learning of several joints models the arm.
-inline constexpr std::array<std::string_view, 2> kJointModels = {"coupled", "independent"};
+inline constexpr std::array<std::string_view, 3> kJointModels = {"coupled", "independent", "identified"};
 
 /// The valve test of the first day at the bench (`bellows rig check`, the console's Rig screen):
 /// each valve opened alone for `valve_pulse_s`, the chamber pressures compared before and after.

@@ -165,8 +165,8 @@ std::vector<ParameterBinding> make_bindings() {
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
   const auto after_law = b.insert(first_ilc, law) + 1;
   b.insert(after_law, name("ilc", "joint_model",
-                           "several joints: the model of the norm-optimal update, coupled (the chain linearized stretched out) or "
-                           "independent (each joint's own single-joint model)",
+                           "several joints: the model of the norm-optimal update, coupled (the chain linearized stretched out), "
+                           "independent (each joint's own single-joint model) or identified ([identified_joint1..J], by bellows identify)",
                            [](C& c) { return &c.ilc.joint_model; }));
   // [arm] joints and [arm_joint1] .. [arm_joint4]: a chain of its own keys, after [arm] preset.
   auto after_preset = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "preset"; }) + 1;
@@ -202,6 +202,30 @@ std::vector<ParameterBinding> make_bindings() {
                                                  "any arm: the engine's guard faults when " + joint +
                                                      " goes beyond this angle; 0: [safety] angle_limit_deg",
                                                  upto(180.0), [j](C& c) { return &c.safety.joint_angle_limit_deg[j]; })) + 1;
+  }
+  // [identified_joint1] .. [identified_joint4]: the coupled model `bellows identify` fitted, after the chain's keys.
+  using Row = IdentifiedJointRow;
+  const auto row_key = [](std::string key, std::string unit, std::string meaning, std::array<double, 4> Row::*member) {
+    return std::make_tuple(std::move(key), std::move(unit), std::move(meaning), member);
+  };
+  const std::array row_keys = {
+      row_key("per_angle_j", "1/s^2", "acceleration per radian of joint ", &Row::per_angle_per_s2),
+      row_key("per_velocity_j", "1/s", "acceleration per rad/s of joint ", &Row::per_velocity_per_s),
+      row_key("per_bar_j", "rad/(s^2 bar)", "acceleration per bar of joint ", &Row::per_bar_rad_per_s2),
+  };
+  const char* row_unit_suffix[] = {"_per_s2", "_per_s", "_rad_per_s2"};
+  for (std::size_t i = 0; i < IdentifiedArmParameters{}.joint.size(); ++i) {
+    const std::string section = "identified_joint" + std::to_string(i + 1);
+    for (std::size_t r = 0; r < row_keys.size(); ++r) {
+      const auto& [key, unit, meaning, member] = row_keys[r];
+      for (std::size_t k = 0; k < IdentifiedJointRow{}.per_angle_per_s2.size(); ++k) {
+        after_preset = b.insert(after_preset, number(section, key + std::to_string(k + 1) + row_unit_suffix[r], unit,
+                                                     "[ilc] joint_model = identified: joint " + std::to_string(i + 1) + "'s " + meaning +
+                                                         std::to_string(k + 1) + " (bellows identify)",
+                                                     between(-1e9, 1e9),
+                                                     [i, k, member = member](C& c) { return &(c.identified.joint[i].*member)[k]; })) + 1;
+      }
+    }
   }
   const ParameterBinding signal = name("identify", "signal", "excitation of the identification trial: chirp or steps",
                                        [](C& c) { return &c.identify.signal; });
@@ -338,7 +362,9 @@ void validate_configuration(const Configuration& config) {
     throw InputError("[ilc] law = '" + config.ilc.law + "': unknown learning law (known: " + known + ")");
   }
   if (std::find(kJointModels.begin(), kJointModels.end(), config.ilc.joint_model) == kJointModels.end()) {
-    throw InputError("[ilc] joint_model = '" + config.ilc.joint_model + "': unknown (known: coupled, independent)");
+    std::string known;
+    for (const std::string_view model : kJointModels) known += (known.empty() ? "" : ", ") + std::string(model);
+    throw InputError("[ilc] joint_model = '" + config.ilc.joint_model + "': unknown (known: " + known + ")");
   }
   validation_signal(config.identify.signal);  // throws for anything but chirp and steps
   // The Q-filters of the law in use; the other laws' keys may hold anything in range.

@@ -27,6 +27,7 @@ struct Configuration {
   ArmParameters arm;
   RigCheckParameters rig_check;
   T7Parameters t7;
+  IdentifiedArmParameters identified;  // last: aggregate initializers of the others keep their order
 };
 
 /// The values a number may take: [min, max], either end open. Every key has one, documented in

@@ -4,6 +4,7 @@
 
 #include "engine/model/arm_chain.hpp"
 #include "engine/model/arm_chain_linearization.hpp"
+#include "engine/model/coupled_joint_dynamics.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/learning_law_factory.hpp"
 #include "engine/learning/noilc_mimo.hpp"
@@ -104,10 +105,18 @@ std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& ch
   return models;
 }
 
-MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s) {
+MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s,
+                                     const IdentifiedArmParameters& identified) {
   if (joint_model == "coupled") return linearize_chain(ArmChain(chain), JointVector::Zero(chain.joints), sample_time_s);
   if (joint_model == "independent") return block_diagonal_model(independent_joint_models(chain, sample_time_s));
-  throw InputError("[ilc] joint_model = '" + joint_model + "': unknown (known: coupled, independent)");
+  if (joint_model == "identified") {
+    try {
+      return discretize_joint_dynamics(identified_dynamics(identified, chain.joints), sample_time_s);
+    } catch (const InputError& error) {
+      throw InputError(std::string("[ilc] joint_model = 'identified': ") + error.what());
+    }
+  }
+  throw InputError("[ilc] joint_model = '" + joint_model + "': unknown (known: coupled, independent, identified)");
 }
 
 std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model, int joints,
@@ -121,9 +130,9 @@ std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, 
   const std::string& law = config.ilc.law;
   const double sample_s = config.timing.sample_s();
   try {
-    if (law == "noilc") return std::make_unique<JointNormOptimal>(joint_learning_model(chain, config.ilc.joint_model, sample_s), config.ilc, samples);
+    if (law == "noilc") return std::make_unique<JointNormOptimal>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
     if (law == "noilc-constrained") {
-      return std::make_unique<JointNormOptimalConstrained>(joint_learning_model(chain, config.ilc.joint_model, sample_s), config.ilc, samples);
+      return std::make_unique<JointNormOptimalConstrained>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
     }
     std::vector<std::unique_ptr<LearningLaw>> laws;
     for (const DiscreteArmModel& joint : independent_joint_models(chain, sample_s)) laws.push_back(make_learning_law(config, joint, samples));

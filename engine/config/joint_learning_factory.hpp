@@ -2,7 +2,8 @@
 // joints, `[ilc] joint_model` and the `[arm]` chain (docs/learning-laws.md, "Several joints").
 //  - one joint: today's single-joint law (make_learning_law) on `model`, unchanged;
 //  - noilc, noilc-constrained: the J-joint norm-optimal update (engine/learning/noilc_mimo*) with the chain
-//    linearized stretched out (`coupled`) or each joint's own single-joint model (`independent`);
+//    linearized stretched out (`coupled`), each joint's own single-joint model (`independent`) or
+//    the coupled model `bellows identify` fitted (`identified`, [identified_joint1..J]);
 //  - the other laws: one single-joint law per joint, each on its joint's own model.
 #pragma once
 
@@ -21,9 +22,11 @@ namespace bellows {
 /// straight, delta), the rest of the chain held still.
 std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s);
 
-/// The model the J-joint norm-optimal update uses: the chain linearized stretched out (coupled), or
-/// the block-diagonal model of independent_joint_models.
-MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s);
+/// The model the J-joint norm-optimal update uses: the chain linearized stretched out (coupled), the
+/// block-diagonal model of independent_joint_models (independent), or the coupled model `bellows
+/// identify` fitted (identified: `identified`'s first J rows, InputError when they hold none).
+MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s,
+                                     const IdentifiedArmParameters& identified = {});
 
 /// The learning for `joints` joints of `samples` samples. `model` is the single-joint model (one
 /// joint only). Throws InputError for a law, model or weights that cannot be used, or a joint count

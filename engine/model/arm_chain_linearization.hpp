@@ -12,9 +12,14 @@
 #pragma once
 
 #include "engine/model/arm_chain.hpp"
+#include "engine/model/coupled_joint_dynamics.hpp"
 #include "engine/model/multi_joint_model.hpp"
 
 namespace bellows {
+
+/// The linearized dynamics in physical units: per_angle = -M^-1 (K + dG/dq), per_velocity = -M^-1 D,
+/// per_bar = M^-1 K kappa (engine/model/coupled_joint_dynamics). InputError for a pose of another size.
+CoupledJointDynamics chain_dynamics(const ArmChain& arm, const JointVector& pose_rad);
 
 /// Continuous-time Ac (2J x 2J), Bc (2J x J) in the normalized coordinates above.
 void continuous_chain_model(const ArmChain& arm, const JointVector& pose_rad, Eigen::MatrixXd& Ac, Eigen::MatrixXd& Bc);

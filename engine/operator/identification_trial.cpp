@@ -60,17 +60,30 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
   return trajectory_from_moves("identify-steps", 0.0, moves, p.duration_s, sample_time_s);
 }
 
+Trajectory joint_excitation(const Trajectory& excitation, int joint, int joints) {
+  if (!valid_joint_count(joints) || joint < 0 || joint >= joints || excitation.joints() != 1) {
+    throw InputError("identification: joint " + std::to_string(joint + 1) + " of " + std::to_string(joints) + " cannot be excited");
+  }
+  Trajectory t{excitation.name + "-joint" + std::to_string(joint + 1), excitation.sample_time_s, Eigen::VectorXd::Zero(excitation.angle_rad.size())};
+  t.more_joints_rad.assign(static_cast<std::size_t>(joints - 1), Eigen::VectorXd::Zero(excitation.angle_rad.size()));
+  (joint == 0 ? t.angle_rad : t.more_joints_rad[static_cast<std::size_t>(joint - 1)]) = excitation.angle_rad;
+  return t;
+}
+
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
                               double max_abs_angle_deg, TrialRecord& record, StopFlag stop) {
   // Through the engine like any trial: armed, guarded, the record prepared outside the loop.
   EngineCore& core = driver.core();
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
+  const int joints = excitation.joints();
   const Eigen::VectorXd no_correction = Eigen::VectorXd::Zero(excitation.learning_samples());
-  record.prepare(excitation.learning_samples(), timing.ticks_per_sample);
+  const Eigen::MatrixXd no_joint_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), joints);
+  record.prepare(excitation.learning_samples(), timing.ticks_per_sample, joints);
+  const int settle_ticks = static_cast<int>(std::lround(timing.settle_s / timing.tick_s));
   const bool sent = core.send(EngineCommand::select_trajectory(excitation)) &&
                     (core.state() == EngineState::kArmed || core.send(EngineCommand::of(CommandKind::kArm))) &&
-                    core.send(EngineCommand::start_trial(excitation, no_correction, record,
-                                                         static_cast<int>(std::lround(timing.settle_s / timing.tick_s)), 1));
+                    core.send(joints == 1 ? EngineCommand::start_trial(excitation, no_correction, record, settle_ticks, 1)
+                                          : EngineCommand::start_trial(excitation, no_joint_correction, record, settle_ticks, 1));
   if (!sent) throw std::runtime_error("identification: the engine's command queue is full");
   TickRecord tick;
   for (;;) {
@@ -91,11 +104,14 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       throw Cancelled("identification stopped by a signal, valves vented");
     }
     core.read_snapshot(tick);
-    if (std::abs(tick.reading.joint[0].angle_rad) > bound_rad) {
+    for (int j = 0; j < joints; ++j) {
+      const double angle_rad = tick.reading.joint[static_cast<std::size_t>(j)].angle_rad;
+      if (std::abs(angle_rad) <= bound_rad) continue;
       core.request_emergency_stop();  // a latch: the next tick vents
       while (core.state() != EngineState::kFault) driver.await();
       std::ostringstream message;
-      message << "identification aborted, valves vented: angle " << tick.reading.joint[0].angle_rad / kRadPerDeg
+      message << "identification aborted, valves vented: " << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string())
+              << "angle " << angle_rad / kRadPerDeg
               << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
               << " deg; lower [identify] amplitude_deg";
       throw InputError(message.str());
