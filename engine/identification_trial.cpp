@@ -1,12 +1,11 @@
 #include "engine/identification_trial.hpp"
 
-#include "engine/learning_session.hpp"
-
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
 #include "engine/errors.hpp"
+#include "engine/trial_runner.hpp"
 #include "engine/units.hpp"
 
 namespace bellows {
@@ -62,44 +61,37 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
 
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
                               double max_abs_angle_deg, TrialRecord& record, StopFlag stop) {
-  // Through the engine like any trial: armed, guarded, the record prepared outside the loop.
-  EngineCore& core = driver.core();
+  // Through the engine like any trial (engine/trial_runner): armed, guarded, the record prepared
+  // outside the loop. The angle bound is this trial's own guard, looked at after every poll.
+  if (!driver.core().send(EngineCommand::select_trajectory(excitation))) {
+    throw std::runtime_error("identification: the engine's command queue is full");
+  }
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
-  const Eigen::VectorXd no_correction = Eigen::VectorXd::Zero(excitation.learning_samples());
-  record.prepare(excitation.learning_samples(), timing.ticks_per_sample);
-  const bool sent = core.send(EngineCommand::select_trajectory(excitation)) &&
-                    (core.state() == EngineState::kArmed || core.send(EngineCommand::of(CommandKind::kArm))) &&
-                    core.send(EngineCommand::start_trial(excitation, no_correction, record,
-                                                         static_cast<int>(std::lround(timing.settle_s / timing.tick_s)), 1));
-  if (!sent) throw std::runtime_error("identification: the engine's command queue is full");
-  TickRecord tick;
-  for (;;) {
-    driver.await();
-    EngineEvent event;
-    while (core.poll_event(event)) {
-      if (event.kind == EventKind::kTrialComplete) return;
-      if (event.kind == EventKind::kCommandRefused) {
-        throw EngineFault(core.fault(), std::string("identification refused by the engine: ") + event.refusal);
-      }
-      if (event.kind == EventKind::kTrialAborted || event.kind == EventKind::kFault) {
-        throw EngineFault(core.fault(), std::string("identification aborted: ") + fault_message(core.fault()));
-      }
-    }
-    if (stop_is_requested(stop)) {
-      core.request_emergency_stop();  // a latch: the next tick vents
-      while (core.state() != EngineState::kFault) driver.await();
+  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), 1);
+  TrialRunner runner(driver.core(), timing);
+  runner.start(excitation, no_correction, record, TrialRunner::Arming::kIfNeeded);
+  std::string left_bound;  // why the guard stopped the trial
+  const TrialStatus& status = runner.run_to_completion(driver, stop, [&](const TickRecord& tick) {
+    const double angle_rad = tick.reading.joint[0].angle_rad;
+    if (std::abs(angle_rad) <= bound_rad) return;
+    std::ostringstream message;
+    message << "identification aborted, valves vented: angle " << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s
+            << " s left +-" << max_abs_angle_deg << " deg; lower [identify] amplitude_deg";
+    left_bound = message.str();
+    runner.cancel();
+  });
+  switch (status.phase) {
+    case TrialPhase::kDone:
+      return;
+    case TrialPhase::kNotSent:
+      throw std::runtime_error("identification: the engine's command queue is full");
+    case TrialPhase::kRefused:
+      throw EngineFault(status.fault, "identification refused by the engine: " + status.message);
+    case TrialPhase::kCancelled:
+      if (!left_bound.empty()) throw InputError(left_bound);
       throw Cancelled("identification stopped by a signal, valves vented");
-    }
-    core.read_snapshot(tick);
-    if (std::abs(tick.reading.joint[0].angle_rad) > bound_rad) {
-      core.request_emergency_stop();  // a latch: the next tick vents
-      while (core.state() != EngineState::kFault) driver.await();
-      std::ostringstream message;
-      message << "identification aborted, valves vented: angle " << tick.reading.joint[0].angle_rad / kRadPerDeg
-              << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
-              << " deg; lower [identify] amplitude_deg";
-      throw InputError(message.str());
-    }
+    default:
+      throw EngineFault(status.fault, "identification aborted: " + status.message);
   }
 }
 
