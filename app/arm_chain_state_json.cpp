@@ -2,9 +2,9 @@
 
 #include <cstddef>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/json_reader.hpp"
-#include "engine/units.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows {
 namespace {

@@ -1,4 +1,4 @@
-// The J-joint simulated arm's state (engine/pneumatic_arm_chain) as JSON, for the resume block of
+// The J-joint simulated arm's state (engine/model/pneumatic_arm_chain) as JSON, for the resume block of
 // a J-joint session's manifest (`resume.device`): every double in its shortest exact form, one
 // array entry per joint, and the noise generator's words as hex, so a resumed arm2/arm3 run
 // continues bit for bit (as app/arm_state_json does for the single-joint arm).

@@ -1,8 +1,8 @@
 #include "app/arm_state_json.hpp"
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/json_reader.hpp"
-#include "engine/units.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows {
 namespace {

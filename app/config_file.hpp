@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 
 namespace bellows {
 

@@ -18,9 +18,9 @@
 #include "app/signals.hpp"
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/errors.hpp"
-#include "engine/iteration_numbering.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/iteration_numbering.hpp"
 #include "ui/console.hpp"
 
 namespace bellows {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "app/device_factory.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

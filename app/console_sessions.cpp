@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "app/transfer_sources.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {

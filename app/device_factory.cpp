@@ -13,8 +13,8 @@
 #include "devices/lcm_device.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/errors.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 
 namespace bellows {
 namespace {

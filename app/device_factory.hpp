@@ -14,9 +14,9 @@
 
 #include "devices/simulated_arm.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/configuration.hpp"
-#include "engine/device.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/control/device.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace CLI {
 class App;

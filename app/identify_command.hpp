@@ -8,8 +8,8 @@
 #include <string>
 
 #include "app/device_factory.hpp"
-#include "engine/configuration.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

@@ -2,9 +2,9 @@
 
 #include <cstdio>
 
-#include "engine/configuration_cost.hpp"
-#include "engine/errors.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/config/configuration_cost.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/operator/learning_session.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {

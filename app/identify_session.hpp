@@ -12,10 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
-#include "engine/identification.hpp"
-#include "engine/trajectory.hpp"
-#include "engine/trial_record.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/operator/identification.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/trial/trial_record.hpp"
 #include "sessions/session_writer.hpp"
 
 namespace bellows {

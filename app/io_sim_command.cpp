@@ -15,7 +15,7 @@
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_rig_server.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

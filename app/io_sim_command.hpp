@@ -6,7 +6,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "engine/realtime_loop.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

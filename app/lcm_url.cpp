@@ -6,7 +6,7 @@
 #include <charconv>
 #include <string_view>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

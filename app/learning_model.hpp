@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 
 namespace bellows {
 

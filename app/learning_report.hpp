@@ -1,11 +1,11 @@
-// JSON for what learning predicts and observes (engine/convergence, engine/learning_monitor):
+// JSON for what learning predicts and observes (engine/config/convergence, engine/learning/learning_monitor):
 // shared by `bellows run --json` and anything else that reports a run.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
-#include "engine/convergence.hpp"
-#include "engine/learning_monitor.hpp"
+#include "engine/config/convergence.hpp"
+#include "engine/learning/learning_monitor.hpp"
 
 namespace bellows {
 

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/plot_gnuplot.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/file_access.hpp"
 #include "sessions/session_store.hpp"

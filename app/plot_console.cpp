@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "app/plot_command.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {

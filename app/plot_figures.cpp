@@ -4,7 +4,7 @@
 #include <charconv>
 #include <set>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"

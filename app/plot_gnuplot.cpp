@@ -9,7 +9,7 @@
 #include <cstring>
 #include <string>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 extern char** environ;
 

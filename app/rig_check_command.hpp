@@ -1,6 +1,6 @@
 // `bellows rig check`: the first day at the bench, headless. Shows every input (raw volts beside
 // the calibrated value, where the device has volts), then, with the operator's confirmation, pulses
-// each valve in turn through the engine (engine/valve_test) and reports each pass or fail. With
+// each valve in turn through the engine (engine/operator/valve_test) and reports each pass or fail. With
 // --zero-angle it makes the angle read now the rig profile's zero instead (written into the file).
 #pragma once
 
@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/device_factory.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

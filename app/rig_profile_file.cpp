@@ -5,7 +5,7 @@
 
 #include <toml++/toml.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/file_access.hpp"
 
 namespace bellows {

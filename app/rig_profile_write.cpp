@@ -7,7 +7,7 @@
 
 #include "app/rig_profile_file.hpp"
 #include "app/toml_key_edit.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/atomic_file.hpp"
 
 namespace bellows {

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "app/device_factory.hpp"
-#include "engine/parameters.hpp"
+#include "engine/base/parameters.hpp"
 
 namespace bellows {
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "app/device_factory.hpp"
-#include "engine/configuration.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

@@ -6,7 +6,7 @@
 
 #include "app/device_factory.hpp"
 #include "devices/lcm_channels.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

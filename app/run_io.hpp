@@ -16,10 +16,10 @@
 #include "devices/lcm_device.hpp"
 #include "devices/simulated_arm.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/operator/learning_session.hpp"
 
 namespace bellows {
 

@@ -8,7 +8,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "engine/learning_session.hpp"
+#include "engine/operator/learning_session.hpp"
 
 namespace bellows {
 

@@ -4,8 +4,8 @@
 
 #include "app/arm_chain_state_json.hpp"
 #include "app/arm_state_json.hpp"
-#include "engine/errors.hpp"
-#include "engine/iteration_numbering.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/iteration_numbering.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
 

@@ -11,9 +11,9 @@
 #include "app/run_command.hpp"
 #include "devices/simulated_arm.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/operator/learning_session.hpp"
 #include "sessions/session_writer.hpp"
 
 namespace bellows {

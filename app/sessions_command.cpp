@@ -12,11 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/engine_state.hpp"
-#include "engine/errors.hpp"
-#include "engine/iteration_numbering.hpp"
-#include "engine/printable_text.hpp"
-#include "engine/safety.hpp"
+#include "engine/rt/engine_state.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/iteration_numbering.hpp"
+#include "engine/base/printable_text.hpp"
+#include "engine/control/safety.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_export.hpp"

@@ -2,7 +2,7 @@
 
 #include <csignal>
 
-#include "engine/engine_core.hpp"
+#include "engine/rt/engine_core.hpp"
 
 namespace bellows {
 namespace {

@@ -7,7 +7,7 @@
 #include <iostream>
 #include <streambuf>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -11,7 +11,7 @@
 #include "app/signals.hpp"
 #include "app/t7_wiring.hpp"
 #include "devices/t7_sim_server.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 

@@ -1,7 +1,7 @@
 #include "app/t7_wiring.hpp"
 
 #include "app/rig_profile_file.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 #include "devices/t7_device.hpp"
 
 namespace bellows {

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "engine/printable_text.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows {
 namespace {

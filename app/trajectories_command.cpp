@@ -5,8 +5,8 @@
 
 #include "app/config_file.hpp"
 #include "app/trajectory_file.hpp"
-#include "engine/errors.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows {
 

@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "app/device_factory.hpp"
-#include "engine/arm_chain_parameters.hpp"
-#include "engine/errors.hpp"
-#include "engine/units.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/model/arm_chain_parameters.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/units.hpp"
+#include "engine/base/printable_text.hpp"
 #include "sessions/file_access.hpp"
 
 namespace bellows {

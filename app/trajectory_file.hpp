@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <string>
 
-#include "engine/parameters.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/base/parameters.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows {
 

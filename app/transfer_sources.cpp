@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {

@@ -1,4 +1,4 @@
-// Saved sessions as the sources of a learning transfer (engine/learning_transfer): loading them,
+// Saved sessions as the sources of a learning transfer (engine/config/learning_transfer): loading them,
 // refusing those that cannot teach the target run, and the report (`bellows run --json`'s
 // "transfer", the progress line, the session's `first_correction`).
 #pragma once
@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
-#include "engine/learning_transfer.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/config/learning_transfer.hpp"
 #include "sessions/session.hpp"
 
 namespace bellows {

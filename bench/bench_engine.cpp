@@ -2,10 +2,10 @@
 #include <benchmark/benchmark.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/control_core.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/noilc_dense.hpp"
+#include "engine/control/control_core.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/noilc_dense.hpp"
 
 namespace bellows {
 namespace {

@@ -5,13 +5,13 @@
 #include <benchmark/benchmark.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/noilc_constrained.hpp"
-#include "engine/noilc_dense.hpp"
-#include "engine/noilc_riccati.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/noilc_constrained.hpp"
+#include "engine/learning/noilc_dense.hpp"
+#include "engine/learning/noilc_riccati.hpp"
 
 namespace bellows {
 namespace {

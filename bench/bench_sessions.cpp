@@ -8,11 +8,11 @@
 #include <benchmark/benchmark.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/operator/learning_session.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/session_export.hpp"
 #include "sessions/session_store.hpp"

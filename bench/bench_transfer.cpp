@@ -7,7 +7,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 #include "tests/test_transfer_scenarios.hpp"
 
 namespace {

@@ -1,5 +1,5 @@
 #include "bridge/telemetry_publisher.hpp"
-#include "engine/single_writer_counter.hpp"
+#include "engine/rt/single_writer_counter.hpp"
 
 #include <time.h>
 
@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "devices/lcm_channels.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

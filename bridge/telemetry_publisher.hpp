@@ -22,8 +22,8 @@
 
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_io_thread.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
 
 namespace bellows {
 

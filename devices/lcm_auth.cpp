@@ -8,7 +8,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -22,9 +22,9 @@
 #include <bellows_v1/io_state_t.hpp>
 
 #include "devices/lcm_auth.hpp"
-#include "engine/single_writer_counter.hpp"
+#include "engine/rt/single_writer_counter.hpp"
 
-#include "engine/device.hpp"
+#include "engine/control/device.hpp"
 
 namespace bellows {
 

@@ -34,8 +34,8 @@
 #include "devices/lcm_io_messages.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/round_trip_stats.hpp"
-#include "engine/device.hpp"
-#include "engine/latest_value.hpp"
+#include "engine/control/device.hpp"
+#include "engine/rt/latest_value.hpp"
 
 namespace bellows {
 

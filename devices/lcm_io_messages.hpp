@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "devices/lcm_codec.hpp"
-#include "engine/joints.hpp"
+#include "engine/base/joints.hpp"
 
 namespace bellows {
 

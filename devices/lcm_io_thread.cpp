@@ -14,8 +14,8 @@
 #include <sstream>
 #include <string>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows {
 namespace {

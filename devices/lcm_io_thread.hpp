@@ -13,7 +13,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "engine/realtime_loop.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 

@@ -6,8 +6,8 @@
 
 #include <cstdint>
 
-#include "engine/configuration.hpp"
-#include "engine/device.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/control/device.hpp"
 
 namespace bellows {
 

@@ -1,11 +1,11 @@
 #include "devices/lcm_rig_server.hpp"
-#include "engine/single_writer_counter.hpp"
+#include "engine/rt/single_writer_counter.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "devices/lcm_channels.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

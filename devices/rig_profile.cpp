@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "devices/t7_registers.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

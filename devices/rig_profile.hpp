@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "engine/parameters.hpp"
+#include "engine/base/parameters.hpp"
 
 namespace bellows {
 

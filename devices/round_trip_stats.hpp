@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/device.hpp"
+#include "engine/control/device.hpp"
 
 namespace bellows {
 

@@ -6,8 +6,8 @@
 #include <numbers>
 #include <utility>
 
-#include "engine/errors.hpp"
-#include "engine/units.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows {
 namespace {

@@ -10,10 +10,10 @@
 #include <string>
 #include <cstdint>
 
-#include "engine/bellows_pneumatics.hpp"
-#include "engine/device.hpp"
-#include "engine/gaussian_noise.hpp"
-#include "engine/parameters.hpp"
+#include "engine/model/bellows_pneumatics.hpp"
+#include "engine/control/device.hpp"
+#include "engine/base/gaussian_noise.hpp"
+#include "engine/base/parameters.hpp"
 
 namespace bellows {
 
@@ -89,7 +89,7 @@ class SimulatedArm final : public Device {
   void activate_scheduled_fault();
 
   PlantParameters params_;
-  BellowsPneumatics bellows_;  // the chambers' physics, shared with every joint of engine/pneumatic_arm_chain
+  BellowsPneumatics bellows_;  // the chambers' physics, shared with every joint of engine/model/pneumatic_arm_chain
   double supply_Pa_;
   State state_;
   GaussianNoise noise_;

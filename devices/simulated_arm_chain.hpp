@@ -1,4 +1,4 @@
-// The simulated arm of J joints (engine/pneumatic_arm_chain, ../shared/spec/multi-joint.md) behind the
+// The simulated arm of J joints (engine/model/pneumatic_arm_chain, ../shared/spec/multi-joint.md) behind the
 // engine's Device interface: readings with joint_count J (each joint's encoder and chambers, one
 // supply), commands of J joints' valves. In process, so its time follows the engine's ticks. A
 // command for another joint count is meant for another arm: every joint is vented, as the
@@ -10,8 +10,8 @@
 #include <array>
 #include <cstdint>
 
-#include "engine/device.hpp"
-#include "engine/pneumatic_arm_chain.hpp"
+#include "engine/control/device.hpp"
+#include "engine/model/pneumatic_arm_chain.hpp"
 
 namespace bellows {
 

@@ -1,5 +1,5 @@
 #include "devices/t7_device.hpp"
-#include "engine/single_writer_counter.hpp"
+#include "engine/rt/single_writer_counter.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <numbers>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

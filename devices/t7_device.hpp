@@ -25,9 +25,9 @@
 #include "devices/modbus_client.hpp"
 #include "devices/rig_profile.hpp"
 #include "devices/t7_registers.hpp"
-#include "engine/device.hpp"
-#include "engine/latest_value.hpp"
-#include "engine/parameters.hpp"
+#include "engine/control/device.hpp"
+#include "engine/rt/latest_value.hpp"
+#include "engine/base/parameters.hpp"
 
 namespace bellows {
 

@@ -17,7 +17,7 @@
 #include <modbus/modbus.h>
 
 #include "devices/t7_registers.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <utility>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

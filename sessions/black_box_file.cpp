@@ -5,9 +5,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "engine/engine_state.hpp"
-#include "engine/errors.hpp"
-#include "engine/safety.hpp"
+#include "engine/rt/engine_state.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/control/safety.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
 

@@ -11,7 +11,7 @@
 
 #include <Eigen/Dense>
 
-#include "engine/engine_messages.hpp"
+#include "engine/rt/engine_messages.hpp"
 
 namespace bellows {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows {
 namespace {

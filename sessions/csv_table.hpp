@@ -2,7 +2,7 @@
 // comma-separated numbers in the shortest form that reads back to the same double. Plain enough for
 // spreadsheets, pandas, MATLAB readtable and PlotJuggler; strict on reading: the exact header, the
 // same field count on every line, finite numbers only, a final end of line (else: truncated).
-// Text from the file that an error quotes is escaped and shortened (engine/printable_text.hpp).
+// Text from the file that an error quotes is escaped and shortened (engine/base/printable_text.hpp).
 #pragma once
 
 #include <string>

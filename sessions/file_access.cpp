@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 #include "sessions/atomic_file.hpp"
 
 namespace bellows {

@@ -6,15 +6,15 @@
 #include <limits>
 #include <numbers>
 
-#include "engine/errors.hpp"
-#include "engine/units.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/units.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/record_columns.hpp"
 
 namespace bellows {
 namespace {
 
-// The engine's own conversion (engine/trajectory.cpp), so degrees read back bit for bit.
+// The engine's own conversion (engine/trial/trajectory.cpp), so degrees read back bit for bit.
 // Times are k * T; a hand-edited or foreign file may round them.
 constexpr double kTimeTolerance_s = 1e-6;
 

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "engine/trajectory.hpp"
+#include "engine/trial/trajectory.hpp"
 #include "sessions/session.hpp"
 
 namespace bellows {

@@ -2,9 +2,9 @@
 
 #include <set>
 
-#include "engine/arm_model.hpp"
-#include "engine/configuration_cost.hpp"
-#include "engine/errors.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/config/configuration_cost.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
 

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 #include "sessions/json_reader.hpp"
 #include "sessions/session.hpp"
 

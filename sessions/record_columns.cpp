@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "engine/units.hpp"
+#include "engine/base/units.hpp"
 #include "sessions/iteration_files.hpp"
 
 namespace bellows {

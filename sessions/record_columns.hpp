@@ -16,8 +16,8 @@
 
 #include <Eigen/Dense>
 
-#include "engine/trajectory.hpp"
-#include "engine/trial_record.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/trial/trial_record.hpp"
 
 namespace bellows {
 

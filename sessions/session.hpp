@@ -12,12 +12,12 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
-#include "engine/control_core.hpp"
-#include "engine/engine_messages.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/trajectory.hpp"
-#include "engine/trial_record.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/control/control_core.hpp"
+#include "engine/rt/engine_messages.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/trial/trial_record.hpp"
 
 namespace bellows {
 

@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/file_access.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session.hpp"

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/file_access.hpp"
 #include "sessions/black_box_file.hpp"

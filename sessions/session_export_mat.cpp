@@ -10,9 +10,9 @@
 #include <hdf5.h>
 #include <matio.h>
 
-#include "engine/engine_state.hpp"
-#include "engine/errors.hpp"
-#include "engine/safety.hpp"
+#include "engine/rt/engine_state.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/control/safety.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/iteration_files.hpp"

@@ -9,8 +9,8 @@
 #include <ctime>
 #include <utility>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows {
 namespace {

@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "engine/errors.hpp"
-#include "engine/printable_text.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/file_digest.hpp"

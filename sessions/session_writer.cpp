@@ -6,7 +6,7 @@
 #include <utility>
 #include <stdexcept>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/file_access.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "app/config_file.hpp"
-#include "engine/configuration.hpp"
-#include "engine/errors.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows::testing {
 

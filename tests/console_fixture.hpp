@@ -14,8 +14,8 @@
 
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"
 

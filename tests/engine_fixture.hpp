@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
 
 namespace bellows::testing {
 

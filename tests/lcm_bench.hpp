@@ -11,7 +11,7 @@
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_rig_server.hpp"
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/test_support.hpp"
 

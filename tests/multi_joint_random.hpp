@@ -7,8 +7,8 @@
 
 #include <Eigen/Dense>
 
-#include "engine/arm_model.hpp"
-#include "engine/noilc_mimo.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/learning/noilc_mimo.hpp"
 
 namespace bellows::mimo_test {
 

@@ -6,9 +6,9 @@
 #include <numbers>
 #include <random>
 
-#include "engine/arm_chain.hpp"
-#include "engine/errors.hpp"
-#include "engine/parameters.hpp"
+#include "engine/model/arm_chain.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/parameters.hpp"
 
 namespace bellows {
 namespace {

@@ -1,13 +1,13 @@
-// The J-joint arm linearized at a pose (engine/arm_chain_linearization): with one joint it is the
+// The J-joint arm linearized at a pose (engine/model/arm_chain_linearization): with one joint it is the
 // single-joint nominal model; for arm2 and arm3 it predicts the simulated chain's small motions.
 #include <gtest/gtest.h>
 
 #include <numbers>
 #include <string>
 
-#include "engine/arm_chain_linearization.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/errors.hpp"
+#include "engine/model/arm_chain_linearization.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <numbers>
 
-#include "engine/arm_model.hpp"
+#include "engine/model/arm_model.hpp"
 
 namespace bellows {
 namespace {

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "app/config_file.hpp"
-#include "engine/configuration_cost.hpp"
-#include "engine/convergence.hpp"
-#include "engine/errors.hpp"
-#include "engine/identification.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/arm_model.hpp"
+#include "engine/config/configuration_cost.hpp"
+#include "engine/config/convergence.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/operator/identification.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/model/arm_model.hpp"
 #include "sessions/manifest_json.hpp"
 #include "tests/config_test_support.hpp"
 

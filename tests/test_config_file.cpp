@@ -4,7 +4,7 @@
 
 #include <fstream>
 #include <sstream>
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "tests/config_test_support.hpp"
 
 namespace bellows {

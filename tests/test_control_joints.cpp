@@ -1,4 +1,4 @@
-// The control scheme for J joints (engine/control_core, issue 14): each joint its own PID, pressure
+// The control scheme for J joints (engine/control/control_core, issue 14): each joint its own PID, pressure
 // pair and set points, joint 1 computing exactly as the single-joint core; a reading of another joint
 // count driving nothing; every joint's state resumed exactly; and the engine refusing trials whose
 // correction or record does not fit the trajectory's joints, and faulting (never indexing beyond a
@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "engine/control_core.hpp"
+#include "engine/control/control_core.hpp"
 #include "tests/engine_fixture.hpp"
 #include "tests/test_support.hpp"
 

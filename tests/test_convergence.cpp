@@ -10,12 +10,12 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/convergence.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/pid_controller.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/config/convergence.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/control/pid_controller.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows {
 namespace {

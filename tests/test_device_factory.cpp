@@ -6,7 +6,7 @@
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "tests/process_runner.hpp"
 
 namespace bellows {

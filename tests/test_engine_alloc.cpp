@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/allocation_counter.hpp"
 #include "tests/engine_fixture.hpp"
 

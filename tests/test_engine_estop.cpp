@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "engine_fixture.hpp"
-#include "engine/safety.hpp"
+#include "engine/control/safety.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

@@ -1,7 +1,7 @@
 // Every (state, command) pair of the safety state machine, allowed and refused.
 #include <gtest/gtest.h>
 
-#include "engine/engine_state.hpp"
+#include "engine/rt/engine_state.hpp"
 
 namespace bellows {
 namespace {

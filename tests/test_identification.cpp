@@ -10,12 +10,12 @@
 #include "app/config_file.hpp"
 #include "app/identify_command.hpp"
 #include "devices/simulated_arm.hpp"
-#include "engine/errors.hpp"
-#include "engine/identification.hpp"
-#include "engine/identification_trial.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/operator/identification.hpp"
+#include "engine/operator/identification_trial.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
 
 namespace bellows {
 namespace {

@@ -8,8 +8,8 @@
 #include <numbers>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/device.hpp"
-#include "engine/safety.hpp"
+#include "engine/control/device.hpp"
+#include "engine/control/safety.hpp"
 
 namespace bellows {
 namespace {

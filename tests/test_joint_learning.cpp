@@ -1,4 +1,4 @@
-// The learning of an arm of J joints as the configuration builds it (engine/joint_learning_factory):
+// The learning of an arm of J joints as the configuration builds it (engine/config/joint_learning_factory):
 // one joint is today's law on the only column, bit for bit; noilc and noilc-constrained are the
 // J-joint norm-optimal update with the coupled or the independent model; the other laws run per
 // joint on each joint's own model; what cannot fit is refused in one line.
@@ -6,11 +6,11 @@
 
 #include <random>
 
-#include "engine/arm_chain_linearization.hpp"
-#include "engine/errors.hpp"
-#include "engine/joint_learning_factory.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/noilc_mimo.hpp"
+#include "engine/model/arm_chain_linearization.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/joint_learning_factory.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/learning/noilc_mimo.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

@@ -14,7 +14,7 @@
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_device.hpp"
 #include "devices/lcm_rig_limits.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "tests/lcm_bench.hpp"
 #include "tests/process_runner.hpp"
 

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "devices/lcm_codec.hpp"
-#include "engine/safety.hpp"
+#include "engine/control/safety.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

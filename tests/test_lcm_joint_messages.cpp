@@ -13,7 +13,7 @@
 #include "devices/lcm_io_messages.hpp"
 #include "devices/lcm_rig_server.hpp"
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/lcm_bench.hpp"
 
 namespace bellows {

@@ -14,8 +14,8 @@
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_device.hpp"
-#include "engine/errors.hpp"
-#include "engine/safety.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/control/safety.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/process_runner.hpp"
 

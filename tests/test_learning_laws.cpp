@@ -7,11 +7,11 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/errors.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/zero_phase_filter.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/zero_phase_filter.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

@@ -2,8 +2,8 @@
 // saturation, and wind-up (persistent growth of a correction the clamp throws away).
 #include <gtest/gtest.h>
 
-#include "engine/errors.hpp"
-#include "engine/learning_monitor.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/learning/learning_monitor.hpp"
 
 namespace bellows {
 namespace {

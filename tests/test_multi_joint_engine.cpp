@@ -1,7 +1,7 @@
 // The engine driving an arm of several joints (issue 14): EngineCore on the simulated clock with the
 // simulated arm2 chain (devices/simulated_arm_chain) and the paper2 trajectory. Armed, one trial
 // runs with each joint's PID, pressure pair and correction; every joint tracks; and J-joint
-// norm-optimal ILC (engine/noilc_mimo, the chain linearized stretched out) between trials lowers
+// norm-optimal ILC (engine/learning/noilc_mimo, the chain linearized stretched out) between trials lowers
 // every joint's RMS error. The per-joint and overall numbers are printed for docs/architecture.md.
 #include <gtest/gtest.h>
 
@@ -10,12 +10,12 @@
 #include <numbers>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/arm_chain_linearization.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/noilc_mimo.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/model/arm_chain_linearization.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/learning/noilc_mimo.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/engine_fixture.hpp"
 
 namespace bellows {

@@ -1,5 +1,5 @@
-// The two multi-joint engine pieces together: J-joint norm-optimal ILC (engine/noilc_mimo) learning
-// on the simulated chain's mechanics (engine/arm_chain) of `arm2` and `arm3`, each joint with the spec's PID
+// The two multi-joint engine pieces together: J-joint norm-optimal ILC (engine/learning/noilc_mimo) learning
+// on the simulated chain's mechanics (engine/model/arm_chain) of `arm2` and `arm3`, each joint with the spec's PID
 // and feed-forward, with the coupled model (the chain linearized stretched out) and with independent
 // joints (each joint's own single-joint model). Mechanics only: the input is each joint's pressure
 // difference as commanded, no valves or chambers; the loop, trajectories and device for J joints are
@@ -10,13 +10,13 @@
 #include <numbers>
 #include <sstream>
 
-#include "engine/arm_chain_linearization.hpp"
-#include "engine/joint_learning_factory.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/noilc_mimo.hpp"
-#include "engine/pid_controller.hpp"
-#include "engine/trajectory.hpp"
-#include "engine/units.hpp"
+#include "engine/model/arm_chain_linearization.hpp"
+#include "engine/config/joint_learning_factory.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/learning/noilc_mimo.hpp"
+#include "engine/control/pid_controller.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows {
 namespace {

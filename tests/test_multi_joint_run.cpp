@@ -9,13 +9,13 @@
 #include <iostream>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/joint_learning_factory.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/config/joint_learning_factory.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows {
 namespace {

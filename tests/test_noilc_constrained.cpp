@@ -8,13 +8,13 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/errors.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/learning_monitor.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/noilc_constrained.hpp"
-#include "engine/noilc_dense.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/learning/learning_monitor.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/noilc_constrained.hpp"
+#include "engine/learning/noilc_dense.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

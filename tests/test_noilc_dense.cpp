@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "engine/noilc_dense.hpp"
+#include "engine/learning/noilc_dense.hpp"
 
 namespace bellows {
 namespace {

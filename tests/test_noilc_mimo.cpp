@@ -1,16 +1,16 @@
-// Norm-optimal ILC for J joints: the O(N) Riccati form (engine/noilc_mimo) must give the dense lifted
-// closed form's optimum (engine/noilc_mimo_dense) to 1e-9 relative on random stable models and random
+// Norm-optimal ILC for J joints: the O(N) Riccati form (engine/learning/noilc_mimo) must give the dense lifted
+// closed form's optimum (engine/learning/noilc_mimo_dense) to 1e-9 relative on random stable models and random
 // data for J = 1..4, coupled and block-diagonal; with one joint both must be the single-joint laws.
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "engine/arm_model.hpp"
-#include "engine/errors.hpp"
-#include "engine/noilc_dense.hpp"
-#include "engine/noilc_mimo.hpp"
-#include "engine/noilc_mimo_dense.hpp"
-#include "engine/noilc_riccati.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/learning/noilc_dense.hpp"
+#include "engine/learning/noilc_mimo.hpp"
+#include "engine/learning/noilc_mimo_dense.hpp"
+#include "engine/learning/noilc_riccati.hpp"
 #include "tests/allocation_counter.hpp"
 #include "tests/multi_joint_random.hpp"
 

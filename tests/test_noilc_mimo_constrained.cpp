@@ -1,12 +1,12 @@
-// Bounded norm-optimal ILC for J joints (engine/noilc_mimo_constrained): the result is always
+// Bounded norm-optimal ILC for J joints (engine/learning/noilc_mimo_constrained): the result is always
 // feasible and satisfies the optimality conditions of the bounded problem, checked with the dense
 // oracle's cost gradient; loose bounds give the unconstrained optimum; solve allocates nothing.
 #include <gtest/gtest.h>
 
-#include "engine/arm_model.hpp"
-#include "engine/noilc_constrained.hpp"
-#include "engine/noilc_mimo_constrained.hpp"
-#include "engine/noilc_mimo_dense.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/learning/noilc_constrained.hpp"
+#include "engine/learning/noilc_mimo_constrained.hpp"
+#include "engine/learning/noilc_mimo_dense.hpp"
 #include "tests/allocation_counter.hpp"
 #include "tests/multi_joint_random.hpp"
 

@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/arm_model.hpp"
-#include "engine/errors.hpp"
-#include "engine/noilc_dense.hpp"
-#include "engine/noilc_riccati.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/learning/noilc_dense.hpp"
+#include "engine/learning/noilc_riccati.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {

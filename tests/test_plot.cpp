@@ -7,7 +7,7 @@
 
 #include "app/plot_command.hpp"
 #include "app/plot_figures.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "tests/session_export_fixture.hpp"
 
 namespace bellows {

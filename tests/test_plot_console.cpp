@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "app/plot_console.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "tests/console_fixture.hpp"
 #include "tests/session_test_support.hpp"
 

@@ -1,4 +1,4 @@
-// The simulated J-joint arm with its bellows (engine/pneumatic_arm_chain, ../shared/spec/multi-joint.md):
+// The simulated J-joint arm with its bellows (engine/model/pneumatic_arm_chain, ../shared/spec/multi-joint.md):
 // one joint without gravity is the single-joint simulated arm, the presets' bellows, each joint's gas
 // law with its own angle-dependent volumes, gravity on the chain, determinism, bit-for-bit resuming,
 // refused commands and parameters, and an allocation-free step. Its own executable: it counts
@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/errors.hpp"
-#include "engine/pneumatic_arm_chain.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/model/pneumatic_arm_chain.hpp"
 #include "tests/allocation_counter.hpp"
 
 namespace bellows {

@@ -1,7 +1,7 @@
 // printable(): text from outside made safe for a terminal, escaped and shortened.
 #include <gtest/gtest.h>
 
-#include "engine/printable_text.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows {
 namespace {

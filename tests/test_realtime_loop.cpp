@@ -6,11 +6,11 @@
 #include <thread>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/configuration.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/noilc_dense.hpp"
-#include "engine/errors.hpp"
-#include "engine/realtime_loop.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/noilc_dense.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/rt/realtime_loop.hpp"
 
 namespace bellows {
 namespace {

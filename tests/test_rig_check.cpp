@@ -1,4 +1,4 @@
-// The valve test of the first day (engine/valve_test): through the engine on the simulated arm,
+// The valve test of the first day (engine/operator/valve_test): through the engine on the simulated arm,
 // healthy and with injected faults (swapped chamber wiring, a dead inlet, no supply), and
 // `bellows rig check`'s exit status and lines.
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-#include "engine/valve_test.hpp"
+#include "engine/operator/valve_test.hpp"
 #include "tests/engine_fixture.hpp"
 #include "tests/process_runner.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"

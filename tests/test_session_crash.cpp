@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/session_layout.hpp"

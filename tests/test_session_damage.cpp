@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"

@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"

@@ -6,14 +6,14 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/json_reader.hpp"
 #include "tests/test_support.hpp"
-#include "engine/units.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows {
 namespace {

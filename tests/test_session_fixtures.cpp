@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "engine/safety.hpp"
+#include "engine/control/safety.hpp"
 #include "session_test_support.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_store.hpp"
@@ -68,9 +68,20 @@ std::vector<double> fixture_csv_column(const fs::path& file, const std::string& 
   return values;
 }
 
-/// sqrt(mean(error_deg[1..N]^2)), as docs/session-format.md defines a samples file's RMS.
-double fixture_rms_deg(const fs::path& samples_file) {
-  const std::vector<double> error = fixture_csv_column(samples_file, "error_deg");
+/// A samples file's column of joint `joint` (0-based): "error_deg", "error_deg_j2", ...
+std::string joint_column(const std::string& name, int joint) {
+  return joint == 0 ? name : name + "_j" + std::to_string(joint + 1);
+}
+
+/// The trajectory file's column of joint `joint` (0-based) in a session of `joints` joints:
+/// "angle_deg" for one joint, "q1_deg", "q2_deg", ... for several.
+std::string trajectory_column(int joint, int joints) {
+  return joints == 1 ? "angle_deg" : "q" + std::to_string(joint + 1) + "_deg";
+}
+
+/// sqrt(mean(error_deg[1..N]^2)) of joint `joint`, as docs/session-format.md defines a samples file's RMS.
+double fixture_rms_deg(const fs::path& samples_file, int joint = 0) {
+  const std::vector<double> error = fixture_csv_column(samples_file, joint_column("error_deg", joint));
   double sum = 0.0;
   for (std::size_t k = 1; k < error.size(); ++k) sum += error[k] * error[k];
   return error.size() > 1 ? std::sqrt(sum / static_cast<double>(error.size() - 1)) : 0.0;
@@ -110,19 +121,30 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
     ASSERT_EQ(raw["iterations"].size(), session.manifest.iterations.size());
     EXPECT_EQ(session.manifest.name, raw["name"].get<std::string>());
     EXPECT_EQ(session.manifest.trajectory_name, raw["trajectory"]["name"].get<std::string>());
+    // Every joint's columns (one joint before the J-joint format; `trajectory.joints` after it).
+    const int joints = raw["trajectory"].value("joints", 1);
+    ASSERT_EQ(session.trajectory.joints(), joints);
     for (std::size_t i = 0; i < session.iterations.size(); ++i) {
       const fs::path samples = fixture / raw["iterations"][i]["samples_file"].get<std::string>();
-      const double rms = fixture_rms_deg(samples);
-      EXPECT_NEAR(session.iterations[i].record.rms_error_deg(), rms, 1e-9 * std::max(1.0, rms)) << samples;
       EXPECT_DOUBLE_EQ(session.manifest.iterations[i].summary.rms_deg, raw["iterations"][i]["rms_deg"].get<double>());
-      const std::vector<double> next = fixture_csv_column(samples, "u_ilc_next_bar");
-      ASSERT_EQ(static_cast<std::size_t>(session.iterations[i].next_correction_bar.size()) + 1, next.size());
-      EXPECT_EQ(session.iterations[i].next_correction_bar(0), next[0]);
+      ASSERT_EQ(session.iterations[i].joints(), joints);
+      const Eigen::MatrixXd next_bar = session.iterations[i].next_corrections_bar();
+      for (int j = 0; j < joints; ++j) {
+        SCOPED_TRACE("joint " + std::to_string(j + 1));
+        const double rms = fixture_rms_deg(samples, j);
+        EXPECT_NEAR(session.iterations[i].record.joint_rms_error_deg(j), rms, 1e-9 * std::max(1.0, rms)) << samples;
+        const std::vector<double> next = fixture_csv_column(samples, joint_column("u_ilc_next_bar", j));
+        ASSERT_EQ(static_cast<std::size_t>(next_bar.rows()) + 1, next.size());
+        EXPECT_EQ(next_bar(0, j), next[0]);
+        EXPECT_EQ(next_bar(next_bar.rows() - 1, j), next[next.size() - 2]);
+      }
     }
-    const std::vector<double> angle_deg = fixture_csv_column(fixture / "trajectory.csv", "angle_deg");
-    ASSERT_EQ(static_cast<std::size_t>(session.trajectory.angle_rad.size()), angle_deg.size());
-    EXPECT_NEAR(session.trajectory.angle_rad(session.trajectory.angle_rad.size() - 1) * 180.0 / M_PI, angle_deg.back(),
-                1e-12);
+    for (int j = 0; j < joints; ++j) {
+      const std::vector<double> angle_deg = fixture_csv_column(fixture / "trajectory.csv", trajectory_column(j, joints));
+      const Eigen::VectorXd& angle_rad = session.trajectory.joint_angle_rad(j);
+      ASSERT_EQ(static_cast<std::size_t>(angle_rad.size()), angle_deg.size());
+      EXPECT_NEAR(angle_rad(angle_rad.size() - 1) * 180.0 / M_PI, angle_deg.back(), 1e-12) << "joint " << j + 1;
+    }
     // A first-format session's clock is taken from the arm's time (docs/session-format.md,
     // "Versions"): where both are recorded, they agree.
     const nlohmann::json& resume = raw["resume"];
@@ -220,12 +242,14 @@ TEST(SessionFixtures, EveryFixtureResumesWithOneMoreIterationAndTheEarlierOnesUn
       for (const auto& [key, value] : keys.items()) EXPECT_EQ(after["configuration"][section][key], value) << section << "." << key;
     }
     if (faults_again) continue;
-    // The new iteration ran with the correction the fixture's last iteration learned.
-    const std::vector<double> saved_next =
-        fixture_csv_column(fixture / before["iterations"][earlier - 1]["samples_file"].get<std::string>(), "u_ilc_next_bar");
-    const std::vector<double> applied =
-        fixture_csv_column(copy / after["iterations"][earlier]["samples_file"].get<std::string>(), "u_ilc_bar");
-    EXPECT_EQ(applied, saved_next);
+    // The new iteration ran, on every joint, with the correction the fixture's last iteration learned.
+    for (int j = 0; j < before["trajectory"].value("joints", 1); ++j) {
+      const std::vector<double> saved_next = fixture_csv_column(
+          fixture / before["iterations"][earlier - 1]["samples_file"].get<std::string>(), joint_column("u_ilc_next_bar", j));
+      const std::vector<double> applied = fixture_csv_column(
+          copy / after["iterations"][earlier]["samples_file"].get<std::string>(), joint_column("u_ilc_bar", j));
+      EXPECT_EQ(applied, saved_next) << "joint " << j + 1;
+    }
   }
 }
 

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_layout.hpp"

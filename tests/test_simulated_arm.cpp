@@ -4,10 +4,10 @@
 #include <numbers>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/noilc_dense.hpp"
-#include "engine/valve_flow.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/learning/noilc_dense.hpp"
+#include "engine/model/valve_flow.hpp"
 
 namespace bellows {
 namespace {

@@ -8,9 +8,9 @@
 #include <functional>
 #include <string>
 
-#include "engine/arm_model.hpp"
-#include "engine/device.hpp"
-#include "engine/errors.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/control/device.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows::testing {
 

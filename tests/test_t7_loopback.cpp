@@ -14,8 +14,8 @@
 #include "devices/modbus_client.hpp"
 #include "devices/t7_device.hpp"
 #include "devices/t7_sim_server.hpp"
-#include "engine/errors.hpp"
-#include "engine/safety.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/control/safety.hpp"
 
 namespace bellows {
 namespace {

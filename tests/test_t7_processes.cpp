@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 #include "tests/lcm_test_support.hpp"
 #include "tests/process_runner.hpp"
 

@@ -14,7 +14,7 @@
 #include "app/toml_key_edit.hpp"
 #include "sessions/atomic_file.hpp"
 #include "devices/t7_registers.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {

@@ -3,8 +3,8 @@
 #include <numbers>
 
 #include "app/trajectory_file.hpp"
-#include "engine/errors.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows {
 namespace {

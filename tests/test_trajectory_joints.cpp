@@ -7,8 +7,8 @@
 #include <numbers>
 
 #include "app/trajectory_file.hpp"
-#include "engine/errors.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/trial/trajectory.hpp"
 #include "tests/process_runner.hpp"
 #include "tests/test_support.hpp"
 

@@ -1,4 +1,4 @@
-// Learning transfer (engine/learning_transfer): trained on `paper` and `steps` (30 iterations each,
+// Learning transfer (engine/config/learning_transfer): trained on `paper` and `steps` (30 iterations each,
 // simulated arm, simulated clock), the first correction for five unseen trajectories of different
 // character (tests/test_transfer_scenarios.hpp) must beat feedback only, and learning must go on
 // from it; a transfer that cannot help falls back to zero and says why.
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "test_transfer_scenarios.hpp"
 
 namespace bellows {

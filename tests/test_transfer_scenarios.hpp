@@ -10,13 +10,13 @@
 #include <vector>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/arm_model.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/engine_driver.hpp"
-#include "engine/learning_law_factory.hpp"
-#include "engine/learning_session.hpp"
-#include "engine/learning_transfer.hpp"
-#include "engine/trajectory.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "engine/config/learning_law_factory.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/config/learning_transfer.hpp"
+#include "engine/trial/trajectory.hpp"
 
 namespace bellows::testing {
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "app/transfer_sources.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 
 namespace bellows {

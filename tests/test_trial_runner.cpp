@@ -1,4 +1,4 @@
-// The trial runner (engine/trial_runner): the one protocol by which headless runs, the console and
+// The trial runner (engine/operator/trial_runner): the one protocol by which headless runs, the console and
 // identification run a trial. Polled tick by tick on the simulated clock with the simulated arm: a
 // trial that completes, one the engine faults mid-way, refused starts (unarmed, arm refused), a full
 // command queue, cancel() and the stop flag; and the same record whether the runner reads the
@@ -11,10 +11,10 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm.hpp"
-#include "engine/configuration.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/trial_runner.hpp"
-#include "engine/units.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/operator/trial_runner.hpp"
+#include "engine/base/units.hpp"
 #include "test_support.hpp"
 
 namespace bellows {

@@ -2,7 +2,7 @@
 // the engine, the trials and the screens, without a terminal.
 #include <gtest/gtest.h>
 
-#include "engine/learning_law_factory.hpp"
+#include "engine/config/learning_law_factory.hpp"
 
 #include <algorithm>
 #include <cmath>

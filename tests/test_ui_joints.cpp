@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "devices/simulated_arm_chain.hpp"
-#include "engine/pneumatic_arm_chain_parameters.hpp"
+#include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/console_fixture.hpp"
 #include "ui/joint_view.hpp"
 #include "ui/render.hpp"

@@ -3,7 +3,7 @@
 
 #include <numbers>
 
-#include "engine/trajectory.hpp"
+#include "engine/trial/trajectory.hpp"
 #include "ui/key_map.hpp"
 #include "tests/ui_sample_state.hpp"
 #include "ui/render.hpp"

@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "app/console_sessions.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/session_store.hpp"
 #include "tests/console_fixture.hpp"
 #include "tests/process_runner.hpp"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/trajectory.hpp"
+#include "engine/trial/trajectory.hpp"
 #include "ui/console_state.hpp"
 #include "tests/test_support.hpp"
 

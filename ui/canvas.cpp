@@ -4,7 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 
-#include "engine/printable_text.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows::ui {
 

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "engine/realtime_loop.hpp"
+#include "engine/rt/realtime_loop.hpp"
 #include "ui/console_controller.hpp"
 
 namespace bellows::ui {

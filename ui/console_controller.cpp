@@ -8,7 +8,7 @@
 
 #include <time.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "ui/canvas.hpp"
 #include "ui/joint_view.hpp"
 

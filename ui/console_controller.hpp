@@ -20,12 +20,12 @@
 #include <string>
 #include <vector>
 
-#include "engine/arm_model.hpp"
-#include "engine/engine_core.hpp"
-#include "engine/joint_learning.hpp"
-#include "engine/realtime_loop.hpp"
-#include "engine/trial_runner.hpp"
-#include "engine/valve_test.hpp"
+#include "engine/model/arm_model.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/learning/joint_learning.hpp"
+#include "engine/rt/realtime_loop.hpp"
+#include "engine/operator/trial_runner.hpp"
+#include "engine/operator/valve_test.hpp"
 #include "ui/background_task.hpp"
 #include "ui/console_state.hpp"
 #include "ui/console_transfer.hpp"

@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <numbers>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/joint_view.hpp"
 #include "ui/keys.hpp"

@@ -1,5 +1,5 @@
 // The Rig screen (the first day at the bench): the device's inputs live, its link's health, and
-// the valve test (engine/valve_test) driven through the engine's commands like any trial, and
+// the valve test (engine/operator/valve_test) driven through the engine's commands like any trial, and
 // zeroing the angle (written into the rig profile by the app's callback).
 #include <cmath>
 #include <numbers>

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "engine/errors.hpp"
-#include "engine/learning_law_factory.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"

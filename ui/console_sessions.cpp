@@ -1,7 +1,7 @@
 // Saving and opening sessions through the SessionGateway, on background tasks.
 #include <algorithm>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "engine/configuration.hpp"
-#include "engine/engine_messages.hpp"
-#include "engine/engine_state.hpp"
-#include "engine/iteration_numbering.hpp"
-#include "engine/safety.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_messages.hpp"
+#include "engine/rt/engine_state.hpp"
+#include "engine/base/iteration_numbering.hpp"
+#include "engine/control/safety.hpp"
 #include "ui/event_log.hpp"
 #include "ui/experiment.hpp"
 #include "ui/session_gateway.hpp"

@@ -1,6 +1,6 @@
 // Learning transfer in the console (issue 13): when the operator selects a trajectory that has no
 // correction yet, what the earlier experiments of this console and the saved sessions taught is
-// turned into a first correction on a worker thread (engine/learning_transfer); the console offers
+// turned into a first correction on a worker thread (engine/config/learning_transfer); the console offers
 // it with its prediction, and `T` takes it. The taught experiments are kept when the operator moves
 // on to another trajectory.
 #pragma once
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/configuration.hpp"
-#include "engine/learning_transfer.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/config/learning_transfer.hpp"
 #include "ui/experiment.hpp"
 #include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"

@@ -1,10 +1,10 @@
 // The console's trials and learning: building the law, running a trial through the engine (the
 // trial runner, fed by the UI loop's events and snapshot: never waiting), finishing it (summary,
 // diagnostics, log), and the run modes (one trial, a step, K iterations).
-#include "engine/convergence.hpp"
-#include "engine/errors.hpp"
-#include "engine/joint_learning_factory.hpp"
-#include "engine/learning_session.hpp"
+#include "engine/config/convergence.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/config/joint_learning_factory.hpp"
+#include "engine/operator/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/joint_view.hpp"

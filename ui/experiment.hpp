@@ -10,11 +10,11 @@
 
 #include <Eigen/Dense>
 
-#include "engine/learning_session.hpp"
-#include "engine/learning_transfer.hpp"
-#include "engine/trajectory.hpp"
-#include "engine/engine_messages.hpp"
-#include "engine/trial_record.hpp"
+#include "engine/operator/learning_session.hpp"
+#include "engine/config/learning_transfer.hpp"
+#include "engine/trial/trajectory.hpp"
+#include "engine/rt/engine_messages.hpp"
+#include "engine/trial/trial_record.hpp"
 
 namespace bellows::ui {
 

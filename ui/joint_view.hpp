@@ -8,8 +8,8 @@
 
 #include <Eigen/Dense>
 
-#include "engine/configuration.hpp"
-#include "engine/engine_messages.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_messages.hpp"
 
 namespace bellows::ui {
 

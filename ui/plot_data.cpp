@@ -2,7 +2,7 @@
 
 #include <numbers>
 
-#include "engine/units.hpp"
+#include "engine/base/units.hpp"
 
 namespace bellows::ui {
 namespace {

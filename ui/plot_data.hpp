@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/trial_record.hpp"
+#include "engine/trial/trial_record.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_state.hpp"
 

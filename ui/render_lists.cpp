@@ -2,9 +2,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/errors.hpp"
-#include "engine/iteration_numbering.hpp"
-#include "engine/learning_law_factory.hpp"
+#include "engine/base/errors.hpp"
+#include "engine/base/iteration_numbering.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "ui/key_map.hpp"
 #include "ui/plot.hpp"
 #include "ui/render_parts.hpp"

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/configuration.hpp"
-#include "engine/errors.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/base/errors.hpp"
 #include "ui/event_log.hpp"
 #include "ui/experiment.hpp"
 

@@ -11,7 +11,7 @@
 
 #include <ncurses.h>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "ui/keys.hpp"
 
 namespace bellows::ui {

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "engine/printable_text.hpp"
+#include "engine/base/printable_text.hpp"
 
 namespace bellows::ui {
 

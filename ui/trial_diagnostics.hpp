@@ -6,7 +6,7 @@
 
 #include <optional>
 
-#include "engine/learning_monitor.hpp"
+#include "engine/learning/learning_monitor.hpp"
 #include "ui/experiment.hpp"
 
 namespace bellows::ui {

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "engine/configuration.hpp"
+#include "engine/config/configuration.hpp"
 
 namespace bellows::ui {
 

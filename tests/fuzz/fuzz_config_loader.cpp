@@ -8,7 +8,7 @@
 #include <string>
 
 #include "app/config_file.hpp"
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

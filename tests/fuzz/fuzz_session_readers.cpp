@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "engine/errors.hpp"
+#include "engine/base/errors.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/csv_table.hpp"
 #include "sessions/iteration_files.hpp"
