@@ -61,24 +61,30 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
 
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
                               double max_abs_angle_deg, TrialRecord& record, StopFlag stop) {
-  // Through the engine like any trial (engine/operator/trial_runner): armed, guarded, the record prepared
-  // outside the loop. The angle bound is this trial's own guard, looked at after every poll.
+  // Through the engine like any trial (engine/operator/trial_runner): armed, guarded, the record
+  // prepared outside the loop; every joint of the excitation. The angle bound is this trial's own
+  // guard, looked at after every poll (every tick on the simulated clock).
   if (!driver.core().send(EngineCommand::select_trajectory(excitation))) {
     throw std::runtime_error("identification: the engine's command queue is full");
   }
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
-  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), 1);
+  const int joints = excitation.joints();
+  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), joints);
   TrialRunner runner(driver.core(), timing);
   runner.start(excitation, no_correction, record, TrialRunner::Arming::kIfNeeded);
   std::string left_bound;  // why the guard stopped the trial
   const TrialStatus& status = runner.run_to_completion(driver, stop, [&](const TickRecord& tick) {
-    const double angle_rad = tick.reading.joint[0].angle_rad;
-    if (std::abs(angle_rad) <= bound_rad) return;
-    std::ostringstream message;
-    message << "identification aborted, valves vented: angle " << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s
-            << " s left +-" << max_abs_angle_deg << " deg; lower [identify] amplitude_deg";
-    left_bound = message.str();
-    runner.cancel();
+    for (int j = 0; j < joints; ++j) {
+      const double angle_rad = tick.reading.joint[static_cast<std::size_t>(j)].angle_rad;
+      if (std::abs(angle_rad) <= bound_rad) continue;
+      std::ostringstream message;
+      message << "identification aborted, valves vented: "
+              << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string()) << "angle " << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
+              << " deg; lower [identify] amplitude_deg";
+      left_bound = message.str();
+      runner.cancel();
+      return;
+    }
   });
   switch (status.phase) {
     case TrialPhase::kDone:
