@@ -86,6 +86,9 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
                              "[arm] joints = 1: a chain has 2 to 4 joints (leave [arm] out for one joint)");
   expect_refused_in_one_line("run --no-save --config " + arm_config("both", "[arm]\njoints = 3\npreset = \"arm2\"\n"),
                              "[arm] preset and [arm] joints both name the arm: keep one");
+  expect_refused_in_one_line(
+      "run --no-save --config " + arm_config("faulty", "[arm]\npreset = \"arm2\"\n[plant]\nfault = \"supply-loss\"\n"),
+      "[plant] fault = 'supply-loss': the simulated arm of several joints ([arm]) injects no faults");
   expect_refused_in_one_line("run --no-save --config " + arm_config("five", "[arm]\njoints = 5\n"), "[arm] joints = 5");
   expect_refused_in_one_line("run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
                              "[arm_joint2] mass_kg = 0");

@@ -178,6 +178,12 @@ TEST(NoilcMimo, SetupReportsEveryBadInput) {
   MultiJointWeights indefinite = weights;
   indefinite.s(1, 1) = -0.1;
   EXPECT_EQ(law.setup(good, indefinite, 100), MultiJointNoilcStatus::kBadWeights);
+  MultiJointWeights coupled_indefinite = weights;  // positive diagonal, eigenvalues -1 and 3
+  coupled_indefinite.m << 1.0, 2.0, 2.0, 1.0;
+  EXPECT_EQ(law.setup(good, coupled_indefinite, 100), MultiJointNoilcStatus::kBadWeights);
+  MultiJointWeights coupled_singular = weights;  // eigenvalues 0 and 2: semidefinite, allowed
+  coupled_singular.m << 1.0, 1.0, 1.0, 1.0;
+  EXPECT_EQ(law.setup(good, coupled_singular, 100), MultiJointNoilcStatus::kOk);
   MultiJointWeights three_joints = MultiJointWeights::uniform(IlcParameters{}, 3);
   EXPECT_EQ(law.setup(good, three_joints, 100), MultiJointNoilcStatus::kBadWeights);
   EXPECT_EQ(law.setup(good, weights, 100, -1.0), MultiJointNoilcStatus::kBadWeights);

@@ -285,6 +285,10 @@ void validate_configuration(const Configuration& config) {
   if (config.arm.joints > 0 && !config.arm.preset.empty()) {
     throw InputError("[arm] preset and [arm] joints both name the arm: keep one");
   }
+  if (config.arm.has_chain() && config.plant.fault != "none") {
+    throw InputError("[plant] fault = '" + config.plant.fault +
+                     "': the simulated arm of several joints ([arm]) injects no faults; leave [plant] fault at none");
+  }
   if (config.lcm.seq_window > 1000000) {
     throw InputError("[lcm] seq_window = " + std::to_string(config.lcm.seq_window) + ": must be at most 1000000");
   }

@@ -198,12 +198,15 @@ MultiJointNoilcStatus make_stages(const MultiJointModel& model, const MultiJoint
   return status;
 }
 
+/// Symmetric with no eigenvalue below -1e-12 * scale: then, and only then, the weight shifted up by
+/// that tolerance is positive definite, which its Cholesky factor tells. The same LLT<MatrixXd> as
+/// riccati_stages: an eigensolver for the test cost 12 s of GCC's time on this file (docs/benchmarks.md).
 bool symmetric_positive_semidefinite(const JointMatrix& weight, int joints) {
   if (weight.rows() != joints || weight.cols() != joints || !weight.allFinite()) return false;
   const double scale = 1.0 + weight.cwiseAbs().maxCoeff();
   if (!(weight - weight.transpose()).isZero(1e-12 * scale)) return false;
-  const Eigen::SelfAdjointEigenSolver<JointMatrix> eigen(weight, Eigen::EigenvaluesOnly);
-  return eigen.info() == Eigen::Success && eigen.eigenvalues().minCoeff() >= -1e-12 * scale;
+  const Eigen::MatrixXd shifted = weight + 1e-12 * scale * Eigen::MatrixXd::Identity(joints, joints);
+  return Eigen::LLT<Eigen::MatrixXd>(shifted).info() == Eigen::Success;
 }
 
 }  // namespace
