@@ -36,6 +36,7 @@ std::string system_clock_text() {
 ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajectory, bool unicode)
     : env_(std::move(env)),
       model_(discretize_arm_model(env_.config.model, env_.config.timing.sample_s())),
+      runner_(*env_.core, env_.config.timing),
       diagnostics_(env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar) {
   if (!env_.clock_text) env_.clock_text = system_clock_text;
   state_.unicode = unicode;
@@ -191,7 +192,10 @@ void ConsoleController::on_emergency_stop_delivered() {
 
 void ConsoleController::poll_engine(double /*now_s*/) {
   EngineEvent event;
-  while (env_.core->poll_event(event)) on_event(event);
+  while (env_.core->poll_event(event)) {
+    on_event(event);
+    if (in_flight_ && runner_.observe(event)) on_trial_moved();
+  }
   const EngineState engine = env_.core->state();
   if (engine != state_.engine_state) {
     state_.engine_state = engine;
@@ -220,17 +224,10 @@ void ConsoleController::on_event(const EngineEvent& event) {
       } else if (event.command == CommandKind::kDisarm && event.to == EngineState::kSafe) {
         set_status("disarmed: the valves are vented (a arms again)");
       }
-      if (event.to == EngineState::kRunning && in_flight_) {
-        in_flight_->accepted = true;
-        state_.run.phase = RunProgress::Phase::kSettling;
-      }
       return;
     case EventKind::kCommandRefused:
       log(LogSource::kEngine, format("refused %s: %s", to_string(event.command), event.refusal), true, event.time_s);
       set_status(format("the engine refused %s: %s", to_string(event.command), event.refusal), true);
-      if (event.command == CommandKind::kStartTrial && in_flight_ && !in_flight_->accepted) {
-        drop_trial("the engine refused the trial");
-      }
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
@@ -260,15 +257,8 @@ void ConsoleController::on_event(const EngineEvent& event) {
       if (held != selected_trajectories_.end()) selected_trajectories_.erase(selected_trajectories_.begin(), held);
       return;
     }
-    case EventKind::kTrialComplete:
-      if (in_flight_ && event.trial_id == in_flight_->id) finish_trial(event.time_s);
-      return;
+    case EventKind::kTrialComplete:  // the trial runner's (poll_engine)
     case EventKind::kTrialAborted:
-      if (in_flight_ && event.trial_id == in_flight_->id) {
-        log(LogSource::kEngine, format("iteration %d aborted", state_.experiment.next_iteration()), false, event.time_s);
-        drop_trial("trial aborted");
-      }
-      return;
     case EventKind::kValvePulseDone:  // the valve test's (forwarded above)
       return;
   }
@@ -303,10 +293,7 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
     state_.device = health;
     ++revision_;
   }
-  if (in_flight_ && in_flight_->accepted && state_.live.trial_id == in_flight_->id && state_.live.sample >= 0) {
-    state_.run.phase = RunProgress::Phase::kRunning;
-    state_.run.sample = state_.live.sample;
-  }
+  if (in_flight_ && runner_.observe(state_.live)) on_trial_moved();
   // The live strip, decimated to the ILC rate.
   if (env_.telemetry != nullptr) {
     const int per_sample = env_.config.timing.ticks_per_sample;

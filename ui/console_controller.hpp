@@ -24,6 +24,7 @@
 #include "engine/rt/engine_core.hpp"
 #include "engine/learning/joint_learning.hpp"
 #include "engine/rt/realtime_loop.hpp"
+#include "engine/operator/trial_runner.hpp"
 #include "engine/operator/valve_test.hpp"
 #include "ui/background_task.hpp"
 #include "ui/console_state.hpp"
@@ -92,13 +93,11 @@ class ConsoleController {
   bool active() const;
 
  private:
-  struct InFlight {  // a trial the engine owns until it hands it back
+  struct InFlight {  // a trial's buffers, the engine's until the runner says it is finished
     std::shared_ptr<const Trajectory> trajectory;
     Eigen::MatrixXd correction_bar;  // N x J
     TrialRecord record;
-    std::uint32_t id = 0;
     std::string origin;
-    bool accepted = false;  // the engine took it (went RUNNING)
   };
 
   // Engine side (console_controller.cpp).
@@ -113,6 +112,8 @@ class ConsoleController {
   void begin_trial();
   void begin_trial_when_saved();  // begin_trial() once everything done so far is on disk
   void on_emergency_stop_delivered();
+  /// The trial moved (the runner said so, from an event or the snapshot): show it, or finish it.
+  void on_trial_moved();
   void finish_trial(double time_s);
   void drop_trial(const std::string& why);
   void continue_run();
@@ -181,8 +182,8 @@ class ConsoleController {
   // Trajectories given to the engine, in the order sent, alive until it hands them back (a
   // kTrajectorySelected event for a later one): it may hold a pointer to any of them until then.
   std::vector<std::shared_ptr<const Trajectory>> selected_trajectories_;
+  TrialRunner runner_;  // fed the engine's events and snapshot by poll_engine() and the snapshot's reader
   std::unique_ptr<InFlight> in_flight_;
-  std::uint32_t last_trial_id_ = 0;
 
   // The learning (every joint's); never touched while a background update uses it.
   std::unique_ptr<JointLearning> law_;

@@ -1,7 +1,6 @@
-// The console's trials and learning: building the law, running a trial through the engine,
-// finishing it (summary, diagnostics, log), and the run modes (one trial, a step, K iterations).
-#include <cmath>
-
+// The console's trials and learning: building the law, running a trial through the engine (the
+// trial runner, fed by the UI loop's events and snapshot: never waiting), finishing it (summary,
+// diagnostics, log), and the run modes (one trial, a step, K iterations).
 #include "engine/config/convergence.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
@@ -108,15 +107,20 @@ void ConsoleController::begin_trial() {
     end_run("arm the valves first (a)", true);
     return;
   }
+  if (in_flight_) {  // the engine still holds the last one's buffers
+    end_run("a trial is still in progress", true);
+    return;
+  }
   auto trial = std::make_unique<InFlight>();
   trial->trajectory = e.trajectory;
   trial->correction_bar = e.next_correction_bar;
-  trial->record.prepare(e.samples(), env_.config.timing.ticks_per_sample, e.joints());
-  trial->id = ++last_trial_id_;
   trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
-  const int settle_ticks = static_cast<int>(std::lround(env_.config.timing.settle_s / env_.config.timing.tick_s));
-  if (!send(EngineCommand::start_trial(*trial->trajectory, trial->correction_bar, trial->record, settle_ticks, trial->id),
-            "start trial")) {
+  // The operator arms (a): the runner never does here. It prepares the record and sends the trial.
+  const TrialStatus& started =
+      runner_.start(*trial->trajectory, trial->correction_bar, trial->record, TrialRunner::Arming::kMustBeArmed);
+  if (started.phase == TrialPhase::kNotSent) {
+    log(LogSource::kOperator, "command queue full: start trial not sent", true);
+    set_status(started.message, true);
     end_run("the trial was not started", true);
     return;
   }
@@ -126,6 +130,35 @@ void ConsoleController::begin_trial() {
   state_.run.phase = RunProgress::Phase::kSettling;
   state_.run.sample = -1;
   ++revision_;
+}
+
+void ConsoleController::on_trial_moved() {
+  const TrialStatus& trial = runner_.status();
+  switch (trial.phase) {
+    case TrialPhase::kSettling:
+      state_.run.phase = RunProgress::Phase::kSettling;
+      return;
+    case TrialPhase::kRunning:
+      state_.run.phase = RunProgress::Phase::kRunning;
+      state_.run.sample = trial.sample;
+      return;
+    case TrialPhase::kDone:
+      finish_trial(trial.time_s);
+      return;
+    case TrialPhase::kRefused:  // said by on_event()
+      drop_trial("the engine refused the trial");
+      return;
+    case TrialPhase::kFaulted:
+    case TrialPhase::kCancelled:
+      log(LogSource::kEngine, format("iteration %d aborted", state_.experiment.next_iteration()), false, trial.time_s);
+      drop_trial("trial aborted");
+      return;
+    case TrialPhase::kIdle:
+    case TrialPhase::kArming:
+    case TrialPhase::kWaiting:
+    case TrialPhase::kNotSent:
+      return;
+  }
 }
 
 void ConsoleController::finish_trial(double time_s) {

@@ -12,8 +12,8 @@
 namespace bellows {
 namespace {
 
-constexpr int kMaxIterations = 100;
-constexpr double kRelativeCostTolerance = 1e-10;
+constexpr int kCoupledFitMaxIterations = 100;
+constexpr double kCoupledFitRelativeCostTolerance = 1e-10;
 constexpr double kRelativeStep = 1e-6;  // finite-difference step, relative to the entry's matrix scale
 constexpr Eigen::Index kMinimumSamples = 50;
 
@@ -168,7 +168,7 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
   if (!std::isfinite(cost)) throw InputError("identification: the coupled model's starting point is unstable on the data");
   double damping = 1e-3;  // Levenberg-Marquardt
   Eigen::MatrixXd jacobian(total, p.size());
-  for (fit.iterations = 1; fit.iterations <= kMaxIterations; ++fit.iterations) {
+  for (fit.iterations = 1; fit.iterations <= kCoupledFitMaxIterations; ++fit.iterations) {
     for (Eigen::Index i = 0; i < p.size(); ++i) {
       Eigen::VectorXd q = p;
       q(i) += steps(i);
@@ -190,7 +190,7 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
         cost = candidate_cost;
         damping = std::max(damping / 3.0, 1e-9);
         improved = true;
-        if (decrease < kRelativeCostTolerance) fit.converged = true;
+        if (decrease < kCoupledFitRelativeCostTolerance) fit.converged = true;
       } else {
         damping *= 4.0;
       }
@@ -198,7 +198,7 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
     if (!improved) fit.converged = true;  // no direction lowers the cost: a minimum
     if (fit.converged) break;
   }
-  fit.iterations = std::min(fit.iterations, kMaxIterations);
+  fit.iterations = std::min(fit.iterations, kCoupledFitMaxIterations);
   fit.dynamics = from_parameters(p, J);
   fit.fit_percent = joint_fit_percent(fit.dynamics, trials);
   fit.rms_residual_deg = std::sqrt(cost / static_cast<double>(total)) / kRadPerDeg;

@@ -1,12 +1,11 @@
 #include "engine/operator/identification_trial.hpp"
 
-#include "engine/operator/learning_session.hpp"
-
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
 #include "engine/base/errors.hpp"
+#include "engine/operator/trial_runner.hpp"
 #include "engine/base/units.hpp"
 
 namespace bellows {
@@ -72,50 +71,43 @@ Trajectory joint_excitation(const Trajectory& excitation, int joint, int joints)
 
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
                               double max_abs_angle_deg, TrialRecord& record, StopFlag stop) {
-  // Through the engine like any trial: armed, guarded, the record prepared outside the loop.
-  EngineCore& core = driver.core();
+  // Through the engine like any trial (engine/operator/trial_runner): armed, guarded, the record
+  // prepared outside the loop; every joint of the excitation. The angle bound is this trial's own
+  // guard, looked at after every poll (every tick on the simulated clock).
+  if (!driver.core().send(EngineCommand::select_trajectory(excitation))) {
+    throw std::runtime_error("identification: the engine's command queue is full");
+  }
   const double bound_rad = max_abs_angle_deg * kRadPerDeg;
   const int joints = excitation.joints();
-  const Eigen::VectorXd no_correction = Eigen::VectorXd::Zero(excitation.learning_samples());
-  const Eigen::MatrixXd no_joint_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), joints);
-  record.prepare(excitation.learning_samples(), timing.ticks_per_sample, joints);
-  const int settle_ticks = static_cast<int>(std::lround(timing.settle_s / timing.tick_s));
-  const bool sent = core.send(EngineCommand::select_trajectory(excitation)) &&
-                    (core.state() == EngineState::kArmed || core.send(EngineCommand::of(CommandKind::kArm))) &&
-                    core.send(joints == 1 ? EngineCommand::start_trial(excitation, no_correction, record, settle_ticks, 1)
-                                          : EngineCommand::start_trial(excitation, no_joint_correction, record, settle_ticks, 1));
-  if (!sent) throw std::runtime_error("identification: the engine's command queue is full");
-  TickRecord tick;
-  for (;;) {
-    driver.await();
-    EngineEvent event;
-    while (core.poll_event(event)) {
-      if (event.kind == EventKind::kTrialComplete) return;
-      if (event.kind == EventKind::kCommandRefused) {
-        throw EngineFault(core.fault(), std::string("identification refused by the engine: ") + event.refusal);
-      }
-      if (event.kind == EventKind::kTrialAborted || event.kind == EventKind::kFault) {
-        throw EngineFault(core.fault(), std::string("identification aborted: ") + fault_message(core.fault()));
-      }
-    }
-    if (stop_is_requested(stop)) {
-      core.request_emergency_stop();  // a latch: the next tick vents
-      while (core.state() != EngineState::kFault) driver.await();
-      throw Cancelled("identification stopped by a signal, valves vented");
-    }
-    core.read_snapshot(tick);
+  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(excitation.learning_samples(), joints);
+  TrialRunner runner(driver.core(), timing);
+  runner.start(excitation, no_correction, record, TrialRunner::Arming::kIfNeeded);
+  std::string left_bound;  // why the guard stopped the trial
+  const TrialStatus& status = runner.run_to_completion(driver, stop, [&](const TickRecord& tick) {
     for (int j = 0; j < joints; ++j) {
       const double angle_rad = tick.reading.joint[static_cast<std::size_t>(j)].angle_rad;
       if (std::abs(angle_rad) <= bound_rad) continue;
-      core.request_emergency_stop();  // a latch: the next tick vents
-      while (core.state() != EngineState::kFault) driver.await();
       std::ostringstream message;
-      message << "identification aborted, valves vented: " << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string())
-              << "angle " << angle_rad / kRadPerDeg
-              << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
+      message << "identification aborted, valves vented: "
+              << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string()) << "angle " << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
               << " deg; lower [identify] amplitude_deg";
-      throw InputError(message.str());
+      left_bound = message.str();
+      runner.cancel();
+      return;
     }
+  });
+  switch (status.phase) {
+    case TrialPhase::kDone:
+      return;
+    case TrialPhase::kNotSent:
+      throw std::runtime_error("identification: the engine's command queue is full");
+    case TrialPhase::kRefused:
+      throw EngineFault(status.fault, "identification refused by the engine: " + status.message);
+    case TrialPhase::kCancelled:
+      if (!left_bound.empty()) throw InputError(left_bound);
+      throw Cancelled("identification stopped by a signal, valves vented");
+    default:
+      throw EngineFault(status.fault, "identification aborted: " + status.message);
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "engine/base/errors.hpp"
@@ -66,7 +67,8 @@ LearningSession::LearningSession(EngineDriver& driver, JointLearning& learning, 
       controller_(controller),
       corrections_(Eigen::MatrixXd::Zero(trajectory_.learning_samples(), trajectory_.joints())),
       next_corrections_(trajectory_.learning_samples(), trajectory_.joints()),
-      feedback_bar_(trajectory_.learning_samples(), trajectory_.joints()) {
+      feedback_bar_(trajectory_.learning_samples(), trajectory_.joints()),
+      runner_(driver.core(), timing) {
   if (learning.samples() != trajectory_.learning_samples()) {
     throw InputError("learning law built for " + std::to_string(learning.samples()) + " samples, trajectory has " +
                      std::to_string(trajectory_.learning_samples()));
@@ -75,7 +77,7 @@ LearningSession::LearningSession(EngineDriver& driver, JointLearning& learning, 
     throw InputError("learning law built for " + std::to_string(learning.joints()) + " joints, trajectory '" + trajectory_.name +
                      "' has " + std::to_string(trajectory_.joints()));
   }
-  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample, trajectory_.joints());
+  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample, trajectory_.joints());  // last_record()'s size
   send_or_throw(driver_.core(), EngineCommand::select_trajectory(trajectory_));
 }
 
@@ -89,48 +91,24 @@ void LearningSession::set_correction(const Eigen::Ref<const Eigen::MatrixXd>& co
   iteration_ = iteration;
 }
 
-EngineEvent LearningSession::next_event() {
-  EngineEvent event;
-  while (!driver_.core().poll_event(event)) {
-    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
-      driver_.core().request_emergency_stop();  // a latch: the next tick vents, whatever is queued
-      while (driver_.core().state() != EngineState::kFault) driver_.await();
-      throw EngineFault(FaultCode::kEmergencyStop, "interrupted: valves vented");
-    }
-    driver_.await();
-  }
-  return event;
-}
-
-void LearningSession::ensure_armed() {
-  EngineCore& core = driver_.core();
-  if (core.state() == EngineState::kArmed) return;
-  send_or_throw(core, EngineCommand::of(CommandKind::kArm));
-  for (;;) {
-    const EngineEvent event = next_event();
-    if (event.kind == EventKind::kStateChanged && event.to == EngineState::kArmed) return;
-    if (event.kind == EventKind::kCommandRefused) {
-      throw EngineFault(core.fault(), std::string("the engine refused to arm: ") + event.refusal);
-    }
-    if (event.kind == EventKind::kFault) throw EngineFault(event.fault, fault_message(event.fault));
-  }
-}
-
 IterationSummary LearningSession::run_trial() {
-  ensure_armed();
-  const EngineCommand start = EngineCommand::start_trial(
-      trajectory_, corrections_, record_, static_cast<int>(std::lround(timing_.settle_s / timing_.tick_s)), next_trial_id_++);
-  send_or_throw(driver_.core(), start);
-  for (;;) {
-    const EngineEvent event = next_event();
-    if (event.kind == EventKind::kTrialComplete && event.trial_id == start.trial_id) break;
-    if (event.kind == EventKind::kTrialAborted && event.trial_id == start.trial_id) {
-      const FaultCode code = driver_.core().fault();
-      throw EngineFault(code, std::string("trial aborted: ") + fault_message(code));
-    }
-    if (event.kind == EventKind::kCommandRefused) {
-      throw EngineFault(driver_.core().fault(), std::string("the engine refused the trial: ") + event.refusal);
-    }
+  runner_.start(trajectory_, corrections_, record_, TrialRunner::Arming::kIfNeeded);
+  const TrialStatus& status = runner_.run_to_completion(driver_, stop_);
+  const bool arming = status.command == CommandKind::kArm;
+  switch (status.phase) {
+    case TrialPhase::kDone:
+      break;
+    case TrialPhase::kNotSent:
+      throw std::runtime_error(status.message);
+    case TrialPhase::kRefused:
+      throw EngineFault(status.fault,
+                        (arming ? "the engine refused to arm: " : "the engine refused the trial: ") + status.message);
+    case TrialPhase::kFaulted:
+      throw EngineFault(status.fault, "trial aborted: " + status.message);
+    case TrialPhase::kCancelled:
+      throw EngineFault(FaultCode::kEmergencyStop, "interrupted: valves vented");
+    default:
+      throw std::logic_error(std::string("LearningSession: the trial ended ") + to_string(status.phase));
   }
   IterationSummary summary =
       summarize_trial(iteration_, record_, corrections_, controller_.gas.ambient_bar, controller_.p_max_bar);

@@ -1,12 +1,12 @@
-// Trials and learning between them, driven through the engine like any operator would: arm, start
-// a trial (the engine settles at the trajectory's start, then runs it with the current correction),
-// wait for the record, hand it to the learning law for the next correction. The same code runs on
-// a simulated clock (headless, deterministic) and on the real-time loop (wall time).
+// Trials and learning between them, driven through the engine like any operator would: the trial
+// runner (engine/operator/trial_runner) arms it, starts a trial (the engine settles at the
+// trajectory's start, then runs it with the current correction) and waits for the record; the
+// learning law makes the next correction from it. The same code runs on a simulated clock
+// (headless, deterministic) and on the real-time loop (wall time).
 #pragma once
 
 #include <atomic>
 #include <memory>
-#include <stdexcept>
 #include <vector>
 
 #include "engine/rt/engine_driver.hpp"
@@ -16,6 +16,7 @@
 #include "engine/learning/learning_law.hpp"
 #include "engine/trial/trajectory.hpp"
 #include "engine/trial/trial_record.hpp"
+#include "engine/operator/trial_runner.hpp"
 
 namespace bellows {
 
@@ -33,16 +34,6 @@ struct IterationSummary {
 /// `correction_bar`: N values (one joint) or N x J, one column per joint.
 IterationSummary summarize_trial(int iteration, const TrialRecord& record, const Eigen::Ref<const Eigen::MatrixXd>& correction_bar,
                                  double ambient_bar, double p_max_bar);
-
-/// The engine faulted (or refused) while the session was running a trial. Carries the fault code.
-class EngineFault : public FaultError {  // exit status 3
- public:
-  EngineFault(FaultCode code, const std::string& message) : FaultError(message), code_(code) {}
-  FaultCode code() const { return code_; }
-
- private:
-  FaultCode code_;
-};
 
 class LearningSession {
  public:
@@ -77,10 +68,6 @@ class LearningSession {
   void set_stop_flag(const std::atomic<bool>* stop) { stop_ = stop; }
 
  private:
-  void ensure_armed();
-  /// Waits for the next event, letting engine time pass.
-  EngineEvent next_event();
-
   LearningSession(EngineDriver& driver, std::unique_ptr<SingleJointLearning> single, Trajectory trajectory,
                   const TimingParameters& timing, const ControllerParameters& controller);
 
@@ -95,7 +82,7 @@ class LearningSession {
   Eigen::MatrixXd feedback_bar_;      // N x J, the last trial's u_pid, for the law's input context
   TrialRecord record_;
   int iteration_ = 0;
-  std::uint32_t next_trial_id_ = 1;
+  TrialRunner runner_;
   std::vector<IterationSummary> history_;
   const std::atomic<bool>* stop_ = nullptr;
 };
