@@ -30,6 +30,9 @@ TEST(ConsoleTransfer, OffersWhatTheLastTrajectoryTaughtAndTakesItWithOneKey) {
   f.arm_valves();
   f.run_batch(7);  // iterations 0..7 (docs/iterations.md)
   ASSERT_EQ(f.state().experiment.trials.size(), 8u);
+  // The first autosave's note ("saved as it goes") is a status too: let it land before the offer
+  // it would otherwise replace on a loaded machine.
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().experiment.session_location.empty(); }));
   choose_steps(f);
   ASSERT_TRUE(f.pump_until([&] { return f.state().status.find("T: start from what") != std::string::npos; }, 50.0))
       << f.state().status;
