@@ -137,6 +137,20 @@ TEST(TrialRunner, AGuardFiringMidTrialEndsItFaultedWithTheFaultCode) {
   EXPECT_EQ(runner.poll().phase, TrialPhase::kFaulted);
 }
 
+// The snapshot's latest-value buffer has one reader: a runner that leaves it to another (the
+// LearningSession beside a console) follows the trial by events alone and never takes a snapshot.
+TEST(TrialRunner, ARunnerLeavingTheSnapshotToOthersNeverReadsIt) {
+  RunnerRig rig;
+  TrialRunner runner(rig.core, rig.config.timing, TrialRunner::Snapshot::kLeaveToOthers);
+  runner.start(rig.trajectory, rig.correction, rig.record, TrialRunner::Arming::kIfNeeded);
+  EXPECT_EQ(runner.run_to_completion(rig.clock).phase, TrialPhase::kDone);
+  EXPECT_TRUE(rig.record.complete);
+  TickRecord tick;
+  EXPECT_TRUE(rig.core.read_snapshot(tick)) << "the runner took the snapshot its reader was owed";
+  EXPECT_GT(tick.time_s, 0.0);
+  EXPECT_EQ(runner.latest_tick().time_s, 0.0);
+}
+
 TEST(TrialRunner, AnUnarmedEngineRefusesATrialThatMustNotArm) {
   RunnerRig rig;
   TrialRunner runner(rig.core, rig.config.timing);

@@ -68,7 +68,7 @@ LearningSession::LearningSession(EngineDriver& driver, JointLearning& learning, 
       corrections_(Eigen::MatrixXd::Zero(trajectory_.learning_samples(), trajectory_.joints())),
       next_corrections_(trajectory_.learning_samples(), trajectory_.joints()),
       feedback_bar_(trajectory_.learning_samples(), trajectory_.joints()),
-      runner_(driver.core(), timing) {
+      runner_(driver.core(), timing, TrialRunner::Snapshot::kLeaveToOthers) {
   if (learning.samples() != trajectory_.learning_samples()) {
     throw InputError("learning law built for " + std::to_string(learning.samples()) + " samples, trajectory has " +
                      std::to_string(trajectory_.learning_samples()));

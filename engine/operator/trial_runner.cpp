@@ -21,8 +21,9 @@ const char* to_string(TrialPhase phase) {
   return "?";
 }
 
-TrialRunner::TrialRunner(EngineCore& core, const TimingParameters& timing)
+TrialRunner::TrialRunner(EngineCore& core, const TimingParameters& timing, Snapshot snapshot)
     : core_(core),
+      reads_snapshot_(snapshot == Snapshot::kRead),
       ticks_per_sample_(timing.ticks_per_sample),
       settle_ticks_(static_cast<int>(std::lround(timing.settle_s / timing.tick_s))) {}
 
@@ -129,11 +130,11 @@ bool TrialRunner::observe(const TickRecord& tick) {
 const TrialStatus& TrialRunner::poll() {
   EngineEvent event;
   while (core_.poll_event(event)) observe(event);
-  if (core_.read_snapshot(latest_)) observe(latest_);
+  if (reads_snapshot_ && core_.read_snapshot(latest_)) observe(latest_);
   if (cancelling_ && status_.in_progress() && core_.state() == EngineState::kFault) {
     status_.fault = core_.fault();
     status_.message = "stopped: valves vented";
-    finish(TrialPhase::kCancelled, latest_.time_s);
+    finish(TrialPhase::kCancelled, reads_snapshot_ ? latest_.time_s : status_.time_s);
   }
   return status_;
 }

@@ -67,7 +67,15 @@ class TrialRunner {
     kMustBeArmed,  // never arm: an operator arms (the console); the engine refuses a trial unarmed
   };
 
-  TrialRunner(EngineCore& core, const TimingParameters& timing);
+  /// Whether poll() reads the engine's snapshot. Its latest-value buffer has exactly one reader
+  /// thread: a runner beside another reader (a console's, a test's consumer) follows the trial by
+  /// the engine's events alone and leaves the snapshot to that reader.
+  enum class Snapshot {
+    kRead,          // poll() reads it: the trial's progress, and run_to_completion's after_poll sees ticks
+    kLeaveToOthers  // poll() reads events only (LearningSession: `bellows run`, or beside a console)
+  };
+
+  TrialRunner(EngineCore& core, const TimingParameters& timing, Snapshot snapshot = Snapshot::kRead);
 
   /// Prepares `record` to the trajectory's samples and joints and starts the trial with
   /// `correction_bar` (N x J). The engine reads and writes all three until the trial is finished():
@@ -76,8 +84,8 @@ class TrialRunner {
   const TrialStatus& start(const Trajectory& trajectory, const Eigen::MatrixXd& correction_bar, TrialRecord& record,
                            Arming arming);
 
-  /// Reads every pending engine event and the latest snapshot, and moves the trial on. For callers
-  /// that read neither themselves (the engine has one reader of each).
+  /// Reads every pending engine event and (Snapshot::kRead) the latest snapshot, and moves the trial
+  /// on. For callers that read neither themselves (the engine has one reader of each).
   const TrialStatus& poll();
   /// For a caller that reads the engine's events itself: one of them. True if the trial moved.
   bool observe(const EngineEvent& event);
@@ -105,6 +113,7 @@ class TrialRunner {
   bool send(const EngineCommand& command);
 
   EngineCore& core_;
+  bool reads_snapshot_ = true;
   int ticks_per_sample_ = 0;
   int settle_ticks_ = 0;
   TrialStatus status_;
