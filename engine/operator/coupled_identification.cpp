@@ -8,6 +8,7 @@
 
 #include "engine/base/errors.hpp"
 #include "engine/base/units.hpp"
+#include "engine/operator/levenberg_marquardt.hpp"
 
 namespace bellows {
 namespace {
@@ -163,42 +164,14 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
   fit.initial = initial;
   Eigen::VectorXd p = to_parameters(initial);
   const Eigen::VectorXd steps = difference_steps(initial);
-  Eigen::VectorXd r = residual(p);
-  double cost = r.squaredNorm();
-  if (!std::isfinite(cost)) throw InputError("identification: the coupled model's starting point is unstable on the data");
-  double damping = 1e-3;  // Levenberg-Marquardt
-  Eigen::MatrixXd jacobian(total, p.size());
-  for (fit.iterations = 1; fit.iterations <= kCoupledFitMaxIterations; ++fit.iterations) {
-    for (Eigen::Index i = 0; i < p.size(); ++i) {
-      Eigen::VectorXd q = p;
-      q(i) += steps(i);
-      jacobian.col(i) = (residual(q) - r) / steps(i);
-    }
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
-    const Eigen::VectorXd gradient = jacobian.transpose() * r;
-    bool improved = false;
-    for (int attempt = 0; attempt < 20 && !improved; ++attempt) {
-      Eigen::MatrixXd lhs = normal;
-      lhs.diagonal() += damping * normal.diagonal();
-      const Eigen::VectorXd candidate = p - lhs.ldlt().solve(gradient);
-      const Eigen::VectorXd candidate_residual = residual(candidate);
-      const double candidate_cost = candidate_residual.squaredNorm();
-      if (std::isfinite(candidate_cost) && candidate_cost < cost) {
-        const double decrease = (cost - candidate_cost) / cost;
-        p = candidate;
-        r = candidate_residual;
-        cost = candidate_cost;
-        damping = std::max(damping / 3.0, 1e-9);
-        improved = true;
-        if (decrease < kCoupledFitRelativeCostTolerance) fit.converged = true;
-      } else {
-        damping *= 4.0;
-      }
-    }
-    if (!improved) fit.converged = true;  // no direction lowers the cost: a minimum
-    if (fit.converged) break;
-  }
-  fit.iterations = std::min(fit.iterations, kCoupledFitMaxIterations);
+  const Eigen::VectorXd start_residual = residual(p);
+  if (!std::isfinite(start_residual.squaredNorm())) throw InputError("identification: the coupled model's starting point is unstable on the data");
+  const LeastSquaresSolution<Eigen::VectorXd> solution = levenberg_marquardt(
+      residual, p, start_residual, steps, kCoupledFitMaxIterations, kCoupledFitRelativeCostTolerance);
+  fit.iterations = solution.iterations;
+  fit.converged = solution.converged;
+  p = solution.parameters;
+  const double cost = solution.cost;
   fit.dynamics = from_parameters(p, J);
   fit.fit_percent = joint_fit_percent(fit.dynamics, trials);
   fit.rms_residual_deg = std::sqrt(cost / static_cast<double>(total)) / kRadPerDeg;

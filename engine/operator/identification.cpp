@@ -13,6 +13,7 @@
 #include "engine/base/errors.hpp"
 #include "engine/model/valve_flow.hpp"
 #include "engine/base/units.hpp"
+#include "engine/operator/levenberg_marquardt.hpp"
 
 namespace bellows {
 namespace {
@@ -155,42 +156,14 @@ ArmModelFit fit_arm_model(const IdentificationData& data, const ModelParameters&
     if (stop_is_requested(stop)) throw Cancelled("identification stopped by a signal");
     return simulate_arm_angle(from_log_parameters(q), data) - data.angle_rad;
   };
-  Eigen::VectorXd r = residual(p);
-  double cost = r.squaredNorm();
-  double damping = 1e-3;  // Levenberg-Marquardt
-  Eigen::MatrixXd J(n, 3);
-  for (fit.iterations = 1; fit.iterations <= kMaxIterations; ++fit.iterations) {
-    for (int i = 0; i < 3; ++i) {
-      constexpr double step = 1e-6;
-      Eigen::Vector3d q = p;
-      q(i) += step;
-      J.col(i) = (residual(q) - r) / step;
-    }
-    const Eigen::Matrix3d normal = J.transpose() * J;
-    const Eigen::Vector3d gradient = J.transpose() * r;
-    bool improved = false;
-    for (int attempt = 0; attempt < 20 && !improved; ++attempt) {
-      Eigen::Matrix3d lhs = normal;
-      lhs.diagonal() += damping * normal.diagonal();
-      const Eigen::Vector3d candidate = p - lhs.ldlt().solve(gradient);
-      const Eigen::VectorXd candidate_residual = residual(candidate);
-      const double candidate_cost = candidate_residual.squaredNorm();
-      if (std::isfinite(candidate_cost) && candidate_cost < cost) {
-        const double decrease = (cost - candidate_cost) / cost;
-        p = candidate;
-        r = candidate_residual;
-        cost = candidate_cost;
-        damping = std::max(damping / 3.0, 1e-9);
-        improved = true;
-        if (decrease < kRelativeCostTolerance) fit.converged = true;
-      } else {
-        damping *= 4.0;
-      }
-    }
-    if (!improved) fit.converged = true;  // no direction lowers the cost: a minimum
-    if (fit.converged) break;
-  }
-  fit.iterations = std::min(fit.iterations, kMaxIterations);
+  const Eigen::Vector3d difference_steps = Eigen::Vector3d::Constant(1e-6);  // in log parameters
+  const LeastSquaresSolution<Eigen::Vector3d> solution =
+      levenberg_marquardt(residual, p, residual(p), difference_steps, kMaxIterations, kRelativeCostTolerance);
+  fit.iterations = solution.iterations;
+  fit.converged = solution.converged;
+  p = solution.parameters;
+  const Eigen::VectorXd& r = solution.residual;
+  const double cost = solution.cost;
   fit.model = from_log_parameters(p);
   fit.fit_percent = normalized_fit_percent(data.angle_rad, data.angle_rad + r);
   fit.rms_residual_deg = std::sqrt(cost / static_cast<double>(n)) * 180.0 / std::numbers::pi;
