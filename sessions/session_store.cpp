@@ -21,6 +21,7 @@
 #include "sessions/record_columns.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
+#include "sessions/uncommitted_files.hpp"
 
 namespace bellows {
 namespace fs = std::filesystem;
@@ -178,7 +179,7 @@ Session load_session(const DirectoryHandle& directory) {
     const int index = static_cast<int>(i);
     IterationData& data = session.iterations[i];
     const IterationEntry& entry = m.iterations[i];
-    const std::string samples_file = session_layout::samples_file(index);
+    const std::string samples_file = session_layout::samples_file(index, entry.samples_revision);
     const std::string telemetry_file = session_layout::telemetry_file(index);
     const std::size_t ticks = rows * static_cast<std::size_t>(config.timing.ticks_per_sample);
     parse_samples_csv(read_session_file(folders, samples_file, csv_size_limit(header_views(samples_names), rows + 1),
@@ -204,7 +205,15 @@ Session load_session(const DirectoryHandle& directory) {
     session.black_boxes.push_back(
         parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity), where + file, entry.ticks));
   }
+  session.dropped = describe_dropped(find_uncommitted_files(directory, m));
   return session;
+}
+
+std::string dropped_line(const Session& session) {
+  if (session.dropped.empty()) return "";
+  const auto n = static_cast<long long>(session.iterations.size());
+  return describe_session(session.directory) + ": a save was interrupted; dropped what it had not committed: " +
+         session.dropped + "; this is its last committed state (" + std::to_string(n) + (n == 1 ? " iteration)" : " iterations)");
 }
 
 void save_session(const Session& session, const fs::path& directory) {
