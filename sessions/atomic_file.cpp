@@ -29,7 +29,13 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
   const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
   const std::string name = path.filename().string();
   if (name.empty() || name == "." || name == "..") throw InputError("cannot write " + path.string() + ": not a file name");
-  write_file_atomic_at(DirectoryHandle::open(directory), name, contents, directory_sync, replace);
+  std::optional<DirectoryHandle> folder;
+  try {
+    folder.emplace(DirectoryHandle::open(directory));
+  } catch (const InputError& error) {
+    throw InputError("cannot create " + path.string() + ": " + error.what());
+  }
+  write_file_atomic_at(*folder, name, contents, directory_sync, replace);
 }
 
 PrivateTemporaryDirectory::PrivateTemporaryDirectory(const DirectoryHandle& folder, const std::string& name)
