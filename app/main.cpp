@@ -169,6 +169,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
+  io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");

@@ -231,10 +231,11 @@ void ConsoleController::on_event(const EngineEvent& event) {
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
-      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint};
+      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint,
+                                    event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(event.fault))};
       black_box_pending_ = true;
-      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), fault_message(event.fault)), true, event.time_s);
-      set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);
+      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), state_.fault_view.detail.c_str()), true, event.time_s);
+      set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), state_.fault_view.detail.c_str()), true);
       state_.dialog = {};
       state_.screen = Screen::kFault;
       if (stop_pending_ && env_.core->emergency_stop_delivered()) on_emergency_stop_delivered();

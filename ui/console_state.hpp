@@ -138,6 +138,7 @@ struct FaultView {
   std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
   std::string where;                  // on a J-joint arm: the joint (and chamber) the guard fired on
   int joint = -1;                     // the joint the engine named (0-based); -1: no joint's
+  std::string detail;                 // the fault's own sentence (a device's words: the rig's reason, the link's silence)
 };
 
 struct ConsoleState;

@@ -114,7 +114,7 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   // The guard and what it means, then when it vented: wrapped, never cut off.
   int y = body.y;
   const int x = c.put(body.x + 1, y, format(" %s ", fault_name(f.code)), Role::kFault, true);
-  for (const std::string& line : wrap(fault_message(f.code), body.right() - x - 2)) {
+  for (const std::string& line : wrap(f.detail.empty() ? std::string(fault_message(f.code)) : f.detail, body.right() - x - 2)) {
     c.put(x + 1, y++, line, Role::kWarning, true);
   }
   if (!f.where.empty()) {  // which joint (and chamber), on an arm with several

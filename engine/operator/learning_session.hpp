@@ -29,6 +29,7 @@ struct IterationSummary {
   double max_abs_correction_bar = 0.0;  // of the correction applied in this trial
   int saturated_samples = 0;            // samples (of any joint) whose total input was clamped
   JointVector joint_rms_deg = JointVector::Zero(1);  // per joint, samples 1..N
+  int held_samples = 0;                 // samples without a fresh reading (TrialRecord::held): error 0, not learned from
 };
 
 /// `correction_bar`: N values (one joint) or N x J, one column per joint.
