@@ -75,10 +75,17 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   }
   const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
   if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
-  if (s.session_id == 0) {  // a free rig's offer
+  // The rig addressed, tripped: it names this session with NO_SESSION and a new offer (docs/lcm-protocol.md).
+  const bool tripped_ours = s.session_id == session_id_ && s.rig_id == rig_id_ && s.binding != binding_ &&
+                            (s.fault_bits & io_state_t::FAULT_NO_SESSION) != 0;
+  if (s.session_id == 0 || tripped_ours) {  // a free rig's offer
     // Ours dropped this session (timeout, angle range): a rig that offers at once, without a tripped
     // state naming this session, still gives its reason in the offer's bits.
     if (s.rig_id == rig_id_ && bound_ && last_armed_) report_trip(s, true);
+    if (tripped_ours) {  // the rig's last word on this session: its reason, in the report too
+      last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
+      bump(rig_fault_states_);
+    }
     if (s.rig_id == rig_id_) bound_ = false;
     // Never switch while the valves are live; while vented, take the offer of any free rig until one
     // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
@@ -189,6 +196,15 @@ void LcmDevice::explain_silence(double silent_s, DeviceFault& fault) const {
               static_cast<unsigned long long>(forged));
     return;
   }
+  // The I/O thread's last turn: if it did not run, this host stalled, not the link.
+  const double io_idle_s = monotonic_s() - io_turn_s_.load(relaxed);
+  if (io_idle_s >= 0.5 * silent_s && io_idle_s < 1e6) {
+    fault.set(FaultCode::kLinkLost, -1,
+              "no state of the LCM rig %llx reached the engine for %.0f ms: this host's LCM I/O thread did not run for "
+              "%.0f ms (the machine stalled: lighten its load, --rt enforce)",
+              rig, silent_s * 1e3, io_idle_s * 1e3);
+    return;
+  }
   const double silence_s = rig_silent_s_.load(relaxed);
   if (silence_s >= 0.5 * silent_s) {  // nothing at all arrived in the window (give or take the I/O thread's turn)
     if (std::isfinite(silence_s)) {
@@ -210,6 +226,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
   now_s_ = now_s;
   // How long the rig addressed has said nothing at all, on this thread's clock (explain_silence()).
   rig_silent_s_.store(rig_id_ == 0 ? INFINITY : now_s - last_rig_state_s_, std::memory_order_relaxed);
+  io_turn_s_.store(monotonic_s(), std::memory_order_relaxed);
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.

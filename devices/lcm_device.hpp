@@ -148,6 +148,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};
   std::atomic<double> last_state_s_{-1.0};
+  std::atomic<double> io_turn_s_{INFINITY};  // monotonic_s() of the I/O thread's last service() turn
   std::atomic<double> rig_silent_s_{INFINITY};  // since the addressed rig's last valid state of any kind (I/O clock)
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};
