@@ -21,6 +21,8 @@
 #include "sessions/record_columns.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
+#include "sessions/session_lock.hpp"
+#include "sessions/atomic_file.hpp"
 
 namespace bellows {
 namespace fs = std::filesystem;
@@ -128,6 +130,35 @@ void validate_session_name(const std::string& name) {
   if (name.find('/') != std::string::npos || printable(name, name.size() * 8) != name) {
     throw InputError(what + " must be a plain directory name (no '/', no control characters)");
   }
+}
+
+std::string session_name_refusal(const std::string& name, const fs::path& parent) {
+  try {
+    validate_session_name(name);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  std::error_code error;
+  if (fs::symlink_status(parent / name, error).type() != fs::file_type::not_found) {
+    return "a session named '" + printable(name) + "' exists already";
+  }
+  return {};
+}
+
+fs::path rename_session(const fs::path& directory, const std::string& new_name) {
+  const fs::path parent = directory.parent_path();
+  if (const std::string why = session_name_refusal(new_name, parent); !why.empty()) throw InputError(why);
+  SessionManifest manifest = load_manifest(directory);
+  const fs::path target = parent / new_name;
+  const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
+  std::error_code error;
+  fs::rename(directory, target, error);
+  if (error) throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " + error.message());
+  manifest.name = new_name;  // the manifest names its session too
+  manifest.updated_utc = utc_now();
+  write_file_atomic(target / session_layout::kManifest, format_manifest(manifest));
+  sync_directory(parent.empty() ? fs::path(".") : parent);
+  return target;
 }
 
 fs::path resolve_session_dir(const std::string& path_or_name, const fs::path& data_dir) {
