@@ -35,6 +35,7 @@ class StoreSessionGateway final : public ui::SessionGateway {
   ui::SessionSnapshot open(const std::string& location) override;
   ui::SessionSnapshot read_trials(const std::string& location) override;
   std::string rename(const std::string& name) override;
+  std::string name_refusal(const std::string& location, const std::string& name) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
 

@@ -66,6 +66,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   controller->start(start_s);
   Canvas canvas(terminal->width(), terminal->height());
   FramePacer pacer;
+  std::uint64_t repaints_done = 0;
 
   while (!controller->quit_requested()) {
     int key = terminal->read_key(kKeyTimeoutMs);
@@ -89,6 +90,10 @@ ConsoleReport run_console(ConsoleSetup setup) {
     if (setup.exit_after_s > 0.0 && now - start_s >= setup.exit_after_s) {
       report.exited_after_time = true;
       break;
+    }
+    if (controller->repaints() != repaints_done) {
+      repaints_done = controller->repaints();
+      terminal->repaint();
     }
     if (pacer.should_draw(now, controller->revision(), controller->active())) {
       render(controller->state(), canvas);
