@@ -67,6 +67,7 @@ struct FigureBuilder {
   std::string extra;  // more settings (ticks, a zero line)
   std::vector<Curve> curves;
   std::vector<bool> on_top;
+  std::string legend_heading = {};  // the legend's own title (plain text, no quote)
 
   void add(Curve curve, bool top = false) {
     curves.push_back(std::move(curve));
@@ -85,7 +86,9 @@ struct FigureBuilder {
       }
       if (c.points.x != nullptr) points.push_back(c.points);
     }
-    const PlotLayout layout = plot_layout(points, x, legend, style, log_y);
+    legend.heading_chars = static_cast<int>(legend_heading.size());
+    PlotLayout layout = plot_layout(points, x, legend, style, log_y);
+    layout.key_heading = legend_heading;
     std::string& p = f.plot;
     if (style.titles && !title.empty()) p += "set title " + gp_quoted(title) + " noenhanced\n";
     p += "set xlabel " + gp_quoted(xlabel) + "\nset ylabel " + gp_quoted(ylabel) + "\n";
@@ -239,23 +242,26 @@ Figure pressure_figure(const Session& session, int trial, const FigureStyle& sty
   std::string data = data_block("pressures", {&time_s, &t.pressure_a_bar, &t.pressure_b_bar, &t.setpoint_a_bar, &t.setpoint_b_bar, &t.supply_bar});
   FigureBuilder b{style, "Pressures, iteration " + std::to_string(trial) + ": " + session.manifest.name, "time [s]",
                   "pressure [bar abs]", time_range(session), false, {}, {}, {}};
-  b.add({"$pressures using 1:2 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberAColour) + "'", "chamber A",
+  b.add({"$pressures using 1:2 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberAColour) + "'", "A measured",
          {&time_s, &t.pressure_a_bar}});
-  b.add({"$pressures using 1:3 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberBColour) + "'", "chamber B",
+  b.add({"$pressures using 1:4 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberAColour) + "' dashtype 2", "A set point",
+         {&time_s, &t.setpoint_a_bar}}, true);
+  b.add({"$pressures using 1:3 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberBColour) + "'", "B measured",
          {&time_s, &t.pressure_b_bar}});
-  b.add({"$pressures using 1:4 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberAColour) + "' dashtype 2", "chamber A set point", {&time_s, &t.setpoint_a_bar}}, true);
-  b.add({"$pressures using 1:5 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberBColour) + "' dashtype 2", "chamber B set point", {&time_s, &t.setpoint_b_bar}}, true);
+  b.add({"$pressures using 1:5 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberBColour) + "' dashtype 2", "B set point",
+         {&time_s, &t.setpoint_b_bar}}, true);
   // The supply (3 bar on the paper's rig) squeezed the chambers into the bottom of the axis: drawn
-  // only when it is near their range, else named in the legend.
-  double low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
-  double high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(), t.setpoint_b_bar.maxCoeff()});
+  // only when it is near their range, else named in the legend's title.
+  const double low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
+  const double high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(), t.setpoint_b_bar.maxCoeff()});
   const double supply = t.supply_bar.size() > 0 ? t.supply_bar.mean() : 0.0;
   if (supply <= high + 0.25 * (high - low)) {
     b.add({"$pressures using 1:6 with lines linewidth 1 linecolor rgb '#999999' dashtype 3", "supply", {&time_s, &t.supply_bar}});
+    b.legend_heading = "chambers";
   } else {
-    char entry[64];
-    std::snprintf(entry, sizeof entry, "supply %.2f bar (off scale)", supply);
-    b.add({"keyentry with lines linecolor rgb '#ffffff'", entry, {}});
+    char heading[64];
+    std::snprintf(heading, sizeof heading, "chambers (supply %.2f bar abs)", supply);
+    b.legend_heading = heading;
   }
   return b.build("pressures", std::move(data));
 }

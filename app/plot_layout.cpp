@@ -14,7 +14,8 @@ constexpr double kMarginFraction = 0.04;  // of the data's span, each side of th
 // the box's padding (measured on the paper-column figures).
 constexpr double kAxesWidthShare = 0.78, kAxesHeightShare = 0.74, kTitleHeightShare = 0.06;
 constexpr double kBoxClearance = 0.03;  // of the axes' span, around the legend's box
-constexpr double kCharWidthEm = 0.6, kRowHeightEm = 1.0, kBoxHeightEm = 1.0, kSampleChars = 8.0;
+constexpr double kCharWidthEm = 0.6, kRowHeightEm = 1.0, kBoxHeightEm = 1.0;
+constexpr double kEntryChars = 6.5, kBoxChars = 2.0;  // beyond its title: an entry's sample, a box's padding
 
 double transformed(double y, bool log_y) { return log_y ? std::log10(y) : y; }
 
@@ -29,8 +30,9 @@ LegendBox legend_box(const LegendSize& legend, const FigureStyle& style, int col
   const double axes_width_in = style.width_in * kAxesWidthShare;
   const double axes_height_in = style.height_in * (kAxesHeightShare - (style.titles ? kTitleHeightShare : 0.0));
   const int rows = (legend.rows + columns - 1) / std::max(1, columns);
-  const double width_in = columns * (legend.widest_title + kSampleChars) * kCharWidthEm * em_in;
-  const double height_in = (rows * kRowHeightEm + kBoxHeightEm) * em_in;
+  const double entries_chars = columns * (legend.widest_title + kEntryChars);
+  const double width_in = (std::max(entries_chars, legend.heading_chars + 1.0) + kBoxChars) * kCharWidthEm * em_in;
+  const double height_in = ((rows + (legend.heading_chars > 0 ? 1 : 0)) * kRowHeightEm + kBoxHeightEm) * em_in;
   return {width_in / axes_width_in, height_in / axes_height_in, columns};
 }
 
@@ -98,7 +100,7 @@ PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, con
                                        {"bottom right", true, false, column}, {"bottom left", false, false, column}};
   for (int columns = 2; columns <= legend.rows; ++columns) {
     const LegendBox across = legend_box(legend, style, columns);
-    if (across.width > 0.95) break;
+    if (across.width > 1.0) break;
     candidates.push_back({"top center", false, true, across});
   }
   for (Candidate& c : candidates) measure(c, series, x, low, high, margin, log_y);
@@ -124,12 +126,13 @@ PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, con
 }
 
 std::string layout_commands(const PlotLayout& layout) {
-  char text[400];
+  char text[600];
   std::snprintf(text, sizeof text,
                 "set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n"
-                "set key inside %s %s reverse Left samplen 2 spacing 1.0 width 1 opaque box linecolor rgb '#b0b0b0'\n",
+                "set key inside %s %s reverse Left samplen 2 spacing 1.0 width 1 opaque box linecolor rgb '#b0b0b0'%s\n",
                 layout.x.low, layout.x.high, layout.y.low, layout.y.high, layout.key_corner.c_str(),
-                layout.key_columns > 1 ? ("horizontal maxcols " + std::to_string(layout.key_columns)).c_str() : "vertical");
+                layout.key_columns > 1 ? ("horizontal maxcols " + std::to_string(layout.key_columns)).c_str() : "vertical",
+                layout.key_heading.empty() ? "" : (" title '" + layout.key_heading + "' noenhanced").c_str());
   return text;
 }
 
