@@ -223,6 +223,11 @@ std::string StoreSessionGateway::name_refusal(const std::string& location, const
   return session_name_refusal(name, directory.parent_path());
 }
 
+void StoreSessionGateway::read_quietly(const std::function<void()>& read) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  read();
+}
+
 std::string StoreSessionGateway::rename(const std::string& name) {
   const std::lock_guard<std::mutex> guard(mutex_);
   if (!writer_) throw InputError("nothing to name yet: the session is created with the first trial");
