@@ -2,6 +2,7 @@
 #include "app/memory_policy.hpp"
 
 #include <cstdio>
+#include <optional>
 #include <ctime>
 #include <sstream>
 
@@ -154,19 +155,27 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const ui::Experiment& e = snapshot.experiment;
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
-  const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
+  // A session this gateway created whose first save then failed is continued, not created twice.
+  const bool continuing =
+      writer_ && (e.session_location.empty()
+                      ? unconfirmed_events_ != kConfirmed && writer_->manifest().trajectory_name == e.trajectory->name &&
+                            writer_->manifest().iterations.empty()
+                      : writer_->directory() == e.session_location);
+  const std::size_t saved_events = e.session_location.empty() && continuing ? unconfirmed_events_ : e.saved_events;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
   const std::size_t held = snapshot.events.size();
   const std::size_t first_held = snapshot.events_total - held;
-  const std::size_t first_new = continuing ? std::max(e.saved_events, first_held) - first_held : 0;
+  const std::size_t first_new = continuing ? std::max(saved_events, first_held) - first_held : 0;
 
   // The snapshot's trials are iterations first_trial..; the trial of iteration i is at i - first_trial.
   const auto first = static_cast<std::size_t>(snapshot.first_trial);
   const std::size_t end = first + e.trials.size();
   const auto trial_at = [&](std::size_t iteration) -> const ui::Trial& { return e.trials[iteration - first]; };
   std::size_t first_trial = 0;
+  std::optional<SessionWriter::Batch> batch;  // one console save, one commit (the manifest's rename)
   if (continuing) {
+    batch.emplace(*writer_);
     first_trial = writer_->manifest().iterations.size();
     if (first_trial > end) throw InputError("the session on disk has more iterations than the console");
     if (first_trial < first) throw std::logic_error("StoreSessionGateway::save: unsaved iterations missing from the snapshot");
@@ -203,6 +212,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     }
     writer_.reset();  // the previous session's lock goes first
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
+    unconfirmed_events_ = snapshot.events_total;  // in its header already
+    batch.emplace(*writer_);
   }
   for (std::size_t i = first_trial; i < end; ++i) {
     const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
@@ -212,6 +223,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
+  batch->commit();
+  unconfirmed_events_ = kConfirmed;
   return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
 }
@@ -307,9 +320,15 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   e.saved_trials = static_cast<int>(e.trials.size());
   e.saved_faults = static_cast<int>(e.faults.size());
   snapshot.events = log_of(m);
+  if (const std::string dropped = dropped_line(loaded); !dropped.empty()) {  // the writer removed it: say so once
+    const std::string now = utc_now();
+    snapshot.events.push_back({local_clock_of(now), -1.0, ui::LogSource::kSession, dropped, true, false, now,
+                               static_cast<int>(loaded.iterations.size())});
+  }
   snapshot.events_total = snapshot.events.size();
   writer_.reset();
   writer_.emplace(std::move(writer));
+  unconfirmed_events_ = kConfirmed;
   return snapshot;
 }
 

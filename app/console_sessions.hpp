@@ -51,6 +51,9 @@ class StoreSessionGateway final : public ui::SessionGateway {
   std::filesystem::path data_dir_;  // empty: not available (reason_ says why)
   std::string reason_;
   std::optional<SessionWriter> writer_;  // the session the console saves into
+  /// After a new session's first save failed past its creation: the log entries its header holds.
+  static constexpr std::size_t kConfirmed = static_cast<std::size_t>(-1);
+  std::size_t unconfirmed_events_ = kConfirmed;
 };
 
 /// "2024-05-01T14:03:07.123Z" as local time "2024-05-01 14:03" (the text itself if it does not parse).

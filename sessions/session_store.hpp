@@ -54,6 +54,11 @@ Session load_session(const DirectoryHandle& directory);
 /// (figures) reads those alone.
 Session load_session_iterations(const std::filesystem::path& directory, const std::vector<int>& only);
 
+/// The one line that says what an interrupted save dropped (Session::dropped), "" when nothing:
+/// "session S: a save was interrupted; dropped what it had not committed: iteration 5; this is its
+/// last committed state (5 iterations)".
+std::string dropped_line(const Session& session);
+
 /// Writes `session` as a new directory `directory` (which must not exist yet), atomically: the
 /// directory appears complete or not at all.
 void save_session(const Session& session, const std::filesystem::path& directory);

@@ -471,13 +471,13 @@ TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
   EXPECT_EQ(e.unsaved_sentence(), "");
   e.trials.resize(3);
   e.saved_trials = 2;
-  EXPECT_EQ(e.unsaved_sentence(), "1 iteration is not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "iteration 2 is not saved.");
   e.saved_trials = 0;
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2) are not saved.");
   e.faults.resize(1);
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations and 1 fault's black box are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2) and 1 fault's black box are not saved.");
   e.settings_changed = true;
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations, 1 fault's black box and changed settings are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2), 1 fault's black box and changed settings are not saved.");
   e.saved_trials = 3;
   e.faults.resize(2);
   e.settings_changed = false;
@@ -485,6 +485,9 @@ TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
   e.saved_faults = 2;
   e.settings_changed = true;
   EXPECT_EQ(e.unsaved_sentence(), "changed settings are not saved.");
+  e.settings_changed = false;
+  e.next_unsaved = true;  // learned after the last trial was saved
+  EXPECT_EQ(e.unsaved_sentence(), "the correction learned from iteration 2 is not saved.");
 }
 
 TEST(UiController, AFaultsBlackBoxIsSavedAtOnceAndAStopIsVentedOnlyWhenTheEngineActed) {

@@ -99,6 +99,12 @@ class ConsoleController {
   bool quit_requested() const { return quit_requested_; }
   /// Bumped by Ctrl-L: the terminal repaints every cell (clears what another program or a glitch left).
   std::uint64_t repaints() const { return repaints_; }
+  /// What is not on disk, naming the trials ("iteration 4 is not saved."); empty when everything
+  /// is. The quit confirmation names it; a failed save says it and keeps the data in memory.
+  std::string unsaved_work() const { return state_.experiment.unsaved_sentence(); }
+  /// Quitting now leaves work the disk did not take although saving is available (a failed save,
+  /// or one not finished): the console then says so and exits non-zero (status 4).
+  bool quitting_loses_work() const { return state_.sessions_available && !unsaved_work().empty(); }
   /// Bumped by every discrete change (keys, events, results): the screen needs a redraw.
   std::uint64_t revision() const { return revision_; }
   /// Trials or learning in progress: the screen changes continuously.
