@@ -133,8 +133,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
       return zero_rig_angle(opened, path, read_rad);
     };
   }
-  setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
-    return write_console_figures(snapshot, root);
+  setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location, int iterations) {
+    return write_console_figures(location, iterations, root, [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
   };
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
@@ -168,6 +168,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   if (report.dropped_events > 0) out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
   out << std::flush;
   if (report.stopped_by_signal) return 128 + stop_signal();
+  // The operator quit with work the disk did not take (a failed save, confirmed): the environment
+  // refused, and a script must not take the run for a saved one.
+  if (report.unsaved_work_lost) return 4;
   return 0;
 }
 

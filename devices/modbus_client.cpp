@@ -52,8 +52,16 @@ void ModbusClient::set_response_timeout(double timeout_s) {
 bool ModbusClient::failed() {
   const int error = errno;
   last_error_ = modbus_strerror(error);
-  if (error > MODBUS_ENOBASE && error < MODBUS_ENOBASE + 20) {
+  // Only codes 1..11 are exceptions the device sent (libmodbus's EMBXILFUN..EMBXGTAR); the codes
+  // after them are libmodbus's own findings about a response, which the device did not report.
+  if (error >= EMBXILFUN && error <= EMBXGTAR) {
     last_error_ += " (Modbus exception " + std::to_string(error - MODBUS_ENOBASE) + ")";
+  } else if (error == EMBBADDATA) {
+    last_error_ += " (a framing or transaction-id mismatch: the response does not answer the request; the device sent no exception)";
+  } else if (error == EMBBADSLAVE) {
+    last_error_ += " (the response came from another unit id; the device sent no exception)";
+  } else if (error == EMBMDATA || error == EMBBADEXC || error == EMBBADCRC) {
+    last_error_ += " (a malformed response; the device sent no exception)";
   }
   return false;
 }
