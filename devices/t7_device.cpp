@@ -326,7 +326,16 @@ bool T7Device::exchange(const ValveCommand& valves) {
     bump(link_errors_);
     // A late answer stays on the connection and is dropped by its transaction id; a lost
     // connection is opened again by the next request (the old one closed first).
-    fail_link(client_.last_exception() != 0 ? refusal(failed_at == write_at ? "writing" : "reading", failed_at) : client_.last_error());
+    if (client_.last_exception() != 0) {
+      const std::string why = refusal(failed_at == write_at ? "writing" : "reading", failed_at);
+      if (!refusal_pending_.load(std::memory_order_acquire)) {  // the engine took the last one
+        std::snprintf(refusal_text_.data(), refusal_text_.size(), "t7 %s: %s", address_.c_str(), why.c_str());
+        refusal_pending_.store(true, std::memory_order_release);
+      }
+      fail_link(why);
+    } else {
+      fail_link(client_.last_error());
+    }
     return false;
   }
   record_round_trip((end - start) * 1e3);
@@ -419,6 +428,13 @@ RawInputs T7Device::raw_inputs() const {
     }
   }
   return raw;
+}
+
+bool T7Device::take_refusal(std::array<char, kRefusalChars>& text) {
+  if (!refusal_pending_.load(std::memory_order_acquire)) return false;
+  text = refusal_text_;
+  refusal_pending_.store(false, std::memory_order_release);
+  return true;
 }
 
 bool T7Device::wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const {

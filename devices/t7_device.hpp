@@ -19,6 +19,7 @@
 // keeps reading every tick, which keeps the watchdog fed and raw_inputs() live.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -85,6 +86,15 @@ class T7Device final : public Device {
   /// Answers to timed-out requests dropped by transaction id, and connections opened again.
   std::uint64_t late_answers() const { return late_answers_.load(std::memory_order_relaxed); }
   std::uint64_t reconnects() const { return reconnects_.load(std::memory_order_relaxed); }
+  /// A request the T7 refused during the run (a Modbus exception): once per refusal, its sentence
+  /// naming the register and LabJack's error ("t7 HOST:PORT: writing DIO2_EF_CONFIG_A (44304)
+  /// refused: ..., LabJack error 2565 EF_VALUE_GREATER_THAN_PERIOD"), for the engine's
+  /// device-error fault (Device::take_fault on branch `links`). Engine thread; allocates nothing.
+  static constexpr std::size_t kRefusalChars = 192;
+  bool take_refusal(std::array<char, kRefusalChars>& text);
+  /// Whether the link answered at all lately (false: it is down, not only frozen), for the
+  /// engine's link-lost fault; any thread.
+  bool link_answers() const { return link_up_.load(std::memory_order_acquire); }
   /// Waits until the I/O thread has handed over a reading made after this call, at most
   /// `timeout_s`; false when none came (link_error() may say why) or *stop was set.
   bool wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const;
@@ -134,6 +144,8 @@ class T7Device final : public Device {
   std::atomic<bool> link_up_{true};
   std::atomic<bool> error_published_{false};
   std::string link_error_;  // written once before error_published_
+  std::array<char, kRefusalChars> refusal_text_{};  // written by the I/O thread while !refusal_pending_
+  std::atomic<bool> refusal_pending_{false};
   std::array<std::atomic<double>, kSensorRoleCount> volts_{};
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
   std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0};
