@@ -198,6 +198,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"t7", "t7-pro"}));
   t7_sim_cmd->add_flag("--nagle", t7_sim.nagle, "Drill: answers with Nagle's algorithm (a T7 sends at once)");
   t7_sim_cmd->add_flag("--silent-reads", t7_sim.silent_reads, "Drill: reads of the analog inputs go unanswered (no reading ever)");
+  t7_sim_cmd->add_option("--halve-roll-after", t7_sim.halve_roll_after_s,
+                         "Drill: this many seconds after the first request, clock 0's roll value halves (another program): wide duties are refused")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
   t7_sim_cmd->add_option("--answer-after", t7_sim.answer_after_s, "Drill: every answer this many seconds later (a slow device)")
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   t7_sim_cmd->add_option("--trickle-after", t7_sim.trickle_after_s, "Drill: this many seconds after the first request, answers trickle one byte at a time")

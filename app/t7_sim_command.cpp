@@ -44,6 +44,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   sim.trickle_after_s = options.trickle_after_s;
   sim.trickle_byte_s = options.trickle_byte_s;
   sim.silent_reads = options.silent_reads;
+  sim.halve_roll_after_s = options.halve_roll_after_s;
   if (!options.dead_valve.empty()) {
     for (ValveRole role : kValveRoles) {
       if (options.dead_valve == to_string(role)) sim.dead_valve = role;
@@ -59,6 +60,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   if (sim.stall_after_s >= 0.0) out << "; drill: one answer " << sim.stall_s << " s late after " << sim.stall_after_s << " s";
   if (sim.nagle) out << "; drill: Nagle";
   if (sim.silent_reads) out << "; drill: reads unanswered";
+  if (sim.halve_roll_after_s >= 0.0) out << "; drill: clock 0's roll halved after " << sim.halve_roll_after_s << " s";
   if (sim.answer_after_s > 0.0) out << "; drill: every answer " << sim.answer_after_s << " s late";
   if (sim.trickle_after_s >= 0.0) out << "; drill: answers trickle after " << sim.trickle_after_s << " s, " << sim.trickle_byte_s << " s a byte";
   out << std::endl;

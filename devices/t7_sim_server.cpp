@@ -310,6 +310,11 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
         }
       }
     }
+    if (options_.halve_roll_after_s >= 0.0 && !roll_halved_ && first_request_s_ >= 0.0 && now - first_request_s_ >= options_.halve_roll_after_s) {
+      roll_halved_ = true;
+      registers_.set_u32(t7::kClock0RollValue, registers_.u32(t7::kClock0RollValue) / 2);
+      events("t7-sim: clock 0's roll value halved, as another program might (drill)");
+    }
     advance_arm(now);
     if (registers_.run_watchdog(now)) {
       ++status_.watchdog_actions;

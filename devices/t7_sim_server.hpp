@@ -55,6 +55,8 @@ struct T7SimOptions {
   double trickle_after_s = -1.0;       // drill: this long after the first request, answers trickle...
   double trickle_byte_s = 0.4;         // ...one byte every this long (the link holds, barely)
   bool silent_reads = false;           // drill: reads of the analog inputs go unanswered (no reading ever)
+  double halve_roll_after_s = -1.0;    // drill: this long after the first request, clock 0's roll value halves
+                                       // (another program reconfigured it): wide duty cycles are refused, 2565
   RigLimits limits;                    // the rig's own limits, enforced whatever the client writes
 };
 
@@ -121,6 +123,7 @@ class T7SimServer {
   double start_s_ = 0.0;
   double arm_time_s_ = 0.0;   // wall time the arm has been advanced to (since start)
   double first_request_s_ = -1.0;
+  bool roll_halved_ = false;
   double last_status_write_s_ = -1.0;
   T7SimStatus status_;                // the server thread's; published copies under the mutex
   mutable std::mutex published_mutex_;

@@ -269,6 +269,19 @@ TEST_F(T7Processes, RigCheckPassesEveryValveOnTheStrictT7Pro) {
   EXPECT_EQ(status().at("max_clients").get<int>(), 1) << sim->out();
 }
 
+// Mid-run, another program halves clock 0's roll value: the T7 refuses bellows' wide duty cycles
+// (LabJack error 2565). The run faults, and what it says names the register and LabJack's error,
+// not only a stale reading.
+TEST_F(T7Processes, AModbusExceptionDuringARunNamesTheRegisterAndLabJacksError) {
+  auto sim = start_sim({"--halve-roll-after", "2"});
+  auto run = start_run(2, "run");
+  ASSERT_EQ(run->wait(60.0), 3) << run->err();
+  const std::string err = run->err();
+  EXPECT_NE(err.find("_EF_CONFIG_A"), std::string::npos) << err;
+  EXPECT_NE(err.find("LabJack error 2565 EF_VALUE_GREATER_THAN_PERIOD"), std::string::npos) << err;
+  EXPECT_NE(sim->out().find("LabJack error 2565"), std::string::npos) << sim->out();
+}
+
 TEST_F(T7Processes, ASilentLinkFaultsTheRunAndTheWatchdogVents) {
   auto sim = start_sim({"--silent-after", "3"});
   auto run = start_run(2, "run");
