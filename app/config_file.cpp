@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 #include "sessions/file_access.hpp"
 
 namespace bellows {
@@ -70,6 +71,31 @@ std::string shortest_exact(double value) {
   return text;
 }
 
+/// "[controller] filter_samples" for the key assigned on line `line` (1-based) of `text`: what a
+/// TOML parse error there is about (a value out of range, a bad number) names the key the docs
+/// promise. Empty when that line assigns no key.
+std::string key_at_line(const std::string& text, std::size_t line) {
+  std::istringstream lines(text);
+  std::string current, section;
+  for (std::size_t n = 1; std::getline(lines, current) && n <= line; ++n) {
+    const std::size_t start = current.find_first_not_of(" \t");
+    if (start == std::string::npos || current[start] == '#') continue;
+    if (current[start] == '[') {
+      const std::size_t end = current.find(']', start);
+      if (end != std::string::npos) section = current.substr(start, end - start + 1);
+      continue;
+    }
+    if (n != line) continue;
+    const std::size_t equals = current.find('=', start);
+    if (equals == std::string::npos) return "";
+    std::string key = current.substr(start, equals - start);
+    while (!key.empty() && (key.back() == ' ' || key.back() == '\t')) key.pop_back();
+    if (key.empty()) return "";
+    return section.empty() ? key : section + " " + key;
+  }
+  return "";
+}
+
 }  // namespace
 
 void apply_config_toml(const std::string& toml_text, const std::string& source_name, Configuration& config) {
@@ -83,8 +109,11 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
     root = toml::parse(toml_text, source_name);
   } catch (const toml::parse_error& error) {
     std::ostringstream where;
-    where << source_name << ":" << error.source().begin.line << ":" << error.source().begin.column << ": "
-          << error.description();
+    where << source_name << ":" << error.source().begin.line << ":" << error.source().begin.column << ": ";
+    if (const std::string key = key_at_line(toml_text, error.source().begin.line); !key.empty()) {
+      where << printable(key, kPrintableField) << ": ";
+    }
+    where << error.description();
     throw InputError("config " + where.str());
   }
   const auto& bindings = parameter_bindings();

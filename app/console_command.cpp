@@ -168,6 +168,9 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   if (report.dropped_events > 0) out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
   out << std::flush;
   if (report.stopped_by_signal) return 128 + stop_signal();
+  // The operator quit with work the disk did not take (a failed save, confirmed): the environment
+  // refused, and a script must not take the run for a saved one.
+  if (report.unsaved_work_lost) return 4;
   return 0;
 }
 

@@ -2,6 +2,7 @@
 #include "app/memory_policy.hpp"
 
 #include <cstdio>
+#include <optional>
 #include <ctime>
 #include <sstream>
 
@@ -47,10 +48,23 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
       std::istringstream lines(e.message);
       std::string line;
       while (std::getline(lines, line)) {
-        const auto colon = line.find(": ", 9);
+        // "HH:MM:SS [t=ENGINE_S ]source: text" (sessions before the engine time: without it)
+        std::size_t from = 9;
+        double engine_time_s = -1.0;
+        if (line.compare(from, 2, "t=") == 0) {
+          const auto space = line.find(' ', from);
+          if (space == std::string::npos) continue;
+          try {
+            engine_time_s = std::stod(line.substr(from + 2, space - from - 2));
+          } catch (const std::exception&) {
+            engine_time_s = -1.0;
+          }
+          from = space + 1;
+        }
+        const auto colon = line.find(": ", from);
         if (line.size() < 10 || colon == std::string::npos) continue;
-        const std::string source = line.substr(9, colon - 9);
-        out.push_back({line.substr(0, 8), -1.0, source_of(source), line.substr(colon + 2), source == "fault", false,
+        const std::string source = line.substr(from, colon - from);
+        out.push_back({line.substr(0, 8), engine_time_s, source_of(source), line.substr(colon + 2), source == "fault", false,
                        e.time_utc, e.iteration});
       }
       continue;
@@ -141,19 +155,27 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   const std::lock_guard<std::mutex> guard(mutex_);
   const ui::Experiment& e = snapshot.experiment;
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
-  const bool continuing = writer_ && !e.session_location.empty() && writer_->directory() == e.session_location;
+  // A session this gateway created whose first save then failed is continued, not created twice.
+  const bool continuing =
+      writer_ && (e.session_location.empty()
+                      ? unconfirmed_events_ != kConfirmed && writer_->manifest().trajectory_name == e.trajectory->name &&
+                            writer_->manifest().iterations.empty()
+                      : writer_->directory() == e.session_location);
+  const std::size_t saved_events = e.session_location.empty() && continuing ? unconfirmed_events_ : e.saved_events;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
   const std::size_t held = snapshot.events.size();
   const std::size_t first_held = snapshot.events_total - held;
-  const std::size_t first_new = continuing ? std::max(e.saved_events, first_held) - first_held : 0;
+  const std::size_t first_new = continuing ? std::max(saved_events, first_held) - first_held : 0;
 
   // The snapshot's trials are iterations first_trial..; the trial of iteration i is at i - first_trial.
   const auto first = static_cast<std::size_t>(snapshot.first_trial);
   const std::size_t end = first + e.trials.size();
   const auto trial_at = [&](std::size_t iteration) -> const ui::Trial& { return e.trials[iteration - first]; };
   std::size_t first_trial = 0;
+  std::optional<SessionWriter::Batch> batch;  // one console save, one commit (the manifest's rename)
   if (continuing) {
+    batch.emplace(*writer_);
     first_trial = writer_->manifest().iterations.size();
     if (first_trial > end) throw InputError("the session on disk has more iterations than the console");
     if (first_trial < first) throw std::logic_error("StoreSessionGateway::save: unsaved iterations missing from the snapshot");
@@ -161,7 +183,15 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     std::string lines;
     for (std::size_t i = first_new; i < held; ++i) {
       const ui::LogEntry& entry = snapshot.events[i];
-      if (worth_saving(entry)) lines += entry.clock + " " + kind_of(entry) + ": " + entry.text + "\n";
+      if (worth_saving(entry)) {
+        lines += entry.clock + " ";
+        if (entry.engine_time_s >= 0.0) {
+          char stamp[40];
+          std::snprintf(stamp, sizeof stamp, "t=%.3f ", entry.engine_time_s);
+          lines += stamp;
+        }
+        lines += kind_of(entry) + ": " + entry.text + "\n";
+      }
     }
     if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
     // Learned (or chosen) after the last saved trial: on disk before the next trial starts.
@@ -182,6 +212,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     }
     writer_.reset();  // the previous session's lock goes first
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
+    unconfirmed_events_ = snapshot.events_total;  // in its header already
+    batch.emplace(*writer_);
   }
   for (std::size_t i = first_trial; i < end; ++i) {
     const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
@@ -191,8 +223,17 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);
   }
+  batch->commit();
+  unconfirmed_events_ = kConfirmed;
   return_free_memory();  // on the saving worker: what the saved records held goes back to the system
   return writer_->directory().string();
+}
+
+std::string StoreSessionGateway::name_refusal(const std::string& location, const std::string& name) {
+  // No lock: a save may hold it for a while, and this runs on the UI thread.
+  const std::filesystem::path directory(location);
+  if (directory.filename() == name) return {};  // its own name: nothing to do
+  return session_name_refusal(name, directory.parent_path());
 }
 
 void StoreSessionGateway::read_quietly(const std::function<void()>& read) {
@@ -203,18 +244,21 @@ void StoreSessionGateway::read_quietly(const std::function<void()>& read) {
 std::string StoreSessionGateway::rename(const std::string& name) {
   const std::lock_guard<std::mutex> guard(mutex_);
   if (!writer_) throw InputError("nothing to name yet: the session is created with the first trial");
-  validate_session_name(name);
   const std::filesystem::path from = writer_->directory();
-  const std::filesystem::path to = data_dir_ / name;
-  if (from == to) return to.string();
-  std::error_code error;
-  if (std::filesystem::exists(to, error)) throw InputError("a session named '" + name + "' exists already");
-  writer_.reset();  // its lock goes with it; taken again below
-  std::filesystem::rename(from, to, error);
+  if (from.filename() == name) return from.string();
+  if (const std::string why = session_name_refusal(name, from.parent_path()); !why.empty()) throw InputError(why);
+  writer_.reset();  // its lock goes with it; rename_session takes it, then the writer again below
+  std::filesystem::path now = from;
+  std::string failure;
+  try {
+    now = rename_session(from, name);  // the directory and the manifest's name, as `sessions rename`
+  } catch (const std::exception& error) {
+    failure = error.what();
+  }
   Session loaded;
-  writer_.emplace(SessionWriter::open(error ? from : to, kPurpose, loaded));
-  if (error) throw InputError("cannot rename " + from.string() + " to '" + name + "': " + error.message());
-  return to.string();
+  writer_.emplace(SessionWriter::open(now, kPurpose, loaded));
+  if (!failure.empty()) throw InputError(failure);
+  return now.string();
 }
 
 std::vector<ui::SessionListing> StoreSessionGateway::list() {
@@ -276,9 +320,15 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   e.saved_trials = static_cast<int>(e.trials.size());
   e.saved_faults = static_cast<int>(e.faults.size());
   snapshot.events = log_of(m);
+  if (const std::string dropped = dropped_line(loaded); !dropped.empty()) {  // the writer removed it: say so once
+    const std::string now = utc_now();
+    snapshot.events.push_back({local_clock_of(now), -1.0, ui::LogSource::kSession, dropped, true, false, now,
+                               static_cast<int>(loaded.iterations.size())});
+  }
   snapshot.events_total = snapshot.events.size();
   writer_.reset();
   writer_.emplace(std::move(writer));
+  unconfirmed_events_ = kConfirmed;
   return snapshot;
 }
 

@@ -252,6 +252,7 @@ int main(int argc, char** argv) {
                                "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file to check");
   trajectories_cmd->add_option("--config", trajectories.config_path, "TOML configuration file ([timing], [trajectory])");
   trajectories_cmd->add_option("--output", trajectories.output_path, "Write the CSV into this file instead of stdout");
+  trajectories_cmd->add_flag("--force", trajectories.force, "Replace the --output file if it exists");
 
   bellows::install_stop_signal_handlers();
 

@@ -78,7 +78,8 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
   }
   fs::create_directory(directory, error);
   if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
-  write_file_atomic(files.front(), gnuplot_script(figures, request.formats, request.style));
+  write_file_atomic(files.front(), gnuplot_script(figures, request.formats, request.style), DirectorySync::kNow,
+                    force ? Replace::kAllowed : Replace::kRefused);
   run_gnuplot(files.front(), directory);
   for (const fs::path& file : files) {
     if (fs::file_size(file, error) == 0 || error) throw InputError("gnuplot wrote no " + file.string());

@@ -49,7 +49,9 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
   if (options.lcm_log && options.lcm_log_file.empty() && options.no_save) {
     throw InputError("--lcm-log without a FILE writes into the session directory: name a FILE with --no-save");
   }
-  if (options.lcm_log && !options.lcm_log_file.empty() && std::filesystem::exists(options.lcm_log_file)) {
+  std::error_code missing;  // a link counts as existing, also a dangling one: nothing is written through it
+  if (options.lcm_log && !options.lcm_log_file.empty() &&
+      std::filesystem::symlink_status(options.lcm_log_file, missing).type() != std::filesystem::file_type::not_found) {
     throw InputError("the LCM log '" + options.lcm_log_file + "' exists already; nothing is overwritten, name a new file");
   }
   if (kind != "sim") {

@@ -1,6 +1,7 @@
 #include "app/run_recording.hpp"
 
 #include <cmath>
+#include <iostream>
 
 #include "app/arm_chain_state_json.hpp"
 #include "app/arm_state_json.hpp"
@@ -30,6 +31,7 @@ RunRecording::RunRecording(const RunOptions& options) : options_(options), resum
   }
   const std::filesystem::path directory = resolve_session_dir(options.resume_dir, data_dir);
   writer_.emplace(SessionWriter::open(directory, kPurpose, resumed_));
+  if (const std::string dropped = dropped_line(resumed_); !dropped.empty()) std::cerr << "bellows: " << dropped << std::endl;
   if (resumed_.manifest.device != "sim") {
     throw InputError("session " + directory.string() + " was recorded on the device '" + resumed_.manifest.device +
                      "'; bellows run drives the simulated arm only");

@@ -3,7 +3,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <optional>
 #include <cstdio>
+#include <iostream>
 #include <istream>
 #include <numbers>
 #include <ostream>
@@ -22,6 +26,7 @@
 #include "sessions/session_export.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_lock.hpp"
+#include "sessions/session_removal.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -169,6 +174,7 @@ void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, c
 
 int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   const Session session = load_session(session_dir_of(options));  // checks every file
+  if (const std::string dropped = dropped_line(session); !dropped.empty()) std::cerr << "bellows: " << dropped << std::endl;
   const SessionManifest& m = session.manifest;
   const Configuration& c = m.configuration;
   const double best = best_rms_deg(m);
@@ -312,15 +318,46 @@ fs::path existing_session(const SessionsOptions& options) {
 }  // namespace
 
 int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::ostream& out, std::ostream& err) {
-  const fs::path directory = existing_session(options);
-  std::string description = "session " + directory.string();
+  const fs::path directory = session_dir_of(options);
+  const std::string shown_directory = printable(directory.string());
+  const auto refuse = [&](const std::string& why) {
+    throw InputError("will not remove " + shown_directory + ": " + why + "; nothing was removed");
+  };
+  std::error_code error;
+  if (fs::symlink_status(directory, error).type() == fs::file_type::symlink) {
+    refuse("it is a symbolic link (remove the link itself, or name the session it points to)");
+  }
+  const DirectoryHandle session = open_session_directory(directory);
+  // A bellows session by its manifest (a regular file, not a link, whose identity parses), and
+  // holding nothing but what the session layout names.
+  std::optional<std::string> manifest_text;
   try {
-    const SessionManifest m = load_manifest(directory);
+    manifest_text = read_regular_file_at(session, session_layout::kManifest, session_layout::kMostManifestBytes);
+  } catch (const InputError& e) {
+    refuse(std::string("it is not a bellows session: ") + e.what());
+  }
+  if (!manifest_text) refuse(std::string("it is not a bellows session (no ") + session_layout::kManifest + ")");
+  try {
+    check_session_identity(*manifest_text, session_layout::kManifest);
+  } catch (const InputError& e) {
+    refuse(std::string("it is not a bellows session: ") + e.what());
+  }
+  if (const std::vector<std::string> foreign = foreign_session_entries(session); !foreign.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < foreign.size() && i < 5; ++i) names += (i ? ", " : "") + printable(foreign[i]);
+    if (foreign.size() > 5) names += ", ...";
+    refuse("it holds what is not a bellows session's (" + names + ")");
+  }
+  std::string description = "session " + shown_directory;
+  try {
+    const SessionManifest m = parse_manifest(*manifest_text, session_layout::kManifest);
     description += " (iterations " + iteration_range(static_cast<long long>(m.iterations.size())) + ", started " + short_time(m.started_utc) + ")";
   } catch (const InputError&) {
     description += " (damaged)";
   }
-  const SessionLock lock(directory, "bellows sessions rm");  // not while a run or a console writes it
+  // Asking creates nothing: the holder is read without creating a lock file; the lock is taken
+  // only to remove.
+  if (const auto holder = SessionLock::holder(session)) refuse("it is in use by " + *holder);
   if (!options.yes) {
     err << "remove " << description << "? [y/N] " << std::flush;
     std::string answer;
@@ -330,17 +367,20 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
       return 1;
     }
   }
+  const SessionLock lock(session, "bellows sessions rm");  // not while a run or a console writes it
   // Out of sight first (hidden names are not sessions), so a removal cut short leaves no half session.
   std::string hidden_name = ".";
   hidden_name += directory.filename().string();
   hidden_name += ".removing-" + std::to_string(::getpid());
-  const fs::path hidden = directory.parent_path() / hidden_name;
-  std::error_code error;
+  const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
+  const fs::path hidden = parent / hidden_name;
   fs::rename(directory, hidden, error);
-  if (error) throw InputError("cannot remove " + directory.string() + ": " + error.message());
-  fs::remove_all(hidden, error);
-  if (error) throw InputError("cannot remove " + hidden.string() + " (renamed from " + directory.string() + "): " + error.message());
-  sync_directory(directory.parent_path().empty() ? fs::path(".") : directory.parent_path());
+  if (error) throw InputError("cannot remove " + shown_directory + ": " + error.message());
+  remove_session_entries(session);  // through the directory's own descriptor: it moved with it
+  if (::rmdir(hidden.c_str()) != 0) {
+    throw InputError("cannot remove " + printable(hidden.string()) + " (renamed from " + shown_directory + "): " + std::strerror(errno));
+  }
+  sync_directory(parent);
   if (options.json) {
     out << Json{{"removed", directory.string()}}.dump() << std::endl;
   } else {
@@ -352,19 +392,7 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
 int sessions_rename_command(const SessionsOptions& options, std::ostream& out) {
   validate_session_name(options.new_name);
   const fs::path directory = existing_session(options);
-  SessionManifest manifest = load_manifest(directory);
-  const fs::path target = directory.parent_path() / options.new_name;
-  std::error_code error;
-  if (fs::symlink_status(target, error).type() != fs::file_type::not_found) {
-    throw InputError("cannot rename " + directory.string() + ": " + target.string() + " exists already");
-  }
-  const SessionLock lock(directory, "bellows sessions rename");
-  fs::rename(directory, target, error);
-  if (error) throw InputError("cannot rename " + directory.string() + " to " + target.string() + ": " + error.message());
-  manifest.name = options.new_name;  // the manifest names its session too
-  manifest.updated_utc = utc_now();
-  write_file_atomic(target / session_layout::kManifest, format_manifest(manifest));
-  sync_directory(target.parent_path().empty() ? fs::path(".") : target.parent_path());
+  const fs::path target = rename_session(directory, options.new_name);
   if (options.json) {
     out << Json{{"renamed", directory.string()}, {"directory", target.string()}}.dump() << std::endl;
   } else {

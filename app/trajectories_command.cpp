@@ -30,7 +30,7 @@ int trajectories_command(const TrajectoriesOptions& options, std::ostream& out) 
   if (options.output_path.empty()) {
     out << trajectory_csv(trajectory);
   } else {
-    write_trajectory_file(options.output_path, trajectory);
+    write_trajectory_file(options.output_path, trajectory, options.force ? Replace::kAllowed : Replace::kRefused);
   }
   return 0;
 }

@@ -13,6 +13,7 @@ struct TrajectoriesOptions {
   std::string trajectory;   // empty: list the library
   std::string config_path;  // [timing] (sample time) and [trajectory] (limits)
   std::string output_path;  // empty: stdout
+  bool force = false;       // --force: replace an existing --output file
 };
 
 int trajectories_command(const TrajectoriesOptions& options, std::ostream& out);

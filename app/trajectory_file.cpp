@@ -156,12 +156,13 @@ std::string trajectory_csv(const Trajectory& trajectory) {
   return text;
 }
 
-void write_trajectory_file(const std::filesystem::path& path, const Trajectory& trajectory) {
+void write_trajectory_file(const std::filesystem::path& path, const Trajectory& trajectory, Replace replace) {
   if (std::filesystem::is_directory(path)) {
     throw InputError("trajectory file " + printable(path.string()) + " is a directory: name a file in it");
   }
   const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  write_file_atomic_at(DirectoryHandle::open(directory), path.filename().string(), trajectory_csv(trajectory));
+  write_file_atomic_at(DirectoryHandle::open(directory), path.filename().string(), trajectory_csv(trajectory),
+                       DirectorySync::kNow, replace);
 }
 
 Trajectory load_trajectory_file(const std::string& path, double sample_time_s, const TrajectoryLimits& limits) {

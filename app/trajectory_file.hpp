@@ -10,6 +10,7 @@
 
 #include "engine/base/parameters.hpp"
 #include "engine/trial/trajectory.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 
@@ -30,6 +31,9 @@ void require_driven_joints(const Trajectory& trajectory, const ArmParameters& ar
 /// `time_s,q1_deg,...`; angles in the shortest form that reads back to the same degrees.
 std::string trajectory_csv(const Trajectory& trajectory);
 /// Writes trajectory_csv() to `path` atomically (a temporary file renamed over it).
-void write_trajectory_file(const std::filesystem::path& path, const Trajectory& trajectory);
+/// By the safe writer (sessions/file_access.hpp); Replace::kRefused: an existing file is refused
+/// ("exists already (--force replaces it)").
+void write_trajectory_file(const std::filesystem::path& path, const Trajectory& trajectory,
+                           Replace replace = Replace::kAllowed);
 
 }  // namespace bellows

@@ -1,10 +1,14 @@
 #include "bridge/telemetry_publisher.hpp"
 #include "engine/rt/single_writer_counter.hpp"
 
+#include <fcntl.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include "devices/lcm_channels.hpp"
@@ -55,10 +59,14 @@ std::int8_t fault_code(FaultCode fault) { return static_cast<std::int8_t>(fault)
 TelemetryPublisher::TelemetryPublisher(TelemetryRing& ring, std::int64_t session_id, const std::string& log_path)
     : ring_(ring), session_id_(session_id), log_path_(log_path) {
   if (!log_path_.empty()) {
-    std::error_code error;
-    if (std::filesystem::exists(log_path_, error)) {
+    // Created here, exclusively and not through a link (a dangling one included), before LCM's
+    // writer opens it by name: nothing is overwritten or created outside.
+    const int fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 && (errno == EEXIST || errno == ELOOP)) {
       throw InputError("the LCM log '" + log_path_ + "' exists already; nothing is overwritten, name a new file");
     }
+    if (fd < 0) throw EnvironmentError("cannot create the LCM log '" + log_path_ + "': " + std::strerror(errno));
+    ::close(fd);
     log_ = std::make_unique<lcm::LogFile>(log_path_, "w");
     if (!log_->good()) throw EnvironmentError("cannot create the LCM log '" + log_path_ + "'");
   }

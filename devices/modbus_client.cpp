@@ -233,7 +233,7 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     if (mine && fc == (function | 0x80) && pdu_size >= 1) {
       last_exception_ = pdu[0];
       char why[80];
-      std::snprintf(why, sizeof why, "Modbus exception %d (%s)", last_exception_, exception_name(last_exception_));
+      std::snprintf(why, sizeof why, "%s (Modbus exception %d)", exception_name(last_exception_), last_exception_);
       last_error_ = why;
     } else if (mine && fc == function && function == kReadHolding && pdu_size == 1 + 2 * static_cast<std::size_t>(count) &&
                pdu[0] == 2 * count) {
@@ -247,6 +247,13 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     }
     std::memmove(rx_.data(), rx_.data() + frame, rx_size_ - frame);  // the frame is consumed either way
     rx_size_ -= frame;
+    // An older transaction id answers a request that timed out; one never sent means the stream
+    // cannot be trusted (issue 24's words: it is no exception the device sent).
+    const auto behind = static_cast<std::uint16_t>(tid - frame_tid);
+    if (!mine && (behind == 0 || behind > 0x7fff)) {
+      lose_connection("a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no exception");
+      return false;
+    }
     if (!mine) {
       ++late_answers_;  // the answer to a request that timed out: read and dropped
       continue;

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <utility>
 
 #include "engine/base/errors.hpp"
@@ -13,7 +14,7 @@
 namespace bellows {
 namespace {
 
-constexpr std::string_view kTemporaryMarker = ".tmp-";
+constexpr std::string_view kTemporaryMarker = ".tmp-";  // unpredictable_temporary_name()'s
 
 [[noreturn]] void fail(const std::string& what, const std::filesystem::path& path, int error_number) {
   throw InputError("cannot " + what + " " + path.string() + ": " + std::strerror(error_number));
@@ -21,34 +22,30 @@ constexpr std::string_view kTemporaryMarker = ".tmp-";
 
 }  // namespace
 
-std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
-  // Hidden, and unique per process: a crashed writer's leftovers never collide with a live one.
-  std::string name = ".";  // built by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
-  name.append(path.filename().string()).append(kTemporaryMarker).append(std::to_string(::getpid()));
-  return path.parent_path() / name;
+void write_file_atomic(const std::filesystem::path& path, std::string_view contents, DirectorySync directory_sync,
+                       Replace replace) {
+  // The folder is the operator's choice (a link in its path is followed); the file itself is
+  // written by the one safe writer, inside that folder's descriptor.
+  const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
+  const std::string name = path.filename().string();
+  if (name.empty() || name == "." || name == "..") throw InputError("cannot write " + path.string() + ": not a file name");
+  write_file_atomic_at(DirectoryHandle::open(directory), name, contents, directory_sync, replace);
 }
 
-void write_file_atomic(const std::filesystem::path& path, std::string_view contents, DirectorySync directory_sync) {
-  const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
-  const std::filesystem::path temporary = temporary_path_for(path);
-  FileDescriptor fd(::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
-  if (fd.get() < 0) fail("create", temporary, errno);
-  if (const int error_number = write_all(fd.get(), contents); error_number != 0) {
-    ::unlink(temporary.c_str());
-    fail("write", temporary, error_number);
+PrivateTemporaryDirectory::PrivateTemporaryDirectory(const DirectoryHandle& folder, const std::string& name)
+    : folder_(&folder), name_(unpredictable_temporary_name(name)) {
+  // 0700 and made here (mkdirat fails on any existing name): nobody else can plant a link in it.
+  if (::mkdirat(folder.fd(), name_.c_str(), 0700) != 0) fail("create", folder.path() / name_, errno);
+  std::optional<DirectoryHandle> made = folder.subdirectory(name_);
+  if (!made) fail("open", folder.path() / name_, ENOENT);
+  directory_.emplace(std::move(*made));
+}
+
+PrivateTemporaryDirectory::~PrivateTemporaryDirectory() {
+  if (directory_) {
+    for (const std::string& entry : entry_names(*directory_)) ::unlinkat(directory_->fd(), entry.c_str(), 0);
   }
-  if (::fsync(fd.get()) != 0) {
-    const int error_number = errno;
-    ::unlink(temporary.c_str());
-    fail("flush", temporary, error_number);
-  }
-  if (::close(fd.release()) != 0) fail("close", temporary, errno);
-  if (::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int error_number = errno;
-    ::unlink(temporary.c_str());
-    fail("rename a file to", path, error_number);
-  }
-  if (directory_sync == DirectorySync::kNow) sync_directory(directory);
+  ::unlinkat(folder_->fd(), name_.c_str(), AT_REMOVEDIR);
 }
 
 void sync_directory(const std::filesystem::path& directory) {

@@ -1,11 +1,15 @@
 #include "sessions/file_access.hpp"
 
 #include <dirent.h>
+#include <sys/random.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 #include <vector>
@@ -189,15 +193,51 @@ int write_all(int fd, std::string_view contents) {
   return 0;
 }
 
+std::string unpredictable_temporary_name(const std::string& name) {
+  // Hidden, marked as a temporary (is_temporary_file_name), and not guessable: a name planted in
+  // advance (a link to a victim) is never the one used, and O_EXCL refuses it if it were.
+  std::uint64_t random = 0;
+  if (::getrandom(&random, sizeof random, 0) != static_cast<ssize_t>(sizeof random)) {
+    random = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) * 0x9e3779b97f4a7c15ULL;
+  }
+  char suffix[40];
+  std::snprintf(suffix, sizeof suffix, "%ld-%016llx", static_cast<long>(::getpid()), static_cast<unsigned long long>(random));
+  std::string temporary = ".";  // built by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
+  temporary.append(name.substr(0, 200)).append(".tmp-").append(suffix);
+  return temporary;
+}
+
+int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& to_directory,
+                      const std::string& to) {
+  if (::renameat2(from_directory.fd(), from.c_str(), to_directory.fd(), to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  // A file system without RENAME_NOREPLACE: a hard link never replaces (files only).
+  if (::linkat(from_directory.fd(), from.c_str(), to_directory.fd(), to.c_str(), 0) == 0) {
+    ::unlinkat(from_directory.fd(), from.c_str(), 0);
+    return 0;
+  }
+  return errno;
+}
+
+void publish_file_at(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& directory,
+                     const std::string& name, Replace replace) {
+  const int error_number = replace == Replace::kAllowed
+                               ? (::renameat(from_directory.fd(), from.c_str(), directory.fd(), name.c_str()) == 0 ? 0 : errno)
+                               : rename_no_replace(from_directory, from, directory, name);
+  if (error_number == 0) return;
+  ::unlinkat(from_directory.fd(), from.c_str(), 0);
+  if (error_number == EEXIST) throw InputError(shown(directory.path() / name) + " exists already (--force replaces it)");
+  throw InputError("cannot rename a file to " + shown(directory.path() / name) + ": " + std::strerror(error_number));
+}
+
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
-                          DirectorySync directory_sync) {
-  const std::string temporary = temporary_path_for(name).filename().string();
+                          DirectorySync directory_sync, Replace replace) {
+  const std::string temporary = unpredictable_temporary_name(name);
   const auto fail = [&](const std::string& what, int error_number) {
     ::unlinkat(directory.fd(), temporary.c_str(), 0);
     throw InputError("cannot " + what + " " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
   };
-  ::unlinkat(directory.fd(), temporary.c_str(), 0);  // a leftover of this pid: a link is removed, not followed
-  // O_EXCL: created here and now, never opened through whatever a name might already be.
+  // O_EXCL | O_NOFOLLOW: created here and now, never opened through whatever a name might already be.
   FileDescriptor fd(::openat(directory.fd(), temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (fd.get() < 0) {
     const int error_number = errno;
@@ -206,7 +246,7 @@ void write_file_atomic_at(const DirectoryHandle& directory, const std::string& n
   if (const int error_number = write_all(fd.get(), contents); error_number != 0) fail("write", error_number);
   if (::fsync(fd.get()) != 0) fail("flush", errno);
   if (::close(fd.release()) != 0) fail("close", errno);
-  if (::renameat(directory.fd(), temporary.c_str(), directory.fd(), name.c_str()) != 0) fail("rename", errno);
+  publish_file_at(directory, temporary, directory, name, replace);  // a link at `name` is replaced, never followed
   if (directory_sync == DirectorySync::kNow) sync(directory);
 }
 
@@ -222,22 +262,29 @@ bool remove_file_at(const DirectoryHandle& directory, const std::string& name) {
   throw InputError("cannot remove " + shown(directory.path() / name) + ": " + std::strerror(errno));
 }
 
-void remove_temporary_files(const DirectoryHandle& directory) {
+std::vector<std::string> entry_names(const DirectoryHandle& directory) {
+  std::vector<std::string> names;
   // fdopendir takes over its descriptor: give it a duplicate.
   const int duplicate = ::fcntl(directory.fd(), F_DUPFD_CLOEXEC, 0);
-  if (duplicate < 0) return;
+  if (duplicate < 0) return names;
   DIR* stream = ::fdopendir(duplicate);
   if (stream == nullptr) {
     ::close(duplicate);
-    return;
+    return names;
   }
   ::rewinddir(stream);  // the duplicate shares the position of earlier scans
-  std::vector<std::string> leftovers;
   while (const dirent* entry = ::readdir(stream)) {
-    if (is_temporary_file_name(entry->d_name)) leftovers.emplace_back(entry->d_name);
+    const std::string name = entry->d_name;
+    if (name != "." && name != "..") names.push_back(name);
   }
   ::closedir(stream);
-  for (const std::string& name : leftovers) ::unlinkat(directory.fd(), name.c_str(), 0);
+  return names;
+}
+
+void remove_temporary_files(const DirectoryHandle& directory) {
+  for (const std::string& name : entry_names(directory)) {
+    if (is_temporary_file_name(name)) ::unlinkat(directory.fd(), name.c_str(), 0);
+  }
 }
 
 }  // namespace bellows

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace bellows {
 
@@ -80,20 +81,44 @@ std::string read_regular_file(const std::filesystem::path& path, std::size_t max
 /// What a file type is called in a message: "a directory", "a FIFO", "a character device", ...
 std::string file_type_name(unsigned mode);
 
-/// Writes `name` in `directory` atomically: a hidden temporary file created exclusively (so never
-/// through a link), written, flushed, renamed over `name` (which replaces a link, never follows it).
 /// Writes all of `contents` to `fd`, again after an interrupted write(2): 0, or the errno that stopped it.
 int write_all(int fd, std::string_view contents);
 
 enum class DirectorySync { kNow, kLater /* the caller calls sync() once for a batch */ };
+/// Whether a write may replace a file of the same name (the operator's --force, or a file bellows
+/// owns such as a manifest), or must refuse: "<path> exists already (--force replaces it)".
+enum class Replace { kAllowed, kRefused };
+
+/// The one safe writer of bellows (the session store's files and every output outside it):
+/// writes `name` in `directory` atomically and durably. A hidden temporary of an unpredictable
+/// name (unpredictable_temporary_name) is created with O_CREAT | O_EXCL | O_NOFOLLOW (so never
+/// through a link planted in advance), written, flushed (fsync), renamed over `name` (which
+/// replaces a link, never follows it; with Replace::kRefused, renameat2(RENAME_NOREPLACE): an
+/// existing name is refused, also one that appeared meanwhile), and the directory is flushed.
+/// A crash at any moment leaves the old file or the new one, never a mix.
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
-                          DirectorySync directory_sync = DirectorySync::kNow);
+                          DirectorySync directory_sync = DirectorySync::kNow, Replace replace = Replace::kAllowed);
+
+/// ".<name>.tmp-<pid>-<64 random bits>": a temporary's name for `name`.
+std::string unpredictable_temporary_name(const std::string& name);
+
+/// Renames `from` (in `from_directory`) to `name` in `directory` as write_file_atomic_at()
+/// publishes its temporary; on failure `from` is removed and InputError thrown.
+void publish_file_at(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& directory,
+                     const std::string& name, Replace replace);
+
+/// renameat2(RENAME_NOREPLACE), or a hard link where the file system lacks it: 0 or the errno.
+int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& to_directory,
+                      const std::string& to);
 
 /// Flushes a directory's entries (new names, renames) to disk.
 void sync(const DirectoryHandle& directory);
 
 /// Removes `name` from `directory` (a link itself, never what it points to). False if absent.
 bool remove_file_at(const DirectoryHandle& directory, const std::string& name);
+
+/// The names in `directory` (not "." and ".."), in no particular order; empty if it cannot be read.
+std::vector<std::string> entry_names(const DirectoryHandle& directory);
 
 /// Removes temporary files a crashed writer left in `directory` (not recursive).
 void remove_temporary_files(const DirectoryHandle& directory);

@@ -1,5 +1,6 @@
 #include "sessions/manifest_json.hpp"
 
+#include <charconv>
 #include <set>
 
 #include "engine/model/arm_model.hpp"
@@ -64,7 +65,7 @@ Json summary_to_json(const IterationEntry& entry) {
               {"max_abs_error_deg", s.max_abs_error_deg},
               {"max_abs_correction_bar", s.max_abs_correction_bar},
               {"saturated_samples", s.saturated_samples},
-              {"samples_file", session_layout::samples_file(s.iteration)},
+              {"samples_file", session_layout::samples_file(s.iteration, entry.samples_revision)},
               {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
   put_digest(out, "samples_sha256", entry.samples_sha256);
   put_digest(out, "telemetry_sha256", entry.telemetry_sha256);
@@ -75,6 +76,26 @@ double non_negative(const JsonReader& r) {
   const double value = r.number();
   if (value < 0.0) r.fail("must not be negative");
   return value;
+}
+
+/// Which revision of iteration `index`'s samples file the manifest names: only the layout's own
+/// names ("iterations/iteration_0004.csv", "iterations/iteration_0004.r2.csv") are accepted.
+int samples_revision_from_json(const JsonReader& r, int index) {
+  const std::string text = r.text();
+  const std::string plain = session_layout::samples_file(index);
+  if (text == plain) return 0;
+  const std::string stem = plain.substr(0, plain.size() - 4) + ".r";
+  if (text.size() > stem.size() + 4 && text.compare(0, stem.size(), stem) == 0 &&
+      text.compare(text.size() - 4, 4, ".csv") == 0) {
+    const std::string digits = text.substr(stem.size(), text.size() - stem.size() - 4);
+    int revision = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), revision);
+    if (error == std::errc() && end == digits.data() + digits.size() && revision >= 1 &&
+        revision <= session_layout::kMostSamplesRevisions && session_layout::samples_file(index, revision) == text) {
+      return revision;
+    }
+  }
+  r.fail("expected \"" + plain + "\" (or a revision of it, \"" + session_layout::samples_file(index, 1) + "\")");
 }
 
 IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
@@ -90,9 +111,9 @@ IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
   s.max_abs_error_deg = non_negative(r["max_abs_error_deg"]);
   s.max_abs_correction_bar = non_negative(r["max_abs_correction_bar"]);
   s.saturated_samples = r["saturated_samples"].integer(0, samples);
-  for (const auto& [key, expected] : {std::pair{"samples_file", session_layout::samples_file(index)},
-                                      std::pair{"telemetry_file", session_layout::telemetry_file(index)}}) {
-    if (r[key].text() != expected) r[key].fail("expected \"" + expected + "\"");
+  entry.samples_revision = samples_revision_from_json(r["samples_file"], index);
+  if (const std::string expected = session_layout::telemetry_file(index); r["telemetry_file"].text() != expected) {
+    r["telemetry_file"].fail("expected \"" + expected + "\"");
   }
   entry.samples_sha256 = digest_from_json(r, "samples_sha256");
   entry.telemetry_sha256 = digest_from_json(r, "telemetry_sha256");
@@ -363,6 +384,16 @@ std::string format_manifest(const SessionManifest& m, ManifestTextCache& cache) 
   splice_list(text, "iterations", cache.iterations_text, newest_iteration);
   splice_list(text, "events", cache.events_text, newest_event);
   return text + "\n";
+}
+
+void check_session_identity(std::string_view text, const std::string& source) {
+  const Json json = parse_json(text, source);
+  const JsonReader r(json, source);
+  if (!json.is_object() || !json.contains("format") || json["format"] != kFormat) {
+    r.fail("not a bellows session manifest (expected \"format\": \"" + std::string(kFormat) + "\")");
+  }
+  r["schema_version"].integer(0, 1000000);
+  r["program_version"].text();
 }
 
 SessionManifest parse_manifest(std::string_view text, const std::string& source) {

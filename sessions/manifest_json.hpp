@@ -32,6 +32,10 @@ struct ManifestTextCache {
 /// newest must not have changed since the cache took them (a writer only appends); a list that
 /// shrank starts the cache afresh.
 std::string format_manifest(const SessionManifest& manifest, ManifestTextCache& cache);
+/// Throws InputError unless `text` is a bellows session's manifest by its identity alone: JSON
+/// with "format": "bellows-session", an integer "schema_version" and a "program_version" (the
+/// rest may be damaged). What `sessions rm` requires before removing anything.
+void check_session_identity(std::string_view text, const std::string& source);
 /// `source` prefixes every error, e.g. "session /data/s1: manifest.json".
 SessionManifest parse_manifest(std::string_view text, const std::string& source);
 

@@ -54,6 +54,7 @@ struct IterationEntry {
   std::string completed_utc;
   std::string samples_sha256 = {};    // the files' digests; empty in sessions saved before digests
   std::string telemetry_sha256 = {};  // were kept
+  int samples_revision = 0;           // which samples file: session_layout::samples_file(iteration, revision)
 };
 
 /// What continuing the run exactly needs beyond the correction: the controllers' state (every
@@ -124,6 +125,10 @@ struct SessionIntegrity {
 struct Session {
   std::filesystem::path directory;
   SessionIntegrity integrity;
+  /// Not empty when a save was interrupted (a crash, a full disk): what it had written but not
+  /// committed, which is not part of the session, in one line ("iteration 5; the correction
+  /// learned from iteration 4"). The session loaded is its last committed state.
+  std::string dropped;
   SessionManifest manifest;
   Trajectory trajectory;
   std::vector<IterationData> iterations;  // in the order of manifest.iterations

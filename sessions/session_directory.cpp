@@ -97,14 +97,6 @@ void write_all_iteration_files(const DirectoryHandle& folder, const std::vector<
 }
 
 /// Renames `from` to `to` in `parent` unless `to` exists (whatever it is: a link, an empty directory).
-int rename_no_replace(const DirectoryHandle& parent, const std::string& from, const std::string& to) {
-  if (::renameat2(parent.fd(), from.c_str(), parent.fd(), to.c_str(), RENAME_NOREPLACE) == 0) return 0;
-  if (errno != EINVAL && errno != ENOSYS) return errno;
-  // A file system without RENAME_NOREPLACE: rename(2) still never replaces a non-empty directory.
-  struct stat info {};
-  if (::fstatat(parent.fd(), to.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0) return EEXIST;
-  return ::renameat(parent.fd(), from.c_str(), parent.fd(), to.c_str()) == 0 ? 0 : errno;
-}
 
 }  // namespace
 
@@ -187,7 +179,7 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
       written.black_boxes[i].sha256 = write_black_box_file(*building, static_cast<int>(i), black_boxes[i]);
     }
     write_manifest(*building, written);
-    if (const int rename_error = rename_no_replace(parent, building_name, name); rename_error != 0) {
+    if (const int rename_error = rename_no_replace(parent, building_name, parent, name); rename_error != 0) {
       if (rename_error == EEXIST || rename_error == ENOTEMPTY) refuse_existing();
       throw InputError("cannot create " + printable(directory.string()) + ": " + std::strerror(rename_error));
     }

@@ -89,13 +89,14 @@ std::vector<fs::path> export_session_csv(const Session& session, const fs::path&
     std::string line = row.dump();  // "[0,12.3,...]": numbers in shortest round-trip form
     summary += line.substr(1, line.size() - 2) + "\n";
   }
-  write_file_atomic(paths[0], stacked("iteration", samples));
-  write_file_atomic(paths[1], stacked("iteration", telemetry));
-  write_file_atomic(paths[2], summary);
+  const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
+  write_file_atomic(paths[0], stacked("iteration", samples), DirectorySync::kNow, replace);
+  write_file_atomic(paths[1], stacked("iteration", telemetry), DirectorySync::kNow, replace);
+  write_file_atomic(paths[2], summary, DirectorySync::kNow, replace);
   if (!session.black_boxes.empty()) {
     std::vector<std::string> boxes;
     for (const std::vector<TickRecord>& ticks : session.black_boxes) boxes.push_back(format_black_box_csv(ticks));
-    write_file_atomic(paths[3], stacked("black_box", boxes));
+    write_file_atomic(paths[3], stacked("black_box", boxes), DirectorySync::kNow, replace);
   }
   return paths;
 }

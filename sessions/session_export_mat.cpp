@@ -216,25 +216,6 @@ MatVar black_boxes_struct(const Session& session) {
   return out;
 }
 
-/// Publishes the finished temporary file as `path`: renamed over it when forced, otherwise
-/// linked, which fails rather than replace a file that appeared meanwhile.
-void publish(const fs::path& temporary, const fs::path& path, bool force) {
-  std::error_code error;
-  if (force) {
-    fs::rename(temporary, path, error);
-  } else if (::link(temporary.c_str(), path.c_str()) != 0) {
-    error = std::error_code(errno, std::generic_category());
-  } else {
-    fs::remove(temporary, error);
-    error.clear();
-  }
-  if (error) {
-    const std::string reason = error == std::errc::file_exists ? "it exists already (--force replaces it)" : error.message();
-    fs::remove(temporary, error);
-    throw InputError("cannot write " + path.string() + ": " + reason);
-  }
-}
-
 }  // namespace
 
 fs::path export_session_mat(const Session& session, const fs::path& path, MatVersion version, bool force) {
@@ -243,9 +224,11 @@ fs::path export_session_mat(const Session& session, const fs::path& path, MatVer
   // one line instead.
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const fs::path directory = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  const fs::path temporary = temporary_path_for(path);
-  std::error_code error;
-  fs::remove(temporary, error);
+  const DirectoryHandle folder = DirectoryHandle::open(directory);
+  // libmatio writes by path: into a folder made for it alone, so no planted link is written through.
+  const PrivateTemporaryDirectory work(folder, path.filename().string());
+  const std::string name = path.filename().string();
+  const fs::path temporary = work.path() / name;
   mat_t* file = Mat_CreateVer(temporary.c_str(), nullptr, version == MatVersion::kV73 ? MAT_FT_MAT73 : MAT_FT_MAT5);
   if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
   try {
@@ -254,21 +237,16 @@ fs::path export_session_mat(const Session& session, const fs::path& path, MatVer
     write_named(file, black_boxes_struct(session), "black_boxes", path);
   } catch (...) {
     Mat_Close(file);
-    fs::remove(temporary, error);
     throw;
   }
   Mat_Close(file);
   // libmatio does not sync: flush it ourselves before the rename makes it visible.
-  const int fd = ::open(temporary.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    const int error_number = errno;
-    if (fd >= 0) ::close(fd);
-    fs::remove(temporary, error);
-    throw InputError("cannot flush " + path.string() + ": " + std::strerror(error_number));
+  {
+    const std::optional<FileDescriptor> fd = open_regular_file_at(work.handle(), name, O_RDONLY);
+    if (!fd || ::fsync(fd->get()) != 0) throw InputError("cannot flush " + path.string() + ": " + std::strerror(errno));
   }
-  ::close(fd);
-  publish(temporary, path, force);
-  sync_directory(directory);
+  publish_file_at(work.handle(), name, folder, name, force ? Replace::kAllowed : Replace::kRefused);
+  sync(folder);
   return path;
 }
 

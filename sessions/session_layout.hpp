@@ -23,8 +23,17 @@ inline std::string numbered(const char* stem, int iteration, const char* folder 
   std::snprintf(name, sizeof name, "%s/%s_%04d.csv", folder, stem, iteration);
   return name;
 }
-/// ILC-rate samples of one iteration, relative to the session directory.
-inline std::string samples_file(int iteration) { return numbered("iteration", iteration); }
+/// ILC-rate samples of one iteration, relative to the session directory. `revision` counts how
+/// often the correction learned from it was replaced after its save (the console learns after
+/// saving): each replacement is a new file, "iteration_0004.r1.csv", and the manifest's switch to
+/// it is the commit, so a committed file is never rewritten in place.
+inline std::string samples_file(int iteration, int revision = 0) {
+  std::string name = numbered("iteration", iteration);
+  if (revision > 0) name.insert(name.size() - 4, ".r" + std::to_string(revision));
+  return name;
+}
+/// The most revisions of one iteration's samples file a manifest may name.
+inline constexpr int kMostSamplesRevisions = 1000000;
 /// Tick-rate telemetry of one iteration, relative to the session directory.
 inline std::string telemetry_file(int iteration) { return numbered("telemetry", iteration); }
 /// The black box of the session's fault number `index` (0, 1, ...), relative to the session directory.

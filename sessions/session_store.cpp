@@ -21,6 +21,9 @@
 #include "sessions/record_columns.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
+#include "sessions/session_lock.hpp"
+#include "sessions/atomic_file.hpp"
+#include "sessions/uncommitted_files.hpp"
 
 namespace bellows {
 namespace fs = std::filesystem;
@@ -133,6 +136,37 @@ void validate_session_name(const std::string& name) {
   }
 }
 
+std::string session_name_refusal(const std::string& name, const fs::path& parent) {
+  try {
+    validate_session_name(name);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  std::error_code error;
+  if (fs::symlink_status(parent / name, error).type() != fs::file_type::not_found) {
+    return "a session named '" + printable(name) + "' exists already";
+  }
+  return {};
+}
+
+fs::path rename_session(const fs::path& directory, const std::string& new_name) {
+  const fs::path parent = directory.parent_path();
+  if (const std::string why = session_name_refusal(new_name, parent); !why.empty()) throw InputError(why);
+  SessionManifest manifest = load_manifest(directory);
+  const fs::path target = parent / new_name;
+  const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
+  std::error_code error;
+  fs::rename(directory, target, error);
+  if (error) throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " + error.message());
+  manifest.name = new_name;  // the manifest names its session too
+  manifest.updated_utc = utc_now();
+  // Through the session's own descriptor, by the one safe writer: a link planted at any name in
+  // it is replaced or refused, never written through.
+  write_file_atomic_at(DirectoryHandle::open(target), session_layout::kManifest, format_manifest(manifest));
+  sync_directory(parent.empty() ? fs::path(".") : parent);
+  return target;
+}
+
 fs::path resolve_session_dir(const std::string& path_or_name, const fs::path& data_dir) {
   std::error_code error;
   if (path_or_name.empty()) throw InputError("no session given");
@@ -190,7 +224,7 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
     if (only != nullptr && std::find(only->begin(), only->end(), index) == only->end()) continue;
     IterationData& data = session.iterations[i];
     const IterationEntry& entry = m.iterations[i];
-    const std::string samples_file = session_layout::samples_file(index);
+    const std::string samples_file = session_layout::samples_file(index, entry.samples_revision);
     const std::string telemetry_file = session_layout::telemetry_file(index);
     const std::size_t ticks = rows * static_cast<std::size_t>(config.timing.ticks_per_sample);
     parse_samples_csv(read_session_file(folders, samples_file, csv_size_limit(header_views(samples_names), rows + 1),
@@ -216,10 +250,18 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
     session.black_boxes.push_back(
         parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity), where + file, entry.ticks));
   }
+  session.dropped = describe_dropped(find_uncommitted_files(directory, m));
   return session;
 }
 
 }  // namespace
+
+std::string dropped_line(const Session& session) {
+  if (session.dropped.empty()) return "";
+  const auto n = static_cast<long long>(session.iterations.size());
+  return describe_session(session.directory) + ": a save was interrupted; dropped what it had not committed: " +
+         session.dropped + "; this is its last committed state (" + std::to_string(n) + (n == 1 ? " iteration)" : " iterations)");
+}
 
 void save_session(const Session& session, const fs::path& directory) {
   create_session_directory(directory, session.manifest, session.trajectory, session.iterations, "bellows save",

@@ -13,6 +13,7 @@
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_store.hpp"
+#include "sessions/uncommitted_files.hpp"
 
 namespace bellows {
 namespace fs = std::filesystem;
@@ -63,20 +64,9 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   // What it writes is this bellows' format (what an older version lacked has its default now).
   manifest.schema_version = kSessionSchemaVersion;
   SessionWriter writer(std::move(session), std::move(manifest), std::move(lock));
-  // Files of an iteration whose manifest update a crash prevented: not part of the session.
-  const auto name_in_folder = [](const std::string& relative) { return session_layout::folder_and_name(relative).second; };
-  remove_temporary_files(writer.iterations_);
-  for (int i = static_cast<int>(loaded.iterations.size());; ++i) {
-    const bool samples = remove_file_at(writer.iterations_, name_in_folder(session_layout::samples_file(i)));
-    const bool telemetry = remove_file_at(writer.iterations_, name_in_folder(session_layout::telemetry_file(i)));
-    if (!samples && !telemetry) break;
-  }
-  if (const std::optional<DirectoryHandle> faults = writer.directory_.subdirectory(session_layout::kFaults)) {
-    remove_temporary_files(*faults);
-    for (int i = static_cast<int>(loaded.black_boxes.size());; ++i) {  // likewise for a black box
-      if (!remove_file_at(*faults, name_in_folder(session_layout::black_box_file(i)))) break;
-    }
-  }
+  // What an interrupted save wrote but never committed, and files a committed revision superseded:
+  // not part of the session.
+  remove_uncommitted_files(writer.directory_, find_uncommitted_files(writer.directory_, writer.manifest_));
   return writer;
 }
 
@@ -110,23 +100,62 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
   std::optional<ResumeState> previous_resume = std::move(manifest_.resume);
   manifest_.iterations.push_back({summary, utc_now(), digests.samples_sha256, digests.telemetry_sha256});
   manifest_.resume = std::move(resume);
-  rewrite_manifest([&] {  // not on disk: not in the session
+  rewrite_manifest([this, previous_resume = std::move(previous_resume)]() mutable {  // not on disk: not in the session
     manifest_.iterations.pop_back();
     manifest_.resume = std::move(previous_resume);
   });
 }
 
-void SessionWriter::rewrite_manifest(const std::function<void()>& undo) {
-  // The manifest is changed in place and the change undone if the write fails: copying it for each
-  // write would copy every iteration's entry after every iteration.
+void SessionWriter::rewrite_manifest(std::function<void()> undo) {
+  undo_.push_back(std::move(undo));
+  if (batch_open_) return;  // Batch::commit() writes it once for the whole batch
+  commit_manifest();
+}
+
+void SessionWriter::commit_manifest() {
+  // The manifest is changed in place and the changes undone if the write fails: copying it for
+  // each write would copy every iteration's entry after every iteration.
   const std::string previous_update = manifest_.updated_utc;
   try {
     write_manifest(directory_, manifest_, &manifest_text_);
   } catch (...) {
-    undo();
     manifest_.updated_utc = previous_update;
+    roll_back();
     throw;
   }
+  undo_.clear();
+  // Committed: the files the manifest no longer names go (a crash before leaves them superseded,
+  // which the next writer removes; a failure here loses nothing).
+  for (const std::string& name : after_commit_) {
+    try {
+      remove_file_at(iterations_, name);
+    } catch (const InputError&) {
+    }
+  }
+  after_commit_.clear();
+}
+
+void SessionWriter::roll_back() {
+  for (auto undo = undo_.rbegin(); undo != undo_.rend(); ++undo) (*undo)();
+  undo_.clear();
+  after_commit_.clear();
+  manifest_text_ = {};  // it may hold entries just undone
+}
+
+SessionWriter::Batch::Batch(SessionWriter& writer) : writer_(writer) {
+  if (writer_.batch_open_) throw std::logic_error("SessionWriter::Batch: a batch is open already");
+  writer_.batch_open_ = true;
+}
+
+SessionWriter::Batch::~Batch() {
+  if (!writer_.batch_open_) return;
+  writer_.batch_open_ = false;
+  writer_.roll_back();  // not committed: nothing of it is in the session
+}
+
+void SessionWriter::Batch::commit() {
+  writer_.batch_open_ = false;
+  if (!writer_.undo_.empty()) writer_.commit_manifest();
 }
 
 void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar) {
@@ -138,12 +167,23 @@ void SessionWriter::update_next_correction(const TrialRecord& record, const Eige
     throw std::invalid_argument("SessionWriter::update_next_correction: no iteration saved yet");
   }
   check_fits(record, next_correction_bar, "update_next_correction");
-  // The rewritten samples file gets its new digest in the manifest, or a resume would refuse it.
+  // The committed samples file is never rewritten: the new correction goes into the next revision
+  // of it, and the manifest naming that revision (with its digest) is the commit. The old file is
+  // removed once the manifest no longer names it.
   const int iteration = next_iteration() - 1;
+  IterationEntry& entry = manifest_.iterations.back();
   const std::string contents = format_samples_csv(record, next_correction_bar);
-  write_file_atomic_at(iterations_, session_layout::folder_and_name(session_layout::samples_file(iteration)).second, contents);
-  std::string previous_digest = std::exchange(manifest_.iterations.back().samples_sha256, sha256_hex(contents));
-  rewrite_manifest([&] { manifest_.iterations.back().samples_sha256 = std::move(previous_digest); });
+  const int revision = entry.samples_revision + 1;
+  const auto name_of = [&](int r) { return session_layout::folder_and_name(session_layout::samples_file(iteration, r)).second; };
+  write_file_atomic_at(iterations_, name_of(revision), contents);
+  std::string previous_digest = std::exchange(entry.samples_sha256, sha256_hex(contents));
+  entry.samples_revision = revision;
+  after_commit_.push_back(name_of(revision - 1));
+  rewrite_manifest([this, previous_digest = std::move(previous_digest)]() mutable {
+    manifest_.iterations.back().samples_sha256 = std::move(previous_digest);
+    --manifest_.iterations.back().samples_revision;
+    after_commit_.pop_back();
+  });
 }
 
 void SessionWriter::save_black_box(const std::string& fault, const std::vector<TickRecord>& ticks) {
@@ -151,17 +191,17 @@ void SessionWriter::save_black_box(const std::string& fault, const std::vector<T
   const auto index = static_cast<int>(manifest_.black_boxes.size());
   const std::string digest = write_black_box_file(directory_, index, ticks);
   manifest_.black_boxes.push_back({utc_now(), next_iteration(), fault, static_cast<int>(ticks.size()), digest});
-  rewrite_manifest([&] { manifest_.black_boxes.pop_back(); });
+  rewrite_manifest([this] { manifest_.black_boxes.pop_back(); });
 }
 
 void SessionWriter::record_event(const std::string& kind, const std::string& message) {
   manifest_.events.push_back({utc_now(), next_iteration(), kind, message});
-  rewrite_manifest([&] { manifest_.events.pop_back(); });
+  rewrite_manifest([this] { manifest_.events.pop_back(); });
 }
 
 void SessionWriter::set_configuration(const Configuration& config) {
   Configuration previous = std::exchange(manifest_.configuration, config);
-  rewrite_manifest([&] { manifest_.configuration = std::move(previous); });
+  rewrite_manifest([this, previous = std::move(previous)]() mutable { manifest_.configuration = std::move(previous); });
 }
 
 }  // namespace bellows

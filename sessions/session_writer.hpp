@@ -1,13 +1,14 @@
 // Saving a session as it happens: a run (or the console) creates or reopens a session, then saves
 // after every completed iteration and records events (faults, operator actions) as they occur.
-// Every save writes the iteration's files first and then the manifest that lists them, each
-// atomically, so a crash at any moment leaves a session that loads with every iteration whose
-// save returned. The writer holds the session's lock for its lifetime: one writer per session.
+// Every save writes new files under new names first and then the manifest that names them: the
+// manifest's rename is the single commit point, so a crash at any moment leaves a session that
+// loads with every iteration whose save returned, and a file already committed is never rewritten. The writer holds the session's lock for its lifetime: one writer per session.
 #pragma once
 
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "sessions/file_access.hpp"
 #include "sessions/manifest_json.hpp"
@@ -41,8 +42,9 @@ class SessionWriter {
   void save_iteration(const TrialRecord& record, const IterationSummary& summary,
                       const Eigen::MatrixXd& next_corrections_bar, ResumeState resume);
   /// The correction learned from the last saved iteration changed (learning ran after the save, or
-  /// the operator chose another): rewrites that iteration's samples file (`record` is its record)
-  /// atomically, so the learned correction is on disk before the next trial starts.
+  /// the operator chose another): writes that iteration's samples file (`record` is its record)
+  /// again as its next revision and commits the manifest naming it, so the learned correction is
+  /// on disk before the next trial starts and the file committed before is never rewritten.
   void update_next_correction(const TrialRecord& record, const Eigen::VectorXd& next_correction_bar);
   void update_next_correction(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar);
   /// Keeps a fault's black box (`ticks` oldest first, ending with the fault tick): writes its file,
@@ -53,6 +55,22 @@ class SessionWriter {
   /// Replaces the configuration (e.g. the operator changed gains); saved at once.
   void set_configuration(const Configuration& config);
 
+  /// Several of the calls above as one save: while a Batch is open they write their files (under
+  /// new names only) but not the manifest; commit() writes the manifest once, and that rename
+  /// commits all of them. A batch destroyed uncommitted (or whose commit throws) undoes them all:
+  /// the writer is as before it, and a retry writes them again.
+  class Batch {
+   public:
+    explicit Batch(SessionWriter& writer);
+    ~Batch();
+    Batch(const Batch&) = delete;
+    Batch& operator=(const Batch&) = delete;
+    void commit();
+
+   private:
+    SessionWriter& writer_;
+  };
+
  private:
   SessionWriter(DirectoryHandle directory, SessionManifest manifest, SessionLock lock);
   int next_iteration() const { return static_cast<int>(manifest_.iterations.size()); }
@@ -61,8 +79,15 @@ class SessionWriter {
 
   DirectoryHandle directory_;  // every file is written relative to it, never through a link
   DirectoryHandle iterations_;
-  /// Writes manifest_ (changed in place); if that fails, `undo` puts the change back and it throws.
-  void rewrite_manifest(const std::function<void()>& undo);
+  /// Writes manifest_ (changed in place) unless a batch is open; if that fails, `undo` (and those
+  /// of the batch) put the changes back and it throws.
+  void rewrite_manifest(std::function<void()> undo);
+  void commit_manifest();
+  void roll_back();
+
+  std::vector<std::function<void()>> undo_;  // of the changes not committed yet, oldest first
+  std::vector<std::string> after_commit_;    // iterations/ files a commit supersedes (removed after it)
+  bool batch_open_ = false;
 
   SessionManifest manifest_;
   ManifestTextCache manifest_text_;  // what of manifest_'s lists is serialized already

@@ -80,6 +80,9 @@ TEST(ConfigFile, RejectsBadConfigurations) {
   expect_config_refused("[plant]\nkappa = nan\n", "finite");
   expect_config_refused("[plant\nkappa = 7\n", "lab.toml:");
   expect_config_refused("plant = 3\n", "must be a table");
+  // The TOML parser's own refusals name the key too, not only the line (issue 24).
+  expect_config_refused("[controller]\nfilter_samples = 18446744073709551617\n", "[controller] filter_samples: ");
+  expect_config_refused("[controller]\n  # a note\nfilter_samples = 18446744073709551617\n", "[controller] filter_samples: ");
 }
 
 TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {

@@ -141,7 +141,8 @@ TEST(AtomicFile, ReplacesContentsAndLeavesNoTemporaryFile) {
   int entries = 0;
   for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) ++entries;
   EXPECT_EQ(entries, 1);
-  EXPECT_TRUE(is_temporary_file_name(temporary_path_for(path).filename().string()));
+  EXPECT_TRUE(is_temporary_file_name(unpredictable_temporary_name("f.txt")));
+  EXPECT_NE(unpredictable_temporary_name("f.txt"), unpredictable_temporary_name("f.txt"));  // not guessable
   EXPECT_FALSE(is_temporary_file_name("f.txt"));
 }
 

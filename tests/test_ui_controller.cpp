@@ -343,8 +343,9 @@ TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   f.type(bad.string());
   f.key(key::kEnter);
-  EXPECT_NE(f.state().chooser.preview_error.find("bad.csv"), std::string::npos) << f.state().chooser.preview_error;
-  f.key(key::kEnter);
+  // Refused: the prompt stays open with the path and why (issue 23).
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
+  EXPECT_NE(f.state().dialog.error.find("bad.csv"), std::string::npos) << f.state().dialog.error;
   for (std::size_t i = 0; i < bad.string().size(); ++i) f.key(key::kBackspace);
   f.type(good.string());
   f.key(key::kEnter);
@@ -434,12 +435,14 @@ TEST(UiController, ATrialWaitsForTheSaveAndAFailedSaveStopsTrials) {
   EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);
 }
 
-TEST(UiController, QuitFinishesTheSaveAndDisarmsWithoutAsking) {
+TEST(UiController, QuitAsksWhileArmedThenFinishesTheSaveAndDisarms) {
   ConsoleFixture f;
   f.arm_valves();
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   f.key('q');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);  // the valves are live: it asks
+  f.key('y');
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   ASSERT_TRUE(f.pump_until([&] { return f.console->quit_requested(); }));
   EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);
@@ -468,13 +471,13 @@ TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
   EXPECT_EQ(e.unsaved_sentence(), "");
   e.trials.resize(3);
   e.saved_trials = 2;
-  EXPECT_EQ(e.unsaved_sentence(), "1 iteration is not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "iteration 2 is not saved.");
   e.saved_trials = 0;
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2) are not saved.");
   e.faults.resize(1);
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations and 1 fault's black box are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2) and 1 fault's black box are not saved.");
   e.settings_changed = true;
-  EXPECT_EQ(e.unsaved_sentence(), "3 iterations, 1 fault's black box and changed settings are not saved.");
+  EXPECT_EQ(e.unsaved_sentence(), "3 iterations (0-2), 1 fault's black box and changed settings are not saved.");
   e.saved_trials = 3;
   e.faults.resize(2);
   e.settings_changed = false;
@@ -482,6 +485,9 @@ TEST(UiExperiment, TheUnsavedSentenceNamesWhatASaveWouldAdd) {
   e.saved_faults = 2;
   e.settings_changed = true;
   EXPECT_EQ(e.unsaved_sentence(), "changed settings are not saved.");
+  e.settings_changed = false;
+  e.next_unsaved = true;  // learned after the last trial was saved
+  EXPECT_EQ(e.unsaved_sentence(), "the correction learned from iteration 2 is not saved.");
 }
 
 TEST(UiController, AFaultsBlackBoxIsSavedAtOnceAndAStopIsVentedOnlyWhenTheEngineActed) {

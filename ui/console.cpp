@@ -66,6 +66,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   controller->start(start_s);
   Canvas canvas(terminal->width(), terminal->height());
   FramePacer pacer;
+  std::uint64_t repaints_done = 0;
 
   while (!controller->quit_requested()) {
     int key = terminal->read_key(kKeyTimeoutMs);
@@ -89,6 +90,10 @@ ConsoleReport run_console(ConsoleSetup setup) {
     if (setup.exit_after_s > 0.0 && now - start_s >= setup.exit_after_s) {
       report.exited_after_time = true;
       break;
+    }
+    if (controller->repaints() != repaints_done) {
+      repaints_done = controller->repaints();
+      terminal->repaint();
     }
     if (pacer.should_draw(now, controller->revision(), controller->active())) {
       render(controller->state(), canvas);
@@ -114,8 +119,11 @@ ConsoleReport run_console(ConsoleSetup setup) {
     terminal->read_key(10);
     controller->update(monotonic_s());
   }
-  report.save_status = controller->saves_settled() ? controller->state().experiment.session_location : std::string();
-  report.unsaved = controller->state().experiment.unsaved_sentence();
+  report.unsaved = controller->unsaved_work();
+  // "saved as it went" only when everything is on disk: a failed save is never reported as saved.
+  report.save_status = controller->saves_settled() && report.unsaved.empty() ? controller->state().experiment.session_location
+                                                                              : std::string();
+  report.unsaved_work_lost = controller->quitting_loses_work();
   report.seconds = monotonic_s() - start_s;
   report.ui_cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID) - cpu_start_s;
   loop->stop();

@@ -37,6 +37,7 @@ struct ConsoleReport {
   bool stopped_by_signal = false;
   std::string save_status;           // the session saved as it went (empty: none)
   std::string unsaved;               // what did not reach the disk (empty: nothing), a sentence
+  bool unsaved_work_lost = false;    // saving was available and work is not on disk: exit non-zero
   std::uint64_t dropped_events = 0;  // engine events lost to a full queue
   std::uint64_t missed_warnings = 0; // missed deadlines counted as warnings (simulated arm)
   bool exited_after_time = false;

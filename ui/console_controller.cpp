@@ -66,7 +66,11 @@ bool ConsoleController::active() const {
 }
 
 void ConsoleController::log(LogSource source, std::string text, bool important, double engine_time_s, bool routine) {
-  if (engine_time_s < -1.0) engine_time_s = state_.live_valid ? state_.live.time_s : -1.0;
+  if (engine_time_s < -1.0) {
+    // The newest engine time the console knows: an event polled in this update may be newer than
+    // the last snapshot, and the log's times never run backwards.
+    engine_time_s = state_.live_valid ? std::max(state_.live.time_s, newest_event_s_) : newest_event_s_;
+  }
   state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine, utc_timestamp(),
                   state_.experiment.next_iteration()});
   ++revision_;
@@ -75,6 +79,8 @@ void ConsoleController::log(LogSource source, std::string text, bool important, 
 void ConsoleController::set_status(std::string text, bool important) {
   state_.status = std::move(text);
   state_.status_important = important;
+  state_.status_screen = state_.screen;  // a key's message moves with the screen the key leads to (handle_key)
+  ++status_serial_;
   ++revision_;
 }
 
@@ -141,6 +147,11 @@ void ConsoleController::update(double now_s) {
   poll_engine(now_s);
   refresh_rig(now_s);  // the link's figures before the health line uses them
   poll_snapshot_and_telemetry(now_s);
+  if (continue_pending_) {
+    poll_engine(now_s);  // the events the engine emitted with the trial's end come first
+    continue_pending_ = false;
+    continue_run();
+  }
   poll_tasks();
   if (black_box_pending_ && env_.core->black_box().frozen()) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
@@ -206,6 +217,7 @@ void ConsoleController::poll_engine(double /*now_s*/) {
 
 void ConsoleController::on_event(const EngineEvent& event) {
   forward_to_valve_test(event);
+  newest_event_s_ = std::max(newest_event_s_, event.time_s);
   switch (event.kind) {
     case EventKind::kStateChanged:
       state_.engine_state = event.to;
@@ -214,8 +226,13 @@ void ConsoleController::on_event(const EngineEvent& event) {
       const bool routine = event.command == CommandKind::kStartTrial &&
                            (event.to == EngineState::kRunning || event.to == EngineState::kArmed);
       // Into FAULT: the fault's own name (a guard is not an emergency stop).
+      // Back to ARMED from RUNNING on the trial's own command: the trial ran to its end (an abort names
+      // its own command, a fault its guard).
+      const bool trial_end = event.from == EngineState::kRunning && event.to == EngineState::kArmed &&
+                             event.command == CommandKind::kStartTrial;
       const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone ? fault_name(event.fault)
-                                                                                              : to_string(event.command);
+                          : trial_end                                                      ? "trial complete"
+                                                                                           : to_string(event.command);
       log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
           event.to == EngineState::kFault, event.time_s, routine);
     }

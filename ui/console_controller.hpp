@@ -35,6 +35,14 @@
 
 namespace bellows::ui {
 
+/// A prompt's verdict on what was typed (ConsoleController::judge_input): refused (`refusal`, the
+/// prompt stays open with the typed text and the reason), or taken (the prompt closes, then `then`
+/// runs, if any).
+struct PromptAnswer {
+  std::string refusal;
+  std::function<void()> then;
+};
+
 /// What the console needs from the program around it.
 struct ConsoleEnvironment {
   EngineCore* core = nullptr;
@@ -89,6 +97,14 @@ class ConsoleController {
 
   const ConsoleState& state() const { return state_; }
   bool quit_requested() const { return quit_requested_; }
+  /// Bumped by Ctrl-L: the terminal repaints every cell (clears what another program or a glitch left).
+  std::uint64_t repaints() const { return repaints_; }
+  /// What is not on disk, naming the trials ("iteration 4 is not saved."); empty when everything
+  /// is. The quit confirmation names it; a failed save says it and keeps the data in memory.
+  std::string unsaved_work() const { return state_.experiment.unsaved_sentence(); }
+  /// Quitting now leaves work the disk did not take although saving is available (a failed save,
+  /// or one not finished): the console then says so and exits non-zero (status 4).
+  bool quitting_loses_work() const { return state_.sessions_available && !unsaved_work().empty(); }
   /// Bumped by every discrete change (keys, events, results): the screen needs a redraw.
   std::uint64_t revision() const { return revision_; }
   /// Trials or learning in progress: the screen changes continuously.
@@ -133,7 +149,8 @@ class ConsoleController {
   void perform(Action action);
   void open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
                    std::string input = {});
-  void accept_input();
+  /// Judges the open prompt's text without closing it (handle_dialog_key closes it when taken).
+  PromptAnswer judge_input();
   void reject_input(std::string why);  // the prompt stays open with the input and the reason
   /// y/Y closes the dialog and runs `on_yes`; n/N closes it with `status_on_no`; any other key leaves
   /// it open with "... is not an answer here" (then returns false).
@@ -147,6 +164,7 @@ class ConsoleController {
   /// The next (+1) or previous (-1) learning law; the law is rebuilt and the change logged.
   void choose_law_step(int step);
   void confirm_discard(std::string what, std::function<void()> action);
+  void quit_when_saved();  // quits once the save in progress is done (it asks again if that save fails)
   void quit_now();
 
   // The Rig screen and the valve test (console_rig.cpp).
@@ -181,6 +199,10 @@ class ConsoleController {
   std::uint64_t revision_ = 0;
   bool quit_requested_ = false;
   bool quit_after_save_ = false;
+  std::uint64_t repaints_ = 0;
+  std::uint64_t status_serial_ = 0;  // set_status() calls, to tell a key's own message
+  bool continue_pending_ = false;    // a trial finished: the run goes on once this update's events are in
+  double newest_event_s_ = -1.0;     // engine time of the newest event polled
 
   // Trajectories given to the engine, in the order sent, alive until it hands them back (a
   // kTrajectorySelected event for a later one): it may hold a pointer to any of them until then.

@@ -124,21 +124,27 @@ bool ConsoleController::handle_screen_key(int k) {
       return false;
     }
     case Screen::kLog: {
-      const int count = static_cast<int>(state_.log.entries().size());
       const int page = std::max(1, state_.height - 8);
+      // At the top the oldest entry is on the first row and the page is full (no page of blanks).
+      const int top = detail::log_top_scroll(state_);
       int& scroll = state_.log_scroll;
-      if (k == key::kUp) scroll = std::min(count - 1, scroll + 1);
-      else if (k == key::kDown) scroll = std::max(0, scroll - 1);
-      else if (k == key::kPageUp) scroll = std::min(std::max(count - 1, 0), scroll + page);
-      else if (k == key::kPageDown) scroll = std::max(0, scroll - page);
+      if (k == key::kUp) scroll += 1;
+      else if (k == key::kDown) scroll -= 1;
+      else if (k == key::kPageUp) scroll += page;
+      else if (k == key::kPageDown) scroll -= page;
+      else if (k == key::kHome) scroll = top;
       else if (k == key::kEnd) scroll = 0;
       else return false;
-      scroll = std::max(0, scroll);
+      scroll = std::clamp(scroll, 0, top);
       return true;
     }
     case Screen::kRig:
       return handle_rig_key(k);
     case Screen::kHelp: {
+      if (k == 'q' || k == key::kEscape) {  // as in less, man and htop: back where help was opened
+        state_.screen = state_.previous_screen;
+        return true;
+      }
       const int page = std::max(1, state_.height - 6);  // the help's inner height
       const int last = std::max(0, detail::help_line_count(state_) - page);
       int& top = state_.help_scroll;
@@ -260,7 +266,11 @@ void ConsoleController::choose_law_step(int step) {
 std::string ConsoleController::apply_tuning(int field, const std::string& text) {
   const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
   double value = 0;
-  if (!parse_number(trim(text), value)) return std::string(f.label) + ": '" + text + "' is not a number";
+  switch (parse_number(trim(text), value)) {
+    case NumberParse::kNumber: break;
+    case NumberParse::kNotANumber: return std::string(f.label) + ": '" + text + "' is not a number";
+    case NumberParse::kOutOfRange: return std::string(f.label) + ": '" + text + "' is out of range";
+  }
   Configuration candidate = state_.config;
   const double old = *f.value(candidate);
   *f.value(candidate) = value;

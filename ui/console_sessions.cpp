@@ -146,8 +146,11 @@ void ConsoleController::poll_session_tasks() {
     } catch (const std::exception& error) {
       autosave_failed_ = true;  // no retry loop: the operator decides (quit asks, s retries)
       begin_after_save_ = false;
-      log(LogSource::kSession, std::string("save failed: ") + error.what(), true);
-      set_status(std::string("save failed: ") + error.what() + "; trials are not started until it is fixed", true);
+      // Which trials are not on disk (they stay in memory, none released), and how to retry.
+      const std::string unsaved = state_.experiment.unsaved_sentence();
+      log(LogSource::kSession, std::string("save failed: ") + error.what() + "; " + unsaved, true);
+      set_status(std::string("save failed: ") + error.what() + "; " + unsaved +
+                     " Kept in memory; the next trial (or s when quitting) retries the save", true);
       if (state_.run.mode != RunProgress::Mode::kIdle) end_run("stopped: the session cannot be saved", true);
       if (figures_after_save_ > 0) log(LogSource::kSession, "figures not written: the session is not saved", true);
       figures_after_save_ = 0;

@@ -155,6 +155,7 @@ struct ConsoleState {
   Dialog dialog;
   std::string status;          // the latest message for the operator
   bool status_important = false;
+  Screen status_screen = Screen::kMain;  // where it was said: another screen does not show it
   int log_scroll = 0;          // log screen: entries scrolled back from the newest
   int help_scroll = 0;         // help screen: its first line shown
 

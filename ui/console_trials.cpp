@@ -206,7 +206,9 @@ void ConsoleController::finish_trial(double time_s) {
   }
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;
-  continue_run();
+  // After the rest of the engine's events (the trial's RUNNING -> ARMED is logged after it ended):
+  // the log keeps the order things happened in, a batch's "done" last.
+  continue_pending_ = true;
 }
 
 void ConsoleController::drop_trial(const std::string& why) {

@@ -18,16 +18,20 @@ std::string Experiment::unsaved_sentence() const {
   std::vector<std::string> parts;
   const int iterations = static_cast<int>(trials.size()) - saved_trials;
   const int black_boxes = static_cast<int>(faults.size()) - saved_faults;
-  if (iterations > 0) parts.push_back(std::to_string(iterations) + (iterations == 1 ? " iteration" : " iterations"));
+  const int first = std::max(saved_trials, 0), last = static_cast<int>(trials.size()) - 1;
+  // Which trials are not on disk, by number: the operator checks them against the history.
+  if (iterations == 1) parts.push_back("iteration " + std::to_string(last));
+  if (iterations > 1) parts.push_back(std::to_string(iterations) + " iterations (" + std::to_string(first) + "-" + std::to_string(last) + ")");
   if (black_boxes > 0) {
     parts.push_back(std::to_string(black_boxes) + (black_boxes == 1 ? " fault's black box" : " faults' black boxes"));
   }
   if (settings_changed) parts.push_back("changed settings");
-  if (next_unsaved && !trials.empty() && iterations <= 0) parts.push_back("the next correction");
+  const bool next = next_unsaved && !trials.empty() && iterations <= 0;
+  if (next) parts.push_back("the correction learned from iteration " + std::to_string(last));
   if (parts.empty()) return {};
   std::string sentence = parts[0];
   for (std::size_t i = 1; i < parts.size(); ++i) sentence += (i + 1 == parts.size() ? " and " : ", ") + parts[i];
-  const bool one = parts.size() == 1 && (iterations == 1 || black_boxes == 1);
+  const bool one = parts.size() == 1 && (iterations == 1 || black_boxes == 1 || next);
   return sentence + (one ? " is not saved." : " are not saved.");
 }
 

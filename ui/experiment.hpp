@@ -88,8 +88,10 @@ struct Experiment {
   /// Releases the records and corrections of saved trials older than the kept window, and the
   /// ticks of saved black boxes (the session on disk has them).
   void release_saved_history();
-  /// What a save would add, as a sentence: "2 iterations, 1 fault's black box and changed settings
-  /// are not saved."; empty when nothing is unsaved.
+  /// What is not on disk (what a save would add), as a sentence naming the trials: "iteration 4
+  /// is not saved.", "2 iterations (3-4), 1 fault's black box and changed settings are not saved.",
+  /// "the correction learned from iteration 4 is not saved."; empty when nothing is unsaved. The
+  /// quit confirmation, the failed save's message and the exit report say this.
   std::string unsaved_sentence() const;
   /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
   void add_trial(Trial trial);

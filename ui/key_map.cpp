@@ -42,7 +42,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kSave, 's', key::kNone, "s", "Name", "name the session (it is saved as you go)"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
       {Action::kFigures, 'g', key::kNone, "g", "Figures", "write figures of this session (PNG, SVG; the engine goes on)"},
-      {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
+      {Action::kQuit, 'q', key::kNone, "q", "Quit", kQuitRule},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
       {Action::kJoint, 'j', key::kNone, "j", "Joint", "next joint: the live strip, plots and inspector show it (arms with several joints)"},
@@ -139,7 +139,7 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
     candidates = {Action::kReset, Action::kFaultView, Action::kLog, Action::kTrajectory, Action::kHelp, Action::kQuit};
   } else if (!run_idle(s) || s.engine_state == EngineState::kRunning) {
     candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kJoint, Action::kInspector,
-                  Action::kLog, Action::kHelp};
+                  Action::kLog, Action::kHelp, Action::kQuit};
   } else if (s.engine_state == EngineState::kArmed) {
     candidates = {Action::kEmergencyStop, Action::kRunTrial, Action::kNextIteration, Action::kRunIterations,
                   Action::kDisarm, Action::kJoint, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
@@ -203,7 +203,7 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kSessions:
       return {{"Up/Down", "choose a session"}, {"Enter", "open it"}};
     case Screen::kLog:
-      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"End", "newest"}};
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "oldest / newest"}};
     case Screen::kFault:
       return {{"R", "reset the fault"}};
     case Screen::kRig:
@@ -212,7 +212,7 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kMain:
       return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"}};
     case Screen::kHelp:
-      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"?/F1, Esc", "close the help"}};
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"q, Esc, ?/F1", "close the help: back to the screen it was opened from"}};
   }
   return {};
 }

@@ -44,6 +44,11 @@ struct KeyBinding {
   const char* description;
 };
 
+/// When `q` asks before quitting: written once, shown by the help and quoted by docs/console.md.
+/// Live: ARMED or RUNNING (or trials running); lost: a save failed, or saving is not available.
+inline constexpr const char* kQuitRule =
+    "quit: asks while the valves are live or work would be lost; otherwise saves, vents and exits";
+
 /// Every global command, in the help screen's order.
 const std::vector<KeyBinding>& key_bindings();
 const KeyBinding& binding(Action action);

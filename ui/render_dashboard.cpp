@@ -127,14 +127,14 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
   }
   // With several joints: the RMS over every joint and sample, then each joint's (docs/console.md).
   const int joints = s.experiment.joints();
-  const int list_width = joints > 1 ? 13 + 7 * joints : 14;
+  const int list_width = joints > 1 ? 13 + 7 * joints : 15;  // "%4d %9.3f" and the best mark '*'
   const Rect list{in.right() - list_width, in.y, list_width, in.height};
   if (joints > 1) {
     std::string head = "  it     all ";
     for (int j = 0; j < joints; ++j) head += format("     j%d", j + 1);
     c.put(list.x, list.y, head, Role::kDim);
   } else {
-    c.put(list.x, list.y, "  it       RMS", Role::kDim);
+    c.put(list.x, list.y, "  it       RMS ", Role::kDim);
   }
   const int rows = list.height - 1;
   const int count = static_cast<int>(trials.size());
@@ -148,7 +148,7 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
       line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j))
                                                             : std::string("      -");
     }
-    c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1);
+    c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1, list.right());
   }
   const Rect plot{in.x, in.y, in.width - list_width - 1, in.height};
   if (plot.width >= 18 && count >= 2) {
@@ -192,7 +192,7 @@ void render_correction(const ConsoleState& s, Canvas& c, const Rect& area, const
 
 void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  const int left_width = std::clamp(body.width * 3 / 10, 30, 40);
+  const int left_width = std::clamp(body.width * 3 / 10, 30, 64);
   const int live_height = std::min(14, body.height - 5);
   render_live(s, c, {body.x, body.y, left_width, live_height}, g);
   const Rect log{body.x, body.y + live_height, left_width, body.height - live_height};
