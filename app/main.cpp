@@ -197,6 +197,21 @@ int main(int argc, char** argv) {
   t7_sim_cmd->add_option("--stall-s", t7_sim.stall_s, "Drill: how late that answer comes")
       ->capture_default_str()
       ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--product", t7_sim.product, "The T7 it is: t7 (resolution index 0..8) or t7-pro (0..12, the paper's)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"t7", "t7-pro"}));
+  t7_sim_cmd->add_flag("--nagle", t7_sim.nagle, "Drill: answers with Nagle's algorithm (a T7 sends at once)");
+  t7_sim_cmd->add_flag("--silent-reads", t7_sim.silent_reads, "Drill: reads of the analog inputs go unanswered (no reading ever)");
+  t7_sim_cmd->add_option("--halve-roll-after", t7_sim.halve_roll_after_s,
+                         "Drill: this many seconds after the first request, clock 0's roll value halves (another program): wide duties are refused")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--answer-after", t7_sim.answer_after_s, "Drill: every answer this many seconds later (a slow device)")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--trickle-after", t7_sim.trickle_after_s, "Drill: this many seconds after the first request, answers trickle one byte at a time")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--trickle-byte-s", t7_sim.trickle_byte_s, "Drill: the trickle's time per byte")
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
