@@ -138,8 +138,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
       return zero_rig_angle(opened, path, read_rad);
     };
   }
-  setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
-    return write_console_figures(snapshot, root);
+  setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location, int iterations) {
+    return write_console_figures(location, iterations, root, [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
   };
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;

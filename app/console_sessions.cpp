@@ -197,6 +197,11 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   return writer_->directory().string();
 }
 
+void StoreSessionGateway::read_quietly(const std::function<void()>& read) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  read();
+}
+
 std::string StoreSessionGateway::rename(const std::string& name) {
   const std::lock_guard<std::mutex> guard(mutex_);
   if (!writer_) throw InputError("nothing to name yet: the session is created with the first trial");

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -37,6 +38,9 @@ class StoreSessionGateway final : public ui::SessionGateway {
   std::string rename(const std::string& name) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
+  /// Runs `read` while no save, rename or open runs (each rewrites files a reader could see half
+  /// changed): the console's figures read the session it saves into (app/plot_console.hpp).
+  void read_quietly(const std::function<void()>& read);
 
  private:
   std::mutex mutex_;

@@ -16,6 +16,7 @@
 #include "app/memory_policy.hpp"
 #include "app/rig_check_command.hpp"
 #include "app/plot_command.hpp"
+#include "app/plot_style.hpp"
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
@@ -143,6 +144,8 @@ int main(int argc, char** argv) {
   plot_cmd->add_option("--trial", plot.trial, "Iteration whose pressures are drawn (default: the last)");
   plot_cmd->add_option("--formats", plot.formats, "png, svg and/or pdf, e.g. png,pdf")->delimiter(',')->default_str("png,svg")
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
+  plot_cmd->add_option("--style", plot.style, "Size and fonts: screen, paper-column (3.5 in wide, 8 pt) or paper-wide "
+                       "(7.16 in, 8 pt)")->capture_default_str()->check(CLI::IsMember(bellows::figure_style_names()));
   plot_cmd->add_option("--paper", plot.paper, "CSV (iteration,rms_deg) overlaid on the RMS figure "
                        "(default for the paper trajectory: the paper's curve, when available)");
   plot_cmd->add_flag("--no-paper", plot.no_paper, "No overlay on the RMS figure");

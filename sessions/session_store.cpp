@@ -74,6 +74,9 @@ std::optional<DirectoryHandle> session_folder(const DirectoryHandle& root, const
   }
 }
 
+/// load_session's work: every iteration when `only` is null, else only those it lists and no black box.
+Session load_session_part(const DirectoryHandle& directory, const std::vector<int>* only);
+
 /// RMS error over every joint and learning sample (deg).
 double overall_rms_deg(const TrialRecord& record) {
   double sum_of_squares = 0.0;
@@ -154,7 +157,15 @@ SessionManifest load_manifest(const DirectoryHandle& directory) {
 
 Session load_session(const fs::path& directory) { return load_session(open_session_directory(directory)); }
 
-Session load_session(const DirectoryHandle& directory) {
+Session load_session(const DirectoryHandle& directory) { return load_session_part(directory, nullptr); }
+
+Session load_session_iterations(const fs::path& directory, const std::vector<int>& only) {
+  return load_session_part(open_session_directory(directory), &only);
+}
+
+namespace {
+
+Session load_session_part(const DirectoryHandle& directory, const std::vector<int>* only) {
   Session session;
   session.directory = directory.path();
   session.manifest = load_manifest(directory);
@@ -176,6 +187,7 @@ Session load_session(const DirectoryHandle& directory) {
   session.iterations.resize(m.iterations.size());
   for (std::size_t i = 0; i < m.iterations.size(); ++i) {
     const int index = static_cast<int>(i);
+    if (only != nullptr && std::find(only->begin(), only->end(), index) == only->end()) continue;
     IterationData& data = session.iterations[i];
     const IterationEntry& entry = m.iterations[i];
     const std::string samples_file = session_layout::samples_file(index);
@@ -197,7 +209,7 @@ Session load_session(const DirectoryHandle& directory) {
                        " deg differs from the manifest's " + std::to_string(listed) + " deg");
     }
   }
-  for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+  for (std::size_t i = 0; only == nullptr && i < m.black_boxes.size(); ++i) {
     const BlackBoxEntry& entry = m.black_boxes[i];
     const std::string file = session_layout::black_box_file(static_cast<int>(i));
     const std::size_t limit = csv_size_limit(header_views(black_box_header(m.joints)), static_cast<std::size_t>(entry.ticks));
@@ -206,6 +218,8 @@ Session load_session(const DirectoryHandle& directory) {
   }
   return session;
 }
+
+}  // namespace
 
 void save_session(const Session& session, const fs::path& directory) {
   create_session_directory(directory, session.manifest, session.trajectory, session.iterations, "bellows save",

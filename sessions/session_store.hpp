@@ -40,6 +40,11 @@ SessionManifest load_manifest(const DirectoryHandle& directory);
 /// a special file or a file larger than its format allows is refused. Throws InputError.
 Session load_session(const std::filesystem::path& directory);
 Session load_session(const DirectoryHandle& directory);
+/// Like load_session, but reads (and checks) only the files of the iterations `only` lists (by
+/// index; an index the manifest does not list is ignored) and no black box: every other iteration
+/// keeps an empty record (learning_samples 0). What needs a few iterations of a long session
+/// (figures) reads those alone.
+Session load_session_iterations(const std::filesystem::path& directory, const std::vector<int>& only);
 
 /// Writes `session` as a new directory `directory` (which must not exist yet), atomically: the
 /// directory appears complete or not at all.

@@ -62,8 +62,10 @@ struct ConsoleEnvironment {
   std::uint64_t seed = 1;
   int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
   std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
-  /// Draws figures of the trials so far (on a background task); returns where. Empty: not available.
-  std::function<std::string(const SessionSnapshot&)> write_figures;
+  /// Draws the figures of the saved session at `session_location` (SessionGateway::save's answer),
+  /// its first `iterations` iterations, from its files (on a background task); returns where.
+  /// Empty: not available.
+  std::function<std::string(const std::string& session_location, int iterations)> write_figures;
 };
 
 class ConsoleController {
@@ -180,7 +182,8 @@ class ConsoleController {
   void start_rename(const std::string& name);
   void start_listing();
   void start_open(const std::string& location);
-  void start_figures();
+  void start_figures();   // when every trial so far is saved; else after the save that does it
+  void launch_figures();
   void poll_session_tasks();
   void adopt(SessionSnapshot snapshot, bool at_start);
 
@@ -219,6 +222,7 @@ class ConsoleController {
   bool stop_pending_ = false;        // an emergency stop requested, not yet acted on by the engine
   double stop_requested_s_ = 0.0;
   bool begin_after_save_ = false;    // a trial waits for the autosave
+  int figures_after_save_ = 0;       // figures of this many trials wait for the autosave (0: none)
   bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
   void export_strip();  // the selected joint's ring into state_.strip

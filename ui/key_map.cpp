@@ -121,6 +121,7 @@ Availability availability(Action action, const ConsoleState& s) {
       return {};
     case Action::kFigures:
       if (s.experiment.trials.empty()) return no("no trial has run yet");
+      if (!s.sessions_available) return no("figures are drawn from the saved session: " + s.sessions_unavailable_reason);
       return {};
     case Action::kOpen:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
