@@ -1,4 +1,6 @@
 #include "app/console_sessions.hpp"
+
+#include "engine/config/learning_law_factory.hpp"
 #include "app/memory_policy.hpp"
 
 #include <cstdio>
@@ -313,6 +315,8 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
     // The correction the last trial ran with again: the next step learns first.
     e.next_tried = e.next_correction_bar.isApprox(e.trials.back().correction_bar) ||
                    (e.next_correction_bar.isZero() && e.trials.back().correction_bar.isZero());
+    // Learned after the last iteration with the session's law, unless it is the one that ran again.
+    e.next_learned_with = e.next_tried ? e.trials.back().summary.learned_with : learned_with(m.configuration);
   }
   for (std::size_t i = 0; i < loaded.black_boxes.size(); ++i) {
     e.faults.push_back({m.black_boxes[i].fault, m.black_boxes[i].iteration, std::move(loaded.black_boxes[i])});

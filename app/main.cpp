@@ -219,6 +219,10 @@ int main(int argc, char** argv) {
   console_cmd->add_option("--speed", console.speed, "The simulated arm's time warp: 1, 2, 5, 10 or max")
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
+  console_cmd->add_option("--clock", console.clock,
+                          "wall (default): the real-time engine loop; sim: the simulated arm on simulated time, which "
+                          "passes only while the engine has work (the same seed gives the numbers of bellows run)")
+      ->check(CLI::IsMember({"sim", "wall"}));
   console_cmd->add_option("--config", console.config_path, "TOML configuration file");
   console_cmd->add_option("--trajectory", console.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();

@@ -26,6 +26,7 @@
 #include "engine/rt/engine_core.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "engine/learning/learning_monitor.hpp"
 #include "engine/operator/learning_session.hpp"
 #include "sessions/session_store.hpp"
@@ -209,7 +210,8 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     }
     said.begin_trials();
     for (int i = 0; failure.empty() && i < trials; ++i) {
-      const IterationSummary s = session.run_trial();
+      IterationSummary s = session.run_trial();
+      if (s.iteration > 0) s.learned_with = learned_with(config);  // iteration 0 applies what it was given
       io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
       // On disk before the line says it is done.

@@ -46,6 +46,7 @@ ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajecto
   state_.loop.speed = env_.speed;
   state_.loop.tick_hz = 1.0 / env_.config.timing.tick_s;
   state_.loop.realtime = static_cast<bool>(env_.latency);
+  state_.loop.clock = env_.simulated_clock ? "sim" : "wall";
   state_.law_name = env_.config.ilc.law;
   state_.stop_after_rises = env_.stop_after_rises;
   state_.sessions_available = env_.sessions != nullptr && env_.sessions->available();
@@ -84,7 +85,16 @@ void ConsoleController::set_status(std::string text, bool important) {
   ++revision_;
 }
 
+bool ConsoleController::needs_engine_time() const {
+  if (env_.core->state() == EngineState::kRunning || !env_.core->emergency_stop_delivered()) return true;
+  if (static_cast<long long>(env_.core->ticks()) <= action_sent_at_tick_) return true;
+  return valve_test_ != nullptr && valve_test_->running();
+}
+
 bool ConsoleController::send(const EngineCommand& command, const char* what) {
+  const CommandKind k = command.kind;
+  const bool setting = k == CommandKind::kSelectTrajectory || k == CommandKind::kSetGains || k == CommandKind::kHeartbeat;
+  if (!setting) note_action_sent();
   if (env_.core->send(command)) return true;
   log(LogSource::kOperator, std::string("command queue full: ") + what + " not sent", true);
   set_status(std::string("the engine's command queue is full: ") + what + " not sent", true);
@@ -102,15 +112,16 @@ void ConsoleController::send_gains() {
 
 void ConsoleController::start(double now_s) {
   now_s_ = now_s;
-  env_.core->monitor_heartbeat(true);
+  env_.core->monitor_heartbeat(!env_.simulated_clock);
   heartbeat(now_s);
   if (selected_trajectories_.empty() || selected_trajectories_.back() != state_.experiment.trajectory) {
     select_trajectory(state_.experiment.trajectory);
   }
   send_gains();
   rebuild_law();
-  log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
-                                   env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
+  log(LogSource::kOperator, format("console started: device %s, %s clock, speed x%s, trajectory %s", env_.device_name.c_str(),
+                                   env_.simulated_clock ? "simulated" : "wall", env_.speed.c_str(),
+                                   state_.experiment.trajectory->name.c_str()));
   if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
@@ -124,6 +135,7 @@ void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> traj
 }
 
 void ConsoleController::heartbeat(double now_s) {
+  if (env_.simulated_clock) return;  // not monitored: heartbeats would only fill a queue no tick empties
   if (state_.heartbeat_drill) {
     const double waited = now_s - drill_started_s_;
     if (state_.engine_state == EngineState::kFault) {
@@ -291,7 +303,8 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
   }
   // Device health from what the sensors say.
   DeviceHealth health{env_.device_name, false, "no data"};
-  if (state_.live_valid && now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS) {
+  // On the simulated clock the reading stands still while no time passes: not stale.
+  if (state_.live_valid && (env_.simulated_clock || now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS)) {
     const SensorReading& r = state_.live.reading;
     bool finite = std::isfinite(r.supply_bar);
     for (int j = 0; j < std::clamp(r.joint_count, 1, kMaxJoints); ++j) {

@@ -50,6 +50,10 @@ struct ConsoleEnvironment {
   std::function<LatencySummary()> latency;       // the loop's statistics; empty on a simulated clock
   std::string rt_description = "other";
   std::string speed = "1";
+  /// The simulated arm on simulated time (console --clock sim): the program around the controller
+  /// ticks the engine only while needs_engine_time(), so a study's numbers repeat those of
+  /// `bellows run` with the same seed. No heartbeat then (there is no wall time to miss it in).
+  bool simulated_clock = false;
   Configuration config;
   /// A library name or a CSV path to a trajectory; throws InputError with the reason.
   std::function<Trajectory(const std::string&)> load_trajectory;
@@ -109,6 +113,11 @@ class ConsoleController {
   std::uint64_t revision() const { return revision_; }
   /// Trials or learning in progress: the screen changes continuously.
   bool active() const;
+  /// On the simulated clock: whether engine time must pass now: a trial runs, a command that changes
+  /// the engine's state (arm, disarm, trial, reset, valve pulse) or an emergency stop waits for its
+  /// tick, or the valve test pulses. Settings (trajectory, gains) wait for the next such tick, so
+  /// that the ticks, and with them the simulated arm's noise, are those of `bellows run`.
+  bool needs_engine_time() const;
 
  private:
   struct InFlight {  // a trial's buffers, the engine's until the runner says it is finished
@@ -116,6 +125,7 @@ class ConsoleController {
     Eigen::MatrixXd correction_bar;  // N x J
     TrialRecord record;
     std::string origin;
+    LearnedWith learned_with;  // what learned correction_bar (empty: not learned)
   };
 
   // Engine side (console_controller.cpp).
@@ -156,6 +166,8 @@ class ConsoleController {
   /// it open with "... is not an answer here" (then returns false).
   bool answer_yes_no(int key, const std::function<void()>& on_yes, const char* status_on_no);
   void not_an_answer(int key);
+  /// The inspector's cursor to the next (+1) or previous (-1) |error| peak of the trial shown.
+  void jump_to_error_peak(int step);
   void open_trajectory_chooser();
   void preview_selected_trajectory();
   void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
@@ -212,10 +224,14 @@ class ConsoleController {
 
   // The learning (every joint's); never touched while a background update uses it.
   std::unique_ptr<JointLearning> law_;
+  LearnedWith law_learned_with_;       // law_'s law and weights
+  LearnedWith updating_learned_with_;  // those of the update running (law_update_)
   bool rebuild_pending_ = false;
   int law_samples_ = 0;
   std::function<void()> pending_discard_action_;
 
+  long long action_sent_at_tick_ = -1;  // engine ticks when the last state-changing command was sent
+  void note_action_sent() { action_sent_at_tick_ = static_cast<long long>(env_.core->ticks()); }
   double last_heartbeat_s_ = -1.0;
   double drill_started_s_ = 0.0;
   double last_loop_stats_s_ = -1.0;
@@ -242,6 +258,7 @@ class ConsoleController {
     std::unique_ptr<JointLearning> law;
     std::string convergence;
     bool warning = false;
+    LearnedWith learned_with;  // the law and weights it was built with
   };
   BackgroundTask<BuiltLaw> law_build_;
   BackgroundTask<Eigen::MatrixXd> law_update_;

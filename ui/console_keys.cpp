@@ -307,6 +307,11 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kInspector;
       return;
     }
+    case Action::kWorstError: jump_to_error_peak(+1); return;
+    case Action::kRmsScale:
+      state_.rms_log_scale = !state_.rms_log_scale;
+      set_status(state_.rms_log_scale ? "the RMS plot on a log scale (L: linear)" : "the RMS plot on a linear scale (L: log)");
+      return;
     case Action::kTuning: state_.screen = Screen::kTuning; return;
     case Action::kLog:
       state_.log_scroll = 0;

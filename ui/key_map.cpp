@@ -47,6 +47,10 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
       {Action::kJoint, 'j', key::kNone, "j", "Joint", "next joint: the live strip, plots and inspector show it (arms with several joints)"},
       {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
+      {Action::kWorstError, 'e', key::kNone, "e", "Worst",
+       "the inspector at the largest |error| of the trial; again: the next largest (E: back)"},
+      {Action::kRmsScale, 'L', key::kNone, "L", "Log RMS",
+       "the RMS plot on a log or a linear scale (the largest error per iteration beside it)"},
   };
   return bindings;
 }
@@ -104,6 +108,8 @@ Availability availability(Action action, const ConsoleState& s) {
       if (run_idle(s)) return no("no trials are running");
       return {};
     case Action::kInspector:
+    case Action::kWorstError:
+    case Action::kRmsScale:
       if (s.experiment.trials.empty()) return no("no trial has run yet");
       return {};
     case Action::kFaultView:
@@ -125,6 +131,7 @@ Availability availability(Action action, const ConsoleState& s) {
       if (s.experiment.joints() < 2) return no("the arm has one joint");
       return {};
     case Action::kHeartbeatDrill: {
+      if (s.loop.clock == "sim") return no("the simulated clock has no heartbeat to withhold (--clock wall has)");
       Availability a = needs_armed_idle(s);
       if (a.available && s.heartbeat_drill) return no("the drill is running");
       return a;
@@ -148,6 +155,7 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
     candidates = {Action::kArm, Action::kJoint, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave,
                   Action::kOpen, Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
   }
+  if (s.screen == Screen::kInspector) candidates.insert(candidates.begin() + 1, Action::kWorstError);
   if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
     const bool stop_first = candidates.front() == Action::kEmergencyStop;
     candidates.insert(candidates.begin() + (stop_first ? 1 : 0), Action::kMain);
@@ -194,7 +202,8 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
               {"PgUp/PgDn", "cursor along time, a tenth of the trial"},
               {"Home/End", "start / end of the trial"},
               {"Up/Down", "earlier / later iteration"},
-              {"m", "overlay this iteration for comparison (m again: remove)"},
+              {"e / E", "the largest |error| of the trial, then the next largest / back to the larger one"},
+              {"m", "overlay this iteration for comparison, with the differences du, de and their RMS (m again: remove)"},
               {"u", "use this iteration's correction for the next trial"}};
     case Screen::kTrajectory:
       return {{"Up/Down", "choose; the preview follows"}, {"Enter", "use it (the file entry asks for a path)"}};
@@ -210,7 +219,8 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
       return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"},
               {"z", "zero the angle: the angle read now becomes the rig profile's zero (asks first; t7)"}};
     case Screen::kMain:
-      return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"}};
+      return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"},
+              {"L", "the RMS plot on a log or a linear scale"}};
     case Screen::kHelp:
       return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"q, Esc, ?/F1", "close the help: back to the screen it was opened from"}};
   }

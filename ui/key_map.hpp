@@ -33,6 +33,8 @@ enum class Action {
   kRig,
   kJoint,
   kMain,
+  kWorstError,   // the inspector's cursor to the largest |error| of the trial, then the next ones
+  kRmsScale,     // the RMS plot on a log or a linear scale
 };
 
 struct KeyBinding {

@@ -130,7 +130,9 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   const LoopHealth& l = s.loop;
   std::vector<Segment> out;
   out.push_back({1, level < 3 ? "loop " : "", Role::kDim, false});
-  out.push_back({0, format("%.0f Hz x%s %s", l.tick_hz, l.speed.c_str(), l.rt.c_str()), Role::kNormal, false});
+  out.push_back({0, format("%.0f Hz x%s%s%s", l.tick_hz, l.speed.c_str(), l.rt.empty() ? "" : " ", l.rt.c_str()), Role::kNormal, false});
+  // Which clock runs: a simulated one repeats `bellows run`'s numbers; the wall clock does not.
+  out.push_back({1, level < 2 ? l.clock + " clock" : l.clock, l.clock == "sim" ? Role::kGood : Role::kDim, false});
   out.push_back({2, "missed ", Role::kDim, false});
   out.push_back({0, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood,
                  false});

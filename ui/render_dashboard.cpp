@@ -117,8 +117,10 @@ void render_trial_plot(const ConsoleState& s, Canvas& c, const Rect& area, const
 }
 
 void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
-  c.frame(area, g, s.experiment.joints() > 1 ? "RMS per iteration (deg), all joints and j" + std::to_string(selected_joint(s) + 1)
-                                              : std::string("RMS per iteration (deg)"));
+  const std::string title = s.experiment.joints() > 1
+                                ? "RMS per iteration (deg), all joints and j" + std::to_string(selected_joint(s) + 1)
+                                : std::string("RMS per iteration (deg)") + (s.rms_log_scale ? ", log" : "");
+  c.frame(area, g, title);
   const Rect in = inner(area);
   const auto& trials = s.experiment.trials;
   if (trials.empty()) {
@@ -156,9 +158,14 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     PlotOptions options;
     options.braille = s.unicode;
     options.integer_x = true;
-    options.y_min = 0.0;
+    options.log_y = s.rms_log_scale;  // L: a log scale shows the late iterations' progress too
+    if (!options.log_y) options.y_min = 0.0;
     options.y_format = "%.2f";
     std::vector<PlotSeries> series;
+    // The largest |error| of each iteration beside its RMS (over every joint), drawn under it.
+    series.push_back({data.iteration, data.max_error_deg, Role::kSeries3, 'x'});
+    // Its legend on the frame's bottom edge: the top one holds the title.
+    legend(c, {area.x, area.bottom() - 1, area.width, 1}, {{"RMS", Role::kSeries1, '*'}, {"max|e|", Role::kSeries3, 'x'}}, g);
     const RmsSeries joint = joints > 1 ? rms_series(s.experiment, selected_joint(s)) : RmsSeries{};  // the series refer to it
     if (joints > 1) series.push_back({joint.iteration, joint.rms_deg, Role::kSeries2, '.'});
     series.push_back({data.iteration, data.rms_deg, Role::kSeries1, '*'});
