@@ -19,6 +19,7 @@
 #include "app/trajectory_file.hpp"
 #include "devices/simulated_arm.hpp"
 #include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/base/iteration_numbering.hpp"
 #include "ui/console.hpp"
@@ -64,6 +65,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   Configuration config = options.config_path.empty() ? Configuration{} : load_config_file(options.config_path);
   if (!options.session_dir.empty()) take_rig_of_session(options.session_dir, options, config);
   config.device = resolve_device(options.device, config.device);
+  if (options.clock != "wall") resolve_clock(options.clock, config.device.kind);  // sim: the simulated arm only
+  const bool simulated_time = options.clock == "sim";
   // The model the learning uses: the rig profile's identified one, if it has one (a reopened session
   // too: it keeps its gains and law, the model is the rig's as it is now).
   const LearningModel learning_model = choose_learning_model(config, config.device);
@@ -115,8 +118,10 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   EngineCore core(device, config.controller, config.timing, config.safety);
   const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP vent at once, from the handler
   RealtimeLoop loop(core, device, speed);
+  SimulatedClock simulated_clock(core, device);  // --clock sim: the UI thread ticks it (as bellows run does)
   setup.core = &core;
   setup.loop = &loop;
+  if (simulated_time) setup.simulated_clock = &simulated_clock;
   setup.rt_mode = options.rt;
   setup.environment.speed = options.speed;
   setup.environment.config = config;
@@ -133,8 +138,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
       return zero_rig_angle(opened, path, read_rad);
     };
   }
-  setup.environment.write_figures = [root = default_figures_root()](const ui::SessionSnapshot& snapshot) {
-    return write_console_figures(snapshot, root);
+  setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location, int iterations) {
+    return write_console_figures(location, iterations, root, [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
   };
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
@@ -143,7 +148,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.allow_colors = !options.no_color;
 
   // The loop wakes 200 times a second: keep the cores out of deep idle while it runs.
-  const CpuIdleHold idle_hold(speed > 0.0 && options.rt != RealtimeMode::kOff);
+  const CpuIdleHold idle_hold(!simulated_time && speed > 0.0 && options.rt != RealtimeMode::kOff);
   const ui::ConsoleReport report = ui::run_console(std::move(setup));
   char line[320];
   std::snprintf(line, sizeof line,
@@ -153,7 +158,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
                 report.seconds, iteration_range(report.iterations).c_str(),
                 report.best_rms_deg >= 0.0 ? (", best RMS " + std::to_string(report.best_rms_deg).substr(0, 6) + " deg").c_str() : "",
                 static_cast<unsigned long long>(report.ticks), static_cast<unsigned long long>(report.loop.missed),
-                report.loop.p50_us, report.loop.p99_us, report.loop.max_us, loop.rt_description().c_str(),
+                report.loop.p50_us, report.loop.p99_us, report.loop.max_us,
+                simulated_time ? "simulated clock" : loop.rt_description().c_str(),
                 idle_hold.held_us() ? ", cores out of deep idle" : "",
                 static_cast<unsigned long long>(report.frames),
                 report.seconds > 0 ? static_cast<double>(report.frames) / report.seconds : 0.0,

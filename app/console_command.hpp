@@ -13,6 +13,7 @@ namespace bellows {
 struct ConsoleOptions {
   DeviceOptions device;              // --device, --lcm, --t7, --rig-profile over [device]
   std::string speed = "1";           // the simulated arm's time warp: 1, 2, 5, 10 or max
+  std::string clock = "wall";        // wall: the real-time loop; sim: simulated time (the simulated arm only)
   std::string config_path;
   std::string trajectory = "paper";  // library name or CSV file
   std::string session_dir;           // open this saved session at start

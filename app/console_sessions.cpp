@@ -1,4 +1,6 @@
 #include "app/console_sessions.hpp"
+
+#include "engine/config/learning_law_factory.hpp"
 #include "app/memory_policy.hpp"
 
 #include <cstdio>
@@ -48,10 +50,23 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
       std::istringstream lines(e.message);
       std::string line;
       while (std::getline(lines, line)) {
-        const auto colon = line.find(": ", 9);
+        // "HH:MM:SS [t=ENGINE_S ]source: text" (sessions before the engine time: without it)
+        std::size_t from = 9;
+        double engine_time_s = -1.0;
+        if (line.compare(from, 2, "t=") == 0) {
+          const auto space = line.find(' ', from);
+          if (space == std::string::npos) continue;
+          try {
+            engine_time_s = std::stod(line.substr(from + 2, space - from - 2));
+          } catch (const std::exception&) {
+            engine_time_s = -1.0;
+          }
+          from = space + 1;
+        }
+        const auto colon = line.find(": ", from);
         if (line.size() < 10 || colon == std::string::npos) continue;
-        const std::string source = line.substr(9, colon - 9);
-        out.push_back({line.substr(0, 8), -1.0, source_of(source), line.substr(colon + 2), source == "fault", false,
+        const std::string source = line.substr(from, colon - from);
+        out.push_back({line.substr(0, 8), engine_time_s, source_of(source), line.substr(colon + 2), source == "fault", false,
                        e.time_utc, e.iteration});
       }
       continue;
@@ -170,7 +185,15 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     std::string lines;
     for (std::size_t i = first_new; i < held; ++i) {
       const ui::LogEntry& entry = snapshot.events[i];
-      if (worth_saving(entry)) lines += entry.clock + " " + kind_of(entry) + ": " + entry.text + "\n";
+      if (worth_saving(entry)) {
+        lines += entry.clock + " ";
+        if (entry.engine_time_s >= 0.0) {
+          char stamp[40];
+          std::snprintf(stamp, sizeof stamp, "t=%.3f ", entry.engine_time_s);
+          lines += stamp;
+        }
+        lines += kind_of(entry) + ": " + entry.text + "\n";
+      }
     }
     if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
     // Learned (or chosen) after the last saved trial: on disk before the next trial starts.
@@ -208,21 +231,36 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   return writer_->directory().string();
 }
 
+std::string StoreSessionGateway::name_refusal(const std::string& location, const std::string& name) {
+  // No lock: a save may hold it for a while, and this runs on the UI thread.
+  const std::filesystem::path directory(location);
+  if (directory.filename() == name) return {};  // its own name: nothing to do
+  return session_name_refusal(name, directory.parent_path());
+}
+
+void StoreSessionGateway::read_quietly(const std::function<void()>& read) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  read();
+}
+
 std::string StoreSessionGateway::rename(const std::string& name) {
   const std::lock_guard<std::mutex> guard(mutex_);
   if (!writer_) throw InputError("nothing to name yet: the session is created with the first trial");
-  validate_session_name(name);
   const std::filesystem::path from = writer_->directory();
-  const std::filesystem::path to = data_dir_ / name;
-  if (from == to) return to.string();
-  std::error_code error;
-  if (std::filesystem::exists(to, error)) throw InputError("a session named '" + name + "' exists already");
-  writer_.reset();  // its lock goes with it; taken again below
-  std::filesystem::rename(from, to, error);
+  if (from.filename() == name) return from.string();
+  if (const std::string why = session_name_refusal(name, from.parent_path()); !why.empty()) throw InputError(why);
+  writer_.reset();  // its lock goes with it; rename_session takes it, then the writer again below
+  std::filesystem::path now = from;
+  std::string failure;
+  try {
+    now = rename_session(from, name);  // the directory and the manifest's name, as `sessions rename`
+  } catch (const std::exception& error) {
+    failure = error.what();
+  }
   Session loaded;
-  writer_.emplace(SessionWriter::open(error ? from : to, kPurpose, loaded));
-  if (error) throw InputError("cannot rename " + from.string() + " to '" + name + "': " + error.message());
-  return to.string();
+  writer_.emplace(SessionWriter::open(now, kPurpose, loaded));
+  if (!failure.empty()) throw InputError(failure);
+  return now.string();
 }
 
 std::vector<ui::SessionListing> StoreSessionGateway::list() {
@@ -277,6 +315,8 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
     // The correction the last trial ran with again: the next step learns first.
     e.next_tried = e.next_correction_bar.isApprox(e.trials.back().correction_bar) ||
                    (e.next_correction_bar.isZero() && e.trials.back().correction_bar.isZero());
+    // Learned after the last iteration with the session's law, unless it is the one that ran again.
+    e.next_learned_with = e.next_tried ? e.trials.back().summary.learned_with : learned_with(m.configuration);
   }
   for (std::size_t i = 0; i < loaded.black_boxes.size(); ++i) {
     e.faults.push_back({m.black_boxes[i].fault, m.black_boxes[i].iteration, std::move(loaded.black_boxes[i])});

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -35,8 +36,12 @@ class StoreSessionGateway final : public ui::SessionGateway {
   ui::SessionSnapshot open(const std::string& location) override;
   ui::SessionSnapshot read_trials(const std::string& location) override;
   std::string rename(const std::string& name) override;
+  std::string name_refusal(const std::string& location, const std::string& name) override;
 
   const std::filesystem::path& data_dir() const { return data_dir_; }
+  /// Runs `read` while no save, rename or open runs (each rewrites files a reader could see half
+  /// changed): the console's figures read the session it saves into (app/plot_console.hpp).
+  void read_quietly(const std::function<void()>& read);
 
  private:
   std::mutex mutex_;

@@ -8,6 +8,7 @@
 
 #include "app/run_io.hpp"
 #include "app/t7_wiring.hpp"
+#include "engine/base/cancellation.hpp"
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_device.hpp"
@@ -134,6 +135,23 @@ class T7Rig final : public OpenedDevice {
   std::optional<double> angle_zero_rad() const override { return device_->angle_zero_rad(); }
   void set_angle_zero_rad(double zero_rad) override { device_->set_angle_zero_rad(zero_rad); }
 
+  // Served: a reading came through the link after this call (not the zeros of one that never came).
+  std::string wait_until_served(double timeout_s, const std::atomic<bool>& stop) override {
+    if (device_->wait_for_reading(timeout_s, stop)) return "";
+    if (stop.load(std::memory_order_relaxed)) return "interrupted while waiting for the T7";
+    const std::string why = device_->link_error();
+    return "no reading from the T7 at " + device_->address() + " within " + std::to_string(timeout_s).substr(0, 4) + " s" +
+           (why.empty() ? std::string() : " (" + why + ")");
+  }
+
+  nlohmann::json report() const override {
+    return {{"t7", device_->address()},
+            {"product", t7::to_string(device_->product())},
+            {"late_answers", device_->late_answers()},
+            {"reconnects", device_->reconnects()},
+            {"link_error", device_->link_error()}};
+  }
+
  private:
   std::unique_ptr<T7Device> device_;
 };
@@ -172,6 +190,13 @@ DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParamete
 /// "[arm] preset = 'arm2'" or "[arm] joints = 3": what the operator wrote.
 static std::string arm_setting(const ArmParameters& arm) {
   return !arm.preset.empty() ? "[arm] preset = '" + arm.preset + "'" : arm.name();
+}
+
+void require_served(OpenedDevice& rig, double timeout_s, const std::atomic<bool>& stop) {
+  const std::string why = rig.wait_until_served(timeout_s, stop);
+  if (why.empty()) return;
+  if (stop.load(std::memory_order_relaxed)) throw Cancelled(why);
+  throw EnvironmentError(why);
 }
 
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind) {

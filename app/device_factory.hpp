@@ -72,6 +72,10 @@ class OpenedDevice {
   virtual void stop() {}
 };
 
+/// Waits until `rig` serves this engine (OpenedDevice::wait_until_served). Throws Cancelled when
+/// `stop` was set (the command exits 128 + signal, nothing armed), else EnvironmentError saying why.
+void require_served(OpenedDevice& rig, double timeout_s, const std::atomic<bool>& stop);
+
 /// Refuses, in one line, an arm `device_kind` cannot drive: an [arm] preset of several joints runs on
 /// the simulated arm and over LCM (the joint messages), not on a T7.
 void require_driven_arm(const ArmParameters& arm, const std::string& device_kind);

@@ -107,9 +107,7 @@ void record_chain_trials(const Configuration& config, const DeviceParameters& de
       rig.stop();
     }
   } stop_loop{loop, *rig};
-  if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
-    throw EnvironmentError(why);
-  }
+  require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
   begin(rig->session_info());
   progress << "on " << device.kind << " " << rig->where() << std::endl;
   for (std::size_t i = 0; i < trials.excitations.size(); ++i) {

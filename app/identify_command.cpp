@@ -75,9 +75,7 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
       rig.stop();
     }
   } stop_loop{loop, *rig};
-  if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
-    throw EnvironmentError(why);
-  }
+  require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
   session.begin(config, device.kind, rig->session_info(),
                 identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()), validation_signal);
   if (!session.path().empty()) progress << "session " << session.path() << std::endl;

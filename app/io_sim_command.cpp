@@ -15,6 +15,7 @@
 #include "devices/lcm_auth.hpp"
 #include "devices/lcm_rig_server.hpp"
 #include "devices/simulated_arm_chain.hpp"
+#include "devices/swapped_chambers.hpp"
 #include "engine/base/errors.hpp"
 
 namespace bellows {
@@ -44,7 +45,9 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
     joints = chain->joints();
     integration_step_s = chain_parameters.chain.integration_step_s;
   }
-  Device& arm = single_joint ? static_cast<Device&>(*single_joint) : *chain;
+  Device& plant = single_joint ? static_cast<Device&>(*single_joint) : *chain;
+  SwappedChambers crossed(plant);
+  Device& arm = options.swapped_chambers ? static_cast<Device&>(crossed) : plant;
   RigServerParameters params;
   params.period_s = config.timing.tick_s;
   params.command_timeout_s = config.lcm.rig_timeout_s;
@@ -62,7 +65,7 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
              << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
              << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
              << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
-             << ")" << std::endl;
+             << ")" << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "") << std::endl;
   });
   const double start_s = monotonic_s();
   io.run(

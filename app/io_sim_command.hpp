@@ -17,6 +17,7 @@ struct IoSimOptions {
   RealtimeMode rt = RealtimeMode::kTry;
   double duration_s = 0.0;      // 0: until a signal
   bool json = false;            // counters as one JSON object on `out` at exit
+  bool swapped_chambers = false;  // drill: the tubes of chambers A and B swapped (devices/swapped_chambers.hpp)
 };
 
 /// Serves until stopped. Progress lines go to `progress`. Throws InputError for bad input or a bus

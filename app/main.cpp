@@ -16,6 +16,7 @@
 #include "app/memory_policy.hpp"
 #include "app/rig_check_command.hpp"
 #include "app/plot_command.hpp"
+#include "app/plot_style.hpp"
 #include "app/run_command.hpp"
 #include "app/sessions_command.hpp"
 #include "app/t7_sim_command.hpp"
@@ -143,6 +144,8 @@ int main(int argc, char** argv) {
   plot_cmd->add_option("--trial", plot.trial, "Iteration whose pressures are drawn (default: the last)");
   plot_cmd->add_option("--formats", plot.formats, "png, svg and/or pdf, e.g. png,pdf")->delimiter(',')->default_str("png,svg")
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
+  plot_cmd->add_option("--style", plot.style, "Size and fonts: screen, paper-column (3.5 in wide, 8 pt) or paper-wide "
+                       "(7.16 in, 8 pt)")->capture_default_str()->check(CLI::IsMember(bellows::figure_style_names()));
   plot_cmd->add_option("--paper", plot.paper, "CSV (iteration,rms_deg) overlaid on the RMS figure "
                        "(default for the paper trajectory: the paper's curve, when available)");
   plot_cmd->add_flag("--no-paper", plot.no_paper, "No overlay on the RMS figure");
@@ -169,6 +172,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
+  io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
@@ -193,6 +197,21 @@ int main(int argc, char** argv) {
   t7_sim_cmd->add_option("--stall-s", t7_sim.stall_s, "Drill: how late that answer comes")
       ->capture_default_str()
       ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--product", t7_sim.product, "The T7 it is: t7 (resolution index 0..8) or t7-pro (0..12, the paper's)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"t7", "t7-pro"}));
+  t7_sim_cmd->add_flag("--nagle", t7_sim.nagle, "Drill: answers with Nagle's algorithm (a T7 sends at once)");
+  t7_sim_cmd->add_flag("--silent-reads", t7_sim.silent_reads, "Drill: reads of the analog inputs go unanswered (no reading ever)");
+  t7_sim_cmd->add_option("--halve-roll-after", t7_sim.halve_roll_after_s,
+                         "Drill: this many seconds after the first request, clock 0's roll value halves (another program): wide duties are refused")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--answer-after", t7_sim.answer_after_s, "Drill: every answer this many seconds later (a slow device)")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--trickle-after", t7_sim.trickle_after_s, "Drill: this many seconds after the first request, answers trickle one byte at a time")
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
+  t7_sim_cmd->add_option("--trickle-byte-s", t7_sim.trickle_byte_s, "Drill: the trickle's time per byte")
+      ->capture_default_str()
+      ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
   CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
@@ -200,6 +219,10 @@ int main(int argc, char** argv) {
   console_cmd->add_option("--speed", console.speed, "The simulated arm's time warp: 1, 2, 5, 10 or max")
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
+  console_cmd->add_option("--clock", console.clock,
+                          "wall (default): the real-time engine loop; sim: the simulated arm on simulated time, which "
+                          "passes only while the engine has work (the same seed gives the numbers of bellows run)")
+      ->check(CLI::IsMember({"sim", "wall"}));
   console_cmd->add_option("--config", console.config_path, "TOML configuration file");
   console_cmd->add_option("--trajectory", console.trajectory, "Library name: " + bellows::trajectory_library_summary() + "; or a CSV file")
       ->capture_default_str();

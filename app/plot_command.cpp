@@ -1,5 +1,6 @@
 #include "app/plot_command.hpp"
 
+#include <algorithm>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -22,10 +23,36 @@ constexpr const char* kScriptName = "figures.gp";
 
 }  // namespace
 
-fs::path default_paper_rms_path() {
-  const fs::path path = BELLOWS_PAPER_RMS_CSV;
-  std::error_code error;
-  return !path.empty() && fs::is_regular_file(path, error) ? path : fs::path();
+fs::path default_paper_rms_path() { return fs::path(BELLOWS_PAPER_RMS_CSV).lexically_normal(); }
+
+PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory_name, const std::string& paper, bool no_paper) {
+  if (no_paper && !paper.empty()) throw InputError("--paper and --no-paper exclude each other");
+  if (no_paper) return {};
+  fs::path file = paper;
+  if (file.empty()) {
+    if (trajectory_name != "paper") return {};  // the paper's curve is of its own trajectory
+    file = default_paper_rms_path();
+    std::error_code error;
+    if (file.empty() || !fs::is_regular_file(file, error)) {
+      return {{}, "paper's RMS curve: not overlaid, " + (file.empty() ? std::string("no default file") : file.string() + " is not there") +
+                      " (--paper FILE gives one)"};
+    }
+  }
+  request.paper_rms = read_paper_rms(file);
+  return {file, "paper's RMS curve from " + file.string()};
+}
+
+Session read_figure_session(const fs::path& directory, const FigureRequest& request, int iterations) {
+  int count = static_cast<int>(load_manifest(directory).iterations.size());
+  if (iterations >= 0) count = std::min(count, iterations);
+  std::vector<int> wanted = figure_iterations(request, count);
+  Session session = load_session_iterations(directory, wanted);
+  if (iterations >= 0 && static_cast<int>(session.iterations.size()) > count) {
+    // Saved after the key was pressed: not in these figures (their folder is named after `count`).
+    session.iterations.resize(static_cast<std::size_t>(count));
+    session.manifest.iterations.resize(static_cast<std::size_t>(count));
+  }
+  return session;
 }
 
 std::vector<fs::path> write_session_figures(const Session& session, const FigureRequest& request, const fs::path& directory,
@@ -51,7 +78,7 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
   }
   fs::create_directory(directory, error);
   if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
-  write_file_atomic(files.front(), gnuplot_script(figures, request.formats), DirectorySync::kNow,
+  write_file_atomic(files.front(), gnuplot_script(figures, request.formats, request.style), DirectorySync::kNow,
                     force ? Replace::kAllowed : Replace::kRefused);
   run_gnuplot(files.front(), directory);
   for (const fs::path& file : files) {
@@ -61,32 +88,33 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
 }
 
 int sessions_plot_command(const PlotOptions& options, std::ostream& out) {
-  if (options.no_paper && !options.paper.empty()) throw InputError("--paper and --no-paper exclude each other");
   fs::path data_dir = options.data_dir.empty() ? fs::path() : given_data_dir(options.data_dir);  // a typo: refused
   try {
     if (data_dir.empty()) data_dir = default_data_dir();
   } catch (const InputError&) {
     // Then only a path can name the session; resolve_session_dir() says so if it is not one.
   }
-  const Session session = load_session(resolve_session_dir(options.session, data_dir));
+  const fs::path session_dir = resolve_session_dir(options.session, data_dir);
   FigureRequest request;
   request.iterations = options.iterations;
   request.pressure_trial = options.trial;
   request.formats = options.formats;
-  fs::path paper = options.paper;
-  if (paper.empty() && !options.no_paper && session.manifest.trajectory_name == "paper") paper = default_paper_rms_path();
-  if (!paper.empty()) request.paper_rms = read_paper_rms(paper);
+  request.style = options.style;
+  const PaperCurve paper = add_paper_curve(request, load_manifest(session_dir).trajectory_name, options.paper, options.no_paper);
+  const Session session = read_figure_session(session_dir, request);
   const fs::path directory =
       options.output.empty() ? fs::path(session.directory.filename().string() + "_figures") : fs::path(options.output);
   const std::vector<fs::path> files = write_session_figures(session, request, directory, options.force);
   if (options.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const fs::path& file : files) list.push_back(file.string());
-    out << nlohmann::json{{"directory", directory.string()}, {"paper", paper.string()}, {"files", list}}.dump() << std::endl;
+    out << nlohmann::json{{"directory", directory.string()}, {"style", request.style}, {"paper", paper.file.string()}, {"paper_note", paper.note},
+                          {"files", list}}.dump()
+        << std::endl;
     return 0;
   }
   for (const fs::path& file : files) out << "wrote " << file.string() << "\n";
-  if (!paper.empty()) out << "paper's RMS curve from " << paper.string() << "\n";
+  if (!paper.note.empty()) out << paper.note << "\n";
   out << std::flush;
   return 0;
 }

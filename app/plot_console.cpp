@@ -17,41 +17,28 @@ fs::path default_figures_root() {
   }
 }
 
-std::string write_console_figures(const ui::SessionSnapshot& snapshot, const fs::path& root) {
-  const ui::Experiment& e = snapshot.experiment;
-  if (!e.trajectory || e.trials.empty()) throw InputError("no trial to draw yet");
+std::string write_console_figures(const std::string& session_location, int iterations, const fs::path& root,
+                                  const QuietRead& quietly) {
+  if (session_location.empty() || iterations <= 0) throw InputError("no saved trial to draw yet");
   if (root.empty()) throw InputError("no folder for figures (set HOME or XDG_DATA_HOME)");
-  // The plotting code reads a Session: build one in memory from the console's trials.
+  FigureRequest request;  // sessions plot's defaults
   Session session;
-  session.manifest.name = e.session_location.empty() ? "console" : fs::path(e.session_location).filename().string();
-  session.manifest.trajectory_name = e.trajectory->name;
-  session.manifest.trajectory_samples = e.samples();
-  session.manifest.configuration = snapshot.config;
-  session.trajectory = *e.trajectory;
-  for (std::size_t i = 0; i < e.trials.size(); ++i) {
-    const ui::Trial& trial = e.trials[i];
-    IterationSummary summary = trial.summary;
-    summary.iteration = static_cast<int>(i);
-    session.manifest.iterations.push_back({summary, {}});
-    const Eigen::MatrixXd& next = i + 1 < e.trials.size() ? e.trials[i + 1].correction_bar : e.next_correction_bar;
-    session.iterations.push_back({trial.record, next.col(0)});  // the figures draw joint 1
-  }
-  FigureRequest request;
-  if (session.manifest.trajectory_name == "paper") {
-    const fs::path paper = default_paper_rms_path();
-    if (!paper.empty()) request.paper_rms = read_paper_rms(paper);
-  }
+  PaperCurve paper;
+  quietly([&] {
+    paper = add_paper_curve(request, load_manifest(session_location).trajectory_name, {}, false);
+    session = read_figure_session(session_location, request, iterations);
+  });
   char suffix[32];
-  std::snprintf(suffix, sizeof suffix, "_iteration_%04zu", e.trials.size() - 1);
+  std::snprintf(suffix, sizeof suffix, "_iteration_%04d", iterations - 1);
   std::error_code error;
   fs::create_directories(root, error);
   if (error) throw InputError("cannot create " + root.string() + ": " + error.message());
-  fs::path directory = root / (session.manifest.name + suffix);
-  for (int n = 2; fs::exists(directory, error); ++n) {  // the same trials drawn again: a new folder
-    directory = root / (session.manifest.name + suffix + "_" + std::to_string(n));
-  }
+  const std::string stem = fs::path(session_location).filename().string() + suffix;
+  fs::path directory = root / stem;
+  for (int n = 2; fs::exists(directory, error); ++n) directory = root / (stem + "_" + std::to_string(n));  // drawn again
   write_session_figures(session, request, directory, false);
-  return directory.string();
+  const bool paper_missing = paper.file.empty() && !paper.note.empty();
+  return directory.string() + (paper_missing ? "; " + paper.note : std::string());
 }
 
 }  // namespace bellows

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/config_file.hpp"
+#include "app/device_factory.hpp"
 #include "app/run_command.hpp"
 #include "app/trajectory_file.hpp"
 #include "app/rig_profile_write.hpp"
@@ -168,9 +169,7 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
       rig.stop();
     }
   } stop_loop{loop, *rig};
-  if (const std::string why = rig->wait_until_served(config.lcm.connect_timeout_s, stop_requested()); !why.empty()) {
-    throw EnvironmentError(why);
-  }
+  require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
 
   TickRecord latest;
   while (!core.read_snapshot(latest)) driver->await();

@@ -57,7 +57,9 @@ void read_input(const Reader& r, const toml::table& t, const std::string& sectio
     else if (key == "offset") c.offset = r.number(v, where);
     else if (key == "volts_min_V") c.volts_min_V = r.number(v, where);
     else if (key == "volts_max_V") c.volts_max_V = r.number(v, where);
-    else r.fail(where, "unknown key (ain, part, range_V, gain_per_V, offset, volts_min_V, volts_max_V)");
+    else if (key == "resolution_index") c.resolution_index = r.whole(v, where);
+    else if (key == "settling_us") c.settling_us = r.number(v, where);
+    else r.fail(where, "unknown key (ain, part, range_V, gain_per_V, offset, volts_min_V, volts_max_V, resolution_index, settling_us)");
   }
   if (!has_ain) r.fail(section + " ain", "missing");
 }

@@ -26,6 +26,7 @@
 #include "engine/rt/engine_core.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "engine/learning/learning_monitor.hpp"
 #include "engine/operator/learning_session.hpp"
 #include "sessions/session_store.hpp"
@@ -39,7 +40,22 @@ nlohmann::json to_json(const IterationSummary& s) {
           {"joint_rms_deg", std::vector<double>(s.joint_rms_deg.data(), s.joint_rms_deg.data() + s.joint_rms_deg.size())},
           {"max_abs_error_deg", s.max_abs_error_deg},
           {"max_abs_correction_bar", s.max_abs_correction_bar},
-          {"saturated_samples", s.saturated_samples}};
+          {"saturated_samples", s.saturated_samples},
+          {"held_samples", s.held_samples}};
+}
+
+/// The session's event for a trial that rode through missing readings: which samples were held
+/// (their error is 0 and nothing is learned from them; the iteration's files are unchanged).
+std::string held_samples_line(const IterationSummary& s, const TrialRecord& record) {
+  std::string line = "iteration " + std::to_string(s.iteration) + ": " + std::to_string(s.held_samples) +
+                     " samples held (no fresh reading; error 0, not learned from): k =";
+  int listed = 0;
+  for (std::size_t k = 0; k < record.held.size(); ++k) {
+    if (record.held[k] == 0) continue;
+    if (++listed > 50) return line + " ...";
+    line += " " + std::to_string(k);
+  }
+  return line;
 }
 
 /// --transfer-from: the first correction learned from saved sessions (before anything starts, so that
@@ -187,19 +203,21 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   try {
     if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
       failure = std::move(why);
-      failure_name = "rig-unavailable";
+      failure_name = fault_name(FaultCode::kRigUnavailable);
       status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault
       said.error("bellows: " + failure);
       recording.fault(failure);
     }
     said.begin_trials();
     for (int i = 0; failure.empty() && i < trials; ++i) {
-      const IterationSummary s = session.run_trial();
+      IterationSummary s = session.run_trial();
+      if (s.iteration > 0) s.learned_with = learned_with(config);  // iteration 0 applies what it was given
       io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
       // On disk before the line says it is done.
       if (chain != nullptr) recording.save(session, s, chain, core, clock);
       else recording.save(session, s, arm, core, clock);
+      if (s.held_samples > 0) recording.note("held-samples", held_samples_line(s, session.last_record()));
       said.iteration(s);
       nlohmann::json iteration = to_json(s);
       iteration.update(diagnostics_json(monitor.observe(s.iteration, session.last_record())));
@@ -209,10 +227,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     const bool interrupted = fault.code() == FaultCode::kEmergencyStop && stop_signal() != 0;
     failure = interrupted ? std::string("interrupted by ") + stop_signal_name() + ": valves vented" : fault.what();
     failure_name = fault_name(core.fault());
-    if (std::string why = io.explain_fault(fault.code()); !why.empty()) {
-      failure = std::move(why);
-      failure_name = "foreign-sender";
-    }
+    if (std::string why = io.explain_fault(fault.code()); !why.empty()) failure = std::move(why);
     status = interrupted ? 128 + stop_signal() : kExitFault;
     said.error("bellows: " + failure + " (" + fault_name(fault.code()) + ")");
     recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);
@@ -271,6 +286,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
       report["loop"] = {{"ticks", core.ticks()},
                         {"missed", l.missed},
                         {"missed_warnings", core.missed_deadline_warnings()},
+                        {"held_ticks", core.held_ticks()},
                         {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
                         {"rt", loop->rt_description()},
                         {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},

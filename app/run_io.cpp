@@ -28,6 +28,7 @@ std::string free_log_name(const std::filesystem::path& directory) {
 
 nlohmann::json receive_counts_json(const ReceiveCounts& c) {
   return {{"accepted", c.accepted},
+          {"offers", c.offers},
           {"ignored",
            {{"truncated", c.truncated},
             {"wrong_type", c.wrong_type},
@@ -126,9 +127,9 @@ const LcmDevice* RunIo::lcm_device() const {
 }
 
 std::string RunIo::explain_fault(FaultCode code) const {
-  // No fresh state is what a rig taken over by another sender looks like from here: say so.
+  // The device named the fault foreign-sender (LcmDevice::explain_silence): its whole diagnosis.
   const LcmDevice* lcm_device_ = lcm_device();
-  if (!lcm_device_ || code != FaultCode::kSensorStale) return "";
+  if (!lcm_device_ || code != FaultCode::kForeignSender) return "";
   const LcmDeviceStats s = lcm_device_->stats();
   if (s.commands_not_ours == 0 && s.states.unauthenticated == 0) return "";
   return lcm_device_->diagnosis();

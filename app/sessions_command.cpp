@@ -392,21 +392,7 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
 int sessions_rename_command(const SessionsOptions& options, std::ostream& out) {
   validate_session_name(options.new_name);
   const fs::path directory = existing_session(options);
-  SessionManifest manifest = load_manifest(directory);
-  const fs::path target = directory.parent_path() / options.new_name;
-  std::error_code error;
-  if (fs::symlink_status(target, error).type() != fs::file_type::not_found) {
-    throw InputError("cannot rename " + directory.string() + ": " + target.string() + " exists already");
-  }
-  const SessionLock lock(directory, "bellows sessions rename");
-  fs::rename(directory, target, error);
-  if (error) throw InputError("cannot rename " + directory.string() + " to " + target.string() + ": " + error.message());
-  manifest.name = options.new_name;  // the manifest names its session too
-  manifest.updated_utc = utc_now();
-  // Through the session's own descriptor, by the one safe writer: a link planted at any name in
-  // it is replaced or refused, never written through.
-  write_file_atomic_at(DirectoryHandle::open(target), session_layout::kManifest, format_manifest(manifest));
-  sync_directory(target.parent_path().empty() ? fs::path(".") : target.parent_path());
+  const fs::path target = rename_session(directory, options.new_name);
   if (options.json) {
     out << Json{{"renamed", directory.string()}, {"directory", target.string()}}.dump() << std::endl;
   } else {

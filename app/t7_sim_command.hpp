@@ -23,6 +23,13 @@ struct T7SimCommandOptions {
   double silent_after_s = -1.0;
   double stall_after_s = -1.0;
   double stall_s = 0.05;
+  std::string product = "t7-pro";  // t7 | t7-pro
+  bool nagle = false;
+  double answer_after_s = 0.0;
+  double trickle_after_s = -1.0;
+  double trickle_byte_s = 0.4;
+  bool silent_reads = false;
+  double halve_roll_after_s = -1.0;
 };
 
 int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out);

@@ -1,6 +1,7 @@
 #include "app/t7_wiring.hpp"
 
 #include "app/rig_profile_file.hpp"
+#include "app/signals.hpp"
 #include "engine/base/errors.hpp"
 
 namespace bellows {
@@ -49,6 +50,7 @@ std::unique_ptr<T7Device> open_t7_device(const T7Options& options, const Configu
   device.link = config.t7;
   device.tick_s = config.timing.tick_s;
   device.realtime = options.realtime;
+  device.stop = &stop_requested();  // SIGINT, SIGTERM while connecting: Cancelled, exit 128 + signal
   if (config.t7.watchdog_timeout_s < 1) throw InputError("[t7] watchdog_timeout_s must be at least 1 (whole seconds)");
   return std::make_unique<T7Device>(std::move(device));
 }

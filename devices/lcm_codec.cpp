@@ -85,6 +85,7 @@ ReceiveCounts ReceiveCounters::snapshot() const {
   c.old_version = old_version_.load(relaxed);
   c.unauthenticated = unauthenticated_.load(relaxed);
   c.other_joints = other_joints_.load(relaxed);
+  c.offers = offers_.load(relaxed);
   return c;
 }
 

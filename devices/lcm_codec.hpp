@@ -54,6 +54,9 @@ struct ReceiveCounts {
   std::uint64_t old_version = 0;   // an earlier protocol version's message
   std::uint64_t unauthenticated = 0;  // MAC missing or wrong (only with a key)
   std::uint64_t other_joints = 0;  // valid, but for an arm of another joint count than this one's
+  // Not an error and not in ignored(): a free rig's offers (session 0), which every engine hears
+  // before it binds (the engine's states only; a rig counts none).
+  std::uint64_t offers = 0;
   std::uint64_t ignored() const {
     return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version + unauthenticated +
            other_joints;
@@ -69,12 +72,13 @@ class ReceiveCounters {
   void foreign() { bump(foreign_); }
   void out_of_order() { bump(out_of_order_); }
   void other_joints() { bump(other_joints_); }
+  void offer() { bump(offers_); }
   ReceiveCounts snapshot() const;
 
  private:
   std::atomic<std::uint64_t> accepted_{0}, truncated_{0}, wrong_type_{0}, too_large_{0}, malformed_{0};
   std::atomic<std::uint64_t> invalid_{0}, foreign_{0}, out_of_order_{0}, old_version_{0}, unauthenticated_{0};
-  std::atomic<std::uint64_t> other_joints_{0};
+  std::atomic<std::uint64_t> other_joints_{0}, offers_{0};
 };
 
 namespace detail {

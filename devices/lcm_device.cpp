@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "devices/lcm_channels.hpp"
 #include "engine/base/errors.hpp"
@@ -74,8 +75,18 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   }
   const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
   if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
-  if (s.session_id == 0) {  // a free rig's offer
-    if (s.rig_id == rig_id_) bound_ = false;  // ours dropped this session (timeout, angle range)
+  // The rig addressed, tripped: it names this session with NO_SESSION and a new offer (docs/lcm-protocol.md).
+  const bool tripped_ours = s.session_id == session_id_ && s.rig_id == rig_id_ && s.binding != binding_ &&
+                            (s.fault_bits & io_state_t::FAULT_NO_SESSION) != 0;
+  if (s.session_id == 0 || tripped_ours) {  // a free rig's offer
+    // Ours dropped this session (timeout, angle range): a rig that offers at once, without a tripped
+    // state naming this session, still gives its reason in the offer's bits.
+    if (s.rig_id == rig_id_ && bound_ && last_armed_) report_trip(s, true);
+    if (tripped_ours) {  // the rig's last word on this session: its reason, in the report too
+      last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
+      bump(rig_fault_states_);
+    }
+    if (s.rig_id == rig_id_) bound_ = false;
     // Never switch while the valves are live; while vented, take the offer of any free rig until one
     // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
     if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) && (s.rig_id != rig_id_ || s.binding != binding_)) {
@@ -87,8 +98,9 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
       last_state_seq_ = 0;
       last_echoed_seq_ = 0;
       last_rig_time_s_ = -INFINITY;
+      reported_trip_bits_ = 0;
     }
-    return counters_.foreign();
+    return counters_.offer();  // what every engine hears before it binds: counted apart, not an error
   }
   if (s.session_id != session_id_) {  // a rig serving someone else
     last_foreign_session_.store(s.session_id, std::memory_order_relaxed);
@@ -111,6 +123,7 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   last_rig_time_s_ = s.time_s;
   last_echoed_seq_ = s.command_seq;
   last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
+  report_trip(s, false);
   constexpr std::int32_t kNoReading = std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} |
                                       std::int32_t{io_state_t::FAULT_SENSOR} | std::int32_t{io_state_t::FAULT_VALVE};
   if ((s.fault_bits & kNoReading) != 0) return bump(rig_fault_states_);  // not a reading to control with
@@ -119,8 +132,101 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   pending_fresh_ = true;
 }
 
+void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
+  constexpr std::int32_t kAngle = io_state_t::FAULT_ANGLE_LIMIT, kPressure = io_state_t::FAULT_PRESSURE_LIMIT,
+                         kTimeout = io_state_t::FAULT_COMMAND_TIMEOUT, kSensor = io_state_t::FAULT_SENSOR,
+                         kValve = io_state_t::FAULT_VALVE, kNoSession = io_state_t::FAULT_NO_SESSION;
+  // An offer always carries NO_SESSION: only its reasons count there.
+  const std::int32_t trip = s.fault_bits & (kAngle | kPressure | kTimeout | kSensor | kValve | (offered ? 0 : kNoSession));
+  if ((trip & ~reported_trip_bits_) == 0) return;  // nothing new since this binding's last report
+  reported_trip_bits_ |= trip;
+  const int joints = std::clamp<int>(s.joint_count, 1, kMaxJoints);
+  const auto at = [](int j) { return static_cast<std::size_t>(j); };
+  DeviceFault fault;
+  const unsigned long long rig = static_cast<unsigned long long>(s.rig_id);
+  if ((trip & kAngle) != 0) {  // the joint furthest out is the one the rig stopped
+    int joint = 0;
+    for (int j = 1; j < joints; ++j) {
+      if (!(std::abs(s.angle_rad[at(j)]) <= std::abs(s.angle_rad[at(joint)]))) joint = j;
+    }
+    fault.set(FaultCode::kRigLimit, joint,
+              "the rig stopped joint %d at %.1f deg beyond its angle range ([lcm] rig_angle_limit_deg): check the chamber "
+              "wiring (bellows rig check --device lcm pulses each chamber)",
+              joint + 1, s.angle_rad[at(joint)] * 180.0 / std::numbers::pi);
+  } else if ((trip & kPressure) != 0) {
+    int joint = 0, chamber = 0;
+    for (int j = 0; j < joints; ++j) {
+      for (int c = 0; c < kActuatorCount; ++c) {
+        if (s.chamber_bar[at(j)][c] > s.chamber_bar[at(joint)][chamber]) joint = j, chamber = c;
+      }
+    }
+    fault.set(FaultCode::kRigLimit, joint,
+              "the rig vented chamber %c of joint %d at %.3f bar above its pressure ceiling ([controller] p_max_bar + [lcm] "
+              "rig_pressure_margin_bar): check that valve and the rig's ceiling",
+              chamber == 0 ? 'A' : 'B', joint + 1, s.chamber_bar[at(joint)][chamber]);
+  } else if ((trip & kTimeout) != 0) {
+    fault.set(FaultCode::kRigTimeout, -1,
+              "the LCM rig %llx heard no command of this session for its [lcm] rig_timeout_s and vented itself: check the "
+              "network from this host to the rig",
+              rig);
+  } else if ((trip & (kSensor | kValve)) != 0) {
+    fault.set(FaultCode::kRigFault, -1, "the LCM rig %llx reports %s (fault_bits %d): check its driver's log", rig,
+              (trip & kSensor) != 0 ? "it cannot read its sensors" : "it cannot drive its valves", s.fault_bits);
+  } else {  // NO_SESSION alone, naming this session: the rig ended it without a reason (shut down, restarted)
+    fault.set(FaultCode::kRigFault, -1, "the LCM rig %llx ended this session without a reason (it shut down or restarted?)", rig);
+  }
+  trips_.write(fault);
+}
+
+bool LcmDevice::take_fault(DeviceFault& fault) { return trips_.read(fault); }
+
+void LcmDevice::explain_silence(double silent_s, DeviceFault& fault) const {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  const unsigned long long rig = static_cast<unsigned long long>(stats_rig_id_.load(relaxed));
+  const std::uint64_t not_ours = commands_not_ours_.load(relaxed);
+  if (not_ours > 0) {
+    fault.set(FaultCode::kForeignSender, -1,
+              "another sender is commanding this rig: it applied commands this session never sent (%llu states)",
+              static_cast<unsigned long long>(not_ours));
+    return;
+  }
+  if (const std::uint64_t forged = counters_.snapshot().unauthenticated; forged > 0) {
+    fault.set(FaultCode::kForeignSender, -1,
+              "another sender publishes rig states on this bus: %llu failed authentication (or the rig has another [lcm] key_file)",
+              static_cast<unsigned long long>(forged));
+    return;
+  }
+  // The I/O thread's last turn: if it did not run, this host stalled, not the link.
+  const double io_idle_s = monotonic_s() - io_turn_s_.load(relaxed);
+  if (io_idle_s >= 0.5 * silent_s && io_idle_s < 1e6) {
+    fault.set(FaultCode::kLinkLost, -1,
+              "no state of the LCM rig %llx reached the engine for %.0f ms: this host's LCM I/O thread did not run for "
+              "%.0f ms (the machine stalled: lighten its load, --rt enforce)",
+              rig, silent_s * 1e3, io_idle_s * 1e3);
+    return;
+  }
+  const double silence_s = rig_silent_s_.load(relaxed);
+  if (silence_s >= 0.5 * silent_s) {  // nothing at all arrived in the window (give or take the I/O thread's turn)
+    if (std::isfinite(silence_s)) {
+      fault.set(FaultCode::kLinkLost, -1,
+                "the LCM rig %llx has been silent for %.0f ms (no state on " "BELLOWS_IO_STATE): check that the rig runs and the network to it",
+                rig, silence_s * 1e3);
+    } else {
+      fault.set(FaultCode::kLinkLost, -1, "no LCM rig has been heard on BELLOWS_IO_STATE: check that the rig runs and the network to it");
+    }
+    return;
+  }
+  fault.set(FaultCode::kSensorStale, -1,
+            "the LCM rig %llx answers, but none of its states for %.0f ms was a usable reading (frozen time or rejected: "
+            "see lcm.rig.states)",
+            rig, silent_s * 1e3);
+}
+
 double LcmDevice::service(lcm::LCM* bus, double now_s) {
   now_s_ = now_s;
+  // How long the rig addressed has said nothing at all, on this thread's clock (explain_silence()).
+  rig_silent_s_.store(rig_id_ == 0 ? INFINITY : now_s - last_rig_state_s_, std::memory_order_relaxed);
+  io_turn_s_.store(monotonic_s(), std::memory_order_relaxed);
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.
@@ -164,8 +270,8 @@ DeviceHealth LcmDevice::health() const {
   h.connected = connected() && monotonic_s() - last_state_s() < kLinkAlive_s;
   round_trips_.summarize(h);
   const ReceiveCounts c = counters_.snapshot();
-  h.link_errors = c.truncated + c.wrong_type + c.too_large + c.malformed + c.invalid + c.foreign + c.out_of_order + c.other_joints +
-                  rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
+  // The rig's offers before binding are not errors (ReceiveCounts::offers): only what went wrong.
+  h.link_errors = c.ignored() + rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
   h.stale_readings = stale_reads_.load(std::memory_order_relaxed);
   return h;
 }

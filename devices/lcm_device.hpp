@@ -18,11 +18,17 @@
 // does not match are counted and ignored, and every command is signed.
 //
 // The reading's time_s is the I/O thread's monotonic clock when the last valid state of this
-// session arrived (not the rig's clock, which restarts with the rig). No valid state for
-// [safety] stale_ticks ticks therefore trips the engine's stale-sensor guard, which vents; a rig
-// reporting a sensor or valve fault counts as no state (its limit bits do not: the engine's own
-// guards judge the reading). Only fresh valve states are published: if the engine
-// thread stops, the commands stop and the rig vents on its own.
+// session arrived (not the rig's clock, which restarts with the rig). A tick without one is a tick
+// without a reading: the engine holds the valves closed and rides through; [safety] stale_ticks of
+// them end the trial, and explain_silence() names why: `link-lost` when the rig addressed has sent
+// nothing at all for that long, `foreign-sender` when another sender is commanding the rig, else
+// `sensor-stale` (states arrive but none is usable). A state of this session carrying the rig's own
+// trip (its angle range, its pressure ceiling, its command timeout, a sensor or valve fault) is no
+// reading but a fault with the rig's reason and joint (take_fault()): `rig-limit`, `rig-timeout`,
+// `rig-fault`. A rig that trips keeps naming the session it dropped in its states for a while
+// (docs/lcm-protocol.md, "the tripped state"), so the reason reaches the engine it served. Only
+// fresh valve states are published: if the engine thread stops, the commands stop and the rig
+// vents on its own.
 #pragma once
 
 #include <atomic>
@@ -74,6 +80,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   void vent() override;
   void advance(double) override {}  // a real rig's time passes on its own
   const char* name() const override { return "lcm"; }
+  bool take_fault(DeviceFault& fault) override;
+  void explain_silence(double silent_s, DeviceFault& fault) const override;
 
   // ---- LcmEndpoint: I/O thread only ----
   void attach(lcm::LCM& bus) override;
@@ -104,6 +112,9 @@ class LcmDevice final : public Device, public LcmEndpoint {
   };
 
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
+  /// A state of this session with trip bits: the rig's reason, for the engine (once per trip).
+  /// `offered`: the rig's new offer (session 0) that dropped this session, its reasons in its bits.
+  void report_trip(const io_joints_state_t& state, bool offered);
 
   const std::int64_t session_id_;
   const LcmKey key_;
@@ -111,6 +122,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   const int joints_;
   LatestValue<Outgoing> outbox_;        // engine -> I/O
   LatestValue<SensorReading> inbox_;    // I/O -> engine
+  LatestValue<DeviceFault> trips_;      // I/O -> engine: the rig's own trips
   SensorReading reading_{};             // engine thread's copy
 
   // I/O thread state.
@@ -122,6 +134,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   bool bound_ = false;             // its last state served this session
   double now_s_ = 0.0;             // of the last service()
   double last_rig_state_s_ = 0.0;  // when the rig addressed last sent anything valid
+  std::int32_t reported_trip_bits_ = 0;  // trip bits of this binding already reported
   std::int64_t last_state_seq_ = 0;
   std::int64_t last_echoed_seq_ = 0;
   double last_rig_time_s_ = 0.0;
@@ -135,6 +148,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};
   std::atomic<double> last_state_s_{-1.0};
+  std::atomic<double> io_turn_s_{INFINITY};  // monotonic_s() of the I/O thread's last service() turn
+  std::atomic<double> rig_silent_s_{INFINITY};  // since the addressed rig's last valid state of any kind (I/O clock)
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};
   std::atomic<std::int32_t> last_fault_bits_{0};

@@ -141,6 +141,16 @@ void RigServer::apply_limits(bool write) {
 }
 
 void RigServer::release(std::int32_t fault_bits) {
+  constexpr std::int32_t kReasons = std::int32_t{io_state_t::FAULT_ANGLE_LIMIT} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT};
+  if (session_ != 0 && (fault_bits & kReasons) != 0) {  // tripped: the states name the session dropped, and why
+    tripped_session_ = session_;
+    tripped_command_seq_ = applied_seq_;
+    tripped_states_left_ = std::max(1, static_cast<int>(std::ceil(params_.command_timeout_s / params_.period_s)));
+  }
+  if (pending_fresh_) {  // a command of the dropped session not applied yet: only its vent remains
+    pending_.armed = false;
+    pending_in_sequence_ = false;
+  }
   arm_.vent();
   commanded_ = ValveCommand::vented(joints_);
   session_ = 0;
@@ -206,9 +216,11 @@ void RigServer::finish(lcm::LCM* bus, double now_s) {
 void RigServer::publish_state(lcm::LCM& bus, double now_s) {
   fill_state(arm_.read_sensors(), state_);
   state_.seq = ++state_seq_;
-  state_.binding = binding_;
-  state_.session_id = session_;
-  state_.command_seq = applied_seq_;
+  const bool tripped = tripped_states_left_ > 0 && session_ == 0;
+  if (tripped) --tripped_states_left_;
+  state_.binding = binding_;  // tripped: already the new offer (a bind is refused while beyond the range)
+  state_.session_id = tripped ? tripped_session_ : session_;
+  state_.command_seq = tripped ? tripped_command_seq_ : applied_seq_;
   state_.utime = static_cast<std::int64_t>(now_s * 1e6);
   state_.fault_bits = fault_bits_ | limit_bits_ | limit_bits_since_state_;  // a limit that acted between two states too
   limit_bits_since_state_ = 0;

@@ -7,8 +7,10 @@
 // that session's commands only, as soon as they arrive (the arm's physics integrated up to that
 // moment first), provided each sequence number is above the last by at most `seq_window`. A vent
 // addressed to this rig is obeyed whatever its session or sequence number. When the session's
-// commands stop for `command_timeout_s`, or the arm leaves the rig's angle range, it vents, drops
-// the session and offers a new binding. A chamber above the rig's ceiling is vented whatever the
+// commands stop for `command_timeout_s`, or the arm leaves the rig's angle range, it vents and drops
+// the session: tripped, it goes on naming that session and its last command in its states (with
+// FAULT_NO_SESSION and the reason's bit, and already its new offer) for `command_timeout_s`, so
+// that the engine it served reads why; then its states name no session. A chamber above the rig's ceiling is vented whatever the
 // command. With a key, a command whose MAC does not match is counted and ignored, and every state
 // is signed. Everything refused is counted, in the states and in the log.
 //
@@ -110,6 +112,9 @@ class RigServer final : public LcmEndpoint {
   std::int64_t last_seq_ = 0;
   std::int64_t applied_seq_ = 0;
   std::int32_t fault_bits_ = io_state_t::FAULT_NO_SESSION;
+  // Tripped: the session dropped for a reason, named in the next states (docs/lcm-protocol.md).
+  std::int64_t tripped_session_ = 0, tripped_command_seq_ = 0;
+  int tripped_states_left_ = 0;
   bool reported_[static_cast<int>(Notice::kCount)] = {};  // one log line per kind per binding
   double origin_s_ = -1.0;
   double device_time_s_ = 0.0;

@@ -1,83 +1,281 @@
 #include "devices/modbus_client.hpp"
 
-#include <cerrno>
-#include <cmath>
+#include <fcntl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
-#include <modbus/modbus.h>
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
 
 #include "devices/t7_registers.hpp"
-#include "engine/base/errors.hpp"
 
 namespace bellows {
 namespace {
 
-void split_timeout(double timeout_s, std::uint32_t& seconds, std::uint32_t& microseconds) {
-  const double t = std::fmax(timeout_s, 1e-6);
-  seconds = static_cast<std::uint32_t>(t);
-  microseconds = static_cast<std::uint32_t>(std::lround((t - seconds) * 1e6));
-  if (microseconds >= 1000000) {
-    seconds += 1;
-    microseconds = 0;
+constexpr int kReadHolding = 3;
+constexpr int kWriteMultiple = 16;
+constexpr std::size_t kHeader = 7;  // MBAP: transaction, protocol, length, unit
+constexpr int kUnit = 0xFF;         // Modbus TCP's "no unit" (a T7 answers any)
+// How often a wait looks at the stop flag.
+constexpr double kStopSlice_s = 0.02;
+
+const char* exception_name(int code) {
+  switch (code) {
+    case 1: return "ILLEGAL FUNCTION";
+    case 2: return "ILLEGAL DATA ADDRESS";
+    case 3: return "ILLEGAL DATA VALUE";
+    case 4: return "SLAVE DEVICE FAILURE";
+    case 6: return "SLAVE DEVICE BUSY";
+    default: return "exception";
   }
+}
+
+void put16(std::uint8_t* at, unsigned value) {
+  at[0] = static_cast<std::uint8_t>(value >> 8);
+  at[1] = static_cast<std::uint8_t>(value & 0xff);
+}
+unsigned get16(const std::uint8_t* at) { return (static_cast<unsigned>(at[0]) << 8) | at[1]; }
+
+std::string milliseconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f ms", s * 1e3);
+  return text;
 }
 
 }  // namespace
 
-ModbusClient::ModbusClient(const std::string& host, int port) : address_(host + ":" + std::to_string(port)) {
-  context_ = modbus_new_tcp_pi(host.c_str(), std::to_string(port).c_str());
-  if (context_ == nullptr) throw InputError("bad Modbus TCP address '" + address_ + "'");
+double monotonic_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-ModbusClient::~ModbusClient() {
-  if (context_ == nullptr) return;
-  modbus_close(context_);
-  modbus_free(context_);
+ModbusClient::ModbusClient(const std::string& host, int port)
+    : host_(host), port_(std::to_string(port)), address_(host + ":" + std::to_string(port)) {}
+
+ModbusClient::~ModbusClient() { close(); }
+
+void ModbusClient::close() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  rx_size_ = 0;  // a new connection starts a new stream
 }
 
-std::string ModbusClient::connect(double timeout_s) {
-  set_response_timeout(timeout_s);  // libmodbus waits this long for the TCP connection too
-  if (modbus_connect(context_) == -1) {
-    failed();
-    return last_error_;
-  }
-  return "";
-}
-
-void ModbusClient::set_response_timeout(double timeout_s) {
-  std::uint32_t s = 0, us = 0;
-  split_timeout(timeout_s, s, us);
-  modbus_set_response_timeout(context_, s, us);
-}
-
-bool ModbusClient::failed() {
-  const int error = errno;
-  last_error_ = modbus_strerror(error);
-  // Only codes 1..11 are exceptions the device sent (libmodbus's EMBXILFUN..EMBXGTAR); the codes
-  // after them are libmodbus's own findings about a response, which the device did not report.
-  if (error >= EMBXILFUN && error <= EMBXGTAR) {
-    last_error_ += " (Modbus exception " + std::to_string(error - MODBUS_ENOBASE) + ")";
-  } else if (error == EMBBADDATA) {
-    last_error_ += " (a framing or transaction-id mismatch: the response does not answer the request; the device sent no exception)";
-  } else if (error == EMBBADSLAVE) {
-    last_error_ += " (the response came from another unit id; the device sent no exception)";
-  } else if (error == EMBMDATA || error == EMBBADEXC || error == EMBBADCRC) {
-    last_error_ += " (a malformed response; the device sent no exception)";
-  }
+bool ModbusClient::fail(const std::string& why) {
+  last_error_ = why;
   return false;
 }
 
+void ModbusClient::lose_connection(const std::string& why) {
+  close();
+  last_error_ = why;
+}
+
+int ModbusClient::wait_for(short events, double deadline) {
+  interrupted_ = false;
+  for (;;) {
+    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
+      interrupted_ = true;
+      return 0;
+    }
+    const double left = deadline - monotonic_seconds();
+    if (left <= 0.0) return 0;
+    pollfd p{fd_, events, 0};
+    const double slice = stop_ != nullptr ? std::min(left, kStopSlice_s) : left;
+    const int ms = std::max(0, static_cast<int>(std::ceil(slice * 1e3)));
+    const int ready = ::poll(&p, 1, ms);
+    if (ready > 0) return (p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0 && (p.revents & events) == 0 ? -1 : 1;
+    if (ready < 0 && errno != EINTR) return -1;
+  }
+}
+
+std::string ModbusClient::connect(double timeout_s) {
+  close();  // never two connections at once: a T7 serves only a few
+  const double deadline = std::min(monotonic_seconds() + timeout_s, deadline_s_);
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (const int error = getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found); error != 0) {
+    last_error_ = std::string("cannot resolve ") + host_ + ": " + gai_strerror(error);
+    return last_error_;
+  }
+  last_error_ = "no address";
+  for (addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    fd_ = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
+    if (fd_ < 0) {
+      last_error_ = std::strerror(errno);
+      continue;
+    }
+    const int one = 1;
+    setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    if (::connect(fd_, a->ai_addr, a->ai_addrlen) == 0) break;
+    if (errno != EINPROGRESS) {
+      last_error_ = std::strerror(errno);
+      close();
+      continue;
+    }
+    const int ready = wait_for(POLLOUT, deadline);
+    int error = 0;
+    socklen_t length = sizeof error;
+    if (ready > 0 && getsockopt(fd_, SOL_SOCKET, SO_ERROR, &error, &length) == 0 && error == 0) break;
+    last_error_ = interrupted_ ? "interrupted" : ready == 0 ? "no answer within " + milliseconds(timeout_s) : std::strerror(error != 0 ? error : errno);
+    close();
+    if (interrupted_ || ready == 0) break;
+  }
+  freeaddrinfo(found);
+  if (fd_ < 0) return last_error_;
+  if (ever_connected_) ++reconnects_;
+  ever_connected_ = true;
+  last_error_.clear();
+  return "";
+}
+
+bool ModbusClient::send_all(const std::uint8_t* bytes, std::size_t size, double deadline) {
+  std::size_t sent = 0;
+  while (sent < size) {
+    const ssize_t n = ::send(fd_, bytes + sent, size - sent, MSG_NOSIGNAL);
+    if (n > 0) {
+      sent += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
+      const int ready = wait_for(POLLOUT, deadline);
+      if (ready > 0) continue;
+      timed_out_ = ready == 0 && !interrupted_;
+      if (ready < 0) lose_connection("the connection failed while sending");
+      else last_error_ = interrupted_ ? "interrupted" : "the request could not leave in time";
+      return false;
+    }
+    lose_connection(std::string("sending failed: ") + std::strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+int ModbusClient::receive_frame(double deadline) {
+  for (;;) {
+    if (rx_size_ >= kHeader) {
+      const std::size_t length = get16(&rx_[4]);
+      if (get16(&rx_[2]) != 0 || length < 2 || length > 254) {
+        lose_connection("the T7's answer is not Modbus TCP (the stream lost its framing)");
+        return -1;
+      }
+      if (rx_size_ >= 6 + length) return 1;
+    }
+    const int ready = wait_for(POLLIN, deadline);
+    if (ready == 0) return 0;
+    if (ready < 0) {
+      lose_connection("the connection failed");
+      return -1;
+    }
+    const ssize_t n = ::recv(fd_, rx_.data() + rx_size_, rx_.size() - rx_size_, 0);
+    if (n == 0) {
+      lose_connection("the T7 closed the connection");
+      return -1;
+    }
+    if (n < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) continue;
+      lose_connection(std::string("receiving failed: ") + std::strerror(errno));
+      return -1;
+    }
+    rx_size_ += static_cast<std::size_t>(n);
+  }
+}
+
+bool ModbusClient::request(int function, int address, int count, const std::uint16_t* values, std::uint16_t* out) {
+  last_exception_ = 0;
+  timed_out_ = false;
+  interrupted_ = false;
+  const double start = monotonic_seconds();
+  const double deadline = std::min(start + response_timeout_s_, deadline_s_);
+  if (fd_ < 0) {  // the connection was lost: a new one (the old one is closed)
+    const std::string why = connect(std::max(0.0, deadline - start));
+    if (!why.empty()) return fail("cannot reconnect: " + why);
+  }
+  const std::uint16_t tid = ++transaction_;
+  std::size_t size = 0;
+  put16(&tx_[0], tid);
+  put16(&tx_[2], 0);
+  tx_[6] = kUnit;
+  tx_[7] = static_cast<std::uint8_t>(function);
+  put16(&tx_[8], static_cast<unsigned>(address));
+  put16(&tx_[10], static_cast<unsigned>(count));
+  if (function == kWriteMultiple) {
+    tx_[12] = static_cast<std::uint8_t>(2 * count);
+    for (int i = 0; i < count; ++i) put16(&tx_[13 + 2 * static_cast<std::size_t>(i)], values[i]);
+    size = 13 + 2 * static_cast<std::size_t>(count);
+  } else {
+    size = 12;
+  }
+  put16(&tx_[4], static_cast<unsigned>(size - 6));
+  if (!send_all(tx_.data(), size, deadline)) return false;
+  for (;;) {
+    const int got = receive_frame(deadline);
+    if (got == 0) {
+      timed_out_ = !interrupted_;
+      return fail(interrupted_ ? "interrupted" : "no answer within " + milliseconds(std::max(0.0, deadline - start)) + " (the exchange's deadline)");
+    }
+    if (got < 0) return false;
+    const std::size_t frame = 6 + get16(&rx_[4]);
+    const unsigned frame_tid = get16(&rx_[0]);
+    const std::uint8_t fc = rx_[7];
+    const std::uint8_t* pdu = &rx_[8];
+    const std::size_t pdu_size = frame - 8;
+    bool ok = false;
+    bool mine = frame_tid == tid;
+    if (mine && fc == (function | 0x80) && pdu_size >= 1) {
+      last_exception_ = pdu[0];
+      char why[80];
+      std::snprintf(why, sizeof why, "%s (Modbus exception %d)", exception_name(last_exception_), last_exception_);
+      last_error_ = why;
+    } else if (mine && fc == function && function == kReadHolding && pdu_size == 1 + 2 * static_cast<std::size_t>(count) &&
+               pdu[0] == 2 * count) {
+      for (int i = 0; i < count; ++i) out[i] = static_cast<std::uint16_t>(get16(pdu + 1 + 2 * i));
+      ok = true;
+    } else if (mine && fc == function && function == kWriteMultiple && pdu_size == 4 &&
+               get16(pdu) == static_cast<unsigned>(address) && get16(pdu + 2) == static_cast<unsigned>(count)) {
+      ok = true;
+    } else if (mine) {
+      last_error_ = "the answer does not match its request";
+    }
+    std::memmove(rx_.data(), rx_.data() + frame, rx_size_ - frame);  // the frame is consumed either way
+    rx_size_ -= frame;
+    // An older transaction id answers a request that timed out; one never sent means the stream
+    // cannot be trusted (issue 24's words: it is no exception the device sent).
+    const auto behind = static_cast<std::uint16_t>(tid - frame_tid);
+    if (!mine && (behind == 0 || behind > 0x7fff)) {
+      lose_connection("a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no exception");
+      return false;
+    }
+    if (!mine) {
+      ++late_answers_;  // the answer to a request that timed out: read and dropped
+      continue;
+    }
+    return ok;
+  }
+}
+
 bool ModbusClient::read(int address, int count, std::uint16_t* registers) {
-  return modbus_read_registers(context_, address, count, registers) == count || failed();
+  return request(kReadHolding, address, count, nullptr, registers);
 }
 
 bool ModbusClient::write(int address, int count, const std::uint16_t* registers) {
-  return modbus_write_registers(context_, address, count, registers) == count || failed();
+  return request(kWriteMultiple, address, count, registers, nullptr);
 }
+
+bool ModbusClient::read_u16(int address, std::uint16_t& value) { return read(address, 1, &value); }
 
 bool ModbusClient::read_u32(int address, std::uint32_t& value) {
   std::uint16_t r[2];
   if (!read(address, 2, r)) return false;
-  value = (static_cast<std::uint32_t>(r[0]) << 16) | r[1];
+  value = t7::get_u32(r);
   return true;
 }
 
@@ -91,7 +289,8 @@ bool ModbusClient::read_float(int address, double& value) {
 bool ModbusClient::write_u16(int address, std::uint16_t value) { return write(address, 1, &value); }
 
 bool ModbusClient::write_u32(int address, std::uint32_t value) {
-  const std::uint16_t r[2] = {static_cast<std::uint16_t>(value >> 16), static_cast<std::uint16_t>(value & 0xffff)};
+  std::uint16_t r[2];
+  t7::put_u32(value, r);
   return write(address, 2, r);
 }
 
@@ -99,11 +298,6 @@ bool ModbusClient::write_float(int address, double value) {
   std::uint16_t r[2];
   t7::put_float(value, r);
   return write(address, 2, r);
-}
-
-bool ModbusClient::reconnect() {
-  modbus_close(context_);
-  return modbus_connect(context_) == 0 || failed();
 }
 
 }  // namespace bellows

@@ -1,12 +1,21 @@
-// A Modbus TCP client over libmodbus: one connection, blocking requests with a response timeout.
-// Used on one thread at a time (libmodbus contexts are not thread-safe): the T7 device's
-// constructor, then its I/O thread.
+// A Modbus TCP client for the T7: one connection, one request at a time, each answer matched to its
+// request by the MBAP transaction id. Used on one thread at a time (the T7 device's constructor,
+// then its I/O thread).
+//
+// Why not libmodbus' client (which t7-sim's server side still uses): libmodbus 3.1.6 waits per
+// read() with a byte timeout (0.5 s by default), so a link that trickles a byte now and then keeps
+// one request alive for seconds; and an answer that arrives after its request timed out is taken
+// for the next request's, which fails "Invalid data" (and its recovery flushes whatever came).
+// Here every request has one deadline for the whole answer, a late answer (an older transaction
+// id) is read and discarded without a reconnect, and a wait can be interrupted (SIGINT while
+// connecting). TCP_NODELAY is set: a request leaves at once.
 #pragma once
 
+#include <array>
+#include <atomic>
 #include <cstdint>
+#include <limits>
 #include <string>
-
-typedef struct _modbus modbus_t;
 
 namespace bellows {
 
@@ -18,37 +27,77 @@ class ModbusClient {
   ModbusClient(const ModbusClient&) = delete;
   ModbusClient& operator=(const ModbusClient&) = delete;
 
-  /// Opens the TCP connection, waiting at most `timeout_s`. Returns "" or why not.
+  /// Opens the TCP connection (closing any old one first: never two at once), waiting at most
+  /// `timeout_s` and no later than the deadline. Returns "" or why not.
   std::string connect(double timeout_s);
-  void set_response_timeout(double timeout_s);
+  /// Closes the connection (the next request opens a new one).
+  void close();
+  bool connected() const { return fd_ >= 0; }
 
-  // Requests (function 3 reads, 16 writes). False on an error or a timeout: last_error() says which.
+  /// Each request waits at most this long for its whole answer...
+  void set_response_timeout(double timeout_s) { response_timeout_s_ = timeout_s; }
+  /// ...and never past this steady-clock time (monotonic_s(); infinity: no such limit).
+  void set_deadline(double deadline_s) { deadline_s_ = deadline_s; }
+  void clear_deadline() { deadline_s_ = std::numeric_limits<double>::infinity(); }
+  /// While set (not null), a wait ends as soon as *stop is true: interrupted() tells.
+  void set_stop(const std::atomic<bool>* stop) { stop_ = stop; }
+
+  // Requests (function 3 reads, 16 writes). False on an error, an exception or a timeout:
+  // last_error() says which. After a lost connection, the next request reconnects first.
   bool read(int address, int count, std::uint16_t* registers);
   bool write(int address, int count, const std::uint16_t* registers);
+  bool read_u16(int address, std::uint16_t& value);
   bool read_u32(int address, std::uint32_t& value);
   bool read_float(int address, double& value);
   bool write_u16(int address, std::uint16_t value);
   bool write_u32(int address, std::uint32_t value);
   bool write_float(int address, double value);
-  /// After a failed request: closes the connection and opens a new one (waiting at most the
-  /// response timeout), so no answer to an older request can be taken for the next one's. False,
-  /// with last_error(), when it cannot; the next request then fails at once and may try again.
-  /// (Dropping what arrived is not enough: a server whose TCP holds an answer until the client's
-  /// next segment acknowledges the one before, as Nagle's algorithm does, hands each answer out
-  /// one request late, for good.)
-  bool reconnect();
 
-  /// The last failure in words (a Modbus exception names its number).
+  /// The last failure in words ("no answer within 4.0 ms", "Modbus exception 4 (...)", ...).
   const std::string& last_error() const { return last_error_; }
+  /// The Modbus exception code of the last failed request (0: it was not an exception).
+  int last_exception() const { return last_exception_; }
+  /// The last failure was a timeout (the answer may still come: it will be discarded).
+  bool timed_out() const { return timed_out_; }
+  /// The last wait ended because *stop was set.
+  bool interrupted() const { return interrupted_; }
   /// "host:port".
   const std::string& address() const { return address_; }
+  /// Answers to earlier, timed-out requests read and discarded since the start.
+  std::uint64_t late_answers() const { return late_answers_; }
+  /// Connections opened again after one was lost.
+  std::uint64_t reconnects() const { return reconnects_; }
 
  private:
-  bool failed();
+  bool request(int function, int address, int count, const std::uint16_t* values, std::uint16_t* out);
+  bool send_all(const std::uint8_t* bytes, std::size_t size, double deadline);
+  /// Reads until a whole frame is in rx_; 1 a frame, 0 the deadline, -1 the connection failed.
+  int receive_frame(double deadline);
+  /// Waits for `events` on the socket until the deadline, in slices that watch *stop.
+  int wait_for(short events, double deadline);
+  bool fail(const std::string& why);
+  void lose_connection(const std::string& why);
 
-  modbus_t* context_ = nullptr;
-  std::string address_;
+  std::string host_, port_, address_;
+  int fd_ = -1;
+  bool ever_connected_ = false;
+  std::uint16_t transaction_ = 0;
+  double response_timeout_s_ = 1.0;
+  double deadline_s_ = std::numeric_limits<double>::infinity();
+  const std::atomic<bool>* stop_ = nullptr;
+  // A partly received frame survives a timeout: the rest comes with the next request's wait.
+  std::array<std::uint8_t, 512> rx_{};
+  std::size_t rx_size_ = 0;
+  std::array<std::uint8_t, 300> tx_{};
   std::string last_error_;
+  int last_exception_ = 0;
+  bool timed_out_ = false;
+  bool interrupted_ = false;
+  std::uint64_t late_answers_ = 0;
+  std::uint64_t reconnects_ = 0;
 };
+
+/// The steady clock in seconds (the clock of ModbusClient's deadlines).
+double monotonic_seconds();
 
 }  // namespace bellows

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "devices/t7_registers.hpp"
+#include "devices/t7_timing.hpp"
 #include "engine/base/errors.hpp"
 
 namespace bellows {
@@ -90,6 +91,12 @@ void validate_rig_profile(const RigProfile& p) {
     if (!(c.volts_min_V < c.volts_max_V)) fail(section + "volts_min_V", "must be below volts_max_V");
     if (c.volts_min_V < -c.range_V || c.volts_max_V > c.range_V) {
       fail(section + "volts_max_V", "the valid voltages must lie inside the input range +-" + std::to_string(c.range_V) + " V");
+    }
+    if (c.resolution_index < 0 || c.resolution_index > t7::kMaxResolutionIndexT7Pro) {
+      fail(section + "resolution_index", "a T7 samples at index 0..8 (0..12 on a T7-Pro), not " + std::to_string(c.resolution_index));
+    }
+    if (!(c.settling_us >= 0.0 && c.settling_us <= t7::kMaxSettling_us)) {
+      fail(section + "settling_us", "must be 0 (automatic) up to 50000 us");
     }
     const PhysicalBounds bounds = physical_bounds(role);
     for (double volts : {c.volts_min_V, c.volts_max_V}) {

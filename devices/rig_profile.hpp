@@ -42,6 +42,11 @@ struct SensorCalibration {
   double offset = 0.0;        // role unit at 0 V
   double volts_min_V = 0.0;   // the voltages the sensor can really produce; outside: a broken
   double volts_max_V = 10.0;  // wire or sensor (sensor-range fault)
+  // How the T7 samples it (AIN#_RESOLUTION_INDEX, AIN#_SETTLING_US; devices/t7_timing.hpp): index
+  // 1..8 (12 on a T7-Pro), 0 the product's default (8, or 9 on a Pro: too slow for a 5 ms tick);
+  // settling 0 = automatic. Index 4 samples in 0.1 ms: five inputs and the link fit a tick.
+  int resolution_index = 4;
+  double settling_us = 0.0;
 
   double value(double volts) const { return offset + gain_per_V * volts; }
   double volts(double value) const { return (value - offset) / gain_per_V; }

@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "devices/t7_errors.hpp"
+#include "engine/base/cancellation.hpp"
 #include "engine/base/errors.hpp"
 
 namespace bellows {
@@ -26,6 +28,12 @@ constexpr std::size_t kRoundTripRefresh = 64;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string seconds_text(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", s);
+  return text;
 }
 
 void sleep_s(double seconds) {
@@ -68,6 +76,9 @@ T7Device::T7Device(T7DeviceOptions options)
       client_(options_.host, options_.port),
       clock_(t7::pwm_clock_for(options_.profile.pwm_frequency_hz)) {
   validate_rig_profile(options_.profile);
+  // Before any traffic: index 0 means the Pro's default here, the slower one (checked again for
+  // the product that answers).
+  t7::require_exchange_fits(options_.profile, t7::Product::kT7Pro, options_.tick_s, options_.link.response_timeout_s);
   int lowest = t7::kDioCount, highest = -1, highest_ain = 0;
   for (ValveRole role : kValveRoles) {
     lowest = std::min(lowest, options_.profile.dio(role));
@@ -83,10 +94,20 @@ T7Device::T7Device(T7DeviceOptions options)
   scratch_ms_.assign(kRoundTripWindow, 0.0);
   for (auto& v : volts_) v.store(0.0);
 
-  if (const std::string why = client_.connect(options_.link.connect_timeout_s); !why.empty()) {
-    throw EnvironmentError("t7 " + address_ + ": cannot connect (" + why + ")");
+  // [t7] connect_timeout_s bounds the connection and the whole configuration together; a stop
+  // signal ends either at once.
+  const double connect_timeout_s = options_.link.connect_timeout_s;
+  client_.set_stop(options_.stop);
+  client_.set_deadline(now_s() + connect_timeout_s);
+  client_.set_response_timeout(connect_timeout_s);
+  if (const std::string why = client_.connect(connect_timeout_s); !why.empty()) {
+    if (client_.interrupted()) throw Cancelled("t7 " + address_ + ": connecting interrupted");
+    throw EnvironmentError("t7 " + address_ + ": cannot connect within [t7] connect_timeout_s = " + seconds_text(connect_timeout_s) +
+                           " (" + why + ")");
   }
   configure();
+  client_.set_stop(nullptr);  // from here on the I/O thread owns the link: its last word is a vent
+  client_.clear_deadline();
   client_.set_response_timeout(options_.link.response_timeout_s);
   origin_s_ = now_s();
   thread_ = std::thread([this] { serve(); });
@@ -101,47 +122,117 @@ void T7Device::stop() {
 
 // ---- configuration (constructor, before the I/O thread) ----
 
-void T7Device::require(bool ok, const char* what) {
-  if (!ok) throw EnvironmentError("t7 " + address_ + ": " + what + " refused (" + client_.last_error() + ")");
+// "writing DIO2_EF_CONFIG_A (44304) refused: Modbus exception 4 (SLAVE DEVICE FAILURE), LabJack
+// error 2565 EF_VALUE_GREATER_THAN_PERIOD": a T7 keeps its own error number in LAST_ERR_DETAIL.
+std::string T7Device::refusal(const char* what, int address) {
+  std::string why = std::string(what) + " (" + t7::register_name(address) + ", " + std::to_string(address) + ") refused: " + client_.last_error();
+  if (client_.last_exception() != 0) {
+    const std::string exception = client_.last_error();
+    std::uint16_t detail = 0;
+    if (client_.read_u16(t7::kLastErrDetail, detail) && detail != 0) {
+      why += ", LabJack error " + std::to_string(detail);
+      if (*t7::error_name(detail) != '\0') why += std::string(" ") + t7::error_name(detail) + ": " + t7::error_description(detail);
+    }
+  }
+  return why;
+}
+
+void T7Device::require(bool ok, const char* what, int address) {
+  if (ok) return;
+  if (client_.interrupted()) throw Cancelled("t7 " + address_ + ": configuring interrupted");
+  if (client_.timed_out()) {
+    throw EnvironmentError("t7 " + address_ + ": no answer within [t7] connect_timeout_s = " + seconds_text(options_.link.connect_timeout_s) +
+                           " while configuring (" + what + " " + t7::register_name(address) + ")");
+  }
+  throw EnvironmentError("t7 " + address_ + ": " + refusal(what, address));
 }
 
 void T7Device::configure() {
   double product = 0.0;
-  require(client_.read_float(t7::kProductId, product), "reading PRODUCT_ID");
+  require(client_.read_float(t7::kProductId, product), "reading", t7::kProductId);
   if (product != t7::kT7ProductId) {
     char why[160];
     std::snprintf(why, sizeof why, "t7 %s: answers Modbus but is not a T7 (PRODUCT_ID %g)", address_.c_str(), product);
     throw EnvironmentError(why);
   }
-  configure_watchdog();
+  std::uint32_t hardware = 0;
+  require(client_.read_u32(t7::kHardwareInstalled, hardware), "reading", t7::kHardwareInstalled);
+  product_ = (hardware & t7::kHardwareHighResolutionAdc) != 0 ? t7::Product::kT7Pro : t7::Product::kT7;
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = options_.profile.input(role);
-    require(client_.write_float(t7::kAinRange(c.ain), c.range_V), "setting AIN#_RANGE");
+    if (c.resolution_index > t7::max_resolution_index(product_)) {
+      throw EnvironmentError("t7 " + address_ + ": rig profile " + options_.profile.source + ": [inputs." + to_string(role) +
+                             "] resolution_index = " + std::to_string(c.resolution_index) + " needs a T7-Pro; this is a " +
+                             t7::to_string(product_) + " (indices 1..8)");
+    }
   }
-  // The clock must be disabled while it is configured.
-  require(client_.write_u16(t7::kClock0Enable, 0), "disabling DIO_EF_CLOCK0");
-  require(client_.write_u16(t7::kClock0Divisor, static_cast<std::uint16_t>(clock_.divisor)), "setting DIO_EF_CLOCK0_DIVISOR");
-  require(client_.write_u32(t7::kClock0RollValue, clock_.roll), "setting DIO_EF_CLOCK0_ROLL_VALUE");
-  require(client_.write_u16(t7::kClock0Enable, 1), "enabling DIO_EF_CLOCK0");
+  try {
+    t7::require_exchange_fits(options_.profile, product_, options_.tick_s, options_.link.response_timeout_s);
+  } catch (const InputError& error) {
+    throw EnvironmentError("t7 " + address_ + ": " + error.what());
+  }
+  configure_watchdog();
+  configure_inputs();
+  configure_clock();
+  configure_lines();
+}
+
+void T7Device::configure_inputs() {
+  const int highest = ain_registers_ / 2 - 1;
+  for (int ain = 0; ain <= highest; ++ain) {  // an input in the read block no sensor uses: the fastest index
+    require(client_.write_u16(t7::kAinResolutionIndex(ain), 1), "setting", t7::kAinResolutionIndex(ain));
+  }
+  for (SensorRole role : kSensorRoles) {
+    const SensorCalibration& c = options_.profile.input(role);
+    require(client_.write_float(t7::kAinRange(c.ain), c.range_V), "setting", t7::kAinRange(c.ain));
+    require(client_.write_u16(t7::kAinResolutionIndex(c.ain), static_cast<std::uint16_t>(c.resolution_index)), "setting",
+            t7::kAinResolutionIndex(c.ain));
+    require(client_.write_float(t7::kAinSettling_us(c.ain), c.settling_us), "setting", t7::kAinSettling_us(c.ain));
+  }
+}
+
+// Clock 0 is the 32-bit clock: clocks 1 and 2 must be off before it starts (LabJack error 2558),
+// and it must be off while configured; disabling a clock that is not running is itself refused
+// (2554), so each is read first. Another program may have left any of them running.
+void T7Device::configure_clock() {
+  for (int clock : {1, 2, 0}) {
+    std::uint16_t enabled = 0;
+    require(client_.read_u16(t7::kClockEnable(clock), enabled), "reading", t7::kClockEnable(clock));
+    if (enabled != 0) require(client_.write_u16(t7::kClockEnable(clock), 0), "disabling", t7::kClockEnable(clock));
+  }
+  require(client_.write_u16(t7::kClock0Divisor, static_cast<std::uint16_t>(clock_.divisor)), "setting", t7::kClock0Divisor);
+  require(client_.write_u32(t7::kClock0RollValue, clock_.roll), "setting", t7::kClock0RollValue);
+  require(client_.write_u16(t7::kClock0Enable, 1), "enabling", t7::kClock0Enable);
+}
+
+// Each valve line: its EF off while configured (and before its index changes: 2566), PWM out on
+// clock 0 at the vented duty (CONFIG_A below the roll value: 2565), the line an output driven low
+// (2563), then PWM on.
+void T7Device::configure_lines() {
   const ValveCommand vented = ValveCommand::vented();
   for (ValveRole role : kValveRoles) {
     const int dio = options_.profile.dio(role);
-    require(client_.write_u32(t7::kDioEfEnable(dio), 0), "disabling DIO#_EF_ENABLE");
-    require(client_.write_u32(t7::kDioEfIndex(dio), t7::kEfIndexPwmOut), "setting DIO#_EF_INDEX");
-    require(client_.write_u32(t7::kDioEfClockSource(dio), 0), "setting DIO#_EF_CLOCK_SOURCE");
-    require(client_.write_u32(t7::kDioEfConfigA(dio), clock_.config_a(duty_of(vented, role))), "setting DIO#_EF_CONFIG_A");
-    require(client_.write_u32(t7::kDioEfEnable(dio), 1), "enabling DIO#_EF_ENABLE");
+    std::uint32_t enabled = 0;
+    require(client_.read_u32(t7::kDioEfEnable(dio), enabled), "reading", t7::kDioEfEnable(dio));
+    if (enabled != 0) require(client_.write_u32(t7::kDioEfEnable(dio), 0), "disabling", t7::kDioEfEnable(dio));
+    require(client_.write_u32(t7::kDioEfIndex(dio), t7::kEfIndexPwmOut), "setting", t7::kDioEfIndex(dio));
+    require(client_.write_u32(t7::kDioEfClockSource(dio), 0), "setting", t7::kDioEfClockSource(dio));
+    require(client_.write_u32(t7::kDioEfConfigA(dio), clock_.config_a(duty_of(vented, role))), "setting", t7::kDioEfConfigA(dio));
+    require(client_.write_u16(t7::kFio(dio), 0), "driving low", t7::kFio(dio));
+    require(client_.write_u32(t7::kDioEfEnable(dio), 1), "enabling", t7::kDioEfEnable(dio));
   }
 }
 
 void T7Device::configure_watchdog() {
   // On timeout: reset the IO configuration to its power-up defaults (ends PWM on every line), and
   // drive the valve lines as outputs, inlets low and outlets high: vented (docs/labjack-t7.md).
+  // The watchdog's DIO inhibit leaves every other line alone and none of the valve lines.
   std::uint32_t direction = 0, state = 0;
   for (ValveRole role : kValveRoles) {
     direction |= 1u << options_.profile.dio(role);
     if (role == ValveRole::kOutletA || role == ValveRole::kOutletB) state |= 1u << options_.profile.dio(role);
   }
+  const std::uint32_t all_lines = (1u << t7::kDioCount) - 1;
   const std::pair<int, std::uint32_t> wanted[] = {
       {t7::kWatchdogAdvanced, t7::kWatchdogAdvancedIoConfigToDefault},
       {t7::kWatchdogTimeout_s, static_cast<std::uint32_t>(options_.link.watchdog_timeout_s)},
@@ -150,18 +241,22 @@ void T7Device::configure_watchdog() {
       {t7::kWatchdogDioEnable, 1},
       {t7::kWatchdogDioState, state},
       {t7::kWatchdogDioDirection, direction},
+      {t7::kWatchdogDioInhibit, all_lines & ~direction},
   };
   // The _DEFAULT registers live in flash: rewrite them only when they differ.
   std::uint32_t enabled = 0;
-  bool same = client_.read_u32(t7::kWatchdogEnable, enabled) && enabled == 1;
+  require(client_.read_u32(t7::kWatchdogEnable, enabled), "reading", t7::kWatchdogEnable);
+  bool same = enabled == 1;
   for (const auto& [address, value] : wanted) {
     std::uint32_t current = 0;
-    same = same && client_.read_u32(address, current) && current == value;
+    require(client_.read_u32(address, current), "reading", address);
+    same = same && current == value;
   }
   if (same) return;
-  require(client_.write_u32(t7::kWatchdogEnable, 0), "disabling WATCHDOG_ENABLE_DEFAULT");
-  for (const auto& [address, value] : wanted) require(client_.write_u32(address, value), "configuring the watchdog");
-  require(client_.write_u32(t7::kWatchdogEnable, 1), "enabling WATCHDOG_ENABLE_DEFAULT");
+  // The watchdog must be disabled before its other registers are written (WATCHDOG_ENABLE_DEFAULT).
+  if (enabled != 0) require(client_.write_u32(t7::kWatchdogEnable, 0), "disabling", t7::kWatchdogEnable);
+  for (const auto& [address, value] : wanted) require(client_.write_u32(address, value), "setting", address);
+  require(client_.write_u32(t7::kWatchdogEnable, 1), "enabling", t7::kWatchdogEnable);
 }
 
 // ---- engine thread ----
@@ -218,13 +313,29 @@ void T7Device::encode_duties(const ValveCommand& valves) {
 bool T7Device::exchange(const ValveCommand& valves) {
   encode_duties(valves);
   const double start = now_s();
-  const bool ok = client_.write(t7::kDioEfConfigA(first_dio_), 2 * dio_span_, duty_registers_.data()) &&
-                  client_.read(t7::kAin(0), ain_registers_, ain_buffer_.data());
+  client_.set_deadline(start + options_.link.response_timeout_s);  // the write and the read together
+  const int write_at = t7::kDioEfConfigA(first_dio_);
+  bool ok = client_.write(write_at, 2 * dio_span_, duty_registers_.data());
+  const int failed_at = ok ? t7::kAin(0) : write_at;
+  ok = ok && client_.read(t7::kAin(0), ain_registers_, ain_buffer_.data());
+  client_.clear_deadline();
   const double end = now_s();
+  late_answers_.store(client_.late_answers(), std::memory_order_relaxed);
+  reconnects_.store(client_.reconnects(), std::memory_order_relaxed);
   if (!ok) {
     bump(link_errors_);
-    fail_link();
-    client_.reconnect();  // a clean stream: the next request reads its own answer (or fails at once)
+    // A late answer stays on the connection and is dropped by its transaction id; a lost
+    // connection is opened again by the next request (the old one closed first).
+    if (client_.last_exception() != 0) {
+      const std::string why = refusal(failed_at == write_at ? "writing" : "reading", failed_at);
+      if (!refusal_pending_.load(std::memory_order_acquire)) {  // the engine took the last one
+        std::snprintf(refusal_text_.data(), refusal_text_.size(), "t7 %s: %s", address_.c_str(), why.c_str());
+        refusal_pending_.store(true, std::memory_order_release);
+      }
+      fail_link(why);
+    } else {
+      fail_link(client_.last_error());
+    }
     return false;
   }
   record_round_trip((end - start) * 1e3);
@@ -256,15 +367,15 @@ bool T7Device::exchange(const ValveCommand& valves) {
   return true;
 }
 
-void T7Device::fail_link() {
+void T7Device::fail_link(const std::string& why) {
   if (!link_up_.load(std::memory_order_relaxed)) return;  // reported at the start of the streak (only this thread writes it)
   if (!error_published_.load(std::memory_order_acquire)) {
-    link_error_ = client_.last_error();
+    link_error_ = why;
     error_published_.store(true, std::memory_order_release);
   }
   link_up_.store(false, std::memory_order_release);  // after the error: whoever sees the link down can read why
-  std::fprintf(stderr, "bellows: t7 link %s: %s: no fresh readings while it lasts (the engine faults sensor-stale and vents)\n",
-               address_.c_str(), client_.last_error().c_str());
+  std::fprintf(stderr, "bellows: t7 link %s: %s: no fresh readings while it lasts (the engine holds, then faults and vents)\n",
+               address_.c_str(), why.c_str());
 }
 
 void T7Device::record_round_trip(double ms) {
@@ -317,6 +428,23 @@ RawInputs T7Device::raw_inputs() const {
     }
   }
   return raw;
+}
+
+bool T7Device::take_refusal(std::array<char, kRefusalChars>& text) {
+  if (!refusal_pending_.load(std::memory_order_acquire)) return false;
+  text = refusal_text_;
+  refusal_pending_.store(false, std::memory_order_release);
+  return true;
+}
+
+bool T7Device::wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const {
+  const std::uint64_t before = exchanges_.load(std::memory_order_acquire);
+  const double deadline = now_s() + timeout_s;
+  while (exchanges_.load(std::memory_order_acquire) <= before) {
+    if (stop.load(std::memory_order_relaxed) || now_s() > deadline) return false;
+    sleep_s(0.002);
+  }
+  return true;
 }
 
 std::string T7Device::link_error() const {

@@ -9,13 +9,17 @@
 // - each new command makes the I/O thread do one exchange: one write of the four duty cycles and
 //   one read of every analog input, then it hands the calibrated reading to read_sensors().
 // So the engine's tick costs no system call, and there is at most one write and one read per tick.
-// A failed or timed-out exchange hands nothing over: the engine sees stale readings and, after
-// [safety] stale_ticks of them, faults (sensor-stale) and vents. There is no reconnect: once the
-// link has failed it stays down until bellows is restarted (the I/O thread reports it on stderr).
+// One exchange has one deadline, [t7] response_timeout_s for the write and the read together, so a
+// vent never waits behind a stuck exchange for longer than that. A failed or timed-out exchange
+// hands nothing over: the engine sees stale readings and, after [safety] stale_ticks of them,
+// faults and vents. A late answer is read and dropped by its transaction id on the same
+// connection (devices/modbus_client.hpp); only a lost connection is opened again, the old one
+// closed first. A Modbus exception names the register and LabJack's error (link_error()).
 // Without commands (the engine not running) the I/O thread vents after [t7] command_timeout_s and
 // keeps reading every tick, which keeps the watchdog fed and raw_inputs() live.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -25,6 +29,7 @@
 #include "devices/modbus_client.hpp"
 #include "devices/rig_profile.hpp"
 #include "devices/t7_registers.hpp"
+#include "devices/t7_timing.hpp"
 #include "engine/control/device.hpp"
 #include "engine/rt/latest_value.hpp"
 #include "engine/base/parameters.hpp"
@@ -39,12 +44,17 @@ struct T7DeviceOptions {
   double tick_s = 1.0 / 200.0;  // the idle exchange period
   bool realtime = true;         // ask for SCHED_FIFO for the I/O thread (ignored when refused)
   int priority = 70;            // just below the engine loop
+  /// While connecting and configuring: set (SIGINT, SIGTERM) ends the constructor at once with
+  /// Cancelled, nothing armed. Null: it cannot be interrupted.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 class T7Device final : public Device {
  public:
-  /// Connects and configures. Throws EnvironmentError when the address cannot be reached, does not
-  /// answer as a T7, or refuses the configuration (the message names the address and the register).
+  /// Checks that the profile's exchange fits the tick (InputError, before any traffic), then connects
+  /// and configures within [t7] connect_timeout_s in all. Throws EnvironmentError when the address
+  /// cannot be reached, does not answer as a T7 in time, or refuses the configuration (the message
+  /// names the address, the register and LabJack's error); Cancelled when options.stop was set.
   explicit T7Device(T7DeviceOptions options);
   /// Vents (one last write of the duty cycles) and closes the link.
   ~T7Device() override;
@@ -71,6 +81,23 @@ class T7Device final : public Device {
   void set_angle_zero_rad(double zero_rad) { angle_zero_rad_.store(zero_rad, std::memory_order_relaxed); }
   /// Why the link failed ("" while it works). Set once, by the I/O thread.
   std::string link_error() const;
+  /// The product that answered: T7 or T7-Pro (HARDWARE_INSTALLED's high-resolution ADC).
+  t7::Product product() const { return product_; }
+  /// Answers to timed-out requests dropped by transaction id, and connections opened again.
+  std::uint64_t late_answers() const { return late_answers_.load(std::memory_order_relaxed); }
+  std::uint64_t reconnects() const { return reconnects_.load(std::memory_order_relaxed); }
+  /// A request the T7 refused during the run (a Modbus exception): once per refusal, its sentence
+  /// naming the register and LabJack's error ("t7 HOST:PORT: writing DIO2_EF_CONFIG_A (44304)
+  /// refused: ..., LabJack error 2565 EF_VALUE_GREATER_THAN_PERIOD"), for the engine's
+  /// device-error fault (Device::take_fault on branch `links`). Engine thread; allocates nothing.
+  static constexpr std::size_t kRefusalChars = 192;
+  bool take_refusal(std::array<char, kRefusalChars>& text);
+  /// Whether the link answered at all lately (false: it is down, not only frozen), for the
+  /// engine's link-lost fault; any thread.
+  bool link_answers() const { return link_up_.load(std::memory_order_acquire); }
+  /// Waits until the I/O thread has handed over a reading made after this call, at most
+  /// `timeout_s`; false when none came (link_error() may say why) or *stop was set.
+  bool wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const;
 
  private:
   struct Outgoing {
@@ -79,18 +106,23 @@ class T7Device final : public Device {
 
   void configure();
   void configure_watchdog();
-  void require(bool ok, const char* what);
+  void require(bool ok, const char* what, int address);
+  std::string refusal(const char* what, int address);
+  void configure_inputs();
+  void configure_clock();
+  void configure_lines();
   void serve();
   bool exchange(const ValveCommand& valves);
   void encode_duties(const ValveCommand& valves);
   void record_round_trip(double ms);
-  void fail_link();
+  void fail_link(const std::string& why);
 
   T7DeviceOptions options_;
   std::atomic<double> angle_zero_rad_;
   std::string address_;
   ModbusClient client_;
   t7::PwmClock clock_;
+  t7::Product product_ = t7::Product::kT7Pro;
   int first_dio_ = 0, dio_span_ = 0;  // the CONFIG_A block written each exchange
   int ain_registers_ = 0;             // AIN0.. up to the highest input used, two registers each
 
@@ -112,9 +144,11 @@ class T7Device final : public Device {
   std::atomic<bool> link_up_{true};
   std::atomic<bool> error_published_{false};
   std::string link_error_;  // written once before error_published_
+  std::array<char, kRefusalChars> refusal_text_{};  // written by the I/O thread while !refusal_pending_
+  std::atomic<bool> refusal_pending_{false};
   std::array<std::atomic<double>, kSensorRoleCount> volts_{};
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
-  std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0};
+  std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0};
 };
 
 }  // namespace bellows

@@ -3,16 +3,22 @@
 // and big-endian; FLOAT32 and UINT32 values take two registers, high word first.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <string>
+#include <utility>
 
 namespace bellows::t7 {
 
 inline constexpr int kAinCount = 14;                  // AIN0..AIN13 on the T7's screw terminals and DB37
 inline constexpr int kAin(int n) { return 2 * n; }    // AIN# FLOAT32 volts, read only
 inline constexpr int kAinRange(int n) { return 40000 + 2 * n; }  // AIN#_RANGE FLOAT32 (+-V)
+inline constexpr int kAinResolutionIndex(int n) { return 41500 + n; }   // UINT16: 0 default, 1..8 (12 on a Pro)
+inline constexpr int kAinSettling_us(int n) { return 42000 + 2 * n; }   // FLOAT32 us: 0 auto, max 50000
+inline constexpr int kAinAllResolutionIndex = 43903;                    // UINT16, every AIN at once
 
 inline constexpr int kDioCount = 23;                  // DIO0..DIO22
 inline constexpr int kDioEfEnable(int dio) { return 44000 + 2 * dio; }       // UINT32
@@ -29,19 +35,33 @@ inline constexpr bool pwm_capable(int dio) {
   return false;
 }
 
-inline constexpr int kClock0Enable = 44900;    // UINT16
-inline constexpr int kClock0Divisor = 44901;   // UINT16: 1, 2, 4, 8, 16, 32, 64 or 256
-inline constexpr int kClock0Options = 44902;   // UINT32
-inline constexpr int kClock0RollValue = 44904; // UINT32, 0 = 2^32
+// DIO_EF_CLOCK0/1/2: clock 0 is the 32-bit clock; clocks 1 and 2 are 16-bit and share its counter
+// (so clock 0 needs them both disabled: LabJack error 2558).
+inline constexpr int kClockEnable(int clock) { return 44900 + 10 * clock; }     // UINT16
+inline constexpr int kClockDivisor(int clock) { return 44901 + 10 * clock; }    // UINT16: 1, 2, 4, 8, 16, 32, 64 or 256
+inline constexpr int kClockOptions(int clock) { return 44902 + 10 * clock; }    // UINT32
+inline constexpr int kClockRollValue(int clock) { return 44904 + 10 * clock; }  // UINT32, 0 = the maximum
+inline constexpr int kClockCount(int clock) { return 44908 + 10 * clock; }      // UINT32, read only
+inline constexpr int kClock0Enable = kClockEnable(0);
+inline constexpr int kClock0Divisor = kClockDivisor(0);
+inline constexpr int kClock0Options = kClockOptions(0);
+inline constexpr int kClock0RollValue = kClockRollValue(0);
 inline constexpr double kCoreClock_Hz = 80e6;
 inline constexpr std::array<int, 8> kClockDivisors = {1, 2, 4, 8, 16, 32, 64, 256};
 
+inline constexpr int kFio(int n) { return 2000 + n; }  // FIO#(0:7) UINT16: a write sets the line an output at that level
+inline constexpr int kFioCount = 8;
 inline constexpr int kDioState = 2800;         // UINT32 bit mask
 inline constexpr int kDioDirection = 2850;     // UINT32 bit mask, 1 = output
+inline constexpr int kDioInhibit = 2900;       // UINT32 bit mask, 1 = _STATE/_DIRECTION writes ignore the line
 
 inline constexpr int kProductId = 60000;       // FLOAT32, 7 for a T7 / T7-Pro
 inline constexpr int kFirmwareVersion = 60004; // FLOAT32
+inline constexpr int kHardwareInstalled = 60010;  // UINT32 bits: 0 high-resolution ADC (a T7-Pro), 1 WiFi, 2 RTC, 3 microSD
+inline constexpr std::uint32_t kHardwareHighResolutionAdc = 1u;
 inline constexpr int kSerialNumber = 60028;    // UINT32
+inline constexpr int kLastErrDetail = 55000;          // UINT16: the last LabJack error number the device met
+inline constexpr int kLastErrTransactionId = 55003;   // UINT16: the Modbus TCP transaction that caused it
 inline constexpr double kT7ProductId = 7.0;
 
 inline constexpr int kWatchdogEnable = 61600;        // UINT32; disable before writing the others
@@ -55,26 +75,75 @@ inline constexpr int kWatchdogResetEnable = 61620;   // UINT32: 1 restarts the d
 inline constexpr int kWatchdogDioEnable = 61630;     // UINT32: 1 sets DIO on timeout
 inline constexpr int kWatchdogDioState = 61632;      // UINT32 mask: high/low after timeout
 inline constexpr int kWatchdogDioDirection = 61634;  // UINT32 mask: output/input after timeout
-inline constexpr int kWatchdogDioInhibit = 61636;
+inline constexpr int kWatchdogDioInhibit = 61636;    // UINT32 mask: 1 = the watchdog leaves that line alone
 inline constexpr std::uint32_t kWatchdogAdvancedIoConfigToDefault = 2;
 
 /// Modbus exception a T7 answers for an address it does not have (or a write to a read-only one):
 /// 2, ILLEGAL DATA ADDRESS (LJM error 1202, LJME_MBE2_ILLEGAL_DATA_ADDRESS).
 inline constexpr int kExceptionIllegalDataAddress = 2;
+/// ...for a value a register cannot take (LJM 1203, LJME_MBE3_ILLEGAL_DATA_VALUE).
+inline constexpr int kExceptionIllegalDataValue = 3;
+/// ...for a write the device refuses with one of its own errors (2554, 2558, 2563, 2565, 2566...):
+/// 4, SLAVE DEVICE FAILURE (LJM 1204 "The device encountered an error"), the error itself in
+/// LAST_ERR_DETAIL. Not stated in the pages we could read: see docs/labjack-t7.md.
+inline constexpr int kExceptionDeviceFailure = 4;
+
+/// LabJack's name of a register bellows or t7-sim uses ("DIO2_EF_CONFIG_A"; "register N" otherwise),
+/// for messages.
+inline std::string register_name(int a) {
+  const auto indexed = [](const char* prefix, int n, const char* suffix) { return prefix + std::to_string(n) + suffix; };
+  if (a >= kAin(0) && a < kAin(kAinCount)) return indexed("AIN", a / 2, "");
+  if (a >= kFio(0) && a < kFio(kFioCount)) return indexed("FIO", a - kFio(0), "");
+  if (a >= kAinRange(0) && a < kAinRange(kAinCount)) return indexed("AIN", (a - kAinRange(0)) / 2, "_RANGE");
+  if (a >= kAinResolutionIndex(0) && a < kAinResolutionIndex(kAinCount)) return indexed("AIN", a - kAinResolutionIndex(0), "_RESOLUTION_INDEX");
+  if (a >= kAinSettling_us(0) && a < kAinSettling_us(kAinCount)) return indexed("AIN", (a - kAinSettling_us(0)) / 2, "_SETTLING_US");
+  const std::pair<int, const char*> ef[] = {{kDioEfEnable(0), "_EF_ENABLE"}, {kDioEfIndex(0), "_EF_INDEX"},
+                                            {kDioEfClockSource(0), "_EF_CLOCK_SOURCE"}, {kDioEfConfigA(0), "_EF_CONFIG_A"}};
+  for (const auto& [first, suffix] : ef) {
+    if (a >= first && a < first + 2 * kDioCount) return indexed("DIO", (a - first) / 2, suffix);
+  }
+  if (a >= kClockEnable(0) && a < kClockEnable(3)) {
+    const int clock = (a - kClockEnable(0)) / 10;
+    const char* what[] = {"_ENABLE", "_DIVISOR", "_OPTIONS", "_OPTIONS", "_ROLL_VALUE", "_ROLL_VALUE", "", "", "_COUNT", "_COUNT"};
+    return indexed("DIO_EF_CLOCK", clock, what[(a - kClockEnable(0)) % 10]);
+  }
+  const std::pair<int, const char*> named[] = {
+      {kAinAllResolutionIndex, "AIN_ALL_RESOLUTION_INDEX"}, {kDioState, "DIO_STATE"}, {kDioDirection, "DIO_DIRECTION"},
+      {kDioInhibit, "DIO_INHIBIT"}, {kProductId, "PRODUCT_ID"}, {kFirmwareVersion, "FIRMWARE_VERSION"},
+      {kHardwareInstalled, "HARDWARE_INSTALLED"}, {kSerialNumber, "SERIAL_NUMBER"}, {kLastErrDetail, "LAST_ERR_DETAIL"},
+      {kLastErrTransactionId, "LAST_ERR_TRANSACTION_ID"}, {kWatchdogEnable, "WATCHDOG_ENABLE_DEFAULT"},
+      {kWatchdogAdvanced, "WATCHDOG_ADVANCED_DEFAULT"}, {kWatchdogTimeout_s, "WATCHDOG_TIMEOUT_S_DEFAULT"},
+      {kWatchdogStartupDelay_s, "WATCHDOG_STARTUP_DELAY_S_DEFAULT"}, {kWatchdogStrictEnable, "WATCHDOG_STRICT_ENABLE_DEFAULT"},
+      {kWatchdogStrictKey, "WATCHDOG_STRICT_KEY_DEFAULT"}, {kWatchdogStrictClear, "WATCHDOG_STRICT_CLEAR"},
+      {kWatchdogResetEnable, "WATCHDOG_RESET_ENABLE_DEFAULT"}, {kWatchdogDioEnable, "WATCHDOG_DIO_ENABLE_DEFAULT"},
+      {kWatchdogDioState, "WATCHDOG_DIO_STATE_DEFAULT"}, {kWatchdogDioDirection, "WATCHDOG_DIO_DIRECTION_DEFAULT"},
+      {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"}};
+  for (const auto& [address, name] : named) {
+    if (a == address || a == address + 1) return name;
+  }
+  return "register " + std::to_string(a);
+}
 
 /// The PWM clock for a frequency: the smallest divisor whose roll value fits 32 bits.
 struct PwmClock {
   std::uint32_t divisor = 1;
   std::uint32_t roll = 0;
   double frequency_hz() const { return kCoreClock_Hz / (divisor * static_cast<double>(roll)); }
-  /// CONFIG_A for a duty cycle in [0, 1] (1: the line never goes low).
+  /// The largest CONFIG_A a T7 accepts: one below the roll value (LabJack error 2565,
+  /// EF_VALUE_GREATER_THAN_PERIOD: "the value must be less than the selected ClockSource's roll value").
+  std::uint32_t max_config_a() const { return roll == 0 ? 4294967295u : roll - 1; }
+  /// CONFIG_A for a duty cycle in [0, 1]. 1 (fully open) is roll - 1: the line is low for one count
+  /// of the clock per period (12.5 ns at divisor 1), which no valve can follow.
   std::uint32_t config_a(double duty) const {
     const double d = std::isfinite(duty) ? std::fmin(std::fmax(duty, 0.0), 1.0) : 0.0;
-    return static_cast<std::uint32_t>(std::lround(d * roll));
+    const double r = roll == 0 ? 4294967296.0 : static_cast<double>(roll);
+    return std::min(static_cast<std::uint32_t>(std::llround(d * r)), max_config_a());
   }
+  /// The duty cycle a line outputs at CONFIG_A; roll - 1 and above is fully open (as config_a()).
   double duty(std::uint32_t config_a) const {
     const double r = roll == 0 ? 4294967296.0 : static_cast<double>(roll);
-    return std::fmin(static_cast<double>(config_a), r) / r;
+    if (config_a >= max_config_a()) return 1.0;
+    return static_cast<double>(config_a) / r;
   }
 };
 

@@ -9,15 +9,29 @@ namespace {
 constexpr std::uint8_t kUnknown = 0, kReadOnly = 1, kReadWrite = 2;
 }
 
-T7SimRegisters::T7SimRegisters() : registers_(kSize, 0), access_(kSize, kUnknown) {
+T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0), access_(kSize, kUnknown) {
   using namespace t7;
   allow(kAin(0), 2 * kAinCount, false);
   allow(kAinRange(0), 2 * kAinCount, true);
+  allow(kAinResolutionIndex(0), kAinCount, true);
+  allow(kAinSettling_us(0), 2 * kAinCount, true);
+  allow(kAinAllResolutionIndex, 1, true);
+  allow(kAinAllResolutionIndex + 1, 2, true);  // AIN_ALL_SETTLING_US
   for (int first : {kDioEfEnable(0), kDioEfIndex(0), kDioEfClockSource(0), kDioEfConfigA(0)}) allow(first, 2 * kDioCount, true);
-  allow(kClock0Enable, 6, true);    // ENABLE, DIVISOR, OPTIONS, ROLL_VALUE
-  allow(44908, 2, false);           // DIO_EF_CLOCK0_COUNT
+  for (int clock = 0; clock < 3; ++clock) {
+    allow(kClockEnable(clock), 6, true);  // ENABLE, DIVISOR, OPTIONS, ROLL_VALUE
+    allow(kClockCount(clock), 2, false);
+    registers_[static_cast<std::size_t>(kClockDivisor(clock))] = 1;
+  }
+  allow(kFio(0), kFioCount, true);
   allow(kDioState, 2, true);
   allow(kDioDirection, 2, true);
+  allow(kDioInhibit, 2, true);
+  allow(kHardwareInstalled, 2, false);
+  allow(kLastErrDetail, 1, false);
+  allow(55002, 1, false);  // LAST_ERR_FRAME
+  allow(kLastErrTransactionId, 1, false);
+  set_u32(kHardwareInstalled, high_resolution_adc ? kHardwareHighResolutionAdc : 0u);
   allow(kProductId, 2, false);
   allow(kFirmwareVersion, 2, false);
   allow(kSerialNumber, 2, false);
@@ -29,7 +43,20 @@ T7SimRegisters::T7SimRegisters() : registers_(kSize, 0), access_(kSize, kUnknown
   put_float(kT7ProductId, &registers_[kProductId]);
   put_float(1.0299, &registers_[kFirmwareVersion]);
   set_u32(kSerialNumber, 470000000u);
-  registers_[kClock0Divisor] = 1;
+}
+
+void T7SimRegisters::wrote(int address, int count) {
+  using namespace t7;
+  for (int a = address; a < address + count; ++a) {
+    if (a >= kFio(0) && a < kFio(kFioCount)) {
+      const std::uint32_t bit = 1u << (a - kFio(0));
+      set_u32(kDioDirection, u32(kDioDirection) | bit);
+      set_u32(kDioState, registers_[static_cast<std::size_t>(a)] != 0 ? (u32(kDioState) | bit) : (u32(kDioState) & ~bit));
+    }
+    if (a == kAinAllResolutionIndex) {
+      for (int n = 0; n < kAinCount; ++n) registers_[static_cast<std::size_t>(kAinResolutionIndex(n))] = registers_[static_cast<std::size_t>(a)];
+    }
+  }
 }
 
 void T7SimRegisters::allow(int first, int count, bool writable) {
@@ -78,12 +105,13 @@ bool T7SimRegisters::run_watchdog(double now_s) {
   if (now_s - last_answer_s_ < timeout) return false;
   last_answer_s_ = now_s;  // it acts again after another timeout of silence
   if (u32(kWatchdogAdvanced) == kWatchdogAdvancedIoConfigToDefault || u32(kWatchdogResetEnable) == 1) {
-    for (int dio = 0; dio < kDioCount; ++dio) set_u32(kDioEfEnable(dio), 0);  // power-up: no EF, all inputs
+    for (int dio = 0; dio < kDioCount; ++dio) set_u32(kDioEfEnable(dio), 0);  // power-up: no EF, no clock, all inputs
+    for (int clock = 0; clock < 3; ++clock) registers_[static_cast<std::size_t>(kClockEnable(clock))] = 0;
     set_u32(kDioDirection, 0);
     set_u32(kDioState, 0);
   }
   if (u32(kWatchdogDioEnable) == 1) {
-    const std::uint32_t direction = u32(kWatchdogDioDirection);
+    const std::uint32_t direction = u32(kWatchdogDioDirection) & ~u32(kWatchdogDioInhibit);  // inhibited lines are left alone
     for (int dio = 0; dio < kDioCount; ++dio) {
       if ((direction & (1u << dio)) != 0) set_u32(kDioEfEnable(dio), 0);  // a line the watchdog sets is a plain output
     }

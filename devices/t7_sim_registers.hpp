@@ -2,6 +2,7 @@
 // lines output, and the T7's watchdog, as docs/labjack-t7.md describes the real one.
 // - Known addresses only: any other one, or a write to a read-only one, is answered with Modbus
 //   exception 2 (ILLEGAL DATA ADDRESS), as a T7 does; a function other than 3, 4, 6, 16 with 1.
+//   What a T7 refuses beyond addresses: devices/t7_sim_rules.hpp.
 // - A line's output: PWM (EF enabled, index 0, clock 0 enabled) at CONFIG_A / roll; else an output
 //   at its DIO_STATE bit; else an input, which the valve driver's pull-down reads as closed.
 // - The watchdog counts from the last answered request; on timeout it resets the IO configuration
@@ -17,14 +18,19 @@ namespace bellows {
 
 class T7SimRegisters {
  public:
-  T7SimRegisters();
+  /// `high_resolution_adc`: a T7-Pro (HARDWARE_INSTALLED bit 0).
+  explicit T7SimRegisters(bool high_resolution_adc = true);
 
   /// The whole 16-bit register space; the server's Modbus mapping points into it.
   std::uint16_t* data() { return registers_.data(); }
   static constexpr int kSize = 65536;
 
-  /// The Modbus exception for a request (function, first address, register count), or 0 to serve it.
+  /// The Modbus exception for a request's addresses (function, first address, register count), or
+  /// 0 (devices/t7_sim_rules.hpp checks the values).
   int check(int function, int address, int count) const;
+  /// What a served write does beside storing its values: a FIO# write makes the line an output at
+  /// that level; AIN_ALL_RESOLUTION_INDEX sets every input's.
+  void wrote(int address, int count);
 
   /// The duty cycle line `dio` outputs now, in [0, 1].
   double line_duty(int dio) const;
@@ -40,6 +46,7 @@ class T7SimRegisters {
   std::uint32_t watchdog_timeout_s() const;
   double last_answer_s() const { return last_answer_s_; }
 
+  std::uint16_t u16(int address) const { return registers_[static_cast<std::size_t>(address)]; }
   std::uint32_t u32(int address) const;
   void set_u32(int address, std::uint32_t value);
 

@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <sys/select.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,7 +17,9 @@
 
 #include <modbus/modbus.h>
 
+#include "devices/t7_errors.hpp"
 #include "devices/t7_registers.hpp"
+#include "devices/t7_sim_rules.hpp"
 #include "engine/base/errors.hpp"
 
 namespace bellows {
@@ -28,6 +31,8 @@ constexpr double kMaxWait_s = 0.001;
 constexpr double kStatusPeriod_s = 0.01;
 // How far the arm may fall behind before it is advanced (its step is much finer than this).
 constexpr double kArmStep_s = 0.0005;
+// Simultaneous Modbus TCP connections a T7 serves (T-Series datasheet 6.0 "Ethernet").
+constexpr int kMaxConnections = 2;
 
 bool inlets_closed_outlets_open(const std::array<double, kValveRoleCount>& duty) {
   return duty[0] == 0.0 && duty[1] == 0.0 && duty[2] == 1.0 && duty[3] == 1.0;
@@ -36,7 +41,10 @@ bool inlets_closed_outlets_open(const std::array<double, kValveRoleCount>& duty)
 }  // namespace
 
 T7SimServer::T7SimServer(T7SimOptions options)
-    : options_(std::move(options)), arm_(options_.plant, options_.seed), query_(MODBUS_TCP_MAX_ADU_LENGTH) {
+    : options_(std::move(options)),
+      registers_(options_.product == t7::Product::kT7Pro),
+      arm_(options_.plant, options_.seed),
+      query_(MODBUS_TCP_MAX_ADU_LENGTH) {
   validate_rig_profile(options_.profile);
   if (options_.no_supply) arm_.set_supply_bar(options_.plant.gas.ambient_bar);
   arm_.vent();
@@ -70,11 +78,15 @@ double T7SimServer::now_s() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - start_s_;
 }
 
+// In steps of kArmStep_s with the rig's limits after each, however late the server comes to it (an
+// answer paced at a T7's speed, a loaded machine): a pressure switch acts continuously.
 void T7SimServer::advance_arm(double now) {
-  if (now - arm_time_s_ < kArmStep_s) return;
-  arm_.advance(now - arm_time_s_);
-  arm_time_s_ = now;
-  apply_limits(false);
+  while (now - arm_time_s_ >= kArmStep_s) {
+    const double step = std::min(now - arm_time_s_, 2.0 * kArmStep_s) >= 2.0 * kArmStep_s ? kArmStep_s : now - arm_time_s_;
+    arm_.advance(step);
+    arm_time_s_ += step;
+    apply_limits(false);
+  }
 }
 
 // The rig's own limits on what reaches the valves (the lines keep what the client wrote): checked
@@ -129,6 +141,48 @@ void T7SimServer::apply_lines(double now) {
   apply_limits(true);  // a new PWM period starts, as at the in-process arm's ticks
 }
 
+double T7SimServer::answer_time_s(int function, int address, int count) const {
+  double t = t7::kEthernetOverhead_s;
+  if (function != MODBUS_FC_READ_HOLDING_REGISTERS && function != MODBUS_FC_READ_INPUT_REGISTERS) return t;
+  for (int ain = 0; ain < t7::kAinCount; ++ain) {
+    if (address < t7::kAin(ain) + 2 && t7::kAin(ain) < address + count) {
+      std::uint16_t settling[2] = {registers_.u16(t7::kAinSettling_us(ain)), registers_.u16(t7::kAinSettling_us(ain) + 1)};
+      t += t7::sample_time_s(registers_.u16(t7::kAinResolutionIndex(ain)), t7::get_float(settling), options_.product);
+    }
+  }
+  return t;
+}
+
+// The trickle drill: the answer leaves one byte at a time (the link holds, barely). Functions 3
+// and 16, the ones bellows uses; the server does nothing else meanwhile, as a stuck T7 would not.
+void T7SimServer::trickle_reply(int fd, int function, int address, int count) {
+  std::uint8_t reply[MODBUS_TCP_MAX_ADU_LENGTH];
+  std::size_t size = 0;
+  for (int i = 0; i < 2; ++i) reply[size++] = query_[static_cast<std::size_t>(i)];  // transaction id
+  reply[size++] = 0;
+  reply[size++] = 0;
+  const std::size_t length_at = size;
+  size += 2;
+  reply[size++] = query_[6];  // unit
+  reply[size++] = static_cast<std::uint8_t>(function);
+  if (function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
+    for (int v : {address >> 8, address & 0xff, count >> 8, count & 0xff}) reply[size++] = static_cast<std::uint8_t>(v);
+  } else {
+    reply[size++] = static_cast<std::uint8_t>(2 * count);
+    for (int i = 0; i < count; ++i) {
+      const std::uint16_t r = registers_.u16(address + i);
+      reply[size++] = static_cast<std::uint8_t>(r >> 8);
+      reply[size++] = static_cast<std::uint8_t>(r & 0xff);
+    }
+  }
+  reply[length_at] = static_cast<std::uint8_t>((size - 6) >> 8);
+  reply[length_at + 1] = static_cast<std::uint8_t>((size - 6) & 0xff);
+  for (std::size_t i = 0; i < size; ++i) {
+    if (::send(fd, reply + i, 1, MSG_NOSIGNAL) != 1) return;
+    std::this_thread::sleep_for(std::chrono::duration<double>(options_.trickle_byte_s));
+  }
+}
+
 void T7SimServer::serve_client(int fd, double now, const std::function<void(const std::string&)>& events) {
   modbus_set_socket(context_, fd);
   const int length = modbus_receive(context_, query_.data());
@@ -153,14 +207,40 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
     std::this_thread::sleep_for(std::chrono::duration<double>(options_.stall_s));  // the requests meanwhile queue up
   }
   const int header = modbus_get_header_length(context_);
-  const int function = query_[static_cast<std::size_t>(header)];
-  const int address = (query_[static_cast<std::size_t>(header + 1)] << 8) | query_[static_cast<std::size_t>(header + 2)];
-  int count = (query_[static_cast<std::size_t>(header + 3)] << 8) | query_[static_cast<std::size_t>(header + 4)];
-  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) count = 1;
-  const int exception = registers_.check(function, address, count);
-  if (exception != 0) {
-    modbus_reply_exception(context_, query_.data(), static_cast<unsigned int>(exception));
+  const auto byte = [&](int i) { return static_cast<int>(query_[static_cast<std::size_t>(header + i)]); };
+  const int function = byte(0);
+  const int address = (byte(1) << 8) | byte(2);
+  int count = (byte(3) << 8) | byte(4);
+  const bool writes = function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS;
+  std::uint16_t values[MODBUS_MAX_WRITE_REGISTERS];
+  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
+    count = 1;
+    values[0] = static_cast<std::uint16_t>((byte(3) << 8) | byte(4));
+  } else if (function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
+    count = std::min(count, MODBUS_MAX_WRITE_REGISTERS);
+    for (int i = 0; i < count; ++i) values[i] = static_cast<std::uint16_t>((byte(6 + 2 * i) << 8) | byte(7 + 2 * i));
+  }
+  if (options_.silent_reads && !writes && address < t7::kAin(t7::kAinCount)) return;  // lost on the way (drill)
+  // As long as a T7 takes: the link, and each input the request reads at its resolution index.
+  const double answer_s = answer_time_s(function, address, count) + options_.answer_after_s;
+  if (answer_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(answer_s));
+  now = now_s();
+  const T7Refusal refusal = check_t7_request(registers_, options_.product, function, address, count, writes ? values : nullptr);
+  if (refusal.exception != 0) {
+    modbus_reply_exception(context_, query_.data(), static_cast<unsigned int>(refusal.exception));
     ++status_.exceptions;
+    // As a T7 keeps it: the error and the transaction that caused it.
+    registers_.data()[t7::kLastErrDetail] = static_cast<std::uint16_t>(refusal.error);
+    registers_.data()[t7::kLastErrTransactionId] = static_cast<std::uint16_t>((query_[0] << 8) | query_[1]);
+    if (refusal.error != t7::kErrorIllegalDataAddress && refusal.error != 1201) {
+      ++status_.refusals;
+      status_.last_refused_error = refusal.error;
+    }
+    char line[400];
+    std::snprintf(line, sizeof line, "t7-sim: refused %s %s (%d): LabJack error %d %s, Modbus exception %d (%s)",
+                  writes ? "writing" : "reading", t7::register_name(refusal.address).c_str(), refusal.address, refusal.error,
+                  t7::error_name(refusal.error), refusal.exception, refusal.why.c_str());
+    events(line);
   } else {
     const bool reads_inputs = (function == MODBUS_FC_READ_HOLDING_REGISTERS || function == MODBUS_FC_READ_INPUT_REGISTERS) &&
                               address < t7::kAin(t7::kAinCount);
@@ -168,12 +248,22 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
       advance_arm(now);
       update_inputs();
     }
-    modbus_mapping_t mapping{};
-    mapping.nb_registers = mapping.nb_input_registers = T7SimRegisters::kSize;
-    mapping.tab_registers = mapping.tab_input_registers = registers_.data();
-    modbus_reply(context_, query_.data(), length, &mapping);
-    const bool writes = function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS;
+    const bool trickles = options_.trickle_after_s >= 0.0 && now - first_request_s_ >= options_.trickle_after_s;
+    if (trickles && !status_.trickling) {
+      status_.trickling = true;
+      events("t7-sim: answers trickle from now on, one byte every " + std::to_string(options_.trickle_byte_s) + " s (drill)");
+    }
+    if (trickles) {
+      if (writes) for (int i = 0; i < count; ++i) registers_.data()[address + i] = values[i];
+      trickle_reply(fd, function, address, count);
+    } else {
+      modbus_mapping_t mapping{};
+      mapping.nb_registers = mapping.nb_input_registers = T7SimRegisters::kSize;
+      mapping.tab_registers = mapping.tab_input_registers = registers_.data();
+      modbus_reply(context_, query_.data(), length, &mapping);
+    }
     if (writes) {
+      registers_.wrote(address, count);
       advance_arm(now);
       apply_lines(now);
     }
@@ -198,17 +288,32 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
     const int ready = select(highest + 1, &readable, nullptr, nullptr, &wait);
     const double now = now_s();
     if (ready > 0) {
-      if (FD_ISSET(listen_fd_, &readable)) {
-        const int fd = accept(listen_fd_, nullptr, nullptr);
-        if (fd >= 0) {
-          clients_.push_back(fd);
-          events("t7-sim: a client connected (" + std::to_string(clients_.size()) + " connected)");
-        }
-      }
+      // Clients first: one that left is gone before a new one is counted (never two at once).
       const std::vector<int> polled = clients_;
       for (int fd : polled) {
         if (FD_ISSET(fd, &readable)) serve_client(fd, now, events);
       }
+      if (FD_ISSET(listen_fd_, &readable)) {
+        const int fd = accept(listen_fd_, nullptr, nullptr);
+        if (fd >= 0 && static_cast<int>(clients_.size()) >= kMaxConnections) {
+          close(fd);  // a T7 serves two Modbus TCP connections at once (T-Series datasheet 6.0)
+          ++status_.refused_connections;
+          events("t7-sim: refused a connection: " + std::to_string(kMaxConnections) + " are open, a T7's limit");
+        } else if (fd >= 0) {
+          if (!options_.nagle) {
+            const int one = 1;
+            setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+          }
+          clients_.push_back(fd);
+          status_.max_clients = std::max(status_.max_clients, static_cast<int>(clients_.size()));
+          events("t7-sim: a client connected (" + std::to_string(clients_.size()) + " connected)");
+        }
+      }
+    }
+    if (options_.halve_roll_after_s >= 0.0 && !roll_halved_ && first_request_s_ >= 0.0 && now - first_request_s_ >= options_.halve_roll_after_s) {
+      roll_halved_ = true;
+      registers_.set_u32(t7::kClock0RollValue, registers_.u32(t7::kClock0RollValue) / 2);
+      events("t7-sim: clock 0's roll value halved, as another program might (drill)");
     }
     advance_arm(now);
     if (registers_.run_watchdog(now)) {
@@ -242,16 +347,18 @@ void T7SimServer::write_status(double now, bool force) {
   }
   if (options_.status_path.empty()) return;
   const T7SimStatus& s = status_;
-  char text[1100];
+  char text[1400];
   std::snprintf(text, sizeof text,
                 "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
                 "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
-                "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, "
+                "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, \"refusals\": %llu, \"last_refused_error\": %d, "
+                "\"max_clients\": %d, \"refused_connections\": %d, "
                 "\"clients\": %d, \"silent\": %s, \"stalls\": %d, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], \"angle_rad\": %.6f, "
                 "\"limits\": {\"pressure_ceiling_bar\": %.6f, \"angle_limit_rad\": %.6f, \"pressure_trips\": %d, \"angle_trips\": %d}}\n",
                 s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
                 s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
-                static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions), s.clients,
+                static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions),
+                static_cast<unsigned long long>(s.refusals), s.last_refused_error, s.max_clients, s.refused_connections, s.clients,
                 s.silent ? "true" : "false", s.stalls, 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1],
                 s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
                 s.angle_limit_trips);

@@ -7,6 +7,11 @@
 // the pressure ceiling is vented, and an arm beyond the angle range vents everything until the
 // client writes its duties again.
 //
+// As strict as a T7 (devices/t7_sim_rules.hpp): what LabJack documents a T7 refuses, it refuses with
+// the same exception and error, logged on stdout. It answers no faster than a T7 over Ethernet:
+// the link's overhead plus each input's sample time at its resolution index (t7_timing.hpp), and
+// like a T7 it serves two Modbus TCP connections at once and closes a third.
+//
 // Its valve state can be read by tests and scripts from a status file (JSON, rewritten atomically
 // at most every 10 ms and at every watchdog action; docs/labjack-t7.md has its fields), and each
 // watchdog action is also a line on stdout.
@@ -25,6 +30,7 @@
 #include "devices/rig_profile.hpp"
 #include "devices/simulated_arm.hpp"
 #include "devices/t7_sim_registers.hpp"
+#include "devices/t7_timing.hpp"
 
 typedef struct _modbus modbus_t;
 
@@ -43,6 +49,14 @@ struct T7SimOptions {
   double stall_after_s = -1.0;         // >= 0: this long after the first request, one answer comes late...
   double stall_s = 0.05;               // ...by this long (the server stalls, as a busy network or T7 would)
   std::string status_path;             // "": no status file
+  t7::Product product = t7::Product::kT7Pro;  // paces the answers, bounds the resolution index
+  bool nagle = false;                  // drill: keep Nagle's algorithm on the answers (a T7 does not)
+  double answer_after_s = 0.0;         // drill: every answer this much later (a slow device)
+  double trickle_after_s = -1.0;       // drill: this long after the first request, answers trickle...
+  double trickle_byte_s = 0.4;         // ...one byte every this long (the link holds, barely)
+  bool silent_reads = false;           // drill: reads of the analog inputs go unanswered (no reading ever)
+  double halve_roll_after_s = -1.0;    // drill: this long after the first request, clock 0's roll value halves
+                                       // (another program reconfigured it): wide duty cycles are refused, 2565
   RigLimits limits;                    // the rig's own limits, enforced whatever the client writes
 };
 
@@ -59,9 +73,14 @@ struct T7SimStatus {
   double last_watchdog_action_s = -1.0;
   std::uint64_t requests = 0;                   // answered
   std::uint64_t exceptions = 0;                 // answered with a Modbus exception
+  std::uint64_t refusals = 0;                   // of which for a LabJack rule (t7_sim_rules.hpp), not an address
+  int last_refused_error = 0;                   // LabJack's error number of the latest refusal (0: none)
+  int max_clients = 0;                          // the most connections at once
+  int refused_connections = 0;                  // connections beyond the T7's limit, closed at once
   int clients = 0;                              // connected now
   bool silent = false;
   int stalls = 0;                               // answers held back by the stall drill
+  bool trickling = false;                       // the trickle drill has begun
   std::array<double, kActuatorCount> chamber_bar{};  // the arm's true chamber pressures, A and B
   double angle_rad = 0.0;                       // the arm's true angle
   int pressure_limit_trips = 0;                 // times a chamber reached the ceiling and was vented
@@ -90,6 +109,9 @@ class T7SimServer {
   void apply_limits(bool write);
   void serve_client(int fd, double now, const std::function<void(const std::string&)>& events);
   void write_status(double now, bool force);
+  /// The time a T7 takes to answer this request: the link's overhead, plus each input it reads.
+  double answer_time_s(int function, int address, int count) const;
+  void trickle_reply(int fd, int function, int address, int count);
 
   T7SimOptions options_;
   modbus_t* context_ = nullptr;
@@ -101,6 +123,7 @@ class T7SimServer {
   double start_s_ = 0.0;
   double arm_time_s_ = 0.0;   // wall time the arm has been advanced to (since start)
   double first_request_s_ = -1.0;
+  bool roll_halved_ = false;
   double last_status_write_s_ = -1.0;
   T7SimStatus status_;                // the server thread's; published copies under the mutex
   mutable std::mutex published_mutex_;

@@ -49,6 +49,21 @@ e2e_wait_for 'At the cursor'
 e2e_keys PageDown PageDown PageDown Right Right Right Up Up m Down
 e2e_wait_for 'overlay: it 3'
 capture inspector
+# The study (issue 23): e jumps to the largest |error| of the trial, e again to the next peak; the
+# error beside the correction and the comparison with iteration 3, at 80x24 and at 120x40.
+e2e_keys e
+e2e_wait_for '\|e\| peak +1 of'
+e2e_resize 80 24
+e2e_wait_for 'Error e'
+e2e_wait_for '\|e\| peak +1 of'
+capture inspector-worst-80x24
+e2e_resize 120 40
+e2e_keys e
+e2e_wait_for '\|e\| peak +2 of'
+e2e_wait_for 'RMS de'
+capture inspector-worst-120x40
+e2e_resize "$width" "$height"
+e2e_wait_for 'At the cursor'
 e2e_keys Escape t
 e2e_wait_for 'Trajectories'
 e2e_keys Down Down Down Down Down Enter  # past paper, steps, sine, paper2, paper3

@@ -9,7 +9,7 @@ packages=(
   liblcm-dev liblcm-bin libglib2.0-dev libmatio-dev libmodbus-dev libsodium-dev
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   tmux rt-tests iproute2 util-linux ccache ninja-build
-  gnuplot-nox python3-scipy python3-pandas octave help2man
+  gnuplot-nox fonts-dejavu-core python3-scipy python3-pandas octave help2man
 )
 
 missing=()

@@ -17,11 +17,12 @@ namespace bellows {
 namespace {
 
 constexpr int kLastState = static_cast<int>(EngineState::kFault);
-constexpr int kLastFault = static_cast<int>(FaultCode::kHeartbeatLost);
+constexpr int kLastFault = static_cast<int>(kLastFaultCode);
 // Legacy files store these codes (docs/session-format.md): they must keep their meaning.
 static_assert(static_cast<int>(EngineState::kSafe) == 0 && kLastState == 3);
 static_assert(static_cast<int>(FaultCode::kNone) == 0 && static_cast<int>(FaultCode::kSupplyLow) == 4 &&
-              static_cast<int>(FaultCode::kSensorStale) == 7 && kLastFault == 9);
+              static_cast<int>(FaultCode::kSensorStale) == 7 &&
+              static_cast<int>(FaultCode::kHeartbeatLost) == 9 && kLastFault == 16);
 
 std::string state_name(int code) { return to_string(static_cast<EngineState>(code)); }
 std::string fault_name_of(int code) { return fault_name(static_cast<FaultCode>(code)); }

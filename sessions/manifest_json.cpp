@@ -1,10 +1,12 @@
 #include "sessions/manifest_json.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <set>
 
 #include "engine/model/arm_model.hpp"
 #include "engine/config/configuration_cost.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "engine/base/errors.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/session_layout.hpp"
@@ -57,6 +59,37 @@ void put_digest(Json& object, const char* key, const std::string& digest) {
   if (!digest.empty()) object[key] = digest;
 }
 
+/// `"learned_with": {"law": ..., <its weight keys>: ...}`: what learned the iteration's correction.
+Json learned_with_to_json(const LearnedWith& learned) {
+  Json out = {{"law", learned.law}};
+  for (const auto& [key, value] : learned.weights) out[key] = value;
+  return out;
+}
+
+LearnedWith learned_with_from_json(const JsonReader& r) {
+  r.expect_object();
+  LearnedWith out;
+  out.law = r["law"].text();
+  const std::vector<std::string> laws = learning_law_names();
+  if (std::find(laws.begin(), laws.end(), out.law) == laws.end()) r["law"].fail("unknown learning law '" + out.law + "'");
+  const std::vector<std::string> keys = learning_law_weight_keys(out.law);
+  for (const auto& item : r.json().items()) {
+    if (item.key() != "law" && std::find(keys.begin(), keys.end(), item.key()) == keys.end()) {
+      r[item.key()].fail("law " + out.law + " has no weight '" + item.key() + "'");
+    }
+  }
+  for (const std::string& key : keys) {
+    const double value = r[key].number();
+    try {
+      check_parameter_value(*find_parameter("ilc", key), value);
+    } catch (const InputError& error) {
+      r[key].fail(error.what());
+    }
+    out.weights.emplace_back(key, value);
+  }
+  return out;
+}
+
 Json summary_to_json(const IterationEntry& entry) {
   const IterationSummary& s = entry.summary;
   Json out = {{"iteration", s.iteration},
@@ -69,6 +102,7 @@ Json summary_to_json(const IterationEntry& entry) {
               {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
   put_digest(out, "samples_sha256", entry.samples_sha256);
   put_digest(out, "telemetry_sha256", entry.telemetry_sha256);
+  if (s.learned_with.known()) out["learned_with"] = learned_with_to_json(s.learned_with);  // absent: not learned or not recorded
   return out;
 }
 
@@ -117,6 +151,7 @@ IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
   }
   entry.samples_sha256 = digest_from_json(r, "samples_sha256");
   entry.telemetry_sha256 = digest_from_json(r, "telemetry_sha256");
+  if (r.has("learned_with")) s.learned_with = learned_with_from_json(r["learned_with"]);
   return entry;
 }
 

@@ -21,6 +21,8 @@
 #include "sessions/record_columns.hpp"
 #include "sessions/session_directory.hpp"
 #include "sessions/session_layout.hpp"
+#include "sessions/session_lock.hpp"
+#include "sessions/atomic_file.hpp"
 #include "sessions/uncommitted_files.hpp"
 
 namespace bellows {
@@ -74,6 +76,9 @@ std::optional<DirectoryHandle> session_folder(const DirectoryHandle& root, const
     throw InputError(describe_session(root.path()) + ": " + error.what());
   }
 }
+
+/// load_session's work: every iteration when `only` is null, else only those it lists and no black box.
+Session load_session_part(const DirectoryHandle& directory, const std::vector<int>* only);
 
 /// RMS error over every joint and learning sample (deg).
 double overall_rms_deg(const TrialRecord& record) {
@@ -131,6 +136,37 @@ void validate_session_name(const std::string& name) {
   }
 }
 
+std::string session_name_refusal(const std::string& name, const fs::path& parent) {
+  try {
+    validate_session_name(name);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  std::error_code error;
+  if (fs::symlink_status(parent / name, error).type() != fs::file_type::not_found) {
+    return "a session named '" + printable(name) + "' exists already";
+  }
+  return {};
+}
+
+fs::path rename_session(const fs::path& directory, const std::string& new_name) {
+  const fs::path parent = directory.parent_path();
+  if (const std::string why = session_name_refusal(new_name, parent); !why.empty()) throw InputError(why);
+  SessionManifest manifest = load_manifest(directory);
+  const fs::path target = parent / new_name;
+  const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
+  std::error_code error;
+  fs::rename(directory, target, error);
+  if (error) throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " + error.message());
+  manifest.name = new_name;  // the manifest names its session too
+  manifest.updated_utc = utc_now();
+  // Through the session's own descriptor, by the one safe writer: a link planted at any name in
+  // it is replaced or refused, never written through.
+  write_file_atomic_at(DirectoryHandle::open(target), session_layout::kManifest, format_manifest(manifest));
+  sync_directory(parent.empty() ? fs::path(".") : parent);
+  return target;
+}
+
 fs::path resolve_session_dir(const std::string& path_or_name, const fs::path& data_dir) {
   std::error_code error;
   if (path_or_name.empty()) throw InputError("no session given");
@@ -155,7 +191,15 @@ SessionManifest load_manifest(const DirectoryHandle& directory) {
 
 Session load_session(const fs::path& directory) { return load_session(open_session_directory(directory)); }
 
-Session load_session(const DirectoryHandle& directory) {
+Session load_session(const DirectoryHandle& directory) { return load_session_part(directory, nullptr); }
+
+Session load_session_iterations(const fs::path& directory, const std::vector<int>& only) {
+  return load_session_part(open_session_directory(directory), &only);
+}
+
+namespace {
+
+Session load_session_part(const DirectoryHandle& directory, const std::vector<int>* only) {
   Session session;
   session.directory = directory.path();
   session.manifest = load_manifest(directory);
@@ -177,6 +221,7 @@ Session load_session(const DirectoryHandle& directory) {
   session.iterations.resize(m.iterations.size());
   for (std::size_t i = 0; i < m.iterations.size(); ++i) {
     const int index = static_cast<int>(i);
+    if (only != nullptr && std::find(only->begin(), only->end(), index) == only->end()) continue;
     IterationData& data = session.iterations[i];
     const IterationEntry& entry = m.iterations[i];
     const std::string samples_file = session_layout::samples_file(index, entry.samples_revision);
@@ -198,7 +243,7 @@ Session load_session(const DirectoryHandle& directory) {
                        " deg differs from the manifest's " + std::to_string(listed) + " deg");
     }
   }
-  for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
+  for (std::size_t i = 0; only == nullptr && i < m.black_boxes.size(); ++i) {
     const BlackBoxEntry& entry = m.black_boxes[i];
     const std::string file = session_layout::black_box_file(static_cast<int>(i));
     const std::size_t limit = csv_size_limit(header_views(black_box_header(m.joints)), static_cast<std::size_t>(entry.ticks));
@@ -208,6 +253,8 @@ Session load_session(const DirectoryHandle& directory) {
   session.dropped = describe_dropped(find_uncommitted_files(directory, m));
   return session;
 }
+
+}  // namespace
 
 std::string dropped_line(const Session& session) {
   if (session.dropped.empty()) return "";

@@ -24,6 +24,14 @@ std::filesystem::path given_data_dir(const std::string& option_value);
 std::string default_session_name(std::time_t start, const std::string& trajectory_name);
 /// Throws InputError unless `name` is a plain directory name (no '/', not hidden, printable).
 void validate_session_name(const std::string& name);
+/// Why a session in `parent` cannot take `name` (validate_session_name's rule, or an entry of that
+/// name exists already), or "" when it can: for a prompt that checks a name before it closes.
+std::string session_name_refusal(const std::string& name, const std::filesystem::path& parent);
+/// Renames the session in `directory` to `new_name` beside it, under the session's lock: the
+/// directory and its manifest's name (which `sessions show` and `sessions list` print). Returns the
+/// new directory. Throws InputError (a bad or taken name, the session locked or unreadable). The
+/// one rename of `bellows sessions rename` and the console's `s`.
+std::filesystem::path rename_session(const std::filesystem::path& directory, const std::string& new_name);
 
 /// A session given as a directory path, or as the name of one inside `data_dir`.
 std::filesystem::path resolve_session_dir(const std::string& path_or_name, const std::filesystem::path& data_dir);
@@ -40,6 +48,11 @@ SessionManifest load_manifest(const DirectoryHandle& directory);
 /// a special file or a file larger than its format allows is refused. Throws InputError.
 Session load_session(const std::filesystem::path& directory);
 Session load_session(const DirectoryHandle& directory);
+/// Like load_session, but reads (and checks) only the files of the iterations `only` lists (by
+/// index; an index the manifest does not list is ignored) and no black box: every other iteration
+/// keeps an empty record (learning_samples 0). What needs a few iterations of a long session
+/// (figures) reads those alone.
+Session load_session_iterations(const std::filesystem::path& directory, const std::vector<int>& only);
 
 /// The one line that says what an interrupted save dropped (Session::dropped), "" when nothing:
 /// "session S: a save was interrupted; dropped what it had not committed: iteration 5; this is its

@@ -82,7 +82,7 @@ struct ConsoleFixture {
   /// arm2 device and configuration).
   explicit ConsoleFixture(const Configuration& c = Configuration{}, int stop_after_rises = 3,
                           ui::SessionGateway* gateway = nullptr, Device* device = nullptr,
-                          std::function<std::string(const ui::SessionSnapshot&)> write_figures = {},
+                          std::function<std::string(const std::string&, int)> write_figures = {},
                           const std::string& start_trajectory = "paper")
       : config(c),
         arm(c.plant, 1),

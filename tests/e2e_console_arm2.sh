@@ -63,7 +63,7 @@ e2e_wait_for 'Bellows +SAFE '
 e2e_keys Escape
 e2e_wait_for 'it +all +j1 +j2'
 for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
-e2e_keys q
+e2e_quit
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has 'bellows console: .* iterations 0\.\.3, best RMS .*valves vented'
@@ -82,6 +82,7 @@ e2e_keys c
 e2e_wait_for 'At the cursor'
 e2e_keys j
 e2e_wait_for "Iteration 3 of 0\.\.3  joint 2/2 elbow .*\(joint 2 $elbow\)"
-e2e_keys Escape q
+e2e_keys Escape
+e2e_quit
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after reopening"
 echo "ok: $(echo "$rms" | tr '\n' ';')"

@@ -23,7 +23,7 @@ echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_f
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video for the keys and states"
 
 # A terminal without colours (vt100), without --no-color: attributes alone, and it still works.
-e2e_keys q  # saved as it went: quitting asks nothing
+e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 e2e_start 100 30 TERM=vt100 -- console --speed max
 e2e_wait_for 'law [a-z-]+  M'
@@ -38,7 +38,7 @@ echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_f
 echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' || e2e_fail "no reverse video on a vt100"
 
 # The same screen in a UTF-8 locale with colours: braille and colour escapes.
-e2e_keys q  # saved as it went: quitting asks nothing
+e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 e2e_start 100 30 -- console --speed max
 e2e_wait_for 'law [a-z-]+  M'
@@ -50,6 +50,6 @@ e2e_keys r
 e2e_wait_for 'Iteration 0: angle and set point' 120
 e2e_screen | LC_ALL=C grep -q $'\xe2[\xa0-\xa3]' || e2e_fail "no braille in a UTF-8 locale"  # U+2800..U+28FF
 e2e_tmux capture-pane -p -e -t console | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' || e2e_fail "no colours"
-e2e_keys q  # saved as it went: quitting asks nothing
+e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 echo ok

@@ -107,7 +107,7 @@ for device in "${DEVICES[@]}"; do
   e2e_keys Escape
 
   # Quit: the session was saved as it went; the valves are vented before the exit.
-  e2e_keys q
+  e2e_quit
   [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "$device: exit status after quit"
   e2e_output_has 'valves vented'
   session="$(e2e_history | grep -oE 'session: /[^ ]+ \(saved as it went\)' | head -1 | cut -d' ' -f2)"
@@ -126,7 +126,7 @@ for device in "${DEVICES[@]}"; do
   e2e_start 120 40 -- console --session "$session" $([ "$device" = sim ] && echo --speed 2)
   e2e_wait_for 'it(eration)? 0  RMS'  # its one iteration, 0
   e2e_wait_for "(device )?$device: ok"
-  e2e_keys q
+  e2e_quit
   [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "$device: exit status after the reopened session"
   stop_rig
   echo "ok: $device"

@@ -36,6 +36,7 @@ e2e_wait_for 'FAULT'
 e2e_keys Escape
 e2e_wait_for 'set point  none: vented'
 e2e_wait_for 'error      no trial'
-e2e_keys R q
+e2e_keys R
+e2e_quit
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 echo "PASS"

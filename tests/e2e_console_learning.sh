@@ -75,7 +75,7 @@ e2e_wait_for 'iteration 6  RMS'
 # Saved as it went: quit does not ask; the closing report names the session, with every iteration.
 for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
 history="$(e2e_rms_list)"
-e2e_keys q
+e2e_quit
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has 'bellows console: .* iterations 0\.\.6, best RMS .*valves vented'
@@ -105,6 +105,6 @@ for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; do
 # writer's SIGPIPE would fail the test.
 shown="$("$BELLOWS" sessions show "$session")"
 grep -qE '^iterations +0\.\.7,' <<<"$shown" || e2e_fail "the session did not grow to iterations 0..7: $shown"
-e2e_keys q
+e2e_quit
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status after the relaunch"
 echo "ok: $(echo "$rms" | tr '\n' ' ')"

@@ -111,3 +111,15 @@ e2e_expect_falling() {
   echo "$1" | awk 'NR > 1 && $2 >= previous { bad = 1 } { previous = $2 } END { exit bad }' ||
     e2e_fail "RMS not falling: $(echo "$1" | tr '\n' ' ')"
 }
+
+# e2e_quit: `q`, and `y` when the console asks (it does while the valves are live, or when work
+# would be lost: docs/console.md, "Quit").
+e2e_quit() {
+  e2e_keys q
+  local deadline=$((SECONDS + 10))
+  while [ $SECONDS -lt $deadline ]; do
+    if e2e_history | grep -qE '^EXIT STATUS [0-9]+'; then return 0; fi
+    if e2e_screen | grep -q 'Quit?'; then e2e_keys y; return 0; fi
+    sleep 0.1
+  done
+}

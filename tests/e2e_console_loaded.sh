@@ -31,7 +31,7 @@ e2e_screen | grep -q 'FAULT' && e2e_fail "a fault on the simulated arm under loa
 missed="$(e2e_screen | grep -oE 'missed [0-9]+' | head -1 | grep -oE '[0-9]+')"
 [ "${missed:-0}" -gt 0 ] || e2e_fail "no missed deadline counted after a 0.3 s stall"
 stop_loads
-e2e_keys q
+e2e_quit
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has '[0-9]+ deadlines missed, counted as warnings'

@@ -7,6 +7,7 @@
 #include "engine/model/pneumatic_arm_chain_parameters.hpp"
 #include "tests/allocation_counter.hpp"
 #include "tests/engine_fixture.hpp"
+#include "tests/gappy_device.hpp"
 
 namespace bellows {
 namespace {
@@ -43,6 +44,42 @@ TEST(EngineAllocations, TicksAllocateNothing) {
   }
   EXPECT_TRUE(record.complete);
   EXPECT_GT(tap.read_available(), 1000u);
+  EXPECT_EQ(allocations, 0);
+}
+
+TEST(EngineAllocations, RidingThroughMissingReadingsAndADevicesFaultAllocateNothing) {
+  const Configuration config;
+  SimulatedArm arm(config.plant, 1);
+  testing::GappyDevice device(arm);
+  EngineCore core(device, config.controller, config.timing, config.safety);
+  SimulatedClock clock(core, device);
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  Eigen::VectorXd correction = Eigen::VectorXd::Constant(paper.learning_samples(), 0.01);
+  TrialRecord record;
+  record.prepare(paper.learning_samples(), config.timing.ticks_per_sample);
+  EXPECT_TRUE(core.send(EngineCommand::select_trajectory(paper)));
+  EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+  clock.step(10);
+  device.lose_repeatedly(200, config.safety.stale_ticks - 1, 3, 100);  // held ticks in the trial
+  DeviceFault trip;
+  trip.set(FaultCode::kRigLimit, 0, "the rig stopped joint 1 at %.1f deg", -100.0);
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 10, 1);
+  long allocations = 0;
+  {
+    CountAllocations counter;
+    EXPECT_TRUE(core.send(start));
+    clock.step(10 + 4 * 400 + 10);
+    device.report(trip);  // the device's own fault, latched with its words
+    clock.step(5);
+    device.lose_readings(device.reads(), 100);  // and a loss beyond the stale limit, named by the device
+    EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kReset)));
+    EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+    clock.step(20);
+    allocations = counter.allocations();
+  }
+  EXPECT_TRUE(record.complete);
+  EXPECT_GT(record.held_samples, 0);
+  EXPECT_EQ(core.fault(), FaultCode::kSensorStale);
   EXPECT_EQ(allocations, 0);
 }
 

@@ -44,7 +44,10 @@ struct Forger {
   std::int64_t seq = 0;
   void act(RigBench& b) {
     const io_state_t s = b.last_state();
-    if (s.session_id == 0) b.send(command(session, ++seq, 0.0, false, s.rig_id, s.binding));  // bind
+    // Bind while the rig serves no one: its offer, or its tripped state (NO_SESSION, naming the session it dropped).
+    if (s.session_id == 0 || (s.fault_bits & io_state_t::FAULT_NO_SESSION) != 0) {
+      b.send(command(session, ++seq, 0.0, false, s.rig_id, s.binding));
+    }
     io_command_t c = command(session, ++seq, 1.0, true, s.rig_id, s.binding);
     c.outlet_duty[0] = 0.0;
     c.inlet_duty[1] = 0.0;

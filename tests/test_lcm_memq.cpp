@@ -326,15 +326,16 @@ void expect_stale_fault_after(int stale_ticks) {
     tick(false);
     ++ticks_without_state;
   }
-  EXPECT_EQ(core.fault(), FaultCode::kSensorStale);
+  // The rig said nothing at all: the link is lost, and the fault says so (not a sensor's fault).
+  EXPECT_EQ(core.fault(), FaultCode::kLinkLost);
   EXPECT_EQ(ticks_without_state, stale_ticks);
   EXPECT_FALSE(b.last_command().armed) << "the fault's vent went out on the bus";
   tick(false);
   EXPECT_FALSE(b.last_command().armed) << "and keeps going out every tick";
 }
 
-TEST(LcmDevice, NoStateForStaleTicksIsAStaleSensorFaultThatVents) {
-  expect_stale_fault_after(3);  // the default
+TEST(LcmDevice, NoStateForStaleTicksIsALostLinkFaultThatVents) {
+  expect_stale_fault_after(SafetyParameters{}.stale_ticks);  // the default
   expect_stale_fault_after(6);  // [safety] stale_ticks
 }
 

@@ -220,14 +220,18 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   EXPECT_EQ(*status, 3) << run.err();
   bus.stop();
   const nlohmann::json report = parse_report(run);
-  EXPECT_EQ(report["fault"]["name"], "sensor-stale");
+  // The rig stopped answering: the link is lost, named with the rig and its silence (never sensor-stale).
+  EXPECT_EQ(report["fault"]["name"], "link-lost");
+  const std::string message = report["fault"]["message"].get<std::string>();
+  EXPECT_NE(message.find("the LCM rig"), std::string::npos) << message;
+  EXPECT_NE(message.find("has been silent for"), std::string::npos) << message;
   // The session holds the LCM log (--lcm-log without a FILE).
   ASSERT_TRUE(report["session"].is_string()) << report.dump();
   const std::string log = (std::filesystem::path(report["session"].get<std::string>()) / "telemetry.lcmlog").string();
   EXPECT_EQ(report["lcm"]["telemetry"]["log"], log);
 
   // In the telemetry log: the first FAULT tick came stale_ticks ticks after the last fresh reading,
-  // during the trial, and its valve command is the vented one.
+  // during the trial (the ticks between held every valve closed), and its valve command is the vented one.
   const int stale_ticks = SafetyParameters{}.stale_ticks;
   lcm::LogFile file(log, "r");
   ASSERT_TRUE(file.good());
@@ -242,11 +246,14 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   while (fault < ticks.size() && ticks[fault].state != telemetry_t::STATE_FAULT) ++fault;
   ASSERT_LT(fault, ticks.size()) << "no FAULT in the telemetry log";
   ASSERT_GT(fault, static_cast<std::size_t>(stale_ticks));
-  EXPECT_EQ(ticks[fault].fault, static_cast<std::int8_t>(FaultCode::kSensorStale));
+  EXPECT_EQ(ticks[fault].fault, static_cast<std::int8_t>(FaultCode::kLinkLost));
   std::size_t fresh = fault;
   while (fresh > 0 && ticks[fresh].reading_time_s <= ticks[fresh - 1].reading_time_s) --fresh;
   EXPECT_EQ(fault - fresh, static_cast<std::size_t>(stale_ticks));
   EXPECT_EQ(ticks[fresh].state, static_cast<std::int8_t>(telemetry_t::STATE_RUNNING));
+  for (std::size_t i = fresh + 1; i < fault; ++i) {  // held: nothing inflates, nothing drains
+    EXPECT_EQ(ticks[i].inlet_duty[0] + ticks[i].inlet_duty[1] + ticks[i].outlet_duty[0] + ticks[i].outlet_duty[1], 0.0) << i;
+  }
   EXPECT_EQ(ticks[fault].inlet_duty[0], 0.0);
   EXPECT_EQ(ticks[fault].inlet_duty[1], 0.0);
   EXPECT_EQ(ticks[fault].outlet_duty[0], 1.0);

@@ -14,6 +14,8 @@
 #include "devices/modbus_client.hpp"
 #include "devices/t7_device.hpp"
 #include "devices/t7_sim_server.hpp"
+#include "devices/t7_errors.hpp"
+#include "engine/base/cancellation.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/control/safety.hpp"
 
@@ -64,7 +66,7 @@ bool eventually(const std::function<bool()>& done) {
 TEST(T7Loopback, ConnectingConfiguresTheWatchdogAndLeavesTheValvesVented) {
   SimThread sim;
   T7Device device(device_options(sim.port()));
-  ASSERT_TRUE(eventually([&] { return sim.status().requests > 30 && sim.status().watchdog_enabled; }));
+  ASSERT_TRUE(eventually([&] { const T7SimStatus s = sim.status(); return s.requests > 30 && s.watchdog_enabled && s.last_request_s > 0.0 && device.health().exchanges > 3 && s.requests > 60; }));
   const T7SimStatus s = sim.status();
   EXPECT_EQ(s.watchdog_timeout_s, 1u);
   EXPECT_TRUE(s.safe);
@@ -296,7 +298,7 @@ TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
   ASSERT_EQ(client.connect(2.0), "");
   client.set_response_timeout(1.0);
   const int actions_before = sim.status().watchdog_actions;
-  ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(2), 400000));  // inlet_a fully open
+  ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(2), 399999));  // inlet_a fully open (roll - 1: the most a T7 takes)
   ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(4), 0));       // outlet_a shut
   ASSERT_TRUE(eventually([&] { return !sim.status().safe; }));  // the status is published every 10 ms
   ASSERT_TRUE(eventually([&] { return sim.status().watchdog_actions > actions_before; }));
@@ -343,6 +345,9 @@ TEST(T7Loopback, ALateAnswerIsDroppedAndTheLinkAnswersAgain) {
   ASSERT_TRUE(eventually([&] { return device.health().exchanges > after_stall.exchanges + 50; }));
   EXPECT_EQ(device.health().link_errors, after_stall.link_errors) << "every request reads its own answer again";
   EXPECT_GT(device.read_sensors().time_s, time_s) << "fresh readings";
+  EXPECT_GT(device.late_answers(), 0u) << "the late answers were read and dropped by transaction id";
+  EXPECT_EQ(device.reconnects(), 0u) << "on the same connection";
+  EXPECT_LE(sim.status().max_clients, 1);
 }
 
 TEST(T7Loopback, AnAddressWhereNothingListensIsAnEnvironmentError) {
@@ -360,6 +365,200 @@ TEST(T7Loopback, AnAddressWhereNothingListensIsAnEnvironmentError) {
     EXPECT_NE(std::string(error.what()).find("t7 127.0.0.1:" + std::to_string(port) + ": cannot connect"), std::string::npos)
         << error.what();
   }
+}
+
+// ---- t7-sim as strict as a T7 (devices/t7_sim_rules.hpp), and bellows breaking none of its rules ----
+
+/// A raw client of the simulated T7: each call expects the T7's answer, refusals included.
+struct RawT7 {
+  explicit RawT7(int port) : client("127.0.0.1", port) {
+    EXPECT_EQ(client.connect(2.0), "");
+    client.set_response_timeout(2.0);
+  }
+  /// The LabJack error a refused request left in LAST_ERR_DETAIL, with the Modbus exception (0: served).
+  std::pair<int, int> refusal_of(bool served) {
+    if (served) return {0, 0};
+    const int exception = client.last_exception();
+    std::uint16_t detail = 0;
+    EXPECT_TRUE(client.read_u16(t7::kLastErrDetail, detail)) << client.last_error();
+    return {exception, detail};
+  }
+  std::pair<int, int> u16(int address, std::uint16_t value) { return refusal_of(client.write_u16(address, value)); }
+  std::pair<int, int> u32(int address, std::uint32_t value) { return refusal_of(client.write_u32(address, value)); }
+  ModbusClient client;
+};
+
+TEST(T7SimStrict, RefusesWhatLabJackDocumentsAT7Refuses) {
+  SimThread sim;
+  RawT7 t7(sim.port());
+  using P = std::pair<int, int>;
+  const int failure = t7::kExceptionDeviceFailure;
+  EXPECT_EQ(t7.u16(t7::kClockEnable(1), 0), P(failure, 2554)) << "disabling a clock that is not running";
+  EXPECT_EQ(t7.u16(t7::kClock0Divisor, 3), P(failure, 2559)) << "a divisor a T7 has not";
+  EXPECT_EQ(t7.u16(t7::kClockEnable(1), 1), P(0, 0));
+  EXPECT_EQ(t7.u16(t7::kClock0Enable, 1), P(failure, 2558)) << "clock 0 while clock 1 runs";
+  EXPECT_EQ(t7.u16(t7::kClockEnable(1), 0), P(0, 0));
+  EXPECT_EQ(t7.u32(t7::kClock0RollValue, 400000), P(0, 0));
+  EXPECT_EQ(t7.u16(t7::kClock0Enable, 1), P(0, 0));
+  EXPECT_EQ(t7.u32(t7::kDioEfConfigA(2), 400000), P(failure, 2565)) << "CONFIG_A = roll (100 % the naive way)";
+  EXPECT_EQ(t7.u32(t7::kDioEfConfigA(2), 399999), P(0, 0)) << "roll - 1, the most it takes";
+  EXPECT_EQ(t7.u32(t7::kDioEfEnable(2), 1), P(failure, 2563)) << "PWM on a line that is an input";
+  EXPECT_EQ(t7.u16(t7::kFio(2), 1), P(0, 0));
+  EXPECT_EQ(t7.u32(t7::kDioEfEnable(2), 1), P(failure, 2563)) << "PWM on a line driven high";
+  EXPECT_EQ(t7.u16(t7::kFio(2), 0), P(0, 0));
+  EXPECT_EQ(t7.u32(t7::kDioEfEnable(2), 1), P(0, 0)) << "an output driven low";
+  EXPECT_EQ(t7.u32(t7::kDioEfIndex(2), 1), P(failure, 2566)) << "a new index while enabled";
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 13), P(t7::kExceptionIllegalDataValue, 1203));
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 12), P(0, 0)) << "a T7-Pro samples at 12";
+  EXPECT_EQ(t7.refusal_of(t7.client.write_float(t7::kAin(0), 1.0)), P(t7::kExceptionIllegalDataAddress, 1202)) << "read only";
+  std::uint16_t r[2];
+  EXPECT_EQ(t7.refusal_of(t7.client.read(12345, 2, r)), P(t7::kExceptionIllegalDataAddress, 1202)) << "no such address";
+  ASSERT_TRUE(eventually([&] { return sim.status().exceptions == 10u; })) << sim.status().exceptions;
+  EXPECT_EQ(sim.status().refusals, 8u);  // the rules' (not the addresses')
+  EXPECT_EQ(sim.status().last_refused_error, 1203);
+}
+
+TEST(T7SimStrict, APlainT7RefusesTheProsResolutionIndices) {
+  T7SimOptions options;
+  options.product = t7::Product::kT7;
+  SimThread sim(options);
+  RawT7 t7(sim.port());
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(3), 9), std::make_pair(t7::kExceptionIllegalDataValue, 1203));
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(3), 8), std::make_pair(0, 0));
+  std::uint32_t hardware = 1;
+  ASSERT_TRUE(t7.client.read_u32(t7::kHardwareInstalled, hardware));
+  EXPECT_EQ(hardware & t7::kHardwareHighResolutionAdc, 0u);
+}
+
+// The other side of each refusal: a whole session of bellows (connect, configure, exchanges, the
+// last vent) sends none of them, on a strict T7-Pro and on a T7, over one connection.
+TEST(T7SimStrict, BellowsSendsNothingAT7WouldRefuseAndHoldsOneConnection) {
+  for (t7::Product product : {t7::Product::kT7Pro, t7::Product::kT7}) {
+    T7SimOptions options;
+    options.product = product;
+    SimThread sim(options);
+    {
+      T7Device device(device_options(sim.port()));
+      EXPECT_EQ(device.product(), product);
+      ValveCommand open = ValveCommand::vented();
+      open.joint[0].inlet_duty = {1.0, 0.3};  // fully open inlets are roll - 1 too
+      open.joint[0].outlet_duty = {0.0, 1.0};
+      device.write_valves(open);
+      ASSERT_TRUE(eventually([&] { return device.health().exchanges > 40; }));
+      device.vent();
+    }
+    ASSERT_TRUE(eventually([&] { return sim.status().clients == 0; }));
+    {
+      T7Device again(device_options(sim.port()));  // what the first left running (clock 0, PWM) is reconfigured as documented
+      ASSERT_TRUE(eventually([&] { return again.health().exchanges > 5; }));
+    }
+    ASSERT_TRUE(eventually([&] { return sim.status().clients == 0; }));
+    const T7SimStatus s = sim.status();
+    EXPECT_EQ(s.exceptions, 0u) << "LabJack error " << s.last_refused_error << " (" << t7::error_name(s.last_refused_error) << ")";
+    EXPECT_EQ(s.refusals, 0u);
+    EXPECT_EQ(s.max_clients, 1) << "never two connections at once";
+    EXPECT_TRUE(s.safe);
+  }
+}
+
+TEST(T7SimStrict, AThirdConnectionIsClosedAtOnce) {
+  SimThread sim;
+  RawT7 first(sim.port()), second(sim.port());
+  double product = 0.0;
+  EXPECT_TRUE(first.client.read_float(t7::kProductId, product));
+  EXPECT_TRUE(second.client.read_float(t7::kProductId, product));
+  ModbusClient third("127.0.0.1", sim.port());
+  ASSERT_EQ(third.connect(2.0), "");  // TCP accepts it; the T7 closes it
+  third.set_response_timeout(2.0);
+  EXPECT_FALSE(third.read_float(t7::kProductId, product));
+  ASSERT_TRUE(eventually([&] { return sim.status().refused_connections == 1; }));
+  EXPECT_EQ(sim.status().max_clients, 2);
+}
+
+// A read costs the link's overhead and each input's sample time at its index (LabJack's A-1 and
+// A-3-2-2): index 0 on a T7-Pro is its default 9, 3.5 ms per input. Lower bounds only (the sim
+// sleeps at least so long; a loaded machine only adds).
+TEST(T7SimStrict, ReadsTakeAsLongAsLabJackSays) {
+  SimThread sim;
+  RawT7 t7(sim.port());
+  std::uint16_t r[10];
+  const auto timed_read = [&] {
+    const double start = monotonic_seconds();
+    EXPECT_TRUE(t7.client.read(t7::kAin(0), 10, r)) << t7.client.last_error();
+    return monotonic_seconds() - start;
+  };
+  EXPECT_GE(timed_read(), 0.001 + 5 * 0.0035) << "five inputs at the Pro's default index 9";
+  for (int ain = 0; ain < 5; ++ain) ASSERT_EQ(t7.u16(t7::kAinResolutionIndex(ain), 12), std::make_pair(0, 0));
+  EXPECT_GE(timed_read(), 0.001 + 5 * 0.159) << "at index 12";
+}
+
+TEST(T7Timing, TheTableAndTheProductDefaults) {
+  using t7::Product;
+  EXPECT_DOUBLE_EQ(t7::sample_time_s(0, 0.0, Product::kT7), 0.0011);     // index 8
+  EXPECT_DOUBLE_EQ(t7::sample_time_s(0, 0.0, Product::kT7Pro), 0.0035);  // index 9
+  EXPECT_DOUBLE_EQ(t7::sample_time_s(4, 100.0, Product::kT7Pro), 0.0002);
+  const RigProfile paper = paper_rig_profile();
+  const t7::ExchangeTime t = t7::exchange_time(paper, Product::kT7Pro);
+  EXPECT_EQ(t.inputs, 5);
+  EXPECT_NEAR(t.exchange_s, 0.0025, 1e-9) << "1 ms write + 1 ms + 5 x 0.1 ms read: half the 5 ms tick";
+  EXPECT_NO_THROW(t7::require_exchange_fits(paper, Product::kT7Pro, 0.005, 0.004));
+}
+
+// resolution_index = 12 on five inputs: 5 x 159 ms. Refused before any traffic (nothing listens
+// at the port: the refusal is not a connection error), naming the key and the read time.
+TEST(T7Timing, AProfileWhoseReadCannotFitTheTickIsRefusedBeforeConnecting) {
+  T7DeviceOptions options = device_options(1);  // port 1: nothing listens
+  for (SensorRole role : kSensorRoles) options.profile.input(role).resolution_index = 12;
+  try {
+    T7Device device(options);
+    FAIL() << "connected";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("[inputs.chamber_a] resolution_index = 12"), std::string::npos) << what;
+    EXPECT_NE(what.find("one read of 5 inputs takes 796.0 ms"), std::string::npos) << what;
+    EXPECT_NE(what.find("5.0 ms tick"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line";
+  }
+  for (SensorRole role : kSensorRoles) options.profile.input(role).resolution_index = 0;  // the Pro's default, 9
+  EXPECT_THROW(T7Device{options}, InputError);
+}
+
+// ---- a bounded, interruptible connect ----
+
+TEST(T7Connect, ASlowDeviceEndsTheConnectWithinItsTimeoutNamingTheAddress) {
+  T7SimOptions options;
+  options.answer_after_s = 1.5;  // each request answered after 1.5 s: ~40 of them would take a minute
+  SimThread sim(options);
+  T7DeviceOptions o = device_options(sim.port());
+  o.link.connect_timeout_s = 2.0;
+  const double start = monotonic_seconds();
+  try {
+    T7Device device(o);
+    FAIL() << "configured a T7 that needs a minute for it";
+  } catch (const EnvironmentError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("t7 127.0.0.1:" + std::to_string(sim.port()) + ": no answer within [t7] connect_timeout_s = 2 s"),
+              std::string::npos) << what;
+  }
+  EXPECT_LT(monotonic_seconds() - start, 2.0 + 1.0);
+}
+
+TEST(T7Connect, AStopSignalEndsTheConnectAtOnce) {
+  T7SimOptions options;
+  options.answer_after_s = 1.5;
+  SimThread sim(options);
+  T7DeviceOptions o = device_options(sim.port());
+  o.link.connect_timeout_s = 60.0;
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  std::thread signal([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    stop.store(true);
+  });
+  const double start = monotonic_seconds();
+  EXPECT_THROW(T7Device{o}, Cancelled);
+  EXPECT_LT(monotonic_seconds() - start, 0.5 + 1.0);
+  signal.join();
 }
 
 }  // namespace

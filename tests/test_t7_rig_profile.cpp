@@ -258,10 +258,11 @@ TEST(T7Pwm, TheClockFor200HzAndItsDutyCycles) {
   EXPECT_EQ(clock.roll, 400000u);  // 80 MHz / 200 Hz
   EXPECT_DOUBLE_EQ(clock.frequency_hz(), 200.0);
   EXPECT_EQ(clock.config_a(0.25), 100000u);
-  EXPECT_EQ(clock.config_a(1.0), 400000u);
+  EXPECT_EQ(clock.config_a(1.0), 399999u);  // fully open: roll - 1, the most a T7 accepts (LabJack error 2565)
   EXPECT_EQ(clock.config_a(-0.5), 0u);
   EXPECT_EQ(clock.config_a(NAN), 0u);
   EXPECT_DOUBLE_EQ(clock.duty(100000u), 0.25);
+  EXPECT_DOUBLE_EQ(clock.duty(399999u), 1.0);  // low for one count of 400000: open
   EXPECT_DOUBLE_EQ(clock.duty(500000u), 1.0);  // beyond the roll value: always high
   // Slow enough to need a divisor: 80e6 / 0.01 Hz does not fit 32 bits at divisor 1.
   const t7::PwmClock slow = t7::pwm_clock_for(0.01);

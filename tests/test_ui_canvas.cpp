@@ -29,6 +29,23 @@ TEST(UiCanvas, WritesClipsAndReadsBackAsText) {
   EXPECT_EQ(c.text(), "  hello wo\ncdef\n\n");
 }
 
+// Issue 23: text is measured by its display width (wcwidth), so a wide glyph takes two cells.
+TEST(UiCanvas, WideGlyphsTakeTwoCells) {
+  const std::string message = "S: '\uff10.\uff15' is not a number";  // fullwidth 0 and 5
+  EXPECT_EQ(text_width("\uff10.\uff15"), 5);
+  EXPECT_EQ(text_width(message), 26);
+  Canvas c(30, 2);
+  EXPECT_EQ(c.put(0, 0, message, Role::kNormal, false, 20), 20);
+  EXPECT_EQ(c.line(0), "S: '\uff10.\uff15' is not a");  // cut at 20 cells, not at 20 code points
+  EXPECT_EQ(fit("\uff10.\uff15", 4), "\uff10. ");   // the wide 5 does not fit half
+  EXPECT_EQ(text_width(fit(message, 11)), 11);
+  for (const std::string& line : wrap(message, 12)) EXPECT_LE(text_width(line), 12) << line;
+  EXPECT_EQ(tail_fit("ab\uff10", 3), "b\uff10");
+  c.put(0, 1, "\uff10x");
+  c.put(1, 1, "y");  // over the right half of the wide 0: its left half goes too
+  EXPECT_EQ(c.line(1), " yx");
+}
+
 TEST(UiCanvas, ControlsFromFilesOrTheBusNeverReachTheTerminal) {
   Canvas canvas(24, 1);
   canvas.put(0, 0, "a\x1b[2J\nb\xc2\x9b\xe2\x80\xae" "c", Role::kNormal);

@@ -343,8 +343,9 @@ TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   f.type(bad.string());
   f.key(key::kEnter);
-  EXPECT_NE(f.state().chooser.preview_error.find("bad.csv"), std::string::npos) << f.state().chooser.preview_error;
-  f.key(key::kEnter);
+  // Refused: the prompt stays open with the path and why (issue 23).
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
+  EXPECT_NE(f.state().dialog.error.find("bad.csv"), std::string::npos) << f.state().dialog.error;
   for (std::size_t i = 0; i < bad.string().size(); ++i) f.key(key::kBackspace);
   f.type(good.string());
   f.key(key::kEnter);
@@ -434,12 +435,14 @@ TEST(UiController, ATrialWaitsForTheSaveAndAFailedSaveStopsTrials) {
   EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);
 }
 
-TEST(UiController, QuitFinishesTheSaveAndDisarmsWithoutAsking) {
+TEST(UiController, QuitAsksWhileArmedThenFinishesTheSaveAndDisarms) {
   ConsoleFixture f;
   f.arm_valves();
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   f.key('q');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);  // the valves are live: it asks
+  f.key('y');
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   ASSERT_TRUE(f.pump_until([&] { return f.console->quit_requested(); }));
   EXPECT_EQ(f.sessions.saved.begin()->second.experiment.trials.size(), 1u);

@@ -3,6 +3,8 @@
 // included), wraps instead of cutting, and scrolls through all of it at 80x24.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <regex>
 
 #include "tests/ui_sample_state.hpp"
@@ -114,6 +116,24 @@ TEST(UiHelp, AtEightyByTwentyFourItScrollsAndSaysWhereItIs) {
   const std::vector<std::string> last = render_lines(s);
   EXPECT_NE(last[2].find(std::to_string(total - 17) + "-" + std::to_string(total) + " of"), std::string::npos) << last[2];
   EXPECT_NE(last[20].find("close the help"), std::string::npos) << last[20];
+}
+
+}  // namespace
+}  // namespace bellows::ui
+
+namespace bellows::ui {
+namespace {
+
+// One rule of when `q` asks, written once: the help shows kQuitRule and docs/console.md quotes it.
+TEST(UiHelp, TheQuitRuleIsWrittenOnceForTheHelpAndTheDocs) {
+  bool in_help = false;
+  for (const HelpEntry& e : help_entries(testing::sample_state(1, true))) in_help |= e.keys == "q" && e.what == kQuitRule;
+  EXPECT_TRUE(in_help);
+  std::ifstream docs(std::string(BELLOWS_SOURCE_DIR) + "/docs/console.md");
+  ASSERT_TRUE(docs) << "docs/console.md";
+  const std::string text((std::istreambuf_iterator<char>(docs)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(std::string("`q` ") + kQuitRule), std::string::npos) << "docs/console.md does not quote kQuitRule";
+  EXPECT_EQ(text.find("asks only when a save failed"), std::string::npos);
 }
 
 }  // namespace

@@ -199,18 +199,18 @@ TEST(UiInput, BadTrajectoryPathsAndFilesSayWhyAndChangeNothing) {
   const std::string missing = (dir / "missing.csv").string();
   f.type(missing);
   f.key(key::kEnter);
-  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
-  EXPECT_FALSE(f.state().chooser.preview);
-  EXPECT_TRUE(has(f.state().chooser.preview_error, "cannot be read")) << f.state().chooser.preview_error;
-  EXPECT_TRUE(f.state().status_important);
-  EXPECT_TRUE(has(f.state().status, "missing.csv")) << f.state().status;
-  f.key(key::kEnter);  // asks again, with the path given before
+  // Refused: the prompt stays open with the path and the reason (issue 23), the preview as it was.
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   EXPECT_EQ(f.state().dialog.input, missing);
+  EXPECT_FALSE(f.state().chooser.preview);
+  EXPECT_TRUE(has(f.state().dialog.error, "cannot be read")) << f.state().dialog.error;
+  EXPECT_TRUE(f.state().status_important);
+  EXPECT_TRUE(has(f.state().status, "missing.csv")) << f.state().status;
   clear_input(f);
   f.type(bad_file);
   f.key(key::kEnter);
-  EXPECT_TRUE(has(f.state().chooser.preview_error, "line 3: 'abc' is not a number")) << f.state().chooser.preview_error;
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
+  EXPECT_TRUE(has(f.state().dialog.error, "line 3: 'abc' is not a number")) << f.state().dialog.error;
   f.key(key::kEscape);
   // Nothing changed: the trajectory, the trial, the valves.
   EXPECT_EQ(f.state().experiment.trajectory->name, "paper");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdarg>
 #include <cstdio>
+#include <cwchar>
+#include <locale.h>
 
 #include "engine/base/printable_text.hpp"
 
@@ -18,21 +20,48 @@ Canvas::Canvas(int width, int height)
 
 void Canvas::clear() { std::fill(cells_.begin(), cells_.end(), Cell{}); }
 
+int glyph_width(char32_t glyph) {
+  if (glyph >= 0x20 && glyph < 0x7f) return 1;
+  if (is_terminal_control(glyph)) return 1;  // shown as '?'
+  // wcwidth in a UTF-8 locale of this thread's own, whatever the program's locale is (tests run in "C").
+  static const locale_t utf8 = newlocale(LC_CTYPE_MASK, "C.UTF-8", static_cast<locale_t>(nullptr));
+  if (utf8 == static_cast<locale_t>(nullptr)) return 1;
+  const locale_t previous = uselocale(utf8);
+  const int width = wcwidth(static_cast<wchar_t>(glyph));
+  uselocale(previous);
+  return width < 0 ? 1 : std::min(width, 2);  // unknown: one cell
+}
+
+void Canvas::set_cell(int x, int y, const Cell& value) {
+  // Overwriting half of a wide glyph blanks its other half: no cell is left pointing at nothing.
+  Cell& target = cell(x, y);
+  if (target.glyph == kWideContinuation && x > 0) cell(x - 1, y).glyph = U' ';
+  if (target.glyph != kWideContinuation && x + 1 < width_ && cell(x + 1, y).glyph == kWideContinuation) {
+    cell(x + 1, y).glyph = U' ';
+  }
+  target = value;
+}
+
 int Canvas::put(int x, int y, std::string_view text, Role role, bool bold, int clip_right) {
   const int right = clip_right < 0 ? width_ : std::min(clip_right, width_);
   if (y < 0 || y >= height_) return x;
   for (char32_t glyph : decode_utf8(text)) {
-    if (x >= right) break;
     // Text from files and the bus may hold controls: a cell never sends one to the terminal.
     if (is_terminal_control(glyph)) glyph = U'?';
-    if (x >= 0) cell(x, y) = Cell{glyph, role, bold};
-    ++x;
+    const int cells = glyph_width(glyph);
+    if (cells == 0) continue;  // a combining mark has no cell of its own
+    if (x + cells > right) break;  // a wide glyph that does not fit whole is not drawn
+    if (x >= 0) {
+      set_cell(x, y, Cell{glyph, role, bold});
+      if (cells == 2) set_cell(x + 1, y, Cell{kWideContinuation, role, bold});
+    }
+    x += cells;
   }
   return x;
 }
 
 void Canvas::put_glyph(int x, int y, char32_t glyph, Role role, bool bold) {
-  if (inside(x, y)) cell(x, y) = Cell{glyph, role, bold};
+  if (inside(x, y)) set_cell(x, y, Cell{glyph, role, bold});
 }
 
 void Canvas::fill(const Rect& area, char32_t glyph, Role role) {
@@ -77,7 +106,9 @@ std::string Canvas::line(int y) const {
   for (int x = 0; x < width_; ++x) {
     if (at(x, y).glyph != U' ') last = x;
   }
-  for (int x = 0; x <= last; ++x) append_utf8(out, at(x, y).glyph);
+  for (int x = 0; x <= last; ++x) {
+    if (at(x, y).glyph != kWideContinuation) append_utf8(out, at(x, y).glyph);
+  }
   return out;
 }
 
@@ -163,7 +194,21 @@ void append_utf8(std::string& out, char32_t glyph) {
   }
 }
 
-int text_width(std::string_view text) { return static_cast<int>(decode_utf8(text).size()); }
+int text_width(std::string_view text) {
+  int width = 0;
+  for (char32_t glyph : decode_utf8(text)) width += glyph_width(glyph);
+  return width;
+}
+
+std::string tail_fit(std::string_view text, int width) {
+  const std::u32string glyphs = decode_utf8(text);
+  std::size_t start = glyphs.size();
+  int used = 0;
+  while (start > 0 && used + glyph_width(glyphs[start - 1]) <= width) used += glyph_width(glyphs[--start]);
+  std::string out;
+  for (std::size_t i = start; i < glyphs.size(); ++i) append_utf8(out, glyphs[i]);
+  return out;
+}
 
 std::string format(const char* fmt, ...) {
   char buffer[512];
@@ -178,9 +223,10 @@ std::string fit(std::string_view text, int width) {
   std::string out;
   int used = 0;
   for (char32_t glyph : decode_utf8(text)) {
-    if (used >= width) break;
+    const int cells = glyph_width(glyph);
+    if (used + cells > width) break;
     append_utf8(out, glyph);
-    ++used;
+    used += cells;
   }
   if (used < width) out.append(static_cast<std::size_t>(width - used), ' ');
   return out;
@@ -192,7 +238,10 @@ std::vector<std::string> wrap(std::string_view text, int width) {
   const std::u32string glyphs = decode_utf8(text);
   std::size_t start = 0;
   while (start < glyphs.size()) {
-    std::size_t end = std::min(glyphs.size(), start + static_cast<std::size_t>(width));
+    // As many glyphs as `width` cells hold (at least one), then back to the last space if cut.
+    std::size_t end = start;
+    int used = 0;
+    while (end < glyphs.size() && (end == start || used + glyph_width(glyphs[end]) <= width)) used += glyph_width(glyphs[end++]);
     if (end < glyphs.size()) {
       const std::size_t space = glyphs.rfind(U' ', end);
       if (space != std::u32string::npos && space > start) end = space;

@@ -28,6 +28,10 @@ enum class Role : std::uint8_t {
   kCursor,
 };
 
+/// The cell right of a wide glyph (CJK, fullwidth forms: two cells) holds this: it is drawn by the
+/// glyph on its left.
+inline constexpr char32_t kWideContinuation = 0;
+
 struct Cell {
   char32_t glyph = U' ';
   Role role = Role::kNormal;
@@ -75,6 +79,7 @@ class Canvas {
   std::string text() const;
 
  private:
+  void set_cell(int x, int y, const Cell& value);
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
   Cell& cell(int x, int y) { return cells_[static_cast<std::size_t>(y * width_ + x)]; }
 
@@ -85,14 +90,18 @@ class Canvas {
 /// Decodes UTF-8 (invalid bytes become '?').
 std::u32string decode_utf8(std::string_view text);
 void append_utf8(std::string& out, char32_t glyph);
-/// Number of cells `text` takes (one per code point: the console only uses single-width glyphs).
+/// Cells a glyph takes on a terminal (wcwidth in UTF-8): 1, 2 for wide ones, 0 for combining marks.
+int glyph_width(char32_t glyph);
+/// Number of cells `text` takes on the screen (its display width: a wide glyph takes two).
 int text_width(std::string_view text);
+/// The end of `text` that fits in `width` cells (a long prompt shows what was typed last).
+std::string tail_fit(std::string_view text, int width);
 
 /// printf into a std::string.
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-/// `text` cut or padded with spaces to exactly `width` cells.
+/// `text` cut or padded with spaces to exactly `width` cells (display width).
 std::string fit(std::string_view text, int width);
-/// `text` broken into lines of at most `width` cells, at spaces where possible.
+/// `text` broken into lines of at most `width` cells (display width), at spaces where possible.
 std::vector<std::string> wrap(std::string_view text, int width);
 
 }  // namespace bellows::ui

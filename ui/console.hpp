@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/rt/engine_driver.hpp"
 #include "engine/rt/realtime_loop.hpp"
 #include "ui/console_controller.hpp"
 
@@ -16,6 +17,9 @@ namespace bellows::ui {
 struct ConsoleSetup {
   EngineCore* core = nullptr;
   RealtimeLoop* loop = nullptr;      // not started yet: the console adds its telemetry tap first
+  /// Instead of `loop` (console --clock sim): the UI thread ticks it while the engine has work,
+  /// `environment.speed` times as fast as the wall clock ("max": as fast as it can).
+  SimulatedClock* simulated_clock = nullptr;
   RealtimeMode rt_mode = RealtimeMode::kTry;
   ConsoleEnvironment environment;    // core, telemetry and latency are filled in here
   Trajectory trajectory;

@@ -46,6 +46,7 @@ ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajecto
   state_.loop.speed = env_.speed;
   state_.loop.tick_hz = 1.0 / env_.config.timing.tick_s;
   state_.loop.realtime = static_cast<bool>(env_.latency);
+  state_.loop.clock = env_.simulated_clock ? "sim" : "wall";
   state_.law_name = env_.config.ilc.law;
   state_.stop_after_rises = env_.stop_after_rises;
   state_.sessions_available = env_.sessions != nullptr && env_.sessions->available();
@@ -66,7 +67,11 @@ bool ConsoleController::active() const {
 }
 
 void ConsoleController::log(LogSource source, std::string text, bool important, double engine_time_s, bool routine) {
-  if (engine_time_s < -1.0) engine_time_s = state_.live_valid ? state_.live.time_s : -1.0;
+  if (engine_time_s < -1.0) {
+    // The newest engine time the console knows: an event polled in this update may be newer than
+    // the last snapshot, and the log's times never run backwards.
+    engine_time_s = state_.live_valid ? std::max(state_.live.time_s, newest_event_s_) : newest_event_s_;
+  }
   state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine, utc_timestamp(),
                   state_.experiment.next_iteration()});
   ++revision_;
@@ -75,10 +80,21 @@ void ConsoleController::log(LogSource source, std::string text, bool important, 
 void ConsoleController::set_status(std::string text, bool important) {
   state_.status = std::move(text);
   state_.status_important = important;
+  state_.status_screen = state_.screen;  // a key's message moves with the screen the key leads to (handle_key)
+  ++status_serial_;
   ++revision_;
 }
 
+bool ConsoleController::needs_engine_time() const {
+  if (env_.core->state() == EngineState::kRunning || !env_.core->emergency_stop_delivered()) return true;
+  if (static_cast<long long>(env_.core->ticks()) <= action_sent_at_tick_) return true;
+  return valve_test_ != nullptr && valve_test_->running();
+}
+
 bool ConsoleController::send(const EngineCommand& command, const char* what) {
+  const CommandKind k = command.kind;
+  const bool setting = k == CommandKind::kSelectTrajectory || k == CommandKind::kSetGains || k == CommandKind::kHeartbeat;
+  if (!setting) note_action_sent();
   if (env_.core->send(command)) return true;
   log(LogSource::kOperator, std::string("command queue full: ") + what + " not sent", true);
   set_status(std::string("the engine's command queue is full: ") + what + " not sent", true);
@@ -96,15 +112,16 @@ void ConsoleController::send_gains() {
 
 void ConsoleController::start(double now_s) {
   now_s_ = now_s;
-  env_.core->monitor_heartbeat(true);
+  env_.core->monitor_heartbeat(!env_.simulated_clock);
   heartbeat(now_s);
   if (selected_trajectories_.empty() || selected_trajectories_.back() != state_.experiment.trajectory) {
     select_trajectory(state_.experiment.trajectory);
   }
   send_gains();
   rebuild_law();
-  log(LogSource::kOperator, format("console started: device %s, speed x%s, trajectory %s", env_.device_name.c_str(),
-                                   env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
+  log(LogSource::kOperator, format("console started: device %s, %s clock, speed x%s, trajectory %s", env_.device_name.c_str(),
+                                   env_.simulated_clock ? "simulated" : "wall", env_.speed.c_str(),
+                                   state_.experiment.trajectory->name.c_str()));
   if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
@@ -118,6 +135,7 @@ void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> traj
 }
 
 void ConsoleController::heartbeat(double now_s) {
+  if (env_.simulated_clock) return;  // not monitored: heartbeats would only fill a queue no tick empties
   if (state_.heartbeat_drill) {
     const double waited = now_s - drill_started_s_;
     if (state_.engine_state == EngineState::kFault) {
@@ -141,6 +159,11 @@ void ConsoleController::update(double now_s) {
   poll_engine(now_s);
   refresh_rig(now_s);  // the link's figures before the health line uses them
   poll_snapshot_and_telemetry(now_s);
+  if (continue_pending_) {
+    poll_engine(now_s);  // the events the engine emitted with the trial's end come first
+    continue_pending_ = false;
+    continue_run();
+  }
   poll_tasks();
   if (black_box_pending_ && env_.core->black_box().frozen()) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
@@ -206,6 +229,7 @@ void ConsoleController::poll_engine(double /*now_s*/) {
 
 void ConsoleController::on_event(const EngineEvent& event) {
   forward_to_valve_test(event);
+  newest_event_s_ = std::max(newest_event_s_, event.time_s);
   switch (event.kind) {
     case EventKind::kStateChanged:
       state_.engine_state = event.to;
@@ -214,8 +238,13 @@ void ConsoleController::on_event(const EngineEvent& event) {
       const bool routine = event.command == CommandKind::kStartTrial &&
                            (event.to == EngineState::kRunning || event.to == EngineState::kArmed);
       // Into FAULT: the fault's own name (a guard is not an emergency stop).
+      // Back to ARMED from RUNNING on the trial's own command: the trial ran to its end (an abort names
+      // its own command, a fault its guard).
+      const bool trial_end = event.from == EngineState::kRunning && event.to == EngineState::kArmed &&
+                             event.command == CommandKind::kStartTrial;
       const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone ? fault_name(event.fault)
-                                                                                              : to_string(event.command);
+                          : trial_end                                                      ? "trial complete"
+                                                                                           : to_string(event.command);
       log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
           event.to == EngineState::kFault, event.time_s, routine);
     }
@@ -231,10 +260,11 @@ void ConsoleController::on_event(const EngineEvent& event) {
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
-      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint};
+      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint,
+                                    event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(event.fault))};
       black_box_pending_ = true;
-      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), fault_message(event.fault)), true, event.time_s);
-      set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), fault_message(event.fault)), true);
+      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), state_.fault_view.detail.c_str()), true, event.time_s);
+      set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), state_.fault_view.detail.c_str()), true);
       state_.dialog = {};
       state_.screen = Screen::kFault;
       if (stop_pending_ && env_.core->emergency_stop_delivered()) on_emergency_stop_delivered();
@@ -273,7 +303,8 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
   }
   // Device health from what the sensors say.
   DeviceHealth health{env_.device_name, false, "no data"};
-  if (state_.live_valid && now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS) {
+  // On the simulated clock the reading stands still while no time passes: not stale.
+  if (state_.live_valid && (env_.simulated_clock || now_s - last_fresh_snapshot_s_ <= kStaleSnapshotS)) {
     const SensorReading& r = state_.live.reading;
     bool finite = std::isfinite(r.supply_bar);
     for (int j = 0; j < std::clamp(r.joint_count, 1, kMaxJoints); ++j) {

@@ -35,6 +35,14 @@
 
 namespace bellows::ui {
 
+/// A prompt's verdict on what was typed (ConsoleController::judge_input): refused (`refusal`, the
+/// prompt stays open with the typed text and the reason), or taken (the prompt closes, then `then`
+/// runs, if any).
+struct PromptAnswer {
+  std::string refusal;
+  std::function<void()> then;
+};
+
 /// What the console needs from the program around it.
 struct ConsoleEnvironment {
   EngineCore* core = nullptr;
@@ -42,6 +50,10 @@ struct ConsoleEnvironment {
   std::function<LatencySummary()> latency;       // the loop's statistics; empty on a simulated clock
   std::string rt_description = "other";
   std::string speed = "1";
+  /// The simulated arm on simulated time (console --clock sim): the program around the controller
+  /// ticks the engine only while needs_engine_time(), so a study's numbers repeat those of
+  /// `bellows run` with the same seed. No heartbeat then (there is no wall time to miss it in).
+  bool simulated_clock = false;
   Configuration config;
   /// A library name or a CSV path to a trajectory; throws InputError with the reason.
   std::function<Trajectory(const std::string&)> load_trajectory;
@@ -58,8 +70,10 @@ struct ConsoleEnvironment {
   std::uint64_t seed = 1;
   int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
   std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
-  /// Draws figures of the trials so far (on a background task); returns where. Empty: not available.
-  std::function<std::string(const SessionSnapshot&)> write_figures;
+  /// Draws the figures of the saved session at `session_location` (SessionGateway::save's answer),
+  /// its first `iterations` iterations, from its files (on a background task); returns where.
+  /// Empty: not available.
+  std::function<std::string(const std::string& session_location, int iterations)> write_figures;
 };
 
 class ConsoleController {
@@ -87,6 +101,8 @@ class ConsoleController {
 
   const ConsoleState& state() const { return state_; }
   bool quit_requested() const { return quit_requested_; }
+  /// Bumped by Ctrl-L: the terminal repaints every cell (clears what another program or a glitch left).
+  std::uint64_t repaints() const { return repaints_; }
   /// What is not on disk, naming the trials ("iteration 4 is not saved."); empty when everything
   /// is. The quit confirmation names it; a failed save says it and keeps the data in memory.
   std::string unsaved_work() const { return state_.experiment.unsaved_sentence(); }
@@ -97,6 +113,11 @@ class ConsoleController {
   std::uint64_t revision() const { return revision_; }
   /// Trials or learning in progress: the screen changes continuously.
   bool active() const;
+  /// On the simulated clock: whether engine time must pass now: a trial runs, a command that changes
+  /// the engine's state (arm, disarm, trial, reset, valve pulse) or an emergency stop waits for its
+  /// tick, or the valve test pulses. Settings (trajectory, gains) wait for the next such tick, so
+  /// that the ticks, and with them the simulated arm's noise, are those of `bellows run`.
+  bool needs_engine_time() const;
 
  private:
   struct InFlight {  // a trial's buffers, the engine's until the runner says it is finished
@@ -104,6 +125,7 @@ class ConsoleController {
     Eigen::MatrixXd correction_bar;  // N x J
     TrialRecord record;
     std::string origin;
+    LearnedWith learned_with;  // what learned correction_bar (empty: not learned)
   };
 
   // Engine side (console_controller.cpp).
@@ -137,12 +159,15 @@ class ConsoleController {
   void perform(Action action);
   void open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
                    std::string input = {});
-  void accept_input();
+  /// Judges the open prompt's text without closing it (handle_dialog_key closes it when taken).
+  PromptAnswer judge_input();
   void reject_input(std::string why);  // the prompt stays open with the input and the reason
   /// y/Y closes the dialog and runs `on_yes`; n/N closes it with `status_on_no`; any other key leaves
   /// it open with "... is not an answer here" (then returns false).
   bool answer_yes_no(int key, const std::function<void()>& on_yes, const char* status_on_no);
   void not_an_answer(int key);
+  /// The inspector's cursor to the next (+1) or previous (-1) |error| peak of the trial shown.
+  void jump_to_error_peak(int step);
   void open_trajectory_chooser();
   void preview_selected_trajectory();
   void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
@@ -151,6 +176,7 @@ class ConsoleController {
   /// The next (+1) or previous (-1) learning law; the law is rebuilt and the change logged.
   void choose_law_step(int step);
   void confirm_discard(std::string what, std::function<void()> action);
+  void quit_when_saved();  // quits once the save in progress is done (it asks again if that save fails)
   void quit_now();
 
   // The Rig screen and the valve test (console_rig.cpp).
@@ -174,7 +200,8 @@ class ConsoleController {
   void start_rename(const std::string& name);
   void start_listing();
   void start_open(const std::string& location);
-  void start_figures();
+  void start_figures();   // when every trial so far is saved; else after the save that does it
+  void launch_figures();
   void poll_session_tasks();
   void adopt(SessionSnapshot snapshot, bool at_start);
 
@@ -184,6 +211,10 @@ class ConsoleController {
   std::uint64_t revision_ = 0;
   bool quit_requested_ = false;
   bool quit_after_save_ = false;
+  std::uint64_t repaints_ = 0;
+  std::uint64_t status_serial_ = 0;  // set_status() calls, to tell a key's own message
+  bool continue_pending_ = false;    // a trial finished: the run goes on once this update's events are in
+  double newest_event_s_ = -1.0;     // engine time of the newest event polled
 
   // Trajectories given to the engine, in the order sent, alive until it hands them back (a
   // kTrajectorySelected event for a later one): it may hold a pointer to any of them until then.
@@ -193,10 +224,14 @@ class ConsoleController {
 
   // The learning (every joint's); never touched while a background update uses it.
   std::unique_ptr<JointLearning> law_;
+  LearnedWith law_learned_with_;       // law_'s law and weights
+  LearnedWith updating_learned_with_;  // those of the update running (law_update_)
   bool rebuild_pending_ = false;
   int law_samples_ = 0;
   std::function<void()> pending_discard_action_;
 
+  long long action_sent_at_tick_ = -1;  // engine ticks when the last state-changing command was sent
+  void note_action_sent() { action_sent_at_tick_ = static_cast<long long>(env_.core->ticks()); }
   double last_heartbeat_s_ = -1.0;
   double drill_started_s_ = 0.0;
   double last_loop_stats_s_ = -1.0;
@@ -209,6 +244,7 @@ class ConsoleController {
   bool stop_pending_ = false;        // an emergency stop requested, not yet acted on by the engine
   double stop_requested_s_ = 0.0;
   bool begin_after_save_ = false;    // a trial waits for the autosave
+  int figures_after_save_ = 0;       // figures of this many trials wait for the autosave (0: none)
   bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
   void export_strip();  // the selected joint's ring into state_.strip
@@ -222,6 +258,7 @@ class ConsoleController {
     std::unique_ptr<JointLearning> law;
     std::string convergence;
     bool warning = false;
+    LearnedWith learned_with;  // the law and weights it was built with
   };
   BackgroundTask<BuiltLaw> law_build_;
   BackgroundTask<Eigen::MatrixXd> law_update_;

@@ -18,12 +18,30 @@ namespace {
 constexpr int kMaxBatch = 1000;
 constexpr std::size_t kMaxInputBytes = 512;
 
+/// A dialog that takes typed text (every other one takes answer keys).
+bool is_prompt(DialogKind kind) {
+  return kind == DialogKind::kAskIterations || kind == DialogKind::kTrajectoryPath || kind == DialogKind::kEditValue ||
+         kind == DialogKind::kSessionName;
+}
+
 }  // namespace
 
 void ConsoleController::handle_key(int k, double now_s) {
   now_s_ = now_s;
   ++revision_;
+  // What a key says belongs to the screen the key leaves the operator on (status_screen).
+  struct StatusFollowsTheKey {
+    ConsoleController& c;
+    std::uint64_t serial;
+    ~StatusFollowsTheKey() {
+      if (c.status_serial_ != serial) c.state_.status_screen = c.state_.screen;
+    }
+  } follows{*this, status_serial_};
   if (k == key::kResize) return;
+  if (k == key::kRepaint) {  // from every screen and every dialog: the terminal redraws every cell
+    ++repaints_;
+    return;
+  }
   if (k == ' ') {  // from every screen and every dialog
     emergency_stop("EMERGENCY STOP (Space)");
     return;
@@ -53,21 +71,32 @@ void ConsoleController::open_dialog(DialogKind kind, std::string title, std::vec
   state_.dialog = Dialog{kind, std::move(title), std::move(text), std::move(input), std::move(hint), {}};
 }
 
+// Every key of an open dialog ends here and nowhere else: a prompt or a question keeps the focus
+// until it takes an answer (Enter with a valid one, or a listed answer key) or Esc; nothing typed
+// into it reaches the command table.
 bool ConsoleController::handle_dialog_key(int k) {
   Dialog& d = state_.dialog;
-  const bool prompt = d.kind == DialogKind::kAskIterations || d.kind == DialogKind::kTrajectoryPath ||
-                      d.kind == DialogKind::kEditValue || d.kind == DialogKind::kSessionName;
-  if (k == key::kEscape) {
-    state_.dialog = {};
+  if (k == key::kEscape || (k == 'q' && !is_prompt(d.kind) && d.kind != DialogKind::kConfirmQuit)) {
+    state_.dialog = {};  // back to the screen beneath it
     pending_discard_action_ = nullptr;
     set_status("cancelled");
     return true;
   }
-  if (prompt) {
+  if (is_prompt(d.kind)) {
     if (k == key::kEnter) {
-      accept_input();
+      // The one place a prompt closes on Enter: only when its answer is taken.
+      PromptAnswer answer = judge_input();
+      if (!answer.refusal.empty()) {
+        reject_input(std::move(answer.refusal));
+        return true;
+      }
+      state_.dialog = {};
+      if (answer.then) answer.then();
     } else if (k == key::kBackspace) {
       pop_last_code_point(d.input);
+      d.error.clear();
+    } else if (k == key::kClearLine) {
+      d.input.clear();
       d.error.clear();
     } else if (k >= 0x20 && k < key::kSpecial) {
       if (d.input.size() < kMaxInputBytes) {
@@ -99,19 +128,19 @@ bool ConsoleController::handle_dialog_key(int k) {
       return true;
     }
     case DialogKind::kConfirmQuit:
-      if (k == 's' && state_.sessions_available) {  // the autosave failed: try once more, then quit
+      if (k == 's' && state_.sessions_available && autosave_failed_) {  // the autosave failed: try once more, then quit
         state_.dialog = {};
         quit_after_save_ = true;
         autosave_failed_ = false;
         start_save();
-      } else if (k == 'q' || k == 'y') {
+      } else if (k == 'q' || k == 'y' || k == 'Y') {
         state_.dialog = {};
-        quit_now();
-      } else if (k == 'n' || k == 'c') {
+        quit_when_saved();
+      } else if (k == 'n' || k == 'N' || k == 'c') {
         state_.dialog = {};
-        set_status("cancelled");
+        set_status("cancelled: the console goes on");
       } else if (k == 's') {
-        d.error = "cannot save: " + state_.sessions_unavailable_reason;
+        d.error = state_.sessions_available ? "nothing to save again: Esc, or q to quit" : "cannot save: " + state_.sessions_unavailable_reason;
       } else {
         not_an_answer(k);
       }
@@ -144,67 +173,60 @@ void ConsoleController::reject_input(std::string why) {
   set_status(std::move(why), true);
 }
 
-void ConsoleController::accept_input() {
+PromptAnswer ConsoleController::judge_input() {
   const Dialog& d = state_.dialog;
   switch (d.kind) {
     case DialogKind::kAskIterations: {
       double k = 0;
-      if (!parse_number(trim(d.input), k) || k < 1 || k > kMaxBatch || std::floor(k) != k) {
-        reject_input(format("K must be a whole number from 1 to %d, not '%s'", kMaxBatch, d.input.c_str()));
-        return;
+      const NumberParse parsed = parse_number(trim(d.input), k);
+      if (parsed != NumberParse::kNumber || k < 1 || k > kMaxBatch || std::floor(k) != k) {
+        return {format("K must be a whole number from 1 to %d, not '", kMaxBatch) + d.input + "'" +
+                (parsed == NumberParse::kOutOfRange ? " (out of range)" : ""), {}};
       }
-      state_.dialog = {};
-      if (!availability(Action::kRunIterations, state_).available) {
-        set_status("cannot run iterations now: " + availability(Action::kRunIterations, state_).reason, true);
-        return;
+      if (const Availability a = availability(Action::kRunIterations, state_); !a.available) {
+        return {"cannot run iterations now: " + a.reason, {}};
       }
-      state_.run = RunProgress{};
-      state_.run.mode = RunProgress::Mode::kBatch;
-      state_.run.batch_first = state_.experiment.next_iteration();
-      state_.run.batch_total = trials_for_iterations(static_cast<int>(k), !state_.experiment.trials.empty());
-      log(LogSource::kOperator, format("run iterations %s (stops by itself after %d rises of the RMS in a row)",
-                                       batch_span(state_.run).c_str(), state_.stop_after_rises));
-      step();
-      return;
+      return {{}, [this, k] {
+                state_.run = RunProgress{};
+                state_.run.mode = RunProgress::Mode::kBatch;
+                state_.run.batch_first = state_.experiment.next_iteration();
+                state_.run.batch_total = trials_for_iterations(static_cast<int>(k), !state_.experiment.trials.empty());
+                log(LogSource::kOperator, format("run iterations %s (stops by itself after %d rises of the RMS in a row)",
+                                                 batch_span(state_.run).c_str(), state_.stop_after_rises));
+                step();
+              }};
     }
     case DialogKind::kTrajectoryPath: {
       const std::string path = expand_home(trim(d.input));
-      if (path.empty()) {
-        reject_input("type the path of a CSV file (time_s,angle_deg), or Esc");
-        return;
+      if (path.empty()) return {"type the path of a CSV file (time_s,angle_deg), or Esc", {}};
+      std::shared_ptr<const Trajectory> loaded;
+      try {
+        loaded = std::make_shared<const Trajectory>(env_.load_trajectory(path));
+      } catch (const std::exception& error) {
+        return {std::string(error.what()) + " (another path, or Esc)", {}};
       }
-      state_.dialog = {};
-      state_.chooser.file_path = path;
-      preview_selected_trajectory();
-      if (!state_.chooser.preview_error.empty()) {
-        set_status(state_.chooser.preview_error + " (Enter: another path)", true);
-      } else {
-        set_status("preview of " + path + ": Enter uses it");
-      }
-      return;
+      return {{}, [this, path, loaded] {
+                state_.chooser.file_path = path;
+                state_.chooser.preview = loaded;
+                state_.chooser.preview_error.clear();
+                set_status("preview of " + path + ": Enter uses it");
+              }};
     }
     case DialogKind::kSessionName: {
       const std::string name(trim(d.input));
-      if (name.empty()) {
-        reject_input("type a name (letters, digits, - _ .), or Esc");
-        return;
+      if (name.empty()) return {"type a name (letters, digits, - _ .), or Esc", {}};
+      if (rename_task_.busy() || save_task_.busy()) return {"saving: Enter again in a moment (or Esc)", {}};
+      if (std::string why = env_.sessions->name_refusal(state_.experiment.session_location, name); !why.empty()) {
+        return {std::move(why), {}};
       }
-      state_.dialog = {};
-      start_rename(name);
-      return;
+      return {{}, [this, name] { start_rename(name); }};
     }
     case DialogKind::kEditValue: {
-      const std::string why = apply_tuning(TuningForm::field_of(state_.tuning.selected), d.input);
-      if (!why.empty()) {
-        reject_input(why);
-        return;
-      }
-      state_.dialog = {};
-      return;
+      std::string why = apply_tuning(TuningForm::field_of(state_.tuning.selected), d.input);
+      return {std::move(why), {}};  // applied when empty
     }
     default:
-      state_.dialog = {};
-      return;
+      return {};
   }
 }
 
@@ -285,6 +307,11 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kInspector;
       return;
     }
+    case Action::kWorstError: jump_to_error_peak(+1); return;
+    case Action::kRmsScale:
+      state_.rms_log_scale = !state_.rms_log_scale;
+      set_status(state_.rms_log_scale ? "the RMS plot on a log scale (L: linear)" : "the RMS plot on a linear scale (L: log)");
+      return;
     case Action::kTuning: state_.screen = Screen::kTuning; return;
     case Action::kLog:
       state_.log_scroll = 0;
@@ -306,24 +333,26 @@ void ConsoleController::perform(Action action) {
       start_listing();
       return;
     case Action::kQuit: {
+      // kQuitRule (ui/key_map.hpp), the one rule of when quitting asks.
       const Experiment& e = state_.experiment;
-      if (!saves_settled()) {
-        quit_after_save_ = true;  // the autosave in progress (or about to start) first, then quit
-        set_status("finishing the save, then quitting");
-        autosave();
-        return;
+      std::vector<std::string> text;
+      if (valves_live(state_.engine_state) || state_.run.mode != RunProgress::Mode::kIdle) {
+        text.push_back(state_.engine_state == EngineState::kRunning ? "A trial is running with the valves live."
+                                                                   : "The valves are live (ARMED).");
       }
       const int unsaved_faults = static_cast<int>(e.faults.size()) - e.saved_faults;
-      if (e.unsaved() && (!e.trials.empty() || unsaved_faults > 0)) {
-        std::vector<std::string> text = {e.unsaved_sentence()};
+      if (saves_settled() && e.unsaved() && (!e.trials.empty() || unsaved_faults > 0)) {
+        text.push_back(e.unsaved_sentence());
         if (!state_.sessions_available) text.push_back("Saving is not available: " + state_.sessions_unavailable_reason);
-        text.push_back("The valves are vented before the console exits.");
-        open_dialog(DialogKind::kConfirmQuit, "Quit?", text,
-                    state_.sessions_available ? "s save and quit   q quit without saving   Esc cancel"
-                                              : "q quit without saving   Esc cancel");
-      } else {
-        quit_now();
       }
+      if (text.empty()) {
+        quit_when_saved();
+        return;
+      }
+      text.push_back("Quitting vents the valves before the console exits; the engine goes on until you answer.");
+      const bool retry = state_.sessions_available && autosave_failed_;
+      open_dialog(DialogKind::kConfirmQuit, "Quit?", text,
+                  retry ? "s save and quit   q or y quit without saving   n or Esc stay" : "q or y quit   n or Esc stay");
       return;
     }
     case Action::kHeartbeatDrill:
@@ -341,6 +370,16 @@ void ConsoleController::perform(Action action) {
     }
     case Action::kMain: state_.screen = Screen::kMain; return;
   }
+}
+
+void ConsoleController::quit_when_saved() {
+  if (!saves_settled()) {
+    quit_after_save_ = true;  // the autosave in progress (or about to start) first, then quit
+    set_status("finishing the save, then quitting");
+    autosave();
+    return;
+  }
+  quit_now();
 }
 
 void ConsoleController::quit_now() {

@@ -4,15 +4,48 @@
 #include <cstdlib>
 
 #include "engine/base/errors.hpp"
+#include "engine/base/units.hpp"
 #include "engine/config/learning_law_factory.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/keys.hpp"
+#include "ui/plot_data.hpp"
 #include "ui/render_parts.hpp"
 #include "ui/text_input.hpp"
 #include "ui/tuning.hpp"
 
 namespace bellows::ui {
+
+void ConsoleController::jump_to_error_peak(int step) {
+  InspectorView& v = state_.inspector;
+  const int trials = static_cast<int>(state_.experiment.trials.size());
+  if (trials == 0) return;
+  if (state_.screen != Screen::kInspector) {  // from anywhere: the inspector on the newest trial
+    v.trial = trials - 1;
+    v.peak = -1;
+    state_.screen = Screen::kInspector;
+  }
+  v.trial = std::clamp(v.trial, 0, trials - 1);
+  const Trial& t = state_.experiment.trials[static_cast<std::size_t>(v.trial)];
+  if (!t.in_memory()) {
+    set_status(format("iteration %d is on disk only (the console keeps the newest %d trials in memory)", t.iteration,
+                      Experiment::kTrialsKeptInMemory), true);
+    return;
+  }
+  const int joint = selected_joint(state_) < t.record.joints() ? selected_joint(state_) : 0;
+  const std::vector<int> peaks = error_peaks(t.record, joint);
+  if (peaks.empty()) {
+    set_status(format("iteration %d has no error to jump to", t.iteration), true);
+    return;
+  }
+  const int count = static_cast<int>(peaks.size());
+  v.peak = v.peak < 0 ? (step > 0 ? 0 : count - 1) : ((v.peak + step) % count + count) % count;
+  v.sample = peaks[static_cast<std::size_t>(v.peak)];
+  const TrialSamples& samples = t.record.joint_samples(joint);
+  set_status(format("iteration %d: |error| peak %d of %d, %.2f deg at %.2f s (sample %d); e next, E back", t.iteration,
+                    v.peak + 1, count, std::abs(samples.error_rad(v.sample)) * kDegPerRad, samples.time_s(v.sample),
+                    v.sample));
+}
 
 bool ConsoleController::handle_screen_key(int k) {
   switch (state_.screen) {
@@ -30,8 +63,9 @@ bool ConsoleController::handle_screen_key(int k) {
         case key::kPageDown: v.sample = std::min(n, v.sample + page); return true;
         case key::kHome: v.sample = 0; return true;
         case key::kEnd: v.sample = n; return true;
-        case key::kUp: v.trial = std::max(0, v.trial - 1); return true;
-        case key::kDown: v.trial = std::min(trials - 1, v.trial + 1); return true;
+        case key::kUp: v.trial = std::max(0, v.trial - 1); v.peak = -1; return true;
+        case key::kDown: v.trial = std::min(trials - 1, v.trial + 1); v.peak = -1; return true;
+        case 'E': jump_to_error_peak(-1); return true;
         case 'm':
           v.chosen = v.chosen == v.trial ? -1 : v.trial;
           return true;
@@ -46,7 +80,7 @@ bool ConsoleController::handle_screen_key(int k) {
                               t.iteration, Experiment::kTrialsKeptInMemory), true);
             return true;
           }
-          state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration));
+          state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration), t.summary.learned_with);
           log(LogSource::kOperator, format("go back to the correction of iteration %d for the next trial", t.iteration));
           set_status(format("the next trial applies the correction of iteration %d", t.iteration));
           return true;
@@ -124,21 +158,27 @@ bool ConsoleController::handle_screen_key(int k) {
       return false;
     }
     case Screen::kLog: {
-      const int count = static_cast<int>(state_.log.entries().size());
       const int page = std::max(1, state_.height - 8);
+      // At the top the oldest entry is on the first row and the page is full (no page of blanks).
+      const int top = detail::log_top_scroll(state_);
       int& scroll = state_.log_scroll;
-      if (k == key::kUp) scroll = std::min(count - 1, scroll + 1);
-      else if (k == key::kDown) scroll = std::max(0, scroll - 1);
-      else if (k == key::kPageUp) scroll = std::min(std::max(count - 1, 0), scroll + page);
-      else if (k == key::kPageDown) scroll = std::max(0, scroll - page);
+      if (k == key::kUp) scroll += 1;
+      else if (k == key::kDown) scroll -= 1;
+      else if (k == key::kPageUp) scroll += page;
+      else if (k == key::kPageDown) scroll -= page;
+      else if (k == key::kHome) scroll = top;
       else if (k == key::kEnd) scroll = 0;
       else return false;
-      scroll = std::max(0, scroll);
+      scroll = std::clamp(scroll, 0, top);
       return true;
     }
     case Screen::kRig:
       return handle_rig_key(k);
     case Screen::kHelp: {
+      if (k == 'q' || k == key::kEscape) {  // as in less, man and htop: back where help was opened
+        state_.screen = state_.previous_screen;
+        return true;
+      }
       const int page = std::max(1, state_.height - 6);  // the help's inner height
       const int last = std::max(0, detail::help_line_count(state_) - page);
       int& top = state_.help_scroll;
@@ -260,7 +300,11 @@ void ConsoleController::choose_law_step(int step) {
 std::string ConsoleController::apply_tuning(int field, const std::string& text) {
   const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
   double value = 0;
-  if (!parse_number(trim(text), value)) return std::string(f.label) + ": '" + text + "' is not a number";
+  switch (parse_number(trim(text), value)) {
+    case NumberParse::kNumber: break;
+    case NumberParse::kNotANumber: return std::string(f.label) + ": '" + text + "' is not a number";
+    case NumberParse::kOutOfRange: return std::string(f.label) + ": '" + text + "' is out of range";
+  }
   Configuration candidate = state_.config;
   const double old = *f.value(candidate);
   *f.value(candidate) = value;

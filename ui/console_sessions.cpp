@@ -72,17 +72,32 @@ void ConsoleController::start_figures() {
     set_status("figures are not available in this console", true);
     return;
   }
-  if (figure_task_.busy()) {
+  if (figure_task_.busy() || figures_after_save_ > 0) {
     set_status("already writing figures");
     return;
   }
-  SessionSnapshot snapshot;  // a copy: the trials go on while gnuplot draws
-  snapshot.config = state_.config;
-  snapshot.experiment = state_.experiment;
-  snapshot.device_name = env_.device_name;
-  snapshot.seed = env_.seed;
-  log(LogSource::kSession, format("writing figures of %d iterations", static_cast<int>(snapshot.experiment.trials.size())));
-  figure_task_.start([write = env_.write_figures, snapshot = std::move(snapshot)] { return write(snapshot); });
+  // Drawn from the saved session's files, as `bellows sessions plot` draws them: memory holds only
+  // the newest trials. Trials not saved yet are saved first.
+  if (!state_.sessions_available) {
+    set_status("figures are drawn from the saved session, and saving is not available: " + state_.sessions_unavailable_reason, true);
+    return;
+  }
+  if (autosave_failed_) {
+    set_status("figures are drawn from the saved session, and saving failed: s saves again", true);
+    return;
+  }
+  figures_after_save_ = static_cast<int>(state_.experiment.trials.size());
+  log(LogSource::kSession, format("writing figures of %d iterations", figures_after_save_));
+  autosave();
+  if (!save_task_.busy() && !rename_task_.busy() && state_.experiment.saved_trials >= figures_after_save_) launch_figures();
+}
+
+void ConsoleController::launch_figures() {
+  const int iterations = figures_after_save_;
+  figures_after_save_ = 0;
+  figure_task_.start([write = env_.write_figures, location = state_.experiment.session_location, iterations] {
+    return write(location, iterations);
+  });
 }
 
 void ConsoleController::start_rename(const std::string& name) {
@@ -137,8 +152,11 @@ void ConsoleController::poll_session_tasks() {
       set_status(std::string("save failed: ") + error.what() + "; " + unsaved +
                      " Kept in memory; the next trial (or s when quitting) retries the save", true);
       if (state_.run.mode != RunProgress::Mode::kIdle) end_run("stopped: the session cannot be saved", true);
+      if (figures_after_save_ > 0) log(LogSource::kSession, "figures not written: the session is not saved", true);
+      figures_after_save_ = 0;
     }
     ++revision_;
+    if (figures_after_save_ > 0 && state_.experiment.saved_trials >= figures_after_save_) launch_figures();
     autosave();  // what changed meanwhile
     if (!save_task_.busy() && !state_.experiment.unsaved()) {
       if (begin_after_save_) {
@@ -165,6 +183,7 @@ void ConsoleController::poll_session_tasks() {
       set_status(std::string("naming failed: ") + error.what(), true);
     }
     ++revision_;
+    if (figures_after_save_ > 0 && !save_task_.busy() && state_.experiment.saved_trials >= figures_after_save_) launch_figures();
   }
   if (figure_task_.ready()) {
     try {

@@ -75,6 +75,7 @@ struct LoopHealth {
   std::uint64_t dropped_telemetry = 0;
   std::uint64_t dropped_events = 0;   // engine events lost to a full event queue
   bool realtime = true;          // false on a simulated clock (no latency to show)
+  std::string clock = "wall";    // "wall" (the real-time loop) or "sim" (console --clock sim)
 };
 
 /// The last seconds of the live signals at the ILC rate, oldest first, for the live plot; time in
@@ -105,6 +106,7 @@ struct InspectorView {
   int trial = -1;     // index into experiment.trials
   int sample = 0;     // cursor, 0..N
   int chosen = -1;    // an iteration overlaid for comparison (-1: none)
+  int peak = -1;      // which of the trial's |error| peaks e last jumped to (0: the largest; -1: none)
 };
 
 struct TrajectoryChooser {
@@ -138,6 +140,7 @@ struct FaultView {
   std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
   std::string where;                  // on a J-joint arm: the joint (and chamber) the guard fired on
   int joint = -1;                     // the joint the engine named (0-based); -1: no joint's
+  std::string detail;                 // the fault's own sentence (a device's words: the rig's reason, the link's silence)
 };
 
 struct ConsoleState;
@@ -155,8 +158,10 @@ struct ConsoleState {
   Dialog dialog;
   std::string status;          // the latest message for the operator
   bool status_important = false;
+  Screen status_screen = Screen::kMain;  // where it was said: another screen does not show it
   int log_scroll = 0;          // log screen: entries scrolled back from the newest
   int help_scroll = 0;         // help screen: its first line shown
+  bool rms_log_scale = false;  // the RMS plot's y axis (L toggles)
 
   // The engine and the rig.
   EngineState engine_state = EngineState::kSafe;

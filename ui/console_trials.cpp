@@ -4,6 +4,7 @@
 #include "engine/config/convergence.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
+#include "engine/config/learning_law_factory.hpp"
 #include "engine/operator/learning_session.hpp"
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
@@ -23,6 +24,7 @@ void ConsoleController::rebuild_law() {
   law_build_.start([config = state_.config, model = model_, samples = law_samples_, joints = state_.experiment.joints()] {
     BuiltLaw built;
     built.law = make_joint_learning(config, model, joints, samples);
+    built.learned_with = learned_with(config);
     // Predicted for one joint's law (the single-joint model); several joints learn without one.
     const LearningLaw* single = built.law->single_joint_law();
     const ConvergencePrediction p = single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
@@ -47,6 +49,7 @@ void ConsoleController::poll_tasks() {
     try {
       BuiltLaw built = law_build_.take();
       law_ = std::move(built.law);
+      law_learned_with_ = std::move(built.learned_with);
       if (law_->samples() != state_.experiment.samples() || law_->joints() != state_.experiment.joints()) rebuild_pending_ = true;
       state_.law_ready = !rebuild_pending_;
       if (state_.law_ready) {
@@ -69,7 +72,7 @@ void ConsoleController::poll_tasks() {
     try {
       Eigen::MatrixXd next = law_update_.take();
       const int from = state_.experiment.trials.back().iteration;
-      state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from));
+      state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from), updating_learned_with_);
       log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
                                       state_.experiment.next_correction_bar.cwiseAbs().maxCoeff()));
       state_.run.phase = RunProgress::Phase::kNone;
@@ -115,7 +118,9 @@ void ConsoleController::begin_trial() {
   trial->trajectory = e.trajectory;
   trial->correction_bar = e.next_correction_bar;
   trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
+  trial->learned_with = e.next_learned_with;
   // The operator arms (a): the runner never does here. It prepares the record and sends the trial.
+  note_action_sent();
   const TrialStatus& started =
       runner_.start(*trial->trajectory, trial->correction_bar, trial->record, TrialRunner::Arming::kMustBeArmed);
   if (started.phase == TrialPhase::kNotSent) {
@@ -170,6 +175,7 @@ void ConsoleController::finish_trial(double time_s) {
   // The RMS over every joint and sample, each joint's, the largest correction of any joint.
   trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
                                   env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);
+  trial.summary.learned_with = std::move(in_flight_->learned_with);
   in_flight_.reset();
   const bool follow = state_.inspector.trial == static_cast<int>(e.trials.size()) - 1;
   e.add_trial(std::move(trial));
@@ -206,7 +212,9 @@ void ConsoleController::finish_trial(double time_s) {
   }
   state_.run.phase = RunProgress::Phase::kNone;
   state_.run.sample = -1;
-  continue_run();
+  // After the rest of the engine's events (the trial's RUNNING -> ARMED is logged after it ended):
+  // the log keeps the order things happened in, a batch's "done" last.
+  continue_pending_ = true;
 }
 
 void ConsoleController::drop_trial(const std::string& why) {
@@ -253,6 +261,7 @@ void ConsoleController::step() {
   }
   const Trial& last = e.trials.back();
   state_.run.phase = RunProgress::Phase::kLearning;
+  updating_learned_with_ = law_learned_with_;
   const Eigen::Index n = last.correction_bar.rows();
   const double input_limit_bar = env_.config.controller.p_max_bar - env_.config.controller.gas.ambient_bar;
   Eigen::MatrixXd feedback(n, last.correction_bar.cols());

@@ -41,9 +41,10 @@ void Experiment::add_trial(Trial trial) {
   next_tried = true;
 }
 
-void Experiment::set_next(Eigen::MatrixXd correction_bar, std::string origin) {
+void Experiment::set_next(Eigen::MatrixXd correction_bar, std::string origin, LearnedWith learned_with) {
   next_correction_bar = std::move(correction_bar);
   next_origin = std::move(origin);
+  next_learned_with = std::move(learned_with);
   next_tried = false;
   next_unsaved = true;
   ++next_revision;

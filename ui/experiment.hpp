@@ -63,6 +63,7 @@ struct Experiment {
   std::vector<Trial> trials;
   Eigen::MatrixXd next_correction_bar;  // what the next trial applies, N x J
   std::string next_origin = "feedback only";
+  LearnedWith next_learned_with;        // the law and weights that learned it (empty: not learned)
   bool next_tried = false;              // a trial already ran with it: a step learns first
   int saved_trials = 0;                 // trials already in the saved session
   bool settings_changed = false;        // gains or weights changed since the last save
@@ -96,7 +97,7 @@ struct Experiment {
   /// Appends a finished trial (numbered next_iteration()); its correction was the next one.
   void add_trial(Trial trial);
   /// The correction the next trial applies, from `origin`.
-  void set_next(Eigen::MatrixXd correction_bar, std::string origin);
+  void set_next(Eigen::MatrixXd correction_bar, std::string origin, LearnedWith learned_with = {});
   /// RMS per trial, in order (over every joint).
   std::vector<double> rms_history_deg() const;
   /// Joint `joint`'s RMS per trial, in order (0-based; with one joint the same as rms_history_deg();

@@ -42,11 +42,15 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kSave, 's', key::kNone, "s", "Name", "name the session (it is saved as you go)"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
       {Action::kFigures, 'g', key::kNone, "g", "Figures", "write figures of this session (PNG, SVG; the engine goes on)"},
-      {Action::kQuit, 'q', key::kNone, "q", "Quit", "quit (asks when there is unsaved work; vents first)"},
+      {Action::kQuit, 'q', key::kNone, "q", "Quit", kQuitRule},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
       {Action::kJoint, 'j', key::kNone, "j", "Joint", "next joint: the live strip, plots and inspector show it (arms with several joints)"},
       {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
+      {Action::kWorstError, 'e', key::kNone, "e", "Worst",
+       "the inspector at the largest |error| of the trial; again: the next largest (E: back)"},
+      {Action::kRmsScale, 'L', key::kNone, "L", "Log RMS",
+       "the RMS plot on a log or a linear scale (the largest error per iteration beside it)"},
   };
   return bindings;
 }
@@ -104,6 +108,8 @@ Availability availability(Action action, const ConsoleState& s) {
       if (run_idle(s)) return no("no trials are running");
       return {};
     case Action::kInspector:
+    case Action::kWorstError:
+    case Action::kRmsScale:
       if (s.experiment.trials.empty()) return no("no trial has run yet");
       return {};
     case Action::kFaultView:
@@ -115,6 +121,7 @@ Availability availability(Action action, const ConsoleState& s) {
       return {};
     case Action::kFigures:
       if (s.experiment.trials.empty()) return no("no trial has run yet");
+      if (!s.sessions_available) return no("figures are drawn from the saved session: " + s.sessions_unavailable_reason);
       return {};
     case Action::kOpen:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
@@ -124,6 +131,7 @@ Availability availability(Action action, const ConsoleState& s) {
       if (s.experiment.joints() < 2) return no("the arm has one joint");
       return {};
     case Action::kHeartbeatDrill: {
+      if (s.loop.clock == "sim") return no("the simulated clock has no heartbeat to withhold (--clock wall has)");
       Availability a = needs_armed_idle(s);
       if (a.available && s.heartbeat_drill) return no("the drill is running");
       return a;
@@ -138,7 +146,7 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
     candidates = {Action::kReset, Action::kFaultView, Action::kLog, Action::kTrajectory, Action::kHelp, Action::kQuit};
   } else if (!run_idle(s) || s.engine_state == EngineState::kRunning) {
     candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kJoint, Action::kInspector,
-                  Action::kLog, Action::kHelp};
+                  Action::kLog, Action::kHelp, Action::kQuit};
   } else if (s.engine_state == EngineState::kArmed) {
     candidates = {Action::kEmergencyStop, Action::kRunTrial, Action::kNextIteration, Action::kRunIterations,
                   Action::kDisarm, Action::kJoint, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
@@ -147,6 +155,7 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
     candidates = {Action::kArm, Action::kJoint, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave,
                   Action::kOpen, Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
   }
+  if (s.screen == Screen::kInspector) candidates.insert(candidates.begin() + 1, Action::kWorstError);
   if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
     const bool stop_first = candidates.front() == Action::kEmergencyStop;
     candidates.insert(candidates.begin() + (stop_first ? 1 : 0), Action::kMain);
@@ -193,7 +202,8 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
               {"PgUp/PgDn", "cursor along time, a tenth of the trial"},
               {"Home/End", "start / end of the trial"},
               {"Up/Down", "earlier / later iteration"},
-              {"m", "overlay this iteration for comparison (m again: remove)"},
+              {"e / E", "the largest |error| of the trial, then the next largest / back to the larger one"},
+              {"m", "overlay this iteration for comparison, with the differences du, de and their RMS (m again: remove)"},
               {"u", "use this iteration's correction for the next trial"}};
     case Screen::kTrajectory:
       return {{"Up/Down", "choose; the preview follows"}, {"Enter", "use it (the file entry asks for a path)"}};
@@ -202,16 +212,17 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kSessions:
       return {{"Up/Down", "choose a session"}, {"Enter", "open it"}};
     case Screen::kLog:
-      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"End", "newest"}};
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "oldest / newest"}};
     case Screen::kFault:
       return {{"R", "reset the fault"}};
     case Screen::kRig:
       return {{"v", "valve test: each valve alone, pass or fail (asks first; arms, disarms after)"},
               {"z", "zero the angle: the angle read now becomes the rig profile's zero (asks first; t7)"}};
     case Screen::kMain:
-      return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"}};
+      return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"},
+              {"L", "the RMS plot on a log or a linear scale"}};
     case Screen::kHelp:
-      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"?/F1, Esc", "close the help"}};
+      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"q, Esc, ?/F1", "close the help: back to the screen it was opened from"}};
   }
   return {};
 }

@@ -33,6 +33,8 @@ enum class Action {
   kRig,
   kJoint,
   kMain,
+  kWorstError,   // the inspector's cursor to the largest |error| of the trial, then the next ones
+  kRmsScale,     // the RMS plot on a log or a linear scale
 };
 
 struct KeyBinding {
@@ -43,6 +45,11 @@ struct KeyBinding {
   const char* bar_label;    // short, for the function bar
   const char* description;
 };
+
+/// When `q` asks before quitting: written once, shown by the help and quoted by docs/console.md.
+/// Live: ARMED or RUNNING (or trials running); lost: a save failed, or saving is not available.
+inline constexpr const char* kQuitRule =
+    "quit: asks while the valves are live or work would be lost; otherwise saves, vents and exits";
 
 /// Every global command, in the help screen's order.
 const std::vector<KeyBinding>& key_bindings();

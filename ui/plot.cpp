@@ -115,7 +115,34 @@ PlotRange plot_range(const std::vector<PlotSeries>& series, const PlotOptions& o
   return r;
 }
 
+namespace {
+void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options,
+                      bool log_labels);
+}  // namespace
+
 void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options) {
+  if (!options.log_y) {
+    draw_linear_plot(canvas, area, series, options, false);
+    return;
+  }
+  // A log scale is a linear plot of log10(y), labelled with the values.
+  std::vector<std::vector<double>> logs(series.size());
+  std::vector<PlotSeries> logged;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    for (double y : series[i].y) logs[i].push_back(std::isfinite(y) && y > 0.0 ? std::log10(y) : std::nan(""));
+    logged.push_back({series[i].x, logs[i], series[i].role, series[i].ascii_mark});
+  }
+  PlotOptions linear = options;
+  linear.log_y = false;
+  const auto log_of = [](std::optional<double> v) { return v && *v > 0.0 ? std::optional<double>(std::log10(*v)) : std::optional<double>(); };
+  linear.y_min = log_of(options.y_min);
+  linear.y_max = log_of(options.y_max);
+  draw_linear_plot(canvas, area, logged, linear, true);
+}
+
+namespace {
+void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options,
+                      bool log_labels) {
   const int cols = area.width - kLabelWidth - 1;
   const int rows = area.height - 1;  // the bottom row holds the x labels
   if (cols < 4 || rows < 2) return;
@@ -125,9 +152,13 @@ void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& 
 
   // Axes and labels.
   for (int y = 0; y < rows; ++y) canvas.put_glyph(left - 1, top + y, options.braille ? U'│' : U'|', Role::kDim);
-  canvas.put(area.x, top, fit(label(options.y_format, r.y_max), kLabelWidth), Role::kDim);
-  canvas.put(area.x, top + rows - 1, fit(label(options.y_format, r.y_min), kLabelWidth), Role::kDim);
-  if (r.y_min < 0.0 && r.y_max > 0.0) {
+  const auto y_label = [&](double y) { return fit(label(options.y_format, log_labels ? std::pow(10.0, y) : y), kLabelWidth); };
+  canvas.put(area.x, top, y_label(r.y_max), Role::kDim);
+  canvas.put(area.x, top + rows - 1, y_label(r.y_min), Role::kDim);
+  if (log_labels && rows >= 5) {  // a log axis: its middle too (the geometric mean)
+    canvas.put(area.x, top + (rows - 1) / 2, y_label(r.y_max - (r.y_max - r.y_min) * static_cast<double>((rows - 1) / 2) / (rows - 1)), Role::kDim);
+  }
+  if (!log_labels && r.y_min < 0.0 && r.y_max > 0.0) {
     const int zero_row = static_cast<int>(std::lround((r.y_max / (r.y_max - r.y_min)) * (rows - 1)));
     if (zero_row > 0 && zero_row < rows - 1) {
       canvas.put(area.x, top + zero_row, fit("0", kLabelWidth), Role::kDim);
@@ -176,6 +207,7 @@ void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& 
     }
   }
 }
+}  // namespace
 
 std::string bar(double fraction, int width, const Glyphs& glyphs) {
   if (width <= 0) return {};

@@ -1,5 +1,7 @@
 #include "ui/plot_data.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
 #include "engine/base/units.hpp"
@@ -23,8 +25,72 @@ TrialSeries trial_series(const TrialRecord& record, int joint) {
 RmsSeries rms_series(const Experiment& experiment, int joint) {
   RmsSeries out;
   out.rms_deg = joint < 0 ? experiment.rms_history_deg() : experiment.joint_rms_history_deg(joint);
-  for (const Trial& t : experiment.trials) out.iteration.push_back(t.iteration);
+  for (const Trial& t : experiment.trials) {
+    out.iteration.push_back(t.iteration);
+    out.max_error_deg.push_back(t.summary.max_abs_error_deg);
+  }
   return out;
+}
+
+std::vector<double> error_series_deg(const TrialRecord& record, int joint) {
+  const TrialSamples& s = joint > 0 && joint < record.joints() ? record.joint_samples(joint) : record.samples;
+  return to_vector(s.error_rad, kDegPerRad, s.error_rad.size());
+}
+
+std::vector<int> error_peaks(const TrialRecord& record, int joint) {
+  const std::vector<double> e = error_series_deg(record, joint);
+  const int n = std::min(record.learning_samples, static_cast<int>(e.size()) - 1);
+  const auto at = [&](int k) { return std::abs(e[static_cast<std::size_t>(k)]); };
+  std::vector<int> peaks;
+  for (int k = 1; k <= n; ++k) {
+    // A local maximum; on a plateau its first sample only.
+    const bool rises_to = k == 1 || at(k) > at(k - 1);
+    const bool falls_after = k == n || at(k) >= at(k + 1);
+    if (rises_to && falls_after && std::isfinite(at(k))) peaks.push_back(k);
+  }
+  std::stable_sort(peaks.begin(), peaks.end(), [&](int a, int b) { return at(a) > at(b); });
+  return peaks;
+}
+
+TrialDifference trial_difference(const Experiment& e, int trial, int other, int joint) {
+  TrialDifference d;
+  const int trials = static_cast<int>(e.trials.size());
+  if (trial < 0 || trial >= trials || other < 0 || other >= trials || trial == other) {
+    d.why = "choose another iteration with m";
+    return d;
+  }
+  const Trial& a = e.trials[static_cast<std::size_t>(trial)];
+  const Trial& b = e.trials[static_cast<std::size_t>(other)];
+  d.iteration = a.iteration;
+  d.other_iteration = b.iteration;
+  if (!a.in_memory() || !b.in_memory()) {
+    d.why = format("iteration %d is on disk only", !a.in_memory() ? a.iteration : b.iteration);
+    return d;
+  }
+  if (joint >= a.record.joints() || joint >= b.record.joints() || a.record.learning_samples != b.record.learning_samples) {
+    d.why = "the two records differ in shape";
+    return d;
+  }
+  const TrialSamples& sa = a.record.joint_samples(joint);
+  const TrialSamples& sb = b.record.joint_samples(joint);
+  const int n = a.record.learning_samples;
+  d.du_bar.resize(static_cast<std::size_t>(n));
+  d.de_deg.resize(static_cast<std::size_t>(n) + 1);
+  double du2 = 0.0, de2 = 0.0;
+  for (int k = 0; k <= n; ++k) {
+    const double de = (sa.error_rad(k) - sb.error_rad(k)) * kDegPerRad;
+    d.de_deg[static_cast<std::size_t>(k)] = de;
+    if (k >= 1) de2 += de * de;
+    if (k < n) {
+      const double du = sa.u_ilc_bar(k) - sb.u_ilc_bar(k);
+      d.du_bar[static_cast<std::size_t>(k)] = du;
+      du2 += du * du;
+    }
+  }
+  d.rms_du_bar = n > 0 ? std::sqrt(du2 / n) : 0.0;
+  d.rms_de_deg = n > 0 ? std::sqrt(de2 / n) : 0.0;
+  d.available = true;
+  return d;
 }
 
 CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chosen, int joint) {

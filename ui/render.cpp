@@ -116,13 +116,23 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
   return out;
 }
 
+/// The weights and gains the law `ilc.law` learns with, and only those.
+std::string law_weights(const IlcParameters& ilc) {
+  if (ilc.law == "pd") return format("k_p %g k_d %g s Q %g Hz", ilc.pd_kp, ilc.pd_kd_s, ilc.pd_q_cutoff_hz);
+  if (ilc.law == "gradient") return format("step %g", ilc.gradient_step);
+  if (ilc.law == "inverse") return format("gain %g Q %g Hz", ilc.inverse_gain, ilc.inverse_q_cutoff_hz);
+  return format("M %g S %g W %g", ilc.m, ilc.s, ilc.w);  // the norm-optimal laws
+}
+
 /// The second line: loop health and the learning; compact forms drop the weights (the tuning
 /// screen shows them), then shorten the latency, then drop its labels.
 std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   const LoopHealth& l = s.loop;
   std::vector<Segment> out;
   out.push_back({1, level < 3 ? "loop " : "", Role::kDim, false});
-  out.push_back({0, format("%.0f Hz x%s %s", l.tick_hz, l.speed.c_str(), l.rt.c_str()), Role::kNormal, false});
+  out.push_back({0, format("%.0f Hz x%s%s%s", l.tick_hz, l.speed.c_str(), l.rt.empty() ? "" : " ", l.rt.c_str()), Role::kNormal, false});
+  // Which clock runs: a simulated one repeats `bellows run`'s numbers; the wall clock does not.
+  out.push_back({1, level < 2 ? l.clock + " clock" : l.clock, l.clock == "sim" ? Role::kGood : Role::kDim, false});
   out.push_back({2, "missed ", Role::kDim, false});
   out.push_back({0, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood,
                  false});
@@ -137,9 +147,7 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   }
   out.push_back({2, "law ", Role::kDim, false});
   out.push_back({0, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning, false});
-  if (level == 0) {
-    out.push_back({2, format("M %g S %g W %g", s.config.ilc.m, s.config.ilc.s, s.config.ilc.w), Role::kDim, false});
-  }
+  if (level == 0) out.push_back({2, law_weights(s.config.ilc), Role::kDim, false});
   if (l.dropped_events > 0) {  // a loss, said like every other
     out.push_back({2, format("%llu events dropped", static_cast<unsigned long long>(l.dropped_events)), Role::kWarning, false});
   }
@@ -165,7 +173,7 @@ void render_header(const ConsoleState& s, Canvas& c) {
 /// (the body's bottom border), and one longer than two lines ends at a word with an ellipsis.
 void render_status(const ConsoleState& s, Canvas& c) {
   const int y = c.height() - 2;
-  std::string text = s.status;
+  std::string text = s.status_screen == s.screen ? s.status : std::string();  // said on another screen: not here
   if (s.learner_busy && !s.learner_task.empty()) text = s.learner_task + "...  " + text;
   if (s.heartbeat_drill) text = "HEARTBEAT DRILL: heartbeats withheld, the engine must vent  " + text;
   const int columns = c.width() - 2;
@@ -248,12 +256,7 @@ void render_dialog(const ConsoleState& s, Canvas& c) {
   if (has_input) {
     ++y;
     const int field = box.width - 6;
-    const std::u32string typed = decode_utf8(d.input);
-    std::string visible = d.input;
-    if (static_cast<int>(typed.size()) >= field) {  // show the end of a long input
-      visible.clear();
-      for (std::size_t i = typed.size() - static_cast<std::size_t>(field - 1); i < typed.size(); ++i) append_utf8(visible, typed[i]);
-    }
+    const std::string visible = tail_fit(d.input, field - 1);  // the end of a long input, by display width
     c.put(box.x + 2, y, "> ", Role::kKey, true);
     c.put(box.x + 4, y, fit(visible + "_", field), Role::kSelected);
     ++y;

@@ -117,8 +117,10 @@ void render_trial_plot(const ConsoleState& s, Canvas& c, const Rect& area, const
 }
 
 void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs& g) {
-  c.frame(area, g, s.experiment.joints() > 1 ? "RMS per iteration (deg), all joints and j" + std::to_string(selected_joint(s) + 1)
-                                              : std::string("RMS per iteration (deg)"));
+  const std::string title = s.experiment.joints() > 1
+                                ? "RMS per iteration (deg), all joints and j" + std::to_string(selected_joint(s) + 1)
+                                : std::string("RMS per iteration (deg)") + (s.rms_log_scale ? ", log" : "");
+  c.frame(area, g, title);
   const Rect in = inner(area);
   const auto& trials = s.experiment.trials;
   if (trials.empty()) {
@@ -127,14 +129,14 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
   }
   // With several joints: the RMS over every joint and sample, then each joint's (docs/console.md).
   const int joints = s.experiment.joints();
-  const int list_width = joints > 1 ? 13 + 7 * joints : 14;
+  const int list_width = joints > 1 ? 13 + 7 * joints : 15;  // "%4d %9.3f" and the best mark '*'
   const Rect list{in.right() - list_width, in.y, list_width, in.height};
   if (joints > 1) {
     std::string head = "  it     all ";
     for (int j = 0; j < joints; ++j) head += format("     j%d", j + 1);
     c.put(list.x, list.y, head, Role::kDim);
   } else {
-    c.put(list.x, list.y, "  it       RMS", Role::kDim);
+    c.put(list.x, list.y, "  it       RMS ", Role::kDim);
   }
   const int rows = list.height - 1;
   const int count = static_cast<int>(trials.size());
@@ -148,7 +150,7 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
       line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j))
                                                             : std::string("      -");
     }
-    c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1);
+    c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1, list.right());
   }
   const Rect plot{in.x, in.y, in.width - list_width - 1, in.height};
   if (plot.width >= 18 && count >= 2) {
@@ -156,9 +158,14 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     PlotOptions options;
     options.braille = s.unicode;
     options.integer_x = true;
-    options.y_min = 0.0;
+    options.log_y = s.rms_log_scale;  // L: a log scale shows the late iterations' progress too
+    if (!options.log_y) options.y_min = 0.0;
     options.y_format = "%.2f";
     std::vector<PlotSeries> series;
+    // The largest |error| of each iteration beside its RMS (over every joint), drawn under it.
+    series.push_back({data.iteration, data.max_error_deg, Role::kSeries3, 'x'});
+    // Its legend on the frame's bottom edge: the top one holds the title.
+    legend(c, {area.x, area.bottom() - 1, area.width, 1}, {{"RMS", Role::kSeries1, '*'}, {"max|e|", Role::kSeries3, 'x'}}, g);
     const RmsSeries joint = joints > 1 ? rms_series(s.experiment, selected_joint(s)) : RmsSeries{};  // the series refer to it
     if (joints > 1) series.push_back({joint.iteration, joint.rms_deg, Role::kSeries2, '.'});
     series.push_back({data.iteration, data.rms_deg, Role::kSeries1, '*'});
@@ -192,7 +199,7 @@ void render_correction(const ConsoleState& s, Canvas& c, const Rect& area, const
 
 void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
-  const int left_width = std::clamp(body.width * 3 / 10, 30, 40);
+  const int left_width = std::clamp(body.width * 3 / 10, 30, 64);
   const int live_height = std::min(14, body.height - 5);
   render_live(s, c, {body.x, body.y, left_width, live_height}, g);
   const Rect log{body.x, body.y + live_height, left_width, body.height - live_height};

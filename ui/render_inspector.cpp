@@ -10,11 +10,22 @@
 namespace bellows::ui::detail {
 namespace {
 
-void readout_row(Canvas& c, const Rect& in, int& row, const std::string& label, const std::string& value) {
-  if (row >= in.height) return;
-  c.put(in.x + 1, in.y + row, label, Role::kDim, false, in.right());
-  c.put(in.x + 12, in.y + row, value, Role::kNormal, true, in.right());
-  ++row;
+struct ReadoutRow {
+  std::string label, value;
+  int priority;  // rows that do not fit go, the highest number first
+  Role role = Role::kNormal;
+};
+
+/// The readout beside the plots: as many rows as fit, the most important kept, in their order.
+void readout(Canvas& c, const Rect& in, std::vector<ReadoutRow> rows) {
+  while (static_cast<int>(rows.size()) > in.height && !rows.empty()) {
+    rows.erase(std::max_element(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.priority < b.priority; }));
+  }
+  int y = in.y;
+  for (const ReadoutRow& r : rows) {
+    c.put(in.x + 1, y, r.label, Role::kDim, false, in.right());
+    c.put(in.x + 12, y++, r.value, r.role, true, in.right());
+  }
 }
 
 }  // namespace
@@ -41,6 +52,8 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   const TrialSamples& samples = t.record.joint_samples(joint);
   const int k = std::clamp(s.inspector.sample, 0, static_cast<int>(samples.time_s.size()) - 1);
   const double cursor_s = samples.time_s(k);
+  const int chosen = s.inspector.chosen;
+  const TrialDifference diff = trial_difference(e, s.inspector.trial, chosen, joint);
 
   int x = c.put(body.x + 1, body.y, format("Iteration %d", t.iteration), Role::kTitle, true);
   x = c.put(x, body.y, format(" of 0..%d", e.trials.back().iteration), Role::kDim);
@@ -50,57 +63,101 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   if (joint < t.summary.joint_rms_deg.size() && t.record.joints() > 1) {
     x = c.put(x + 1, body.y, format("(joint %d %.3f)", joint + 1, t.summary.joint_rms_deg(joint)), Role::kNormal);
   }
-  if (s.inspector.chosen >= 0) c.put(x + 2, body.y, format("overlay: it %d", s.inspector.chosen), Role::kSeries3);
+  if (chosen >= 0) c.put(x + 2, body.y, format("overlay: it %d", chosen), Role::kSeries3);
 
+  // The correction and the error it left side by side when there is room, else one above the other;
+  // the angle against its set point below.
   constexpr int kReadoutWidth = 30;
   const Rect plots{body.x, body.y + 1, body.width - kReadoutWidth, body.height - 1};
-  const int top_height = plots.height / 2;
-  const Rect top{plots.x, plots.y, plots.width, top_height};
-  const Rect bottom{plots.x, plots.y + top_height, plots.width, plots.height - top_height};
+  const bool side_by_side = plots.width >= 80;
+  const int rows = side_by_side ? 2 : 3;
+  const int row_height = plots.height / rows;
+  const Rect correction_area{plots.x, plots.y, side_by_side ? plots.width / 2 : plots.width, row_height};
+  const Rect error_area = side_by_side ? Rect{correction_area.right(), plots.y, plots.width - correction_area.width, row_height}
+                                       : Rect{plots.x, plots.y + row_height, plots.width, row_height};
+  const int angle_y = plots.y + row_height * (rows - 1);
+  const Rect angle_area{plots.x, angle_y, plots.width, plots.bottom() - angle_y};
 
   PlotOptions options;
   options.braille = s.unicode;
   options.x_unit = "s";
   options.cursor_x = cursor_s;
 
-  c.frame(top, g, "Correction u_ilc (bar)");
-  const CorrectionOverlay overlay = correction_overlay(e, s.inspector.trial, s.inspector.chosen, joint);
+  c.frame(correction_area, g, side_by_side ? "u_ilc (bar)" : "Correction u_ilc (bar)");  // the legend needs the room
+  const CorrectionOverlay overlay = correction_overlay(e, s.inspector.trial, chosen, joint);
   std::vector<LegendItem> items;
   std::vector<PlotSeries> series;
   for (const auto& o : overlay.series) {
     items.push_back({o.label, o.role, o.mark});
     series.push_back({overlay.time_s, o.values, o.role, o.mark});
   }
-  legend(c, top, items, g);
+  legend(c, correction_area, items, g);
   options.y_format = "%.3f";
-  draw_plot(c, inner(top), series, options);
+  draw_plot(c, inner(correction_area), series, options);
 
-  c.frame(bottom, g, "Angle and set point (deg)");
-  legend(c, bottom, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
+  // The error e(t) = set point - angle, and the compared iteration's (m) beside it.
+  c.frame(error_area, g, "Error e (deg)");
   const TrialSeries data = trial_series(t.record, joint);
+  const std::vector<double> error_deg = error_series_deg(t.record, joint);
+  std::vector<double> chosen_error_deg;
+  std::vector<LegendItem> error_items;
+  std::vector<PlotSeries> error_plot;
+  if (diff.available) {
+    chosen_error_deg = error_series_deg(e.trials[static_cast<std::size_t>(chosen)].record, joint);
+    error_items.push_back({"it " + std::to_string(diff.other_iteration), Role::kSeries3, 'o'});
+    error_plot.push_back({data.time_s, chosen_error_deg, Role::kSeries3, 'o'});
+  }
+  error_items.push_back({"it " + std::to_string(t.iteration), Role::kSeries1, '*'});
+  error_plot.push_back({data.time_s, error_deg, Role::kSeries1, '*'});
+  legend(c, error_area, error_items, g);
+  options.y_format = "%.2f";
+  draw_plot(c, inner(error_area), error_plot, options);
+
+  c.frame(angle_area, g, "Angle and set point (deg)");
+  legend(c, angle_area, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
   options.y_format = "%.1f";
-  draw_plot(c, inner(bottom),
+  draw_plot(c, inner(angle_area),
             {{data.time_s, data.setpoint_deg, Role::kSeries2, '.'}, {data.time_s, data.angle_deg, Role::kSeries1, '*'}},
             options);
 
-  const Rect readout{plots.right(), body.y + 1, kReadoutWidth, std::min(body.height - 1, 14)};
-  c.frame(readout, g, "At the cursor");
-  const Rect in = inner(readout);
-  int row = 0;
-  readout_row(c, in, row, "iteration", format("%d", t.iteration));
-  readout_row(c, in, row, "sample", format("%d / %d", k, t.record.learning_samples));
-  readout_row(c, in, row, "time", format("%.2f s", cursor_s));
-  readout_row(c, in, row, "set point", number("%.2f deg", to_deg(samples.setpoint_rad(k))));
-  readout_row(c, in, row, "angle", number("%.2f deg", to_deg(samples.angle_rad(k))));
-  readout_row(c, in, row, "error", number("%.2f deg", to_deg(samples.error_rad(k))));
-  readout_row(c, in, row, "u_pid", number("%.4f bar", samples.u_pid_bar(k)));
-  readout_row(c, in, row, "u_ilc", number("%.4f bar", samples.u_ilc_bar(k)));
-  readout_row(c, in, row, "p A", number("%.3f bar", samples.pressure_a_bar(k)));
-  readout_row(c, in, row, "p B", number("%.3f bar", samples.pressure_b_bar(k)));
-  if (readout.bottom() + 3 <= body.bottom()) {
-    const int y = readout.bottom();
-    c.put(readout.x + 1, y, "m overlay this iteration", Role::kDim);
-    c.put(readout.x + 1, y + 1, "u use its correction next", Role::kDim);
+  // The readout: the values at the cursor, which |error| peak it is on (e), the differences to the
+  // compared iteration (m).
+  std::vector<ReadoutRow> rows_shown = {
+      {"iteration", format("%d", t.iteration), 1},
+      {"sample", format("%d / %d", k, t.record.learning_samples), 1},
+      {"time", format("%.2f s", cursor_s), 1},
+      {"set point", number("%.2f deg", to_deg(samples.setpoint_rad(k))), 2},
+      {"angle", number("%.2f deg", to_deg(samples.angle_rad(k))), 2},
+      {"error", number("%.2f deg", to_deg(samples.error_rad(k))), 1},
+      {"u_pid", number("%.4f bar", samples.u_pid_bar(k)), 4},
+      {"u_ilc", number("%.4f bar", samples.u_ilc_bar(k)), 2},
+      {"p A", number("%.3f bar", samples.pressure_a_bar(k)), 5},
+      {"p B", number("%.3f bar", samples.pressure_b_bar(k)), 5},
+  };
+  const std::vector<int> peaks = s.inspector.peak >= 0 ? error_peaks(t.record, joint) : std::vector<int>{};
+  if (s.inspector.peak >= 0 && s.inspector.peak < static_cast<int>(peaks.size()) &&
+      peaks[static_cast<std::size_t>(s.inspector.peak)] == k) {
+    rows_shown.insert(rows_shown.begin() + 6,
+                      ReadoutRow{"|e| peak", format("%d of %zu", s.inspector.peak + 1, peaks.size()), 1, Role::kWarning});
+  }
+  if (diff.available) {
+    const auto du_at = static_cast<std::size_t>(std::min(k, static_cast<int>(diff.du_bar.size()) - 1));
+    const std::string vs = format(" vs %d", diff.other_iteration);
+    rows_shown.push_back({"du" + vs, number("%.4f bar", diff.du_bar[du_at]), 3, Role::kSeries3});
+    rows_shown.push_back({"de" + vs, number("%.2f deg", diff.de_deg[static_cast<std::size_t>(k)]), 3, Role::kSeries3});
+    rows_shown.push_back({"RMS du", number("%.4f bar", diff.rms_du_bar), 2, Role::kSeries3});
+    rows_shown.push_back({"RMS de", number("%.3f deg", diff.rms_de_deg), 2, Role::kSeries3});
+  } else if (chosen >= 0 && chosen != s.inspector.trial) {
+    rows_shown.push_back({"compare", diff.why, 3, Role::kDim});
+  }
+  const int wanted = static_cast<int>(rows_shown.size()) + 2;
+  const Rect readout_area{plots.right(), body.y + 1, kReadoutWidth, std::min(body.height - 1, wanted)};
+  c.frame(readout_area, g, "At the cursor");
+  readout(c, inner(readout_area), std::move(rows_shown));
+  int y = readout_area.bottom();
+  for (const char* hint : {"e worst |error|, E back", "m compare this iteration", "u use its correction next"}) {
+    if (y + 1 > body.bottom()) break;
+    c.put(readout_area.x + 1, y++, hint, Role::kDim);
   }
 }
 
@@ -114,7 +171,7 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   // The guard and what it means, then when it vented: wrapped, never cut off.
   int y = body.y;
   const int x = c.put(body.x + 1, y, format(" %s ", fault_name(f.code)), Role::kFault, true);
-  for (const std::string& line : wrap(fault_message(f.code), body.right() - x - 2)) {
+  for (const std::string& line : wrap(f.detail.empty() ? std::string(fault_message(f.code)) : f.detail, body.right() - x - 2)) {
     c.put(x + 1, y++, line, Role::kWarning, true);
   }
   if (!f.where.empty()) {  // which joint (and chamber), on an arm with several

@@ -201,6 +201,36 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
   if (count == 0) c.put(cin.x + 1, cin.y, "none yet", Role::kDim);
 }
 
+namespace {
+
+// The log screen's columns: clock, engine time, source, then the text, which wraps under itself.
+constexpr int kLogTextColumn = 1 + 8 + 1 + 11 + 1 + 9;
+
+int log_text_cells(const Rect& in) { return std::max(10, in.right() - (in.x + kLogTextColumn)); }
+
+Rect log_inner(const ConsoleState& s) { return inner({0, 2, s.width, s.height - 4}); }
+
+std::vector<std::string> log_entry_lines(const LogEntry& e, int cells) {
+  std::vector<std::string> lines = wrap(e.text, cells);
+  if (lines.empty()) lines.emplace_back();
+  return lines;
+}
+
+}  // namespace
+
+int log_top_scroll(const ConsoleState& s) {
+  const Rect in = log_inner(s);
+  const auto& entries = s.log.entries();
+  const int count = static_cast<int>(entries.size());
+  int rows = 0, last = -1;  // the newest entry that still fits whole below the oldest
+  for (int i = 0; i < count; ++i) {
+    rows += static_cast<int>(log_entry_lines(entries[static_cast<std::size_t>(i)], log_text_cells(in)).size());
+    if (rows > in.height) break;
+    last = i;
+  }
+  return last < 0 ? 0 : count - 1 - last;
+}
+
 void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
   const Glyphs g = Glyphs::for_unicode(s.unicode);
   c.frame(body, g, format("Event log (%zu entries)", s.log.entries().size()));
@@ -209,23 +239,29 @@ void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
   const int count = static_cast<int>(entries.size());
   const int last = std::max(0, count - 1 - s.log_scroll);
   // Long entries wrap under their text: nothing the operator or the engine said is cut off.
-  const int text_x = in.x + 1 + 8 + 1 + 11 + 1 + 9;  // clock, engine time, source
-  const int text_width_cells = std::max(10, in.right() - text_x);
+  const int text_x = in.x + kLogTextColumn;
+  const int cells = log_text_cells(in);
   struct Row {
     const LogEntry* entry;
     std::string text;
     bool first;
   };
-  std::vector<Row> rows;  // newest first, until the screen is full
-  for (int i = last; i >= 0 && i < count && static_cast<int>(rows.size()) < in.height; --i) {
+  std::vector<Row> page;  // oldest first
+  int i = last;
+  for (; i >= 0 && static_cast<int>(page.size()) < in.height; --i) {
     const LogEntry& e = entries[static_cast<std::size_t>(i)];
-    std::vector<std::string> lines = wrap(e.text, text_width_cells);
-    if (lines.empty()) lines.emplace_back();
-    for (std::size_t j = lines.size(); j-- > 0;) rows.push_back({&e, lines[j], j == 0});
+    const std::vector<std::string> lines = log_entry_lines(e, cells);
+    for (std::size_t j = lines.size(); j-- > 0;) page.insert(page.begin(), {&e, lines[j], j == 0});
   }
-  const int shown = std::min(static_cast<int>(rows.size()), in.height);
-  for (int r = 0; r < shown; ++r) {
-    const Row& row = rows[static_cast<std::size_t>(shown - 1 - r)];
+  if (static_cast<int>(page.size()) > in.height) page.erase(page.begin(), page.end() - in.height);  // the oldest cut at the top
+  // At the top (the oldest entry shown) a page is still full: newer entries fill it below.
+  for (int k = last + 1; i < 0 && k < count && static_cast<int>(page.size()) < in.height; ++k) {
+    const LogEntry& e = entries[static_cast<std::size_t>(k)];
+    const std::vector<std::string> lines = log_entry_lines(e, cells);
+    for (std::size_t j = 0; j < lines.size() && static_cast<int>(page.size()) < in.height; ++j) page.push_back({&e, lines[j], j == 0});
+  }
+  for (int r = 0; r < static_cast<int>(page.size()); ++r) {
+    const Row& row = page[static_cast<std::size_t>(r)];
     const int y = in.y + r;
     const LogEntry& e = *row.entry;
     if (row.first) {

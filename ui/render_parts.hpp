@@ -25,6 +25,9 @@ int help_line_count(const ConsoleState& s);
 void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_log(const ConsoleState& s, Canvas& c, const Rect& body);
+/// The log screen's scroll (entries back from the newest) at which its oldest entry is on the
+/// first row: PgUp and Home stop there (the controller bounds its scrolling by it).
+int log_top_scroll(const ConsoleState& s);
 void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body);
 void render_rig(const ConsoleState& s, Canvas& c, const Rect& body);
 /// The newest log entries that fit in `area`, one a line, without the routine ones.

@@ -1,6 +1,6 @@
 // How the console saves and opens sessions, without knowing the store's files: app/ gives the
 // console an implementation (sessions/ on disk); without one, save and open say they are not
-// available. Every call runs on a worker thread, never on the UI thread, and gets a copy of what
+// available. Every call but name_refusal() runs on a worker thread, never on the UI thread, and gets a copy of what
 // it needs, so a slow disk never stalls the console or its heartbeat.
 #pragma once
 
@@ -72,6 +72,11 @@ class SessionGateway {
   /// Names the session last saved or opened (renames its directory to `name` in the data
   /// directory) and returns its new location. Throws InputError (bad or taken name).
   virtual std::string rename(const std::string& name) { throw InputError("naming sessions is not available: " + name); }
+  /// Why rename(name) would refuse `name` for the session at `location` (not a plain directory
+  /// name, taken), or "" when it would take it: checked before the console's name prompt closes,
+  /// so a refused name keeps it open. Quick (the name's rule and one directory entry) and lock-free:
+  /// the one call made on the UI thread.
+  virtual std::string name_refusal(const std::string& /*location*/, const std::string& /*name*/) { return {}; }
 };
 
 /// The gateway when no session store is built in: everything says "not available".

@@ -149,6 +149,8 @@ Terminal::~Terminal() {
 int Terminal::width() const { return getmaxx(stdscr); }
 int Terminal::height() const { return getmaxy(stdscr); }
 
+void Terminal::repaint() { clearok(curscr, TRUE); }
+
 int Terminal::read_key(int timeout_ms) {
   wtimeout(stdscr, timeout_ms);
   wint_t ch = 0;
@@ -170,7 +172,8 @@ void Terminal::draw(const Canvas& canvas) {
       run.clear();
       const int start = x;
       while (x < cols && canvas.at(x, y).role == first.role && canvas.at(x, y).bold == first.bold) {
-        run.push_back(static_cast<wchar_t>(canvas.at(x, y).glyph));
+        // A wide glyph covers the cell after it: ncurses advances two columns for it.
+        if (canvas.at(x, y).glyph != kWideContinuation) run.push_back(static_cast<wchar_t>(canvas.at(x, y).glyph));
         ++x;
       }
       attr_set(attributes, pair, nullptr);

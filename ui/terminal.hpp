@@ -24,6 +24,8 @@ class Terminal {
   /// A key, or key::kNone when none came within `timeout_ms`. KEY_RESIZE comes back as key::kResize.
   int read_key(int timeout_ms);
   void draw(const Canvas& canvas);
+  /// The next draw repaints every cell of the terminal, not only what changed (Ctrl-L).
+  void repaint();
 
  private:
   void* screen_ = nullptr;  // SCREEN*

@@ -1,6 +1,7 @@
 // What the console's prompts do with typed text.
 #pragma once
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -26,13 +27,23 @@ inline std::string expand_home(std::string_view path_text) {
   return home != nullptr && *home != '\0' ? std::string(home) + path.substr(1) : path;
 }
 
-/// A whole finite number ("0.45", "2e-5"): false for anything else, trailing text included.
-inline bool parse_number(std::string_view text_view, double& value) {
+enum class NumberParse { kNumber, kNotANumber, kOutOfRange };
+
+/// A whole finite number ("0.45", "2e-5") into `value`: kNotANumber for anything else, trailing text
+/// included ("inf" and "nan" too); kOutOfRange for a number a double cannot hold (400 digits, 1e999).
+inline NumberParse parse_number(std::string_view text_view, double& value) {
   const std::string text(text_view);
-  if (text.empty()) return false;
+  if (text.empty()) return NumberParse::kNotANumber;
   char* end = nullptr;
+  errno = 0;
   value = std::strtod(text.c_str(), &end);
-  return end != nullptr && *end == '\0' && std::isfinite(value);
+  if (end == nullptr || *end != '\0' || end == text.c_str()) return NumberParse::kNotANumber;
+  if (errno == ERANGE || !std::isfinite(value)) {
+    // strtod reads "inf" and "nan" as words it knows: those are not numbers an operator typed.
+    const bool word = text.find_first_of("iInN") != std::string::npos;
+    return word && !std::isfinite(value) && errno != ERANGE ? NumberParse::kNotANumber : NumberParse::kOutOfRange;
+  }
+  return NumberParse::kNumber;
 }
 
 }  // namespace bellows::ui

@@ -1,5 +1,7 @@
 #include "engine/config/learning_law_factory.hpp"
 
+#include <stdexcept>
+
 #include "engine/config/configuration_cost.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/learning/gradient_ilc.hpp"
@@ -23,6 +25,28 @@ std::string learning_law_description(const std::string& name) {
   if (name == "gradient") return "steepest-descent ILC along P'e";
   if (name == "inverse") return "robust inverse-model ILC with a zero-phase Q-filter";
   throw InputError("unknown learning law '" + name + "'");
+}
+
+std::vector<std::string> learning_law_weight_keys(const std::string& name) {
+  if (name == "noilc" || name == "noilc-dense") return {"m", "s", "w"};
+  if (name == "noilc-constrained") {
+    return {"m", "s", "w", "admm_rho", "admm_max_iterations", "admm_tolerance", "limit_margin_bar", "limit_recovery_s"};
+  }
+  if (name == "pd") return {"pd_kp", "pd_kd_s", "pd_q_cutoff_hz"};
+  if (name == "gradient") return {"gradient_step"};
+  if (name == "inverse") return {"inverse_gain", "inverse_q_cutoff_hz"};
+  throw InputError("unknown learning law '" + name + "'");
+}
+
+LearnedWith learned_with(const Configuration& config) {
+  LearnedWith out{config.ilc.law, {}};
+  Configuration copy = config;  // the bindings point into a Configuration they may change
+  for (const std::string& key : learning_law_weight_keys(config.ilc.law)) {
+    const ParameterBinding* binding = find_parameter("ilc", key);
+    if (binding == nullptr) throw std::logic_error("learned_with: no [ilc] " + key + " in the configuration table");
+    out.weights.emplace_back(key, binding->real ? *binding->real(copy) : static_cast<double>(*binding->integer(copy)));
+  }
+  return out;
 }
 
 std::unique_ptr<LearningLaw> make_learning_law(const Configuration& config, const DiscreteArmModel& model, int samples) {

@@ -144,24 +144,61 @@ void ControlCore::run_sample(const SensorReading& reading) {
       s.setpoint_b_bar(k) = c.setpoints.b_bar;
     }
   }
-  if (recording && k == trajectory_->learning_samples()) {
-    record_->complete = true;
-    hold(trajectory_->setpoint_rad(k));
-  }
+  if (recording) end_trial_at(k);
 }
 
-ValveCommand ControlCore::tick(const SensorReading& reading) {
+void ControlCore::end_trial_at(int k) {
+  if (k != trajectory_->learning_samples()) return;
+  record_->complete = true;
+  hold(trajectory_->setpoint_rad(k));
+}
+
+void ControlCore::hold_sample(const SensorReading& last) {
+  if (trajectory_ == nullptr) return;  // holding: the hold angle stays
+  const int k = sample_;
+  record_->held[static_cast<std::size_t>(k)] = 1;
+  ++record_->held_samples;
+  for (int j = 0; j < joints_; ++j) {
+    JointLoop& c = loop(j);
+    const JointReading& r = last.joint[static_cast<std::size_t>(j)];
+    c.desired_rad = trajectory_->joint_angle_rad(j)(k);
+    TrialSamples& s = record_->joint_samples(j);
+    s.time_s(k) = k * trajectory_->sample_time_s;
+    s.setpoint_rad(k) = c.desired_rad;
+    s.angle_rad(k) = r.angle_rad;  // the last reading: no measurement of this sample
+    s.error_rad(k) = 0.0;          // not learned from
+    s.pressure_a_bar(k) = r.chamber_bar[0];
+    s.pressure_b_bar(k) = r.chamber_bar[1];
+    const int in_force = k > 0 ? k - 1 : 0;  // the inputs and set points in force
+    s.u_pid_bar(k) = k > 0 ? s.u_pid_bar(in_force) : 0.0;
+    s.u_ilc_bar(k) = k > 0 ? s.u_ilc_bar(in_force) : 0.0;
+    s.u_total_bar(k) = c.u_total_bar;
+    s.setpoint_a_bar(k) = c.setpoints.a_bar;
+    s.setpoint_b_bar(k) = c.setpoints.b_bar;
+  }
+  end_trial_at(k);
+}
+
+ValveCommand ControlCore::tick(const SensorReading& reading) { return step(reading, true); }
+
+ValveCommand ControlCore::tick_held(const SensorReading& last) { return step(last, false); }
+
+ValveCommand ControlCore::step(const SensorReading& reading, bool fresh) {
   // A reading of another arm: nothing of it may drive these controllers (see the header).
   if (reading.joint_count != joints_) return ValveCommand::vented(joints_);
-  if (tick_in_sample_ == 0) run_sample(reading);
+  if (tick_in_sample_ == 0) {
+    if (fresh) run_sample(reading);
+    else hold_sample(reading);
+  }
   const bool recording = trajectory_ != nullptr;
   ValveCommand command;
   command.joint_count = joints_;
   for (int j = 0; j < joints_; ++j) {
     JointLoop& c = loop(j);
     const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
-    const DutyCycles a = c.pressure_a.step(c.setpoints.a_bar, r.chamber_bar[0], reading.supply_bar);
-    const DutyCycles b = c.pressure_b.step(c.setpoints.b_bar, r.chamber_bar[1], reading.supply_bar);
+    // Held: every valve closed, the pressure controllers not stepped on a reading they have seen.
+    const DutyCycles a = fresh ? c.pressure_a.step(c.setpoints.a_bar, r.chamber_bar[0], reading.supply_bar) : DutyCycles{};
+    const DutyCycles b = fresh ? c.pressure_b.step(c.setpoints.b_bar, r.chamber_bar[1], reading.supply_bar) : DutyCycles{};
     JointValves& valves = command.joint[static_cast<std::size_t>(j)];
     valves.inlet_duty = {a.inlet, b.inlet};
     valves.outlet_duty = {a.outlet, b.outlet};

@@ -68,6 +68,12 @@ class ControlCore {
   void abort_trial();
 
   ValveCommand tick(const SensorReading& reading);
+  /// A tick without a fresh reading (`last`: the device's last one): no controller runs, every
+  /// valve closes (nothing can inflate; the chambers keep their air, so the arm stays near where it
+  /// was and control resumes from there), and the trial's clock goes on. A sample that falls on such
+  /// a tick is recorded as held (TrialRecord::held): its error is 0, as at k = 0, so that no learning
+  /// law learns from it; its inputs and set points are those in force (the previous sample's).
+  ValveCommand tick_held(const SensorReading& last);
 
   /// The joints the core drives (J).
   int joints() const { return joints_; }
@@ -107,7 +113,11 @@ class ControlCore {
   void reset_loop(JointLoop& loop) const;
   void start(const Trajectory& trajectory, const double* correction_bar, Eigen::Index rows, Eigen::Index columns,
              TrialRecord& record);
+  ValveCommand step(const SensorReading& reading, bool fresh);
   void run_sample(const SensorReading& reading);
+  void hold_sample(const SensorReading& last);
+  /// Sample k's end of the trial: the record complete, the trajectory's end held.
+  void end_trial_at(int k);
   double correction_bar(int sample, int joint) const;
 
   ControllerParameters controller_;

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "engine/base/joints.hpp"
+#include "engine/control/fault_code.hpp"
 
 namespace bellows {
 
@@ -20,6 +21,12 @@ struct JointReading {
 /// One reading of every sensor, taken at the start of a tick. Fixed capacity (kMaxJoints joints,
 /// no allocation); joints [0, joint_count) are read, the rest stay zero. Supply and temperature
 /// are shared by all joints.
+///
+/// "No reading this tick": a device with nothing new returns its last reading again, with the same
+/// `time_s` (a reading is fresh exactly when its time_s is above the last one the engine saw). The
+/// engine then holds the valves (inlets and outlets closed: nothing can inflate) and runs no
+/// controller on it; [safety] stale_ticks such ticks in a row are a fault, named by
+/// Device::explain_silence().
 struct SensorReading {
   double time_s = 0.0;        // device time of the reading
   int joint_count = 1;
@@ -109,6 +116,23 @@ class Device {
   virtual DeviceHealth health() const { return {}; }
   /// The raw inputs beside their calibrated values; any thread. Empty where there are no volts.
   virtual RawInputs raw_inputs() const { return {}; }
+
+  // ---- faults the device finds itself (engine thread, every tick; neither may allocate) ----
+  /// A fault the device found since the last call: the rig's own trip with its reason and joint
+  /// (kRigLimit, kRigTimeout, kRigFault), a refused request (kDeviceError), a link it knows is gone
+  /// (kLinkLost). Fills `fault` and returns true once per fault; the engine latches it (venting)
+  /// while the valves are live and ignores it otherwise. Default: none.
+  virtual bool take_fault(DeviceFault& fault) {
+    (void)fault;
+    return false;
+  }
+  /// Why no fresh reading came for `silent_s` (the engine's stale limit reached): asked once, just
+  /// before the engine faults. A device with a link that heard nothing at all in that time says
+  /// kLinkLost, naming itself (the rig, the address) and how long it has been silent; one whose
+  /// link answers with frozen values leaves the default, kSensorStale.
+  virtual void explain_silence(double silent_s, DeviceFault& fault) const {
+    fault.set(FaultCode::kSensorStale, -1, "no fresh reading for %.0f ms: %s", silent_s * 1e3, fault_message(FaultCode::kSensorStale));
+  }
 };
 
 }  // namespace bellows

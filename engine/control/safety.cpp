@@ -5,40 +5,6 @@
 
 namespace bellows {
 
-const char* fault_name(FaultCode code) {
-  switch (code) {
-    case FaultCode::kNone: return "none";
-    case FaultCode::kEmergencyStop: return "emergency-stop";
-    case FaultCode::kAngleLimit: return "angle-limit";
-    case FaultCode::kOverpressure: return "overpressure";
-    case FaultCode::kSupplyLow: return "supply-low";
-    case FaultCode::kSensorNotANumber: return "sensor-nan";
-    case FaultCode::kSensorOutOfRange: return "sensor-range";
-    case FaultCode::kSensorStale: return "sensor-stale";
-    case FaultCode::kMissedDeadlines: return "missed-deadlines";
-    case FaultCode::kHeartbeatLost: return "heartbeat-lost";
-  }
-  return "unknown";
-}
-
-const char* fault_message(FaultCode code) {
-  switch (code) {
-    case FaultCode::kNone: return "no fault";
-    case FaultCode::kEmergencyStop: return "emergency stop requested by the operator";
-    case FaultCode::kAngleLimit: return "the arm went beyond its angle limit";
-    case FaultCode::kOverpressure: return "a chamber pressure exceeded p_max plus the safety margin";
-    case FaultCode::kSupplyLow: return "the supply pressure is too low to control the arm";
-    case FaultCode::kSensorNotANumber: return "a sensor reading is not a number";
-    case FaultCode::kSensorOutOfRange: return "a sensor reading is outside its plausible range";
-    case FaultCode::kSensorStale: return "the sensors stopped updating";
-    case FaultCode::kMissedDeadlines:
-      return "the control loop missed [safety] missed_deadline_streak deadlines in a row: lighten the machine's "
-             "load, run with --rt enforce (real-time scheduling), or raise [safety] missed_deadline_streak";
-    case FaultCode::kHeartbeatLost: return "the console stopped responding";
-  }
-  return "unknown fault";
-}
-
 GuardFault find_guard_fault(const SensorReading& r, const GuardInputs& in, const SafetyParameters& limits) {
   constexpr double kDeg = std::numbers::pi / 180.0;
   if (in.stale_count >= limits.stale_ticks) return {FaultCode::kSensorStale, -1};

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "engine/control/device.hpp"
+#include "engine/control/fault_code.hpp"
 
 namespace bellows {
 
@@ -20,7 +21,10 @@ struct SafetyParameters {
   double sensor_min_bar = 0.5;            // plausible range of any pressure reading
   double sensor_max_bar = 10.0;
   double sensor_max_angle_deg = 180.0;    // plausible range of the encoder
-  int stale_ticks = 3;                    // readings whose time did not advance
+  // Ticks in a row without a fresh reading: held (valves closed) below it, a fault at it. 8 ticks =
+  // 40 ms at 200 Hz: below the rig's own 50 ms command timeout, and a chamber filling at the full
+  // inlet flow gains < 0.1 bar in it (docs/architecture.md, "Riding through missing readings").
+  int stale_ticks = 8;
   int missed_deadline_streak = 5;         // consecutive ticks that missed their deadline
   double heartbeat_timeout_s = 1.0;       // console silent for longer: fault
   double black_box_s = 2.0;               // ticks kept for the fault record
@@ -31,23 +35,6 @@ struct SafetyParameters {
     return own ? joint_angle_limit_deg[static_cast<std::size_t>(joint)] : angle_limit_deg;
   }
 };
-
-enum class FaultCode : std::uint8_t {
-  kNone,
-  kEmergencyStop,
-  kAngleLimit,
-  kOverpressure,
-  kSupplyLow,
-  kSensorNotANumber,
-  kSensorOutOfRange,
-  kSensorStale,
-  kMissedDeadlines,
-  kHeartbeatLost,
-};
-
-/// A short stable name ("overpressure") and a sentence for the operator.
-const char* fault_name(FaultCode code);
-const char* fault_message(FaultCode code);
 
 /// What the guards need to know besides the reading.
 struct GuardInputs {

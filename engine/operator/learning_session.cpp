@@ -25,6 +25,7 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record, const
                                  double ambient_bar, double p_max_bar) {
   IterationSummary s;
   s.iteration = iteration;
+  s.held_samples = record.held_samples;
   const int joints = record.joints();
   s.joint_rms_deg.resize(joints);
   for (int j = 0; j < joints; ++j) s.joint_rms_deg(j) = record.joint_rms_error_deg(j);

@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/rt/engine_driver.hpp"
@@ -20,6 +22,16 @@
 
 namespace bellows {
 
+/// The law and weights that learned the correction a trial applied: a study changes them between
+/// trials, and each saved iteration says which it was (the manifest's `learned_with`). An empty law:
+/// not learned (iteration 0, a transferred correction) or not recorded (sessions saved before).
+struct LearnedWith {
+  std::string law;
+  std::vector<std::pair<std::string, double>> weights;  // the [ilc] keys the law reads, table order
+  bool known() const { return !law.empty(); }
+  bool operator==(const LearnedWith&) const = default;
+};
+
 /// What one iteration achieved, as the run reports it. With several joints the figures are over
 /// every joint (and `joint_rms_deg` has each joint's); with one they are its own.
 struct IterationSummary {
@@ -29,6 +41,8 @@ struct IterationSummary {
   double max_abs_correction_bar = 0.0;  // of the correction applied in this trial
   int saturated_samples = 0;            // samples (of any joint) whose total input was clamped
   JointVector joint_rms_deg = JointVector::Zero(1);  // per joint, samples 1..N
+  int held_samples = 0;                 // samples without a fresh reading (TrialRecord::held): error 0, not learned from
+  LearnedWith learned_with = {};        // what learned the correction it applied (callers fill it in)
 };
 
 /// `correction_bar`: N values (one joint) or N x J, one column per joint.

@@ -106,7 +106,7 @@ bool TrialRunner::observe(const EngineEvent& event) {
     case EventKind::kTrialAborted:
       if (!held || event.trial_id != status_.trial_id) return false;
       status_.fault = core_.fault();
-      status_.message = fault_message(status_.fault);
+      status_.message = event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(status_.fault));
       finish(TrialPhase::kFaulted, event.time_s);
       return true;
     case EventKind::kFault:  // a held trial ends with its kTrialAborted; an arm is refused or not

@@ -9,6 +9,12 @@ namespace {
 constexpr std::size_t kCommandCapacity = 256;
 constexpr std::size_t kEventCapacity = 1024;
 constexpr int kMaxCommandsPerTick = 16;  // bounds the work of one tick
+
+void copy_text(const char* text, FaultDetail& out) {  // truncated to fit, no allocation
+  std::size_t i = 0;
+  for (; text[i] != '\0' && i + 1 < out.size(); ++i) out[i] = text[i];
+  out[i] = '\0';
+}
 }  // namespace
 
 EngineCore::EngineCore(Device& device, const ControllerParameters& controller, const TimingParameters& timing,
@@ -54,6 +60,7 @@ void EngineCore::hand_back_trial(EventKind kind, double now_s) {
   event.record = record_;
   event.trial_id = trial_id_;
   event.from = event.to = state();
+  if (kind == EventKind::kTrialAborted && fault() != FaultCode::kNone) event.detail = fault_detail_;
   emit(event);
   record_ = nullptr;
   correction_ = nullptr;
@@ -117,7 +124,19 @@ void EngineCore::hold_trajectory(const Trajectory* trajectory, double now_s) {
   emit(event);
 }
 
+void EngineCore::enter_fault(const DeviceFault& fault, double now_s) {
+  fault_detail_ = fault.text;
+  fault_detail_.back() = '\0';
+  if (fault_detail_[0] == '\0') copy_text(fault_message(fault.code), fault_detail_);
+  latch_fault(fault.code, now_s, fault.joint);
+}
+
 void EngineCore::enter_fault(FaultCode code, double now_s, int joint) {
+  copy_text(fault_message(code), fault_detail_);
+  latch_fault(code, now_s, joint);
+}
+
+void EngineCore::latch_fault(FaultCode code, double now_s, int joint) {
   fault_joint_ = joint;
   fault_.store(code, std::memory_order_release);
   manual_ = false;
@@ -131,6 +150,7 @@ void EngineCore::enter_fault(FaultCode code, double now_s, int joint) {
   event.time_s = now_s;
   event.fault = code;
   event.fault_joint = joint;
+  event.detail = fault_detail_;
   event.from = event.to = EngineState::kFault;
   emit(event);
 }
@@ -230,6 +250,7 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       }
       fault_.store(FaultCode::kNone, std::memory_order_release);
       fault_joint_ = -1;
+      fault_detail_[0] = '\0';
       black_box_.clear();
       break;
   }
@@ -266,11 +287,23 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   for (int i = 0; i < kMaxCommandsPerTick && commands_.pop(command); ++i) apply(command, now_s, wall_s);
 
   const SensorReading reading = device_.read_sensors();
-  stale_count_ = reading.time_s > last_reading_time_s_ ? 0 : stale_count_ + 1;
+  const bool fresh = reading.time_s > last_reading_time_s_;  // else: no reading this tick (device.hpp)
+  stale_count_ = fresh ? 0 : stale_count_ + 1;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
   if (std::isfinite(reading.joint[0].angle_rad)) last_angle_rad_ = reading.joint[0].angle_rad;
   count_missed_deadlines(missed_deadlines, now_s);
 
+  // What the device found itself is taken every tick (and acted on only while the valves are live).
+  DeviceFault device_fault;
+  const bool device_faulted = device_.take_fault(device_fault);
+  if (valves_live(state()) && device_faulted) enter_fault(device_fault, now_s);
+  if (valves_live(state()) && stale_count_ >= safety_.stale_ticks) {
+    // The stale limit: the device names why (a lost link, or frozen sensors).
+    DeviceFault silence;
+    device_.explain_silence(stale_count_ * timing_.tick_s, silence);
+    if (silence.code == FaultCode::kNone) silence.code = FaultCode::kSensorStale;
+    enter_fault(silence, now_s);
+  }
   if (valves_live(state())) {
     GuardInputs inputs;
     inputs.p_max_bar = controller_.p_max_bar;
@@ -312,8 +345,11 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
           emit(event);
         }
       }
-    } else {
+    } else if (fresh) {
       valves = control_.tick(reading);
+    } else {  // ride through: the valves held closed, the trial's clock going on, until a reading returns
+      valves = control_.tick_held(reading);
+      held_ticks_.fetch_add(1, std::memory_order_relaxed);
     }
     device_.write_valves(valves);
     if (record_ != nullptr && record_->complete) {

@@ -69,6 +69,8 @@ class EngineCore {
   /// Missed deadlines the engine counted as warnings, not faults: on a device whose time follows
   /// the ticks (Device::time_follows_ticks()) a late tick harms nothing physical.
   std::uint64_t missed_deadline_warnings() const { return missed_warnings_.load(std::memory_order_relaxed); }
+  /// Ticks that had no fresh reading and held the valves (ride-through), since the start.
+  std::uint64_t held_ticks() const { return held_ticks_.load(std::memory_order_relaxed); }
 
   // ---- loop side ----
   /// One tick. `now_s`: engine (device) time; `wall_s`: monotonic wall time, for the heartbeat;
@@ -94,6 +96,10 @@ class EngineCore {
   void change_state(EngineState next, double now_s, CommandKind cause, FaultCode fault_cause = FaultCode::kNone);
   /// `joint`: the joint (0-based) the guard fired on, -1 when the fault is no joint's.
   void enter_fault(FaultCode code, double now_s, int joint = -1);
+  /// A fault with its own sentence (a device's, DeviceFault::text).
+  void enter_fault(const DeviceFault& fault, double now_s);
+  /// Both: latch `code` with the sentence in fault_detail_, vent, hand back the trial, emit.
+  void latch_fault(FaultCode code, double now_s, int joint);
   void count_missed_deadlines(int missed, double now_s);
   void hold_trajectory(const Trajectory* trajectory, double now_s);
   void hand_back_trial(EventKind kind, double now_s);
@@ -124,6 +130,7 @@ class EngineCore {
   static_assert(std::atomic<std::uint32_t>::is_always_lock_free, "the stop latch is set from signal handlers");
   std::atomic<std::uint64_t> missed_warnings_{0};
   std::atomic<std::uint64_t> tick_count_{0};
+  std::atomic<std::uint64_t> held_ticks_{0};
   std::atomic<std::uint64_t> dropped_telemetry_{0};
   std::atomic<std::uint64_t> dropped_events_{0};
 
@@ -138,6 +145,7 @@ class EngineCore {
   double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;
   int fault_joint_ = -1;  // the joint the latched fault fired on (-1: none, or no joint's)
+  FaultDetail fault_detail_{};  // the latched fault's sentence, for its events
   int missed_streak_ = 0;
   const bool time_follows_ticks_;  // the device's, read once: missed deadlines warn instead of fault
   double last_heartbeat_s_ = 0.0;

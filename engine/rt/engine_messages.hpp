@@ -116,6 +116,8 @@ struct EngineEvent {
   std::uint32_t trial_id = 0;
   SensorReading reading{};                        // kValvePulseDone: read after the pulse's last tick
   std::uint32_t count = 0;                        // kWarning: how many (e.g. deadlines missed in a row)
+  FaultDetail detail{};                           // kFault, kTrialAborted by a fault: the fault's own sentence
+                                                  // (the device's words: the rig's reason, the link's silence)
 };
 
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.

@@ -28,6 +28,8 @@ void TrialRecord::prepare(int learning_samples_count, int ticks_per_sample, int 
     joint_samples(j).resize(learning_samples_count + 1);
     joint_ticks(j).resize(static_cast<Eigen::Index>(learning_samples_count) * ticks_per_sample);
   }
+  held.assign(static_cast<std::size_t>(learning_samples_count + 1), 0);  // within its capacity: no allocation
+  held_samples = 0;
   complete = false;
 }
 

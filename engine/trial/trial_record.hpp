@@ -6,6 +6,7 @@
 // Trajectory's `more_joints_rad` does.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -33,6 +34,11 @@ struct TrialRecord {
   std::vector<TrialTicks> more_joint_ticks = {};      // joints 2..J, like more_joint_samples
   int learning_samples = 0;  // N
   bool complete = false;
+  // Samples k = 0..N taken on a tick without a fresh reading (1: held; ControlCore::tick_held):
+  // their error is 0 and nothing is learned from them. Shared by every joint (one reading for all).
+  // Sessions keep them as an event, not a column: a file without held samples is as it always was.
+  std::vector<unsigned char> held = {};
+  int held_samples = 0;  // how many of `held` are 1
 
   /// Sizes every joint's columns (zeroed). Preparing again to the same sizes allocates nothing.
   void prepare(int learning_samples_count, int ticks_per_sample, int joints = 1);

@@ -1,0 +1,179 @@
+// The engine rides through missing readings (issue 22): a tick without a fresh reading holds every
+// valve closed and runs no controller, the trial goes on and records the sample as held (error 0,
+// nothing learned from it); [safety] stale_ticks of them in a row fault, named by the device. A
+// device's own fault (the rig's trip) is latched with the device's words and joint.
+#include <cstring>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "devices/simulated_arm.hpp"
+#include "engine/config/configuration.hpp"
+#include "engine/rt/engine_core.hpp"
+#include "engine/rt/engine_driver.hpp"
+#include "tests/gappy_device.hpp"
+
+namespace bellows {
+namespace {
+
+struct GappyEngine {
+  explicit GappyEngine(const Configuration& c = Configuration{})
+      : config(c), arm(c.plant, 1), device(arm), core(device, c.controller, c.timing, c.safety), clock(core, device) {}
+  std::vector<EngineEvent> drain() {
+    std::vector<EngineEvent> events;
+    EngineEvent e;
+    while (core.poll_event(e)) events.push_back(e);
+    return events;
+  }
+  /// Arms and runs one trial of `trajectory` to its end (or a fault); the record is returned.
+  void run_trial(const Trajectory& trajectory, TrialRecord& record) {
+    correction = Eigen::VectorXd::Zero(trajectory.learning_samples());
+    record.prepare(trajectory.learning_samples(), config.timing.ticks_per_sample);
+    EXPECT_TRUE(core.send(EngineCommand::select_trajectory(trajectory)));
+    EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+    clock.step(20);
+    EXPECT_TRUE(core.send(EngineCommand::start_trial(trajectory, correction, record, 10, 7)));
+    const long ticks = 10 + static_cast<long>(trajectory.learning_samples()) * config.timing.ticks_per_sample + 20;
+    for (long i = 0; i < ticks && core.state() != EngineState::kFault; ++i) clock.step();
+  }
+  Configuration config;
+  SimulatedArm arm;
+  testing::GappyDevice device;
+  EngineCore core;
+  SimulatedClock clock;
+  Eigen::VectorXd correction;
+};
+
+TEST(EngineRideThrough, GapsShorterThanTheStaleLimitCostTheirTicksNotTheTrial) {
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  TrialRecord clean;
+  {
+    GappyEngine e;
+    e.run_trial(paper, clean);
+  }
+  GappyEngine e;
+  const int gap = e.config.safety.stale_ticks - 1;  // the longest gap that rides through
+  ASSERT_GE(gap, 1);
+  // Gaps of `gap` readings, 5 fresh ones between them, over the middle of the trial: some fall on
+  // the ILC's sample ticks (every 4th), whatever the phase.
+  e.device.lose_repeatedly(600, gap, 5, 40);
+  TrialRecord record;
+  e.run_trial(paper, record);
+  ASSERT_TRUE(clean.complete);
+  ASSERT_TRUE(record.complete) << "faulted: " << fault_name(e.core.fault());
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
+  EXPECT_EQ(e.core.held_ticks(), static_cast<std::uint64_t>(gap) * 40);
+  ASSERT_GT(record.held_samples, 0);
+  int held = 0;
+  const int tps = e.config.timing.ticks_per_sample;
+  for (int k = 0; k <= paper.learning_samples(); ++k) {
+    if (record.held[static_cast<std::size_t>(k)] == 0) continue;
+    ++held;
+    EXPECT_EQ(record.samples.error_rad(k), 0.0) << "held sample " << k << " must not be learned from";
+    if (k < paper.learning_samples()) {  // its tick held every valve closed: nothing can inflate
+      const int i = k * tps;
+      EXPECT_EQ(record.ticks.inlet_a(i), 0.0);
+      EXPECT_EQ(record.ticks.inlet_b(i), 0.0);
+      EXPECT_EQ(record.ticks.outlet_a(i), 0.0);
+      EXPECT_EQ(record.ticks.outlet_b(i), 0.0);
+    }
+  }
+  EXPECT_EQ(held, record.held_samples);
+  EXPECT_EQ(record.normalized_error().cwiseAbs().maxCoeff() > 0.0, true);
+  // Control resumed: the trial tracks about as well as without gaps.
+  EXPECT_NEAR(record.rms_error_deg(), clean.rms_error_deg(), 0.15 * clean.rms_error_deg());
+  EXPECT_EQ(clean.held_samples, 0);
+}
+
+TEST(EngineRideThrough, ALossAsLongAsTheStaleLimitVentsAndFaultsNamedByTheDevice) {
+  GappyEngine e;
+  const int limit = e.config.safety.stale_ticks;
+  e.device.lose_readings(800, 100000);
+  TrialRecord record;
+  e.run_trial(library_trajectory("paper", 0.02), record);
+  ASSERT_EQ(e.core.state(), EngineState::kFault);
+  EXPECT_EQ(e.core.fault(), FaultCode::kSensorStale);  // an in-process device: the default explanation
+  EXPECT_FALSE(record.complete);
+  EXPECT_EQ(e.core.held_ticks(), static_cast<std::uint64_t>(limit - 1));
+  bool fault_seen = false;
+  for (const EngineEvent& event : e.drain()) {
+    if (event.kind != EventKind::kFault) continue;
+    fault_seen = true;
+    EXPECT_NE(std::strstr(event.detail.data(), "no fresh reading for"), nullptr) << event.detail.data();
+  }
+  EXPECT_TRUE(fault_seen);
+  TickRecord tick;
+  e.core.read_snapshot(tick);
+  EXPECT_EQ(tick.valves.joint[0].outlet_duty[0], 1.0);  // vented
+  EXPECT_EQ(tick.valves.joint[0].outlet_duty[1], 1.0);
+}
+
+TEST(EngineRideThrough, ADevicesOwnFaultIsLatchedWithItsWordsAndJoint) {
+  GappyEngine e;
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step(10);
+  DeviceFault trip;
+  trip.set(FaultCode::kRigLimit, 0, "the rig stopped joint %d at %.0f deg beyond its range %d deg: check the chamber wiring", 1, -100.0, 100);
+  e.device.report(trip);
+  e.drain();
+  e.clock.step();
+  ASSERT_EQ(e.core.fault(), FaultCode::kRigLimit);
+  EXPECT_STREQ(fault_name(e.core.fault()), "rig-limit");
+  bool fault_seen = false;
+  for (const EngineEvent& event : e.drain()) {
+    if (event.kind != EventKind::kFault) continue;
+    fault_seen = true;
+    EXPECT_EQ(event.fault_joint, 0);
+    EXPECT_STREQ(event.detail.data(), "the rig stopped joint 1 at -100 deg beyond its range 100 deg: check the chamber wiring");
+  }
+  EXPECT_TRUE(fault_seen);
+  // Reset clears the words: the next fault has its own.
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kReset)));
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kEmergencyStop)));
+  e.clock.step();
+  for (const EngineEvent& event : e.drain()) {
+    if (event.kind == EventKind::kFault) {
+      EXPECT_STREQ(event.detail.data(), fault_message(FaultCode::kEmergencyStop));
+    }
+  }
+}
+
+TEST(EngineRideThrough, ADeviceFaultWhileVentedIsTakenButNotLatched) {
+  GappyEngine e;
+  DeviceFault trip;
+  trip.set(FaultCode::kRigTimeout, -1, "the rig vented by itself");
+  e.device.report(trip);
+  e.clock.step(3);
+  EXPECT_EQ(e.core.state(), EngineState::kSafe);
+  EXPECT_EQ(e.core.fault(), FaultCode::kNone);
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step(10);
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);  // the old report does not fire on arming
+}
+
+TEST(FaultVocabulary, EveryCodeHasAStableNameAndASentence) {
+  std::set<std::string> names;
+  for (int code = 0; code <= static_cast<int>(kLastFaultCode); ++code) {
+    const std::string name = fault_name(static_cast<FaultCode>(code));
+    EXPECT_NE(name, "unknown") << code;
+    EXPECT_TRUE(names.insert(name).second) << name << " twice";
+    EXPECT_STRNE(fault_message(static_cast<FaultCode>(code)), "unknown fault");
+  }
+  // The numbers are on the wire (telemetry_t.fault) and in black boxes: appended, never renumbered.
+  EXPECT_EQ(static_cast<int>(FaultCode::kHeartbeatLost), 9);
+  EXPECT_STREQ(fault_name(static_cast<FaultCode>(10)), "link-lost");
+  EXPECT_STREQ(fault_name(static_cast<FaultCode>(11)), "rig-limit");
+  EXPECT_STREQ(fault_name(static_cast<FaultCode>(15)), "foreign-sender");
+  EXPECT_STREQ(fault_name(static_cast<FaultCode>(16)), "rig-unavailable");
+}
+
+TEST(FaultVocabulary, ADeviceFaultsTextIsTruncatedToFit) {
+  DeviceFault f;
+  const std::string long_text(500, 'x');
+  f.set(FaultCode::kLinkLost, -1, "%s", long_text.c_str());
+  EXPECT_EQ(std::strlen(f.text.data()), kFaultDetailChars - 1);
+}
+
+}  // namespace
+}  // namespace bellows
