@@ -437,6 +437,22 @@ bool T7Device::take_refusal(std::array<char, kRefusalChars>& text) {
   return true;
 }
 
+bool T7Device::take_fault(DeviceFault& fault) {
+  std::array<char, kRefusalChars> text{};
+  if (!take_refusal(text)) return false;
+  fault.set(FaultCode::kDeviceError, -1, "%s", text.data());
+  return true;
+}
+
+void T7Device::explain_silence(double silent_s, DeviceFault& fault) const {
+  if (link_answers()) {
+    Device::explain_silence(silent_s, fault);
+    return;
+  }
+  fault.set(FaultCode::kLinkLost, -1, "the T7 at %s has answered nothing for %.0f ms: check its power and cable",
+            address_.c_str(), silent_s * 1e3);
+}
+
 bool T7Device::wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const {
   const std::uint64_t before = exchanges_.load(std::memory_order_acquire);
   const double deadline = now_s() + timeout_s;

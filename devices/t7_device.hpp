@@ -72,6 +72,12 @@ class T7Device final : public Device {
   // ---- any thread ----
   DeviceHealth health() const override;
   RawInputs raw_inputs() const override;
+  /// A request the T7 refused during the run reaches the engine as `device-error`, naming the
+  /// register and LabJack's error (take_refusal). Engine thread; allocates nothing.
+  bool take_fault(DeviceFault& fault) override;
+  /// Silent for the stale limit: `link-lost` naming the address when the link answered nothing
+  /// (down, not only late), else the default `sensor-stale`.
+  void explain_silence(double silent_s, DeviceFault& fault) const override;
   /// "host:port".
   const std::string& address() const { return address_; }
   const RigProfile& profile() const { return options_.profile; }
@@ -89,7 +95,7 @@ class T7Device final : public Device {
   /// A request the T7 refused during the run (a Modbus exception): once per refusal, its sentence
   /// naming the register and LabJack's error ("t7 HOST:PORT: writing DIO2_EF_CONFIG_A (44304)
   /// refused: ..., LabJack error 2565 EF_VALUE_GREATER_THAN_PERIOD"), for the engine's
-  /// device-error fault (Device::take_fault on branch `links`). Engine thread; allocates nothing.
+  /// device-error fault (take_fault). Engine thread; allocates nothing.
   static constexpr std::size_t kRefusalChars = 192;
   bool take_refusal(std::array<char, kRefusalChars>& text);
   /// Whether the link answered at all lately (false: it is down, not only frozen), for the

@@ -43,9 +43,11 @@ device_setup() {
     # be long against that lag (docs/rig-bring-up.md), so this rig gets longer ones. And the
     # loaded-machine guards of the t7 rig below: io-sim without real-time priority beside other
     # tests and builds can fall silent for longer than a rig may (its guards have tests of their own).
-    lcm) "$BELLOWS" io-sim --rt off >"$E2E_DIR/io-sim.out" 2>&1 & RIG_PID=$!
-         printf '[rig_check]\nfill_s = 0.1\nvalve_pulse_s = 0.1\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n' \
+    # The rig's own command timeout is loaded-machine too: a console engine stalled by a build
+    # beside it (118 ms seen) would otherwise trip the rig (rig-timeout, which has tests of its own).
+    lcm) printf '[rig_check]\nfill_s = 0.1\nvalve_pulse_s = 0.1\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n[lcm]\nrig_timeout_s = 2.0\n' \
            >"$E2E_DIR/lcm-rig.toml"
+         "$BELLOWS" io-sim --rt off --config "$E2E_DIR/lcm-rig.toml" >"$E2E_DIR/io-sim.out" 2>&1 & RIG_PID=$!
          DEVICE_ARGS=(--device lcm --config "$E2E_DIR/lcm-rig.toml") ;;
     # Loopback only, on a free port: t7-sim says which one it got on its first line.
     t7)  "$BELLOWS" t7-sim --listen 127.0.0.1:0 >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!

@@ -103,7 +103,8 @@ e2e_pid() {
 
 # The RMS list of the main screen as "iteration rms" lines.
 e2e_rms_list() {
-  e2e_screen | grep -oE ' [0-9]+ +[0-9]+\.[0-9]{3}\*?[│|]' | sed -E 's/[*│|]//g; s/^ +//; s/ +/ /'
+  # A row ends in its value, then the best's `*` or a space, then the panel's frame.
+  e2e_screen | grep -oE ' [0-9]+ +[0-9]+\.[0-9]{3}[* ]?[│|]' | sed -E 's/[*│|]//g; s/^ +//; s/ +$//; s/ +/ /'
 }
 
 # e2e_expect_falling LIST: each RMS below the one before.

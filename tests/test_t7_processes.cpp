@@ -192,10 +192,13 @@ TEST_F(T7Processes, T7SimStoppedMidTrialFaultsTheRunNamingTheLink) {
   sim->signal(SIGKILL);
   ASSERT_EQ(run->wait(30.0), 3) << run->err();
   const std::string err = run->err();
-  EXPECT_NE(err.find("sensor-stale"), std::string::npos) << err;
-  EXPECT_NE(err.find("t7 link " + address_), std::string::npos) << err;
+  // A dead link is named for what it is (issue 25): link-lost, naming the T7's address; never sensor-stale.
+  EXPECT_NE(err.find("link-lost"), std::string::npos) << err;
+  EXPECT_EQ(err.find("sensor-stale"), std::string::npos) << err;
+  EXPECT_NE(err.find("the T7 at " + address_), std::string::npos) << err;
   const nlohmann::json report = nlohmann::json::parse(run->out());
-  EXPECT_EQ(report.at("fault").at("name"), "sensor-stale");
+  EXPECT_EQ(report.at("fault").at("name"), "link-lost");
+  EXPECT_NE(report.at("fault").at("message").get<std::string>().find(address_), std::string::npos) << report.dump();
 }
 
 // A link that trickles (one byte of each answer every 0.4 s, within libmodbus' default byte
@@ -286,7 +289,9 @@ TEST_F(T7Processes, ASilentLinkFaultsTheRunAndTheWatchdogVents) {
   auto sim = start_sim({"--silent-after", "3"});
   auto run = start_run(2, "run");
   ASSERT_EQ(run->wait(60.0), 3) << run->err();
-  EXPECT_NE(run->err().find("sensor-stale"), std::string::npos) << run->err();
+  // A T7 that answers nothing is a lost link, named with its address (issue 25), not a stale sensor.
+  EXPECT_NE(run->err().find("link-lost"), std::string::npos) << run->err();
+  EXPECT_NE(run->err().find("the T7 at " + address_), std::string::npos) << run->err();
   ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; }));
   EXPECT_TRUE(status().at("safe").get<bool>());
 }
