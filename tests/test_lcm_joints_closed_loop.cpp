@@ -74,6 +74,10 @@ TEST(LcmJointClosedLoop, TheEngineDrivesArm2OverMemqAndEveryJointTracksAsInProce
   // About learning over the bus on the wall clock: a loaded 2-core machine may keep the I/O thread
   // off its core longer than the default 3 ticks (the stale guard has exact-tick tests elsewhere).
   c.safety.stale_ticks = 40;
+  // Likewise the engine's own wake-ups and the rig's command timeout (their guards have tests of
+  // their own): a build beside the suite stalls threads for longer than 5 ticks or 50 ms.
+  c.safety.missed_deadline_streak = 1000;
+  c.lcm.rig_timeout_s = 1.0;
   const Trajectory paper2 = library_trajectory("paper2", c.timing.sample_s());
   const PneumaticChainParameters arm2 = pneumatic_chain_of(c.plant, ArmParameters{"arm2"});
   SimulatedArmChain arm(arm2, 1);

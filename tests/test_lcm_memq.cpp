@@ -366,6 +366,10 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   // I/O thread can be kept off its core for more than the default 3 ticks (15 ms), which the guard
   // rightly calls stale; the stale guard has its own tests above (exact tick counts).
   c.safety.stale_ticks = 40;
+  // Likewise the engine's own wake-ups and the rig's command timeout (tested above and in
+  // LcmRigFaults): a build beside the suite stalls threads for longer than 5 ticks or 50 ms.
+  c.safety.missed_deadline_streak = 1000;
+  c.lcm.rig_timeout_s = 1.0;
   SimulatedArm arm(c.plant, 3);
   std::vector<std::string> rig_log;
   RigServer rig(arm, RigBench::parameters(c, LcmKey{}, rig_log), 77);

@@ -72,9 +72,10 @@ TEST(LcmRigFaults, SwappedChambersInsideTheGuardEndWithTheRigsTripNamed) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-swapped");
   setenv("XDG_DATA_HOME", (dir / "xdg").c_str(), 1);
-  // The lab's rig stops at 90 deg (its hardware's stops), inside the engine's guard of 95 deg.
+  // The lab's rig stops at 90 deg (its hardware's stops), inside the engine's guard of 95 deg. A
+  // build beside the suite may stall threads: not this test's subject (nor a rig timeout).
   const std::string rig_config =
-      testing::write_file(dir, "rig.toml", "[trajectory]\nmax_abs_angle_deg = 80\n[safety]\nangle_limit_deg = 85\n[lcm]\nrig_angle_limit_deg = 90\n").string();
+      testing::write_file(dir, "rig.toml", "[trajectory]\nmax_abs_angle_deg = 80\n[safety]\nangle_limit_deg = 85\nmissed_deadline_streak = 1000\n[lcm]\nrig_angle_limit_deg = 90\nrig_timeout_s = 2.0\n").string();
   const RigRun r = run_against_rig(dir, {"--swapped-chambers"}, rig_config, {"--iterations", "0", "--name", "swapped"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_EQ(r.report["fault"]["name"], "rig-limit") << r.report.dump();
@@ -95,7 +96,9 @@ TEST(LcmRigFaults, SwappedChambersInsideTheGuardEndWithTheRigsTripNamed) {
 TEST(LcmRigFaults, SwappedChambersWithTheRigsRangeOutsideTheGuardEndWithTheEnginesAngleLimit) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-swapped-wide");
-  const RigRun r = run_against_rig(dir, {"--swapped-chambers"}, "", {"--iterations", "0", "--no-save"});  // rig 100, guard 95
+  // The rig's default range (100 deg) outside the engine's guard (95); its command timeout loaded-machine.
+  const std::string rig_config = testing::write_file(dir, "rig.toml", "[lcm]\nrig_timeout_s = 2.0\n").string();
+  const RigRun r = run_against_rig(dir, {"--swapped-chambers"}, rig_config, {"--iterations", "0", "--no-save"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_EQ(r.report["fault"]["name"], "angle-limit") << r.report.dump();
   EXPECT_EQ(r.err.find("sensor-stale"), std::string::npos) << r.err;
@@ -104,8 +107,9 @@ TEST(LcmRigFaults, SwappedChambersWithTheRigsRangeOutsideTheGuardEndWithTheEngin
 TEST(LcmRigFaults, ACleanRunReportsNoLinkErrorsAndCountsTheOffersApart) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-clean");
-  // The machine's stalls are not this test's subject: ride-through and the stale limit have theirs.
-  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n").string();
+  // The machine's stalls are not this test's subject: ride-through, the stale limit and the rig's
+  // command timeout have theirs.
+  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n").string();
   const RigRun r = run_against_rig(dir, {}, config, {"--iterations", "0", "--no-save", "--config", config});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json& rig = r.report["lcm"]["rig"];
@@ -118,7 +122,7 @@ TEST(LcmRigFaults, ACleanRunReportsNoLinkErrorsAndCountsTheOffersApart) {
 TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambers) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-rig-check");
-  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n").string();
+  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n").string();
   for (const bool swapped : {false, true}) {
     std::vector<std::string> rig_argv = {kBellows, "io-sim", "--config", config};
     if (swapped) rig_argv.push_back("--swapped-chambers");
