@@ -115,6 +115,13 @@ inline std::string enter_private_network_namespace() {
   return "";
 }
 
+/// In a test body (namespace bellows): enters a private network namespace, or skips the test saying why not.
+#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                       \
+  do {                                                                                  \
+    const std::string why_not = testing::enter_private_network_namespace();            \
+    if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
+  } while (false)
+
 /// A child process with stdout and stderr in files.
 class Child {
  public:

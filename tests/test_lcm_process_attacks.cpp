@@ -27,12 +27,6 @@ using testing::Child;
 
 using testing::kBellows;
 
-#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                       \
-  do {                                                                                  \
-    const std::string why_not = testing::enter_private_network_namespace();            \
-    if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
-  } while (false)
-
 /// A host on the bus without the key, speaking the protocol. Mode kIdleRig: it takes the rig as
 /// soon as it is free and drives inlet A fully open (B vented), every 2 ms. Mode kFollow: it lets
 /// the engine bind, then sends commands of the engine's own session just ahead of its sequence.

@@ -33,12 +33,6 @@ using testing::kBellows;
 /// Sessions of the runs started here go into a fresh directory, never into a real home.
 void isolate_sessions() { setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-lcm-xdg").c_str(), 1); }
 
-#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                              \
-  do {                                                                         \
-    const std::string why_not = testing::enter_private_network_namespace();   \
-    if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
-  } while (false)
-
 template <typename Message>
 Message decode(const Recorded& recorded) {
   Message message{};

@@ -19,12 +19,6 @@ namespace {
 using testing::Child;
 using testing::kBellows;
 
-#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                   \
-  do {                                                                              \
-    const std::string why_not = testing::enter_private_network_namespace();        \
-    if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
-  } while (false)
-
 nlohmann::json report_of(const Child& child) {
   const std::string out = child.out();
   EXPECT_FALSE(out.empty()) << child.err();
