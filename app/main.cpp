@@ -273,7 +273,10 @@ int main(int argc, char** argv) {
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
+  identify_cmd->add_option("--write-model", identify.write_model_path,
+                           "Write the fit into the [model] of this config file or rig profile (created if missing; the rest of "
+                           "the file is kept; a file that holds a model already is refused without --force)");
+  identify_cmd->add_flag("--force", identify.force, "--write-model: replace the model the file holds already");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
   CLI::Option* identify_no_save = identify_cmd->add_flag("--no-save", identify.no_save, "Do not record the identification in a session");
   identify_cmd->add_option("--data-dir", identify.data_dir, "Where its session is saved (default: where runs save theirs)")
