@@ -173,6 +173,8 @@ int main(int argc, char** argv) {
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
   io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
+  io_sim_cmd->add_flag("--no-command-timeout", io_sim.no_command_timeout,
+                       "Drill: the rig announces its [lcm] rig_timeout_s but never vents when the commands stop");
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
