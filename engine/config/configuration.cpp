@@ -128,7 +128,7 @@ std::vector<ParameterBinding> make_bindings() {
       number("safety", "sensor_max_bar", "bar", "highest plausible pressure reading", pos(100.0), [](C& c) { return &c.safety.sensor_max_bar; }),
       number("safety", "sensor_max_angle_deg", "deg", "largest plausible encoder reading", pos(360.0), [](C& c) { return &c.safety.sensor_max_angle_deg; }),
       whole("safety", "stale_ticks", "ticks in a row without a fresh reading (valves held closed) before the fault: 8 x 5 ms = 40 ms, docs/architecture.md", count(100000), [](C& c) { return &c.safety.stale_ticks; }),
-      whole("safety", "missed_deadline_streak", "consecutive missed deadlines before a fault", count(1000000), [](C& c) { return &c.safety.missed_deadline_streak; }),
+      whole("safety", "missed_deadline_streak", "missed deadlines in a row before a fault (a rig whose time is its own; held below it): 8 x 5 ms = 40 ms, docs/architecture.md", count(1000000), [](C& c) { return &c.safety.missed_deadline_streak; }),
       number("safety", "heartbeat_timeout_s", "s", "console silent this long: fault", pos(3600.0), [](C& c) { return &c.safety.heartbeat_timeout_s; }),
       number("safety", "black_box_s", "s", "ticks kept before a fault", pos(60.0), [](C& c) { return &c.safety.black_box_s; }),
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", pos(180.0), [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
