@@ -72,7 +72,7 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
       continue;
     }
     const bool known = e.kind == "operator" || e.kind == "engine" || e.kind == "session" || e.kind == "fault";
-    out.push_back({local_clock_of(e.time_utc), -1.0, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
+    out.push_back({local_clock_of(e.time_utc), e.engine_time_s, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
                    e.kind == "fault", false, e.time_utc, e.iteration});
   }
   return out;
@@ -210,7 +210,9 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     header.model_source = model_source_;
     header.first_correction = first_correction_json(e);
     for (const ui::LogEntry& entry : snapshot.events) {
-      if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
+      if (worth_saving(entry)) {
+        header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text, entry.engine_time_s});
+      }
     }
     writer_.reset();  // the previous session's lock goes first
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
