@@ -3,6 +3,7 @@
 #include "engine/config/learning_law_factory.hpp"
 #include "app/memory_policy.hpp"
 
+#include <any>
 #include <cstdio>
 #include <optional>
 #include <ctime>
@@ -221,8 +222,10 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   }
   for (std::size_t i = first_trial; i < end; ++i) {
     const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
-    // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
-    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, ResumeState{});
+    // On the wall clock the controllers' state is not captured (a resume arms afresh); on --clock
+    // sim the trial carries the state it ended in (app/run_recording.hpp).
+    const auto* end_state = std::any_cast<ResumeState>(&trial_at(i).end_state);
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, end_state != nullptr ? *end_state : ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);

@@ -78,10 +78,7 @@ question 'Valve test: open each valve alone?' "$question_letters" SAFE
 e2e_keys Escape
 
 # One trial, saved: the session every later prompt must leave alone.
-e2e_keys a
-wait_text 'Arm the valves?'
-e2e_keys y
-e2e_wait_for 'Bellows +ARMED '
+e2e_arm
 e2e_keys r
 e2e_wait_for 'iteration 0  RMS' 120
 for _ in $(seq 1 100); do has_text 'unsaved' || break; sleep 0.1; done
