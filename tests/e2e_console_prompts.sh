@@ -16,17 +16,16 @@ quit_letters="$(tr -d 'yYnNqcs' <<<"$letters")"
 
 # has_text TEXT: the screen shows TEXT (fixed string).
 has_text() { e2e_screen | grep -qF -- "$1"; }
-wait_text() {
-  local deadline=$((SECONDS + E2E_WAIT_S))
-  until has_text "$1"; do
-    [ $SECONDS -lt $deadline ] || e2e_fail "no '$1' on the screen within ${E2E_WAIT_S} s"
-    sleep 0.1
-  done
-}
-wait_gone() {
-  local deadline=$((SECONDS + E2E_WAIT_S))
-  while has_text "$1"; do
-    [ $SECONDS -lt $deadline ] || e2e_fail "'$1' still on the screen after ${E2E_WAIT_S} s"
+# wait_text TEXT / wait_gone TEXT: until the screen shows TEXT (a fixed string) / no longer does.
+wait_text() { wait_screen_text shown "$1"; }
+wait_gone() { wait_screen_text gone "$1"; }
+wait_screen_text() {
+  local want="$1" text="$2" deadline=$((SECONDS + E2E_WAIT_S)) now
+  while true; do
+    now=gone
+    has_text "$text" && now=shown
+    [ "$now" = "$want" ] && return 0
+    [ $SECONDS -lt $deadline ] || e2e_fail "'$text' not $want on the screen within ${E2E_WAIT_S} s"
     sleep 0.1
   done
 }

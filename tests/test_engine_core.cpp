@@ -85,16 +85,23 @@ TEST(EngineCore, FaultLatchesUntilResetAndResetNeedsAFreshArm) {
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
 }
 
-TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
-  EngineFixture f;
-  const Trajectory paper = library_trajectory("paper", 0.02);
+/// A trial of the paper trajectory with no correction, armed and sent as trial `trial_id`.
+struct PaperTrial {
+  Trajectory paper = library_trajectory("paper", 0.02);
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
   TrialRecord record;
-  record.prepare(paper.learning_samples(), 4);
-  f.send(CommandKind::kArm);
-  f.clock.step();
-  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 0, 42);
-  EXPECT_TRUE(f.core.send(start));
+  PaperTrial(EngineFixture& f, std::uint32_t trial_id) {
+    record.prepare(paper.learning_samples(), 4);
+    f.send(CommandKind::kArm);
+    f.clock.step();
+    EXPECT_TRUE(f.core.send(EngineCommand::start_trial(paper, correction, record, 0, trial_id)));
+  }
+};
+
+TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
+  EngineFixture f;
+  PaperTrial trial(f, 42);
+  TrialRecord& record = trial.record;
   f.clock.step(100);
   EXPECT_EQ(f.core.state(), EngineState::kRunning);
   f.drain_events();
@@ -111,13 +118,8 @@ TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
 
 TEST(EngineCore, ATrialsEndIsReportedAsItsOwnCauseNotAsTheStartCommand) {
   EngineFixture f;
-  const Trajectory paper = library_trajectory("paper", 0.02);
-  Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
-  TrialRecord record;
-  record.prepare(paper.learning_samples(), 4);
-  f.send(CommandKind::kArm);
-  f.clock.step();
-  ASSERT_TRUE(f.core.send(EngineCommand::start_trial(paper, correction, record, 0, 7)));
+  PaperTrial trial(f, 7);
+  const TrialRecord& record = trial.record;
   std::vector<EngineEvent> events;
   for (int i = 0; i < 20000 && !record.complete; ++i) {
     f.clock.step();
