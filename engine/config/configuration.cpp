@@ -150,6 +150,7 @@ std::vector<ParameterBinding> make_bindings() {
       number("rig_check", "fill_s", "s", "both inlets open before an outlet's test (air to let out)", pos(10.0), [](C& c) { return &c.rig_check.fill_s; }),
       number("rig_check", "valve_pulse_s", "s", "how long the valve under test opens, alone", pos(10.0), [](C& c) { return &c.rig_check.valve_pulse_s; }),
       number("rig_check", "min_change_bar", "bar", "a chamber moved: by at least this, and this much more than the other", pos(10.0), [](C& c) { return &c.rig_check.min_change_bar; }),
+      number("rig_check", "timeout_tolerance_s", "s", "`rig check --device lcm`: the rig's command timeout, provoked, acts within [lcm] rig_timeout_s +- this", pos(60.0), [](C& c) { return &c.rig_check.timeout_tolerance_s; }),
       whole("rig_check", "zero_readings", "`rig check --zero-angle` averages this many fresh readings, the arm at rest", count(1000000), [](C& c) { return &c.rig_check.zero_readings; }),
       number("t7", "response_timeout_s", "s", "one Modbus request to the T7 waits this long for its answer", pos(1.0), [](C& c) { return &c.t7.response_timeout_s; }),
       number("t7", "connect_timeout_s", "s", "connecting to the T7 and configuring it may take this long", pos(3600.0), [](C& c) { return &c.t7.connect_timeout_s; }),
