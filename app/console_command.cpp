@@ -1,5 +1,6 @@
 #include "app/console_command.hpp"
 
+#include <any>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include "app/config_file.hpp"
 #include "app/console_sessions.hpp"
+#include "app/run_recording.hpp"
 #include "app/device_factory.hpp"
 #include "app/learning_model.hpp"
 #include "app/rig_profile_write.hpp"
@@ -141,6 +143,22 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location, int iterations) {
     return write_console_figures(location, iterations, root, [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
   };
+  if (simulated_time) {
+    setup.environment.capture_trial_end = [&core, &opened = *rig, &simulated_clock] {
+      return std::any(capture_resume_state(core, opened.simulated_arm(), opened.simulated_arm_chain(), &simulated_clock));
+    };
+  }
+  if (simulated_time && setup.session) {
+    const std::string location = setup.session->experiment.session_location;
+    setup.environment.arm_where_saved = [&core, &opened = *rig, &simulated_clock, location]() -> std::string {
+      const SessionManifest manifest = load_manifest(location);
+      if (!can_restore_exactly(manifest)) return "the session holds no engine state to continue from (recorded on the wall clock)";
+      if (core.ticks() != 0) return "the engine has run since the session was opened";
+      restore_resume_state(manifest, opened.simulated_arm(), opened.simulated_arm_chain(), core, &simulated_clock,
+                           "session " + location + ": manifest.json");
+      return "";
+    };
+  }
   setup.environment.seed = seed;
   setup.environment.stop_after_rises = options.stop_after_rises;
   setup.stop_flag = &stop_requested();

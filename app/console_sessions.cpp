@@ -3,6 +3,7 @@
 #include "engine/config/learning_law_factory.hpp"
 #include "app/memory_policy.hpp"
 
+#include <any>
 #include <cstdio>
 #include <optional>
 #include <ctime>
@@ -72,7 +73,7 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
       continue;
     }
     const bool known = e.kind == "operator" || e.kind == "engine" || e.kind == "session" || e.kind == "fault";
-    out.push_back({local_clock_of(e.time_utc), -1.0, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
+    out.push_back({local_clock_of(e.time_utc), e.engine_time_s, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
                    e.kind == "fault", false, e.time_utc, e.iteration});
   }
   return out;
@@ -210,7 +211,9 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     header.model_source = model_source_;
     header.first_correction = first_correction_json(e);
     for (const ui::LogEntry& entry : snapshot.events) {
-      if (worth_saving(entry)) header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text});
+      if (worth_saving(entry)) {
+        header.events.push_back({entry.time_utc, entry.iteration, kind_of(entry), entry.text, entry.engine_time_s});
+      }
     }
     writer_.reset();  // the previous session's lock goes first
     writer_.emplace(SessionWriter::create(data_dir_, "", std::move(header), *e.trajectory, kPurpose));
@@ -219,8 +222,10 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   }
   for (std::size_t i = first_trial; i < end; ++i) {
     const Eigen::MatrixXd& next = i + 1 < end ? trial_at(i + 1).correction_bar : e.next_correction_bar;
-    // The console runs on the wall clock: the controllers' state is not captured, a resume arms afresh.
-    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, ResumeState{});
+    // On the wall clock the controllers' state is not captured (a resume arms afresh); on --clock
+    // sim the trial carries the state it ended in (app/run_recording.hpp).
+    const auto* end_state = std::any_cast<ResumeState>(&trial_at(i).end_state);
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, end_state != nullptr ? *end_state : ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);

@@ -21,6 +21,42 @@ std::filesystem::path data_dir_of(const RunOptions& options) {
 
 }  // namespace
 
+ResumeState capture_resume_state(EngineCore& core, const SimulatedArm* arm, const SimulatedArmChain* chain,
+                                 const SimulatedClock* clock) {
+  ResumeState resume;
+  if (clock == nullptr || (arm == nullptr && chain == nullptr)) return resume;
+  resume.controller = core.control().state();
+  resume.device = chain != nullptr ? chain_state_to_json(*chain) : arm_state_to_json(*arm);
+  resume.clock_ticks = clock->ticks();
+  return resume;
+}
+
+bool can_restore_exactly(const SessionManifest& manifest) {
+  return !manifest.iterations.empty() && manifest.resume && manifest.resume->exact();
+}
+
+void restore_resume_state(const SessionManifest& m, SimulatedArm* arm, SimulatedArmChain* chain, EngineCore& core,
+                          SimulatedClock* clock, const std::string& source) {
+  double arm_time_s = 0.0;
+  if (chain != nullptr) {
+    restore_chain_state(*chain, m.resume->device, source);
+    arm_time_s = chain->chain().state().time_s;
+  } else if (arm != nullptr) {
+    restore_arm_state(*arm, m.resume->device, source);
+    arm_time_s = arm->state().time_s;
+  }
+  if (clock != nullptr) {
+    // A first-format session did not record the clock: it ticked with the arm from 0, so the
+    // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
+    const double arm_ticks = arm_time_s / m.configuration.timing.tick_s;
+    if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
+      throw InputError(source + ": /resume/device/time_s: expected the arm's time since it started, at least 0");
+    }
+    clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
+  }
+  core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
+}
+
 RunRecording::RunRecording(const RunOptions& options) : options_(options), resuming_(!options.resume_dir.empty()) {
   if (!resuming_) return;
   std::filesystem::path data_dir;
@@ -77,21 +113,6 @@ void RunRecording::require_joints(int joints, const std::string& arm) const {
   }
 }
 
-void RunRecording::restore_clock_and_core(double arm_time_s, EngineCore& core, SimulatedClock* clock) {
-  const SessionManifest& m = resumed_.manifest;
-  if (clock != nullptr) {
-    // A first-format session did not record the clock: it ticked with the arm from 0, so the
-    // arm's time in ticks is the clock's (rounded away from the sum's last-place errors).
-    const double arm_ticks = arm_time_s / m.configuration.timing.tick_s;
-    if (!m.resume->clock_ticks && !(arm_ticks >= 0.0 && arm_ticks < 1e15)) {
-      throw InputError("session " + resumed_.directory.string() + ": " + session_layout::kManifest +
-                       ": /resume/device/time_s: expected the arm's time since it started, at least 0");
-    }
-    clock->set_ticks(m.resume->clock_ticks ? *m.resume->clock_ticks : std::llround(arm_ticks));
-  }
-  core.restore_armed(*m.resume->controller, clock != nullptr ? clock->now_s() : 0.0);
-}
-
 void RunRecording::record_resumption() {
   writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
                                       " more iterations");
@@ -102,9 +123,8 @@ void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* 
   require_joints(learning.joints(), "an arm");
   const SessionManifest& m = resumed_.manifest;
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
-    if (m.resume && m.resume->exact() && arm != nullptr) {
-      restore_arm_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
-      restore_clock_and_core(arm->state().time_s, core, clock);
+    if (can_restore_exactly(m) && arm != nullptr) {
+      restore_resume_state(m, arm, nullptr, core, clock, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
     }
     learning.set_correction(resumed_corrections_bar(), static_cast<int>(m.iterations.size()));
     learning.set_history(resumed_history());
@@ -126,9 +146,8 @@ void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedCl
   if (!resuming_) return;
   const SessionManifest& m = resumed_.manifest;
   if (arm != nullptr) require_joints(arm->joints(), "a simulated arm");
-  if (!resumed_.iterations.empty() && m.resume && m.resume->exact() && arm != nullptr) {
-    restore_chain_state(*arm, m.resume->device, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
-    restore_clock_and_core(arm->chain().state().time_s, core, clock);
+  if (!resumed_.iterations.empty() && can_restore_exactly(m) && arm != nullptr) {
+    restore_resume_state(m, nullptr, arm, core, clock, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
   }
   record_resumption();
 }
@@ -148,13 +167,9 @@ std::vector<IterationSummary> RunRecording::resumed_history() const {
 void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArm* arm,
                         EngineCore& core, const SimulatedClock* clock) {
   if (!writer_) return;
-  ResumeState resume;
-  if (clock != nullptr && arm != nullptr) {  // same thread as the engine: its state is quiet between trials
-    resume.controller = core.control().state();
-    resume.device = arm_state_to_json(*arm);
-    resume.clock_ticks = clock->ticks();
-  }
-  writer_->save_iteration(learning.last_record(), summary, learning.joint_corrections_bar(), std::move(resume));
+  // Same thread as the engine: its state is quiet between trials.
+  writer_->save_iteration(learning.last_record(), summary, learning.joint_corrections_bar(),
+                          capture_resume_state(core, arm, nullptr, clock));
 }
 
 void RunRecording::save(const LearningSession& learning, const IterationSummary& summary, const SimulatedArmChain* arm,
@@ -165,13 +180,8 @@ void RunRecording::save(const LearningSession& learning, const IterationSummary&
 void RunRecording::save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar, const IterationSummary& summary,
                         const SimulatedArmChain* arm, EngineCore& core, const SimulatedClock* clock) {
   if (!writer_) return;
-  ResumeState resume;
-  if (clock != nullptr && arm != nullptr) {  // as above: between trials, on the engine's thread
-    resume.controller = core.control().state();
-    resume.device = chain_state_to_json(*arm);
-    resume.clock_ticks = clock->ticks();
-  }
-  writer_->save_iteration(record, summary, corrections_bar, std::move(resume));
+  // As above: between trials, on the engine's thread.
+  writer_->save_iteration(record, summary, corrections_bar, capture_resume_state(core, nullptr, arm, clock));
 }
 
 void RunRecording::fault(const std::string& what) noexcept {

@@ -18,6 +18,28 @@
 
 namespace bellows {
 
+// A simulated run's exact state between trials, for a resume that continues bit for bit: what
+// `bellows run` saves after each iteration and `run --resume` puts back, and what `bellows console
+// --clock sim` saves with each trial and puts back when it arms a reopened session. One capture and
+// one restore for both.
+
+/// The controllers' state, the simulated arm's (one joint: `arm`, several: `chain`; the other null)
+/// and the clock's ticks, read on the engine's thread between trials (its state is quiet then).
+/// Without a clock or an arm (the wall clock, a rig) nothing is captured: such a session resumes
+/// with its correction and freshly armed controllers.
+ResumeState capture_resume_state(EngineCore& core, const SimulatedArm* arm, const SimulatedArmChain* chain,
+                                 const SimulatedClock* clock);
+
+/// Whether `manifest` holds what restore_resume_state() needs: an exact resume state, after at
+/// least one iteration.
+bool can_restore_exactly(const SessionManifest& manifest);
+
+/// Before the engine's first tick: the arm (or chain), the clock and the engine (ARMED, with its
+/// controllers' state) where the session stopped. `source` prefixes errors ("session DIR:
+/// manifest.json"). Throws InputError for a state that does not fit the arm.
+void restore_resume_state(const SessionManifest& manifest, SimulatedArm* arm, SimulatedArmChain* chain, EngineCore& core,
+                          SimulatedClock* clock, const std::string& source);
+
 class RunRecording {
  public:
   /// With --resume: takes the session's lock and loads it (InputError if busy or bad).
@@ -88,7 +110,6 @@ class RunRecording {
  private:
   /// The clock and the controllers where the session stopped (`arm_time_s`: the arm's own time,
   /// for a first-format session without the clock's ticks).
-  void restore_clock_and_core(double arm_time_s, EngineCore& core, SimulatedClock* clock);
   void record_resumption();
   /// Throws InputError unless the resumed session has `joints` joints (`arm` says which arm).
   void require_joints(int joints, const std::string& arm) const;

@@ -23,6 +23,7 @@
 #include "engine/control/safety.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/manifest_json.hpp"
+#include "sessions/session_event_record.hpp"
 #include "sessions/session_export.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_lock.hpp"
@@ -182,9 +183,7 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
     Json iterations = Json::array();
     for (const IterationEntry& entry : m.iterations) iterations.push_back(summary_json(entry));
     Json events = Json::array();
-    for (const SessionEvent& e : m.events) {
-      events.push_back({{"time_utc", e.time_utc}, {"iteration", e.iteration}, {"kind", e.kind}, {"message", e.message}});
-    }
+    for (const SessionEvent& e : m.events) events.push_back(event_to_json(e));
     Json black_boxes = Json::array();
     for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
       const BlackBoxEntry& b = m.black_boxes[i];

@@ -9,6 +9,7 @@
 #include "engine/config/learning_law_factory.hpp"
 #include "engine/base/errors.hpp"
 #include "sessions/file_digest.hpp"
+#include "sessions/session_event_record.hpp"
 #include "sessions/session_layout.hpp"
 
 namespace bellows {
@@ -153,14 +154,6 @@ IterationEntry summary_from_json(const JsonReader& r, int index, int samples) {
   entry.telemetry_sha256 = digest_from_json(r, "telemetry_sha256");
   if (r.has("learned_with")) s.learned_with = learned_with_from_json(r["learned_with"]);
   return entry;
-}
-
-Json event_to_json(const SessionEvent& e) {
-  return {{"time_utc", e.time_utc}, {"iteration", e.iteration}, {"kind", e.kind}, {"message", e.message}};
-}
-
-SessionEvent event_from_json(const JsonReader& r) {
-  return {r["time_utc"].text(), r["iteration"].integer(0, kMostIterations), r["kind"].text(), r["message"].text()};
 }
 
 Json black_box_to_json(const BlackBoxEntry& b, int index) {

@@ -37,6 +37,7 @@ struct SessionEvent {
   int iteration = 0;     // the iteration running or next to run when it happened
   std::string kind;      // "start", "resume", "finish", "fault", "configuration", "note", ...
   std::string message;
+  double engine_time_s = -1.0;  // the engine's time when it happened, when known (console log lines); else negative
 };
 
 /// A fault's black box as the manifest lists it; its ticks are in session_layout::black_box_file().

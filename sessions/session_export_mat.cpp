@@ -3,8 +3,10 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -19,6 +21,7 @@
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/record_columns.hpp"
+#include "sessions/session_event_record.hpp"
 #include "sessions/session_export.hpp"
 
 namespace bellows {
@@ -141,13 +144,26 @@ MatVar session_struct(const Session& session) {
             columns_struct({"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples"},
                            {iteration, rms, max_error, max_correction, saturated}));
 
-  MatVar events = structure({"time_utc", "iteration", "kind", "message"}, m.events.size());
+  // The event record's fields (session_event_record.hpp); an optional one only when some event has
+  // it, NaN in the others (a struct array's elements share their fields).
+  std::vector<const EventField*> event_fields;
+  std::vector<std::string> event_names;
+  for (const EventField& f : event_record_fields()) {
+    if (f.optional && std::none_of(m.events.begin(), m.events.end(), f.known)) continue;
+    event_fields.push_back(&f);
+    event_names.emplace_back(f.name);
+  }
+  MatVar events = structure(event_names, m.events.size());
   for (std::size_t e = 0; e < m.events.size(); ++e) {
-    const SessionEvent& event = m.events[e];
-    set_field(events.get(), "time_utc", e, text(event.time_utc));
-    set_field(events.get(), "iteration", e, scalar(event.iteration));
-    set_field(events.get(), "kind", e, text(event.kind));
-    set_field(events.get(), "message", e, text(event.message));
+    for (const EventField* f : event_fields) {
+      const std::string name(f->name);
+      if (!f->known(m.events[e])) {
+        set_field(events.get(), name, e, scalar(std::numeric_limits<double>::quiet_NaN()));
+      } else {
+        const nlohmann::ordered_json value = f->value(m.events[e]);
+        set_field(events.get(), name, e, f->text ? text(value.get<std::string>()) : scalar(value.get<double>()));
+      }
+    }
   }
   set_field(out.get(), "events", 0, std::move(events));
   return out;

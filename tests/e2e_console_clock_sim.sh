@@ -1,32 +1,45 @@
 #!/usr/bin/env bash
-# Issue 23, reproducible numbers: `bellows console --clock sim --speed max`, arm, N 10: the session the
-# console saved holds exactly the RMS values of `bellows run --iterations 10 --json` with the same
-# seed (to the last digit: the JSON's shortest round-trip numbers compared as text), and the header
-# says which clock runs. Every saved iteration after the first records the law and weights it was
-# learned with (the manifest's learned_with).
+# Issue 23, reproducible numbers: `bellows console --clock sim --speed max`, arm, N 5, quit; the
+# session reopened in the console with --clock sim, arm (where it stopped: the engine, the arm and
+# the clock as `run --resume` puts them), N 5 more: the session holds exactly the RMS values of
+# `bellows run --iterations 10 --json` with the same seed (to the last digit: the JSON's shortest
+# round-trip numbers compared as text), and the header says which clock runs. Every saved
+# iteration after the first records the law and weights it was learned with (learned_with).
 source "$(dirname "$0")/e2e_console_lib.sh"
 
 seed=7
+# arm_and_run_5 SPAN: arm, N 5, until "iterations SPAN done".
+arm_and_run_5() {
+  e2e_arm
+  e2e_keys N
+  e2e_wait_for 'Run K iterations'
+  e2e_keys BSpace BSpace BSpace 5 Enter
+  e2e_wait_for "iterations $1 done" 600
+}
 e2e_start 120 40 -- console --clock sim --speed max --seed "$seed"
 e2e_wait_for 'Bellows +SAFE '
 e2e_wait_for 'sim clock'
 e2e_wait_for 'law [a-z-]+'  # the header names the law once it is ready
 e2e_wait_for 'a arms the valves'
-e2e_keys a
-e2e_wait_for 'Arm the valves\?'
-e2e_keys y
-e2e_wait_for 'Bellows +ARMED '
-e2e_keys N
-e2e_wait_for 'Run K iterations'
-e2e_keys BSpace BSpace BSpace 10 Enter
-e2e_wait_for 'iterations 0\.\.10 done' 600
+arm_and_run_5 '0\.\.5'
 e2e_keys d
 e2e_wait_for 'Bellows +SAFE '
-e2e_keys q
-sleep 1
-if ! e2e_history | grep -qE '^EXIT STATUS'; then e2e_screen | grep -q 'Quit' && e2e_keys q; fi
+e2e_quit
 [ "$(e2e_wait_exit)" = 0 ] || e2e_fail "the console did not exit cleanly"
 e2e_output_has 'simulated clock'
+session="$(find "$E2E_DIR/data/bellows/sessions" -mindepth 1 -maxdepth 1 -type d)"
+[ -d "$session" ] || e2e_fail "expected one saved session, found: $session"
+
+# Reopened: the first arm continues where the session stopped.
+e2e_start 120 40 -- console --clock sim --speed max --session "$session"
+e2e_wait_for 'sim clock'
+e2e_wait_for 'a arms the valves'
+arm_and_run_5 '6\.\.10'
+e2e_keys d
+e2e_wait_for 'Bellows +SAFE '
+e2e_quit
+[ "$(e2e_wait_exit)" = 0 ] || e2e_fail "the reopened console did not exit cleanly"
+grep -q 'arm where the session stopped' "$session/manifest.json" || e2e_fail "the reopened session was armed afresh"
 
 sessions=("$E2E_DIR"/data/bellows/sessions/*/manifest.json)
 [ "${#sessions[@]}" = 1 ] && [ -f "${sessions[0]}" ] || e2e_fail "expected one saved session, found: ${sessions[*]}"

@@ -113,6 +113,14 @@ e2e_expect_falling() {
     e2e_fail "RMS not falling: $(echo "$1" | tr '\n' ' ')"
 }
 
+# e2e_arm: `a`, then `y` to the question: the valves ARMED.
+e2e_arm() {
+  e2e_keys a
+  e2e_wait_for 'Arm the valves\?'
+  e2e_keys y
+  e2e_wait_for 'Bellows +ARMED '
+}
+
 # e2e_quit: `q`, and `y` when the console asks (it does while the valves are live, or when work
 # would be lost: docs/console.md, "Quit").
 e2e_quit() {

@@ -85,16 +85,23 @@ TEST(EngineCore, FaultLatchesUntilResetAndResetNeedsAFreshArm) {
   EXPECT_EQ(f.core.state(), EngineState::kArmed);
 }
 
-TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
-  EngineFixture f;
-  const Trajectory paper = library_trajectory("paper", 0.02);
+/// A trial of the paper trajectory with no correction, armed and sent as trial `trial_id`.
+struct PaperTrial {
+  Trajectory paper = library_trajectory("paper", 0.02);
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(paper.learning_samples());
   TrialRecord record;
-  record.prepare(paper.learning_samples(), 4);
-  f.send(CommandKind::kArm);
-  f.clock.step();
-  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 0, 42);
-  EXPECT_TRUE(f.core.send(start));
+  PaperTrial(EngineFixture& f, std::uint32_t trial_id) {
+    record.prepare(paper.learning_samples(), 4);
+    f.send(CommandKind::kArm);
+    f.clock.step();
+    EXPECT_TRUE(f.core.send(EngineCommand::start_trial(paper, correction, record, 0, trial_id)));
+  }
+};
+
+TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
+  EngineFixture f;
+  PaperTrial trial(f, 42);
+  TrialRecord& record = trial.record;
   f.clock.step(100);
   EXPECT_EQ(f.core.state(), EngineState::kRunning);
   f.drain_events();
@@ -107,6 +114,37 @@ TEST(EngineCore, DisarmDuringATrialHandsTheRecordBack) {
   EXPECT_EQ(events[0].record, &record);
   EXPECT_EQ(events[0].trial_id, 42u);
   EXPECT_FALSE(record.complete);
+}
+
+TEST(EngineCore, ATrialsEndIsReportedAsItsOwnCauseNotAsTheStartCommand) {
+  EngineFixture f;
+  PaperTrial trial(f, 7);
+  const TrialRecord& record = trial.record;
+  std::vector<EngineEvent> events;
+  for (int i = 0; i < 20000 && !record.complete; ++i) {
+    f.clock.step();
+    for (const EngineEvent& e : f.drain_events()) events.push_back(e);
+  }
+  f.clock.step();
+  for (const EngineEvent& e : f.drain_events()) events.push_back(e);
+  ASSERT_TRUE(record.complete);
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  int starts = 0, ends = 0;
+  for (const EngineEvent& e : events) {
+    if (e.kind != EventKind::kStateChanged) continue;
+    if (e.from == EngineState::kArmed && e.to == EngineState::kRunning) {
+      ++starts;
+      EXPECT_EQ(e.command, CommandKind::kStartTrial);
+    }
+    if (e.from == EngineState::kRunning && e.to == EngineState::kArmed) {
+      ++ends;
+      EXPECT_EQ(e.command, CommandKind::kTrialEnd) << to_string(e.command);
+      EXPECT_STREQ(to_string(e.command), "trial complete");
+    }
+  }
+  EXPECT_EQ(starts, 1);
+  EXPECT_EQ(ends, 1);
+  EXPECT_FALSE(transition(EngineState::kRunning, CommandKind::kTrialEnd).allowed);  // a cause, never a command
 }
 
 // Arms, holds for a second, injects `fault` and runs until the engine faults.

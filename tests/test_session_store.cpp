@@ -175,6 +175,22 @@ TEST(SessionStore, ManifestRoundTripsThroughJson) {
   EXPECT_EQ(loaded.events.back().message, "quotes \" and\nnewlines, ünïcödé");
 }
 
+TEST(SessionStore, AnEventKeepsItsEngineTimeAndOneWithoutNoneIsWrittenForIt) {
+  Session saved = testing::simulate_session(1);
+  saved.manifest.events.push_back({"2024-01-01T00:00:00.000Z", 0, "operator", "arm", 12.345678901});
+  saved.manifest.events.push_back({"2024-01-01T00:00:01.000Z", 0, "note", "no engine time"});
+  const std::string text = format_manifest(saved.manifest);
+  const SessionManifest loaded = parse_manifest(text, "m");
+  ASSERT_GE(loaded.events.size(), 2u);
+  EXPECT_EQ(loaded.events[loaded.events.size() - 2].engine_time_s, 12.345678901);  // to the last bit
+  EXPECT_LT(loaded.events.back().engine_time_s, 0.0);
+  const nlohmann::json json = nlohmann::json::parse(text);
+  EXPECT_FALSE(json["events"].back().contains("engine_time_s"));  // older readers' and sessions' shape
+  nlohmann::json hostile = json;
+  hostile["events"].back()["engine_time_s"] = -3.0;
+  EXPECT_THROW(parse_manifest(hostile.dump(), "m"), InputError);
+}
+
 TEST(SessionStore, AManifestWrittenPieceByPieceIsTheSameText) {
   // A writer serializes only what was added since its last write: the text must be what a whole
   // serialization gives, through appends, a change of the newest entry and a list that shrank.

@@ -2,6 +2,7 @@
 // later saves append, a session is one console's at a time, and bad sessions say why.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 
@@ -61,8 +62,23 @@ TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
   EXPECT_THROW(other.open(saved.session_location), InputError);
 
   const std::string location = saved.session_location;
+  std::vector<std::pair<std::string, double>> engine_times;  // what the log showed, with engine times
+  for (const ui::LogEntry& entry : f.state().log.entries()) {
+    if (entry.engine_time_s >= 0.0 && !entry.routine && entry.source != ui::LogSource::kLearner) {
+      engine_times.emplace_back(entry.text, entry.engine_time_s);
+    }
+  }
   f.console.reset();
   const ui::SessionSnapshot copy = gateway.open(location);  // the gateway that holds it may reopen it
+  // Every saved line keeps its engine time, those of the first save (the session's creation) too;
+  // later saves write it to the millisecond.
+  ASSERT_FALSE(engine_times.empty());
+  for (const auto& [text, engine_time_s] : engine_times) {
+    const auto reopened = std::find_if(copy.events.begin(), copy.events.end(),
+                                       [&](const ui::LogEntry& e) { return e.text == text; });
+    ASSERT_NE(reopened, copy.events.end()) << text;
+    EXPECT_NEAR(reopened->engine_time_s, engine_time_s, 0.0005) << text;
+  }
   const ui::Experiment& e = copy.experiment;
   ASSERT_EQ(e.trials.size(), 3u);
   EXPECT_EQ(e.trajectory->name, "paper");

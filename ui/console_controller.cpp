@@ -234,16 +234,11 @@ void ConsoleController::on_event(const EngineEvent& event) {
     case EventKind::kStateChanged:
       state_.engine_state = event.to;
     {
-      // A trial's own ARMED <-> RUNNING changes are routine: the trial's lines say it better.
-      const bool routine = event.command == CommandKind::kStartTrial &&
-                           (event.to == EngineState::kRunning || event.to == EngineState::kArmed);
-      // Into FAULT: the fault's own name (a guard is not an emergency stop).
-      // Back to ARMED from RUNNING on the trial's own command: the trial ran to its end (an abort names
-      // its own command, a fault its guard).
-      const bool trial_end = event.from == EngineState::kRunning && event.to == EngineState::kArmed &&
-                             event.command == CommandKind::kStartTrial;
+      // A trial's own ARMED <-> RUNNING changes (its start, its end) are routine: the trial's lines say it better.
+      const bool routine = (event.command == CommandKind::kStartTrial && event.to == EngineState::kRunning) ||
+                           event.command == CommandKind::kTrialEnd;
+      // Into FAULT: the fault's own name (a guard is not an emergency stop); else the engine's cause.
       const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone ? fault_name(event.fault)
-                          : trial_end                                                      ? "trial complete"
                                                                                            : to_string(event.command);
       log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
           event.to == EngineState::kFault, event.time_s, routine);

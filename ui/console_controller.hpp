@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <any>
 #include <functional>
 #include <memory>
 #include <string>
@@ -74,6 +75,14 @@ struct ConsoleEnvironment {
   /// its first `iterations` iterations, from its files (on a background task); returns where.
   /// Empty: not available.
   std::function<std::string(const std::string& session_location, int iterations)> write_figures;
+  /// --clock sim: the state the engine and the simulated arm are in at a trial's end (read on the
+  /// thread that ticks them, before the next tick), saved with the trial for an exact resume.
+  /// Empty: nothing captured (the wall clock).
+  std::function<std::any()> capture_trial_end;
+  /// A session reopened with --clock sim: arms where its last trial ended (the engine, the arm and
+  /// the clock, as `run --resume` puts them) instead of arming afresh; returns "" when it did, else
+  /// why not (the console then arms afresh). Offered for the first arm after opening only.
+  std::function<std::string()> arm_where_saved;
 };
 
 class ConsoleController {
@@ -204,6 +213,7 @@ class ConsoleController {
   void launch_figures();
   void poll_session_tasks();
   void adopt(SessionSnapshot snapshot, bool at_start);
+  void arm();  // the operator said yes to arming
 
   ConsoleEnvironment env_;
   DiscreteArmModel model_;
@@ -211,6 +221,7 @@ class ConsoleController {
   std::uint64_t revision_ = 0;
   bool quit_requested_ = false;
   bool quit_after_save_ = false;
+  bool arm_where_saved_pending_ = false;  // the session opened at start may arm where it stopped (arm_where_saved)
   std::uint64_t repaints_ = 0;
   std::uint64_t status_serial_ = 0;  // set_status() calls, to tell a key's own message
   bool continue_pending_ = false;    // a trial finished: the run goes on once this update's events are in

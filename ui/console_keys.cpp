@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <utility>
 
 #include "engine/base/errors.hpp"
 #include "ui/console_controller.hpp"
@@ -112,7 +113,7 @@ bool ConsoleController::handle_dialog_key(int k) {
   }
   switch (d.kind) {
     case DialogKind::kConfirmArm:
-      answer_yes_no(k, [this] { if (send_simple(CommandKind::kArm, "arm")) log(LogSource::kOperator, "arm"); }, "not armed");
+      answer_yes_no(k, [this] { arm(); }, "not armed");
       return true;
     case DialogKind::kConfirmZeroAngle:
       answer_yes_no(k, [this] { zero_angle(); }, "angle zero unchanged");
@@ -148,6 +149,23 @@ bool ConsoleController::handle_dialog_key(int k) {
     default:
       return true;
   }
+}
+
+void ConsoleController::arm() {
+  if (std::exchange(arm_where_saved_pending_, false) && env_.arm_where_saved) {
+    std::string why_not;
+    try {
+      why_not = env_.arm_where_saved();
+    } catch (const std::exception& error) {
+      why_not = error.what();
+    }
+    if (why_not.empty()) {
+      log(LogSource::kOperator, "arm where the session stopped (the engine, the arm and the clock as run --resume puts them)");
+      return;
+    }
+    log(LogSource::kSession, "arming afresh, not where the session stopped: " + why_not);
+  }
+  if (send_simple(CommandKind::kArm, "arm")) log(LogSource::kOperator, "arm");
 }
 
 bool ConsoleController::answer_yes_no(int k, const std::function<void()>& on_yes, const char* status_on_no) {

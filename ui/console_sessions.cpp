@@ -251,6 +251,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.experiment.next_unsaved = false;
   state_.experiment.release_saved_history();  // on disk: only the newest trials stay in memory
   autosave_failed_ = false;
+  arm_where_saved_pending_ = at_start && !state_.experiment.trials.empty();
   state_.inspector = InspectorView{};
   state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
   const Experiment& adopted = state_.experiment;

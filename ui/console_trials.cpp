@@ -172,6 +172,8 @@ void ConsoleController::finish_trial(double time_s) {
   trial.correction_bar = std::move(in_flight_->correction_bar);
   trial.record = std::move(in_flight_->record);
   trial.origin = in_flight_->origin;
+  if (env_.capture_trial_end) trial.end_state = env_.capture_trial_end();  // before the engine ticks again
+  arm_where_saved_pending_ = false;
   // The RMS over every joint and sample, each joint's, the largest correction of any joint.
   trial.summary = summarize_trial(e.next_iteration(), trial.record, trial.correction_bar,
                                   env_.config.controller.gas.ambient_bar, env_.config.controller.p_max_bar);

@@ -4,6 +4,7 @@
 // origin says where its correction came from, so the history is never rewritten.
 #pragma once
 
+#include <any>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +26,8 @@ struct Trial {
   TrialRecord record;              // empty once released (saved, and older than the kept window)
   IterationSummary summary;        // rms_deg over every joint and sample, joint_rms_deg per joint
   std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
+  std::any end_state;              // --clock sim: the engine's and arm's state at its end (saved for an
+                                   // exact resume; the app's type, opaque here); empty: none
 
   /// False once its record and correction were released: they are in the session on disk only.
   bool in_memory() const { return record.learning_samples > 0; }

@@ -41,7 +41,7 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kFaultView, 'f', key::kNone, "f", "Fault", "the last fault: which guard fired and the black box"},
       {Action::kSave, 's', key::kNone, "s", "Name", "name the session (it is saved as you go)"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
-      {Action::kFigures, 'g', key::kNone, "g", "Figures", "write figures of this session (PNG, SVG; the engine goes on)"},
+      {Action::kFigures, 'g', key::kNone, "g", "Figures", "figures from the saved files: RMS, angle, error, u_ilc, pressures as PNG and SVG"},
       {Action::kQuit, 'q', key::kNone, "q", "Quit", kQuitRule},
       {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
       {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},

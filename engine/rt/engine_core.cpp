@@ -175,7 +175,8 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
     case CommandKind::kHeartbeat:
       last_heartbeat_s_ = wall_s;
       return;
-    case CommandKind::kGuard:  // refused by transition(): a cause, never a command
+    case CommandKind::kGuard:  // refused by transition(): causes, never commands
+    case CommandKind::kTrialEnd:
       return;
     case CommandKind::kEmergencyStop:
       enter_fault(FaultCode::kEmergencyStop, now_s);
@@ -382,7 +383,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
       record_ = nullptr;
       correction_ = nullptr;
       joint_correction_ = nullptr;
-      change_state(EngineState::kArmed, now_s, CommandKind::kStartTrial);
+      change_state(EngineState::kArmed, now_s, CommandKind::kTrialEnd);
     }
   } else {
     device_.vent();

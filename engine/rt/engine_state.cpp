@@ -32,6 +32,8 @@ Transition transition(EngineState state, CommandKind command) {
       return refuse("no fault to reset");
     case CommandKind::kGuard:
       return refuse("a safety guard is not a command");
+    case CommandKind::kTrialEnd:
+      return refuse("a trial's end is not a command");
     case CommandKind::kSelectTrajectory:
     case CommandKind::kSetGains:
       if (state == S::kSafe || state == S::kArmed) return allow(state);
@@ -69,6 +71,7 @@ const char* to_string(CommandKind command) {
     case CommandKind::kSetGains: return "set gains";
     case CommandKind::kValvePulse: return "valve pulse";
     case CommandKind::kGuard: return "safety guard";
+    case CommandKind::kTrialEnd: return "trial complete";
   }
   return "?";
 }

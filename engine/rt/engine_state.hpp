@@ -25,6 +25,7 @@ enum class CommandKind : std::uint8_t {
   kSetGains,        // SAFE/ARMED: PID gains between trials
   kValvePulse,      // ARMED: the operator sets the valves for a while (the valve test); no transition
   kGuard,           // not a command: the cause of a state change a safety guard made (FAULT)
+  kTrialEnd,        // not a command: the cause of RUNNING -> ARMED when a trial ran to its end
 };
 
 struct Transition {
