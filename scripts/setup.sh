@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libncurses-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libboost-dev
   liblcm-dev liblcm-bin libglib2.0-dev libmatio-dev libmodbus-dev libsodium-dev
-  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev clang-format clang-tidy
   tmux rt-tests iproute2 util-linux ccache ninja-build
   gnuplot-nox fonts-dejavu-core python3-scipy python3-pandas octave help2man
 )
