@@ -13,7 +13,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for law in noilc noilc-learned; do
   printf '[ilc]\nlaw = "%s"\n' "$law" > "$work/$law.toml"
-  "$binary" run --trajectory paper --iterations "$iterations" --json --no-save -q --config "$work/$law.toml" |
+  nice -n 10 "$binary" run --trajectory paper --seed 1 --iterations "$iterations" --json --no-save -q --config "$work/$law.toml" |
     python3 -c 'import json, sys
 for it in json.load(sys.stdin)["iterations"]: print(it["iteration"], it["rms_deg"])' > "$work/$law.dat"
 done
@@ -28,7 +28,7 @@ set ylabel 'RMS error (deg)'
 set logscale y
 set grid
 set key top right
-plot '$work/noilc.dat' using 1:2 with linespoints pt 7 ps 0.6 title 'noilc (the paper'"'"'s law)', \
+plot '$work/noilc.dat' using 1:2 with linespoints pt 7 ps 0.6 title 'noilc (paper law, default)', \
      '$work/noilc-learned.dat' using 1:2 with linespoints pt 5 ps 0.6 title 'noilc-learned', \
      '$work/paper.dat' using 1:2 with linespoints pt 9 ps 0.8 title 'the paper (its arm)'
 GNUPLOT
