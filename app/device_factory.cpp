@@ -65,6 +65,7 @@ class LcmRig final : public OpenedDevice {
   }
   ~LcmRig() override { io_.stop(); }
   Device& device() override { return device_; }
+  LcmDevice* lcm_device() override { return &device_; }
   nlohmann::ordered_json session_info() const override { return {{"lcm", io_.url()}, {"session_id", device_.session_id()}}; }
   std::string where() const override { return io_.url(); }
   void stop() override { io_.stop(); }

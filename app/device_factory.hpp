@@ -24,6 +24,8 @@ class App;
 
 namespace bellows {
 
+class LcmDevice;
+
 /// The device options as given on the command line; an empty field takes the [device] value.
 struct DeviceOptions {
   std::string kind;         // --device
@@ -68,6 +70,8 @@ class OpenedDevice {
   /// one, which the readings take from then on. A device without one keeps nothing.
   virtual std::optional<double> angle_zero_rad() const { return std::nullopt; }
   virtual void set_angle_zero_rad(double zero_rad) { (void)zero_rad; }
+  /// The LCM rig's device (--device lcm), else null: `rig check` provokes its command timeout.
+  virtual LcmDevice* lcm_device() { return nullptr; }
   /// Stops the I/O thread (the rig's last vent goes out). Idempotent.
   virtual void stop() {}
 };

@@ -207,6 +207,7 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
                            std::ostream& out, std::ostream& progress) {
   const DeviceParameters device = resolve_device(options.device, config.device);
   require_driven_arm(config.arm, device.kind);  // the T7 carries one joint
+  const bool write_model_exists = !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
   if (!options.write_model_path.empty()) {  // checked before any trial runs
     Configuration written;
     apply_config_toml(write_model_text, options.write_model_path, written);
@@ -274,8 +275,10 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
                   100.0 * markov_relative_gap, 100.0 * static_gain_relative_gap);
     session.record("identify-gap", gap);
     if (!options.write_model_path.empty()) {
+      // Created (a file that appeared meanwhile is refused), or the file read before the trials, edited.
       write_file_atomic(options.write_model_path,
-                        with_identified_model(write_model_text, options.write_model_path, identified_parameters(coupled.dynamics), J));
+                        with_identified_model(write_model_text, options.write_model_path, identified_parameters(coupled.dynamics), J),
+                        DirectorySync::kNow, write_model_exists ? Replace::kAllowed : Replace::kRefused);
       progress << "wrote [identified_joint1.." << J << "] and [ilc] joint_model = \"identified\" to " << options.write_model_path
                << std::endl;
       session.record("model-written", "[identified_joint1.." + std::to_string(J) + "] and [ilc] joint_model written into the configuration " +

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <tuple>
 #include <utility>
@@ -93,6 +94,38 @@ nlohmann::json model_json(const ModelParameters& m) {
 
 }  // namespace
 
+std::string model_held_in(const std::string& toml_text, bool rig_profile, bool several_joints) {
+  const toml::table table = toml::parse(toml_text);
+  std::vector<std::string> held;
+  if (several_joints) {
+    for (const auto& [key, node] : table) {
+      if (key.str().rfind("identified_joint", 0) == 0 && node.is_table()) held.push_back("[" + std::string(key.str()) + "]");
+    }
+  } else if (const toml::table* model = table["model"].as_table()) {
+    // The keys identify writes: a profile's (units in the names) or a configuration's.
+    const std::vector<std::string> keys = rig_profile ? std::vector<std::string>{"kappa_rad_per_bar", "omega0_rad_per_s", "damping"}
+                                                      : std::vector<std::string>{"kappa", "omega0", "damping"};
+    for (const std::string& key : keys) {
+      if (const toml::node* value = model->get(key)) {
+        const std::optional<double> number = value->value<double>();
+        held.push_back((held.empty() ? "[model] " : "") + key + " = " + (number ? toml_number(*number) : std::string("...")));
+      }
+    }
+  }
+  std::string out;
+  for (const std::string& part : held) out += (out.empty() ? "" : ", ") + part;
+  return out;
+}
+
+void check_write_model_target(const IdentifyOptions& options, const std::string& toml_text, bool exists, bool rig_profile,
+                              bool several_joints) {
+  if (!exists || options.force) return;
+  if (const std::string held = model_held_in(toml_text, rig_profile, several_joints); !held.empty()) {
+    throw InputError("--write-model " + printable(options.write_model_path, kPrintableField) + " holds a model already (" + held +
+                     "): --force replaces it (the rest of the file is kept)");
+  }
+}
+
 std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model) {
   const std::string text = with_table_values(toml_text, "model",
                                              {{"kappa", toml_number(model.kappa_rad_per_bar)},
@@ -130,14 +163,17 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
       }
     }
   }
+  const bool write_model_exists = !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
   if (!options.signal.empty()) config.identify.signal = options.signal;
   if (config.arm.has_chain()) {  // every joint, and the coupled model (app/identify_chain)
     if (into_profile) {
       throw InputError("--write-model " + options.write_model_path + ": a rig profile holds one joint's [model]; the coupled model of " +
                        config.arm.name() + " goes into its configuration");
     }
+    check_write_model_target(options, existing_text, write_model_exists, false, true);
     return identify_chain_command(options, config, existing_text, out, progress);
   }
+  check_write_model_target(options, existing_text, write_model_exists, into_profile, false);
   const std::string estimation_signal = config.identify.signal;
   const std::string held_out_signal = validation_signal(estimation_signal);
 
@@ -175,7 +211,9 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
         session.record("model-written", "[model] kappa_rad_per_bar, omega0_rad_per_s, damping written into the rig profile " +
                                             options.write_model_path);
       } else {
-        write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model));
+        // Created (a file that appeared meanwhile is refused), or the file read above, edited.
+        write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model),
+                          DirectorySync::kNow, write_model_exists ? Replace::kAllowed : Replace::kRefused);
         progress << "wrote [model] to " << options.write_model_path << std::endl;
         session.record("model-written", "[model] kappa, omega0, damping written into the configuration " + options.write_model_path);
       }

@@ -53,6 +53,7 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   params.command_timeout_s = config.lcm.rig_timeout_s;
   params.seq_window = config.lcm.seq_window;
   params.limits = RigLimits::from(config);
+  params.command_timeout_enforced = !options.no_command_timeout;
   params.key = load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path());
   params.log = [&progress](const std::string& line) { progress << "io-sim: " << line << std::endl; };
   const bool keyed = params.key.present();
@@ -65,7 +66,8 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
              << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
              << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
              << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
-             << ")" << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "") << std::endl;
+             << ")" << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "")
+             << (options.no_command_timeout ? "; drill: no command timeout (it never vents by itself)" : "") << std::endl;
   });
   const double start_s = monotonic_s();
   io.run(

@@ -173,6 +173,8 @@ int main(int argc, char** argv) {
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
   io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
+  io_sim_cmd->add_flag("--no-command-timeout", io_sim.no_command_timeout,
+                       "Drill: the rig announces its [lcm] rig_timeout_s but never vents when the commands stop");
 
   bellows::T7SimCommandOptions t7_sim;
   CLI::App* t7_sim_cmd = app.add_subcommand("t7-sim", "Serve the simulated arm as a LabJack T7 over Modbus TCP");
@@ -273,7 +275,10 @@ int main(int argc, char** argv) {
   identify_cmd->add_option("--seed", identify.seed, "Seed of the simulated arm's noise")
       ->capture_default_str()
       ->check(bellows::unsigned_whole_number());
-  identify_cmd->add_option("--write-model", identify.write_model_path, "Write the fit into the [model] of this config file or rig profile");
+  identify_cmd->add_option("--write-model", identify.write_model_path,
+                           "Write the fit into the [model] of this config file or rig profile (created if missing; the rest of "
+                           "the file is kept; a file that holds a model already is refused without --force)");
+  identify_cmd->add_flag("--force", identify.force, "--write-model: replace the model the file holds already");
   identify_cmd->add_flag("--json", identify.json, "Print one JSON object on stdout");
   CLI::Option* identify_no_save = identify_cmd->add_flag("--no-save", identify.no_save, "Do not record the identification in a session");
   identify_cmd->add_option("--data-dir", identify.data_dir, "Where its session is saved (default: where runs save theirs)")

@@ -1,6 +1,12 @@
 #include "app/plot_command.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -78,12 +84,26 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
   }
   fs::create_directory(directory, error);
   if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
-  write_file_atomic(files.front(), gnuplot_script(figures, request.formats, request.style), DirectorySync::kNow,
-                    force ? Replace::kAllowed : Replace::kRefused);
-  run_gnuplot(files.front(), directory);
-  for (const fs::path& file : files) {
-    if (fs::file_size(file, error) == 0 || error) throw InputError("gnuplot wrote no " + file.string());
+  const DirectoryHandle folder = DirectoryHandle::open(directory);
+  const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
+  write_file_atomic_at(folder, kScriptName, gnuplot_script(figures, request.formats, request.style), DirectorySync::kNow, replace);
+  // gnuplot opens its outputs by name (truncating, following links): it draws into a folder made
+  // for it alone, and each figure leaves it by the safe writer's last steps (fsync, a rename that
+  // replaces only with --force, fsync of the folder), so a crash leaves whole figures or none.
+  const PrivateTemporaryDirectory drawing(folder, kScriptName);
+  run_gnuplot(directory / kScriptName, drawing.path());
+  for (std::size_t f = 1; f < files.size(); ++f) {
+    const std::string name = files[f].filename().string();
+    const std::optional<FileDescriptor> drawn = open_regular_file_at(drawing.handle(), name, O_RDONLY);
+    struct stat info {};
+    if (!drawn || ::fstat(drawn->get(), &info) != 0 || info.st_size == 0) throw InputError("gnuplot wrote no " + files[f].string());
+    if (::fsync(drawn->get()) != 0) throw InputError("cannot flush " + files[f].string() + ": " + std::strerror(errno));
   }
+  for (std::size_t f = 1; f < files.size(); ++f) {
+    const std::string name = files[f].filename().string();
+    publish_file_at(drawing.handle(), name, folder, name, replace);
+  }
+  sync(folder);
   return files;
 }
 

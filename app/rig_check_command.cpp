@@ -14,8 +14,11 @@
 #include "app/device_factory.hpp"
 #include "app/run_command.hpp"
 #include "app/trajectory_file.hpp"
+#include "app/rig_check_limits.hpp"
 #include "app/rig_profile_write.hpp"
 #include "app/signals.hpp"
+#include "devices/lcm_channels.hpp"
+#include "devices/lcm_io_thread.hpp"
 #include "engine/rt/engine_core.hpp"
 #include "engine/rt/engine_driver.hpp"
 #include "engine/base/errors.hpp"
@@ -125,6 +128,50 @@ class RigCheckSession {
   std::optional<SessionWriter> writer_;
 };
 
+// The LCM rig's own limits (app/rig_check_limits.hpp): announced, then the command timeout provoked.
+// Prints a line each, records them in the session; returns how many failed.
+int check_rig_limits(EngineDriver& driver, LcmDevice& device, const Configuration& config, bool valves_finished,
+                     RigCheckSession& session, nlohmann::json& report, std::ostream& progress) {
+  RigAnnouncedLimits announced;
+  const double wait_until_s = monotonic_s() + 2.0 * kIoLimitsPeriod_s + 0.5;  // announced once a second
+  bool have = device.read_announced_limits(announced);
+  while (!have && monotonic_s() < wait_until_s && !stop_requested().load(std::memory_order_relaxed)) {
+    driver.await();
+    have = device.read_announced_limits(announced);
+  }
+  std::vector<LimitVerdict> verdicts = judge_announced_limits(have ? &announced : nullptr, config, device.joints());
+  TimeoutObservation timeout;
+  if (valves_finished) {
+    progress << "command timeout: the chambers take a little air, every valve closed, then the engine falls silent ..." << std::endl;
+    timeout = provoke_command_timeout(driver, device, config, link_lag_s(device.health()), &stop_requested());
+  } else {
+    timeout.not_provoked = "the valve test stopped early";
+  }
+  verdicts.push_back(judge_command_timeout(timeout, config));
+  progress << "limits (what the rig announces and does, against this configuration):\n";
+  int failed = 0;
+  for (const LimitVerdict& v : verdicts) {
+    if (v.pass()) {
+      progress << line_of("  %-26s pass  %s, expected %s\n", v.name.c_str(), v.found.c_str(), v.expected.c_str());
+    } else {
+      ++failed;
+      progress << "FAIL " << v.name << ": " << v.problem << "\n";
+    }
+    session.record("rig-limit-check", v.pass() ? v.name + " pass: " + v.found + ", expected " + v.expected : v.name + " FAIL: " + v.problem);
+  }
+  if (timeout.tripped) {
+    progress << line_of("  the rig's trip: fault_bits %d, session %s, command_seq %lld (last sent %lld); chambers %.3f/%.3f -> "
+                        "%.3f/%.3f bar; served again after %.0f ms; the engine said %s: %s\n",
+                        timeout.trip.fault_bits, timeout.trip.session_id == timeout.session_id ? "this one" : "another",
+                        static_cast<long long>(timeout.trip.command_seq), static_cast<long long>(timeout.last_command_seq),
+                        timeout.before.joint[0].chamber_bar[0], timeout.before.joint[0].chamber_bar[1],
+                        timeout.after.joint[0].chamber_bar[0], timeout.after.joint[0].chamber_bar[1], timeout.served_again_s * 1e3,
+                        fault_name(timeout.engine_fault), timeout.engine_detail.c_str());
+  }
+  report["limits"] = limits_json(verdicts, have ? &announced : nullptr, &timeout);
+  return failed;
+}
+
 void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession& session) {
   if (raw.count == 0) {
     session.record("rig-input", line_of("no volts (simulated): angle %.3f deg, chamber A %.4f bar, chamber B %.4f bar, "
@@ -171,6 +218,9 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   } stop_loop{loop, *rig};
   require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
 
+  // The inputs of a tick that began once the rig served (a tick before may show none yet: zeros).
+  driver->await();
+  driver->await();
   TickRecord latest;
   while (!core.read_snapshot(latest)) driver->await();
   const RawInputs raw = rig->device().raw_inputs();
@@ -243,15 +293,24 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
                                 {"problem", v.problem}});
   }
   if (!result.aborted.empty()) progress << "stopped early: " << result.aborted << "\n";
-  session.record("finish", (result.aborted.empty() ? std::string() : "stopped early: " + result.aborted + "; ") +
-                               (failed == 0 ? "every valve passed" : line_of("%d of %d valves failed", failed, kValveCount)));
-  progress << (failed == 0 ? "rig check: every valve passed" : line_of("rig check: %d of %d valves failed", failed, kValveCount))
-           << std::endl;
+  // An LCM rig's own limits: what it announces, and its command timeout provoked (after the valves:
+  // a rig whose valves are wrong is named first).
+  LcmDevice* lcm = rig->lcm_device();
+  const int limits_failed = lcm != nullptr && stop_signal() == 0
+                                ? check_rig_limits(*driver, *lcm, config, result.aborted.empty(), session, report, progress)
+                                : 0;
+  const std::string valves_outcome = failed == 0 ? "every valve passed" : line_of("%d of %d valves failed", failed, kValveCount);
+  const std::string limits_outcome =
+      lcm == nullptr ? "" : limits_failed == 0 ? ", every limit passed" : line_of(", %d limit check%s failed", limits_failed, limits_failed == 1 ? "" : "s");
+  session.record("finish", (result.aborted.empty() ? std::string() : "stopped early: " + result.aborted + "; ") + valves_outcome +
+                               limits_outcome);
+  progress << "rig check: " << valves_outcome << limits_outcome << std::endl;
+  const bool all_pass = result.all_pass() && limits_failed == 0;
   report["aborted"] = result.aborted;
-  report["all_pass"] = result.all_pass();
+  report["all_pass"] = all_pass;
   if (options.json) out << report.dump() << std::endl;
   if (stop_signal() != 0) return 128 + stop_signal();
-  return result.all_pass() ? 0 : kExitRigCheckFailed;
+  return all_pass ? 0 : kExitRigCheckFailed;
 }
 
 }  // namespace bellows

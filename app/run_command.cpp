@@ -241,8 +241,9 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   }
   if (loop != nullptr) loop->stop();  // vents
   else device.vent();
-  io.stop();  // the rig's last vent command, the rest of the telemetry
+  const std::string log_error = io.finish_log();  // the rig's last vent command, the rest of the telemetry, the log
   said.finish();
+  if (!log_error.empty()) said.error("bellows: " + log_error);
   if (const std::string warning = io.warning(); !warning.empty()) said.error("bellows: " + warning);  // a loss
   if (monitor.windup().detected) {
     std::ostringstream warning;
@@ -260,6 +261,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
                 " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)");
   }
   if (status == 0) recording.finish(trials);
+  if (!log_error.empty() && status == 0) status = kExitEnvironment;  // the session is whole; the log is not there
 
   if (options.json) {
     nlohmann::json report = {{"device", device.name()},

@@ -7,6 +7,7 @@
 #include "app/device_factory.hpp"
 #include "devices/lcm_channels.hpp"
 #include "engine/base/errors.hpp"
+#include "sessions/atomic_file.hpp"
 
 namespace bellows {
 namespace {
@@ -86,7 +87,12 @@ std::unique_ptr<SimulatedClock> RunIo::simulated_clock(EngineCore& core) {
 void RunIo::start_telemetry(const std::filesystem::path& session_directory) {
   if (tap_ == nullptr) return;
   if (options_.lcm_log) log_path_ = !options_.lcm_log_file.empty() ? options_.lcm_log_file : free_log_name(session_directory);
-  publisher_ = std::make_unique<TelemetryPublisher>(*tap_, session_id_, log_path_);
+  if (!log_path_.empty()) {
+    // The one safe writer: the log is written into its exclusive temporary (never through a name
+    // planted in advance) and appears under its name, whole, when the run ends (finish_log()).
+    log_file_ = std::make_unique<AtomicOutputFile>(log_path_, Replace::kRefused);
+  }
+  publisher_ = std::make_unique<TelemetryPublisher>(*tap_, session_id_, log_file_ ? log_file_->stream() : nullptr);
   publisher_io_ = std::make_unique<LcmIoThread>(options_.lcm_url, std::vector<LcmEndpoint*>{publisher_.get()});
   publisher_io_->start(RealtimeMode::kOff, 0);  // telemetry is not real-time
 }
@@ -104,6 +110,18 @@ void RunIo::stop() {
   if (publisher_io_) publisher_io_->stop();
 }
 
+std::string RunIo::finish_log() {
+  stop();  // the publisher wrote its last event
+  if (!log_file_) return log_error_;
+  const std::unique_ptr<AtomicOutputFile> log = std::move(log_file_);
+  try {
+    log->commit();
+  } catch (const InputError& error) {
+    log_error_ = std::string("the LCM log is not written: ") + error.what();
+  }
+  return log_error_;
+}
+
 nlohmann::json RunIo::report() const {
   if (session_id_ == 0) return nullptr;
   nlohmann::json lcm = {{"session_id", session_id_}};
@@ -117,7 +135,8 @@ nlohmann::json RunIo::report() const {
                         {"trials", s.trials},
                         {"log_events", s.log_events},
                         {"errors", s.errors}};
-    if (!log_path_.empty()) lcm["telemetry"]["log"] = log_path_;
+    if (!log_path_.empty()) lcm["telemetry"]["log"] = log_error_.empty() ? nlohmann::json(log_path_) : nlohmann::json(nullptr);
+    if (!log_error_.empty()) lcm["telemetry"]["log_error"] = log_error_;
   }
   return lcm;
 }

@@ -24,6 +24,7 @@
 namespace bellows {
 
 class OpenedDevice;
+class AtomicOutputFile;
 
 /// Received-message counters as a JSON object ({"accepted", "ignored": {by reason}}).
 nlohmann::json receive_counts_json(const ReceiveCounts& counts);
@@ -64,6 +65,11 @@ class RunIo {
   /// After the engine loop stopped: the device's last vent on the bus, the rest of the telemetry,
   /// the log closed.
   void stop();
+  /// Instead of stop() when a run ended (completed or faulted): stops, then publishes the LCM log
+  /// under its name (fsync, rename, fsync of the folder). Returns "" or "the LCM log is not
+  /// written: ..." (a full disk, a file of that name that appeared meanwhile), also in report().
+  /// A run that never gets here (an exception, a kill) leaves no log under the name.
+  std::string finish_log();
 
   /// Stops the I/O threads when it goes out of scope: declare it after the EngineCore whose
   /// telemetry tap the publisher drains, so that an exception never leaves it draining a freed ring.
@@ -95,6 +101,8 @@ class RunIo {
   std::unique_ptr<OpenedDevice> device_;
   TelemetryRing* tap_ = nullptr;
   std::string log_path_;
+  std::string log_error_;
+  std::unique_ptr<AtomicOutputFile> log_file_;  // declared before the publisher, which writes into it
   std::unique_ptr<TelemetryPublisher> publisher_;
   std::unique_ptr<LcmIoThread> publisher_io_;
   std::int64_t session_id_ = 0;

@@ -56,20 +56,10 @@ std::int8_t state_code(EngineState state) {
 // FaultCode's own numbering, which docs/lcm-protocol.md lists.
 std::int8_t fault_code(FaultCode fault) { return static_cast<std::int8_t>(fault); }
 
-TelemetryPublisher::TelemetryPublisher(TelemetryRing& ring, std::int64_t session_id, const std::string& log_path)
-    : ring_(ring), session_id_(session_id), log_path_(log_path) {
-  if (!log_path_.empty()) {
-    // Created here, exclusively and not through a link (a dangling one included), before LCM's
-    // writer opens it by name: nothing is overwritten or created outside.
-    const int fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0 && (errno == EEXIST || errno == ELOOP)) {
-      throw InputError("the LCM log '" + log_path_ + "' exists already; nothing is overwritten, name a new file");
-    }
-    if (fd < 0) throw EnvironmentError("cannot create the LCM log '" + log_path_ + "': " + std::strerror(errno));
-    ::close(fd);
-    log_ = std::make_unique<lcm::LogFile>(log_path_, "w");
-    if (!log_->good()) throw EnvironmentError("cannot create the LCM log '" + log_path_ + "'");
-  }
+TelemetryPublisher::TelemetryPublisher(TelemetryRing& ring, std::int64_t session_id, std::FILE* log)
+    : ring_(ring), session_id_(session_id) {
+  log_.f = log;
+  log_.eventcount = 0;
   log_epoch_us_ = realtime_us();
   telemetry_.session_id = session_id_;
   joints_telemetry_.session_id = session_id_;
@@ -101,14 +91,15 @@ void TelemetryPublisher::emit(lcm::LCM* bus, const char* channel, const Message&
   const std::size_t size = encode_into(message, buffer_);
   bool ok = true;
   if (bus != nullptr) ok = bus->publish(channel, buffer_.data(), static_cast<unsigned int>(size)) == 0;
-  if (log_) {
-    lcm::LogEvent event;
-    event.eventnum = 0;  // LogFile numbers the events itself
+  if (log_.f != nullptr) {
+    lcm_eventlog_event_t event{};
+    event.eventnum = 0;  // the writer numbers the events itself
     event.timestamp = log_epoch_us_ + std::llround(latest_time_s_ * 1e6);
-    event.channel = channel;
+    event.channellen = static_cast<std::int32_t>(std::strlen(channel));
+    event.channel = const_cast<char*>(channel);
     event.datalen = static_cast<std::int32_t>(size);
     event.data = buffer_.data();
-    if (log_->writeEvent(&event) == 0) bump(log_events_);
+    if (lcm_eventlog_write_event(&log_, &event) == 0) bump(log_events_);
     else ok = false;
   }
   if (ok) bump(counter);
@@ -218,7 +209,7 @@ double TelemetryPublisher::service(lcm::LCM* bus, double now_s) {
 
 void TelemetryPublisher::finish(lcm::LCM* bus, double) {
   drain(bus);
-  log_.reset();  // flushes and closes
+  if (log_.f != nullptr) std::fflush(log_.f);  // the caller publishes it (and sees a failed flush)
 }
 
 TelemetryPublisherStats TelemetryPublisher::stats() const {

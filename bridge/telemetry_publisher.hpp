@@ -5,13 +5,16 @@
 // it publishes a telemetry_t (one joint, as always) or a telemetry_joints_t (an arm of several
 // joints: every joint's values, on the same channel); from consecutive ticks it derives engine events (state changes,
 // faults, trials started and ended); the operator thread posts a trial summary after every
-// completed trial. Every message published also goes into the log, written with lcm::LogFile in
-// LCM's own format, so lcm-logplayer replays it and any LCM tool reads it. Log timestamps are the
+// completed trial. Every message published also goes into the log, written by LCM's own event-log
+// writer (lcm_eventlog_write_event) in LCM's format, so lcm-logplayer replays it and any LCM tool
+// reads it. The log's stream is the caller's (bellows run: the safe writer's temporary, published
+// when the run ends, app/run_io). Log timestamps are the
 // engine's time from the run's start (wall clock at the start + engine time), so a replay keeps
 // the tick rate even when the publisher drains the ring in bursts.
 #pragma once
 
 #include <atomic>
+#include <cstdio>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <lcm/eventlog.h>
 
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_io_thread.hpp"
@@ -43,9 +47,9 @@ std::int8_t fault_code(FaultCode fault);
 
 class TelemetryPublisher final : public LcmEndpoint {
  public:
-  /// `log_path` empty: no log. Throws InputError if the log file exists (nothing is overwritten)
-  /// or cannot be created.
-  TelemetryPublisher(TelemetryRing& ring, std::int64_t session_id, const std::string& log_path);
+  /// `log` null: no log. Else the stream the event log is written into (the caller's; it outlives
+  /// the publisher's finish() and is flushed and closed by the caller).
+  TelemetryPublisher(TelemetryRing& ring, std::int64_t session_id, std::FILE* log);
   ~TelemetryPublisher() override;
 
   /// Operator thread: a trial completed with `summary`, having applied `correction_bar`.
@@ -56,7 +60,6 @@ class TelemetryPublisher final : public LcmEndpoint {
 
   /// Any thread.
   TelemetryPublisherStats stats() const;
-  const std::string& log_path() const { return log_path_; }
 
  private:
   void drain(lcm::LCM* bus);
@@ -68,8 +71,7 @@ class TelemetryPublisher final : public LcmEndpoint {
 
   TelemetryRing& ring_;
   const std::int64_t session_id_;
-  const std::string log_path_;
-  std::unique_ptr<lcm::LogFile> log_;
+  lcm_eventlog_t log_{};  // LCM's writer state over the caller's stream (log_.f null: no log)
   std::int64_t log_epoch_us_ = 0;
 
   // I/O thread state.

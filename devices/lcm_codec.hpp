@@ -15,6 +15,7 @@
 #include <bellows/io_command_t.hpp>
 #include <bellows/io_joints_command_t.hpp>
 #include <bellows/io_joints_state_t.hpp>
+#include <bellows/io_rig_limits_t.hpp>
 #include <bellows/io_state_t.hpp>
 #include <bellows/telemetry_joints_t.hpp>
 #include <bellows/telemetry_t.hpp>
@@ -135,6 +136,9 @@ inline SizeRange size_range(const io_joints_command_t&, const std::uint8_t*, std
 }
 inline SizeRange size_range(const io_joints_state_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<io_joints_state_t>(), fixed_size<io_joints_state_t>()};
+}
+inline SizeRange size_range(const io_rig_limits_t&, const std::uint8_t*, std::size_t) {
+  return {fixed_size<io_rig_limits_t>(), fixed_size<io_rig_limits_t>()};
 }
 inline SizeRange size_range(const telemetry_t&, const std::uint8_t*, std::size_t) {
   return {fixed_size<telemetry_t>(), fixed_size<telemetry_t>()};

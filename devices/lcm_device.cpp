@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "devices/lcm_channels.hpp"
@@ -62,9 +63,22 @@ void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(joints_), f
 
 // ---- I/O thread ----
 
-void LcmDevice::attach(lcm::LCM& bus) { subscribe(bus, kIoStateChannel); }
+void LcmDevice::attach(lcm::LCM& bus) {
+  subscribe(bus, kIoStateChannel);
+  subscribe(bus, kIoLimitsChannel);
+}
 
-void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  // io_state_t or io_joints_state_t
+void LcmDevice::on_limits(const void* data, std::size_t size) {
+  io_rig_limits_t& l = limits_received_;
+  if (decode_checked(data, size, l, key_.present() ? &key_ : nullptr) != DecodeStatus::kOk || !valid_rig_limits(l) ||
+      l.rig_id != rig_id_) {  // only the rig addressed speaks for this session's rig
+    return bump(limits_ignored_);
+  }
+  limits_seen_.write({now_s_, l.rig_id, l.joint_count, l.period_s, l.command_timeout_s, l.pressure_ceiling_bar, l.angle_limit_rad});
+}
+
+void LcmDevice::on_message(const char* channel, const void* data, std::size_t size) {  // io_state_t or io_joints_state_t
+  if (std::strcmp(channel, kIoLimitsChannel) == 0) return on_limits(data, size);
   const DecodeStatus status = decode_io_state(data, size, received_, key_.present() ? &key_ : nullptr);
   if (status != DecodeStatus::kOk) return counters_.count(status);
   const io_joints_state_t& s = received_;
@@ -72,6 +86,15 @@ void LcmDevice::on_message(const char*, const void* data, std::size_t size) {  /
   if (s.joint_count != joints_) {  // a rig of another arm: never bound to, whatever it offers
     last_other_joints_.store(s.joint_count, std::memory_order_relaxed);
     return counters_.other_joints();
+  }
+  if (s.rig_id == rig_id_ && rig_id_ != 0) {  // for the rig check: what the rig addressed says, whatever its session
+    const RigStateSeen seen{now_s_, s.session_id, s.binding, s.command_seq, s.fault_bits, to_reading(s)};
+    rig_seen_.write(seen);
+    constexpr std::int32_t kTrip = std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT};
+    if (hold_seen_ && !trip_kept_ && (s.fault_bits & kTrip) != 0) {
+      trip_seen_.write(seen);
+      trip_kept_ = true;
+    }
   }
   const bool rig_gone = now_s_ - last_rig_state_s_ > rig_silence_s_;  // e.g. it restarted, with a new id
   if (s.rig_id == rig_id_) last_rig_state_s_ = now_s_;
@@ -237,8 +260,12 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
     last_state_s_.store(now_s, std::memory_order_relaxed);
     connected_.store(true, std::memory_order_release);
   }
+  const bool hold = hold_commands_.load(std::memory_order_acquire);
+  if (hold && !hold_seen_) trip_kept_ = false;  // a new hold: watch for the trip anew
+  hold_seen_ = hold;
   Outgoing outgoing;
-  if (outbox_.read(outgoing) && bus != nullptr) publish(*bus, outgoing, now_s);
+  if (outbox_.read(outgoing) && bus != nullptr && !hold) publish(*bus, outgoing, now_s);
+  commands_held_.store(hold, std::memory_order_release);
   return now_s + kOutboxPoll_s;
 }
 
@@ -262,6 +289,8 @@ void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   }
   bump(commands_sent_);
   if (!outgoing.armed) bump(vent_commands_sent_);
+  last_sent_seq_.store(seq_, std::memory_order_relaxed);
+  last_sent_s_.store(now_s, std::memory_order_release);
 }
 
 DeviceHealth LcmDevice::health() const {

@@ -63,6 +63,23 @@ struct LcmDeviceStats {
   bool keyed = false;                     // [lcm] key_file set
 };
 
+/// What the rig addressed says it enforces by itself (its io_rig_limits_t), for `bellows rig check`.
+struct RigAnnouncedLimits {
+  double received_s = -1.0;  // the I/O thread's clock (monotonic_s()); < 0: none received
+  std::int64_t rig_id = 0;
+  int joints = 0;
+  double period_s = 0.0, command_timeout_s = 0.0, pressure_ceiling_bar = 0.0, angle_limit_rad = 0.0;
+};
+
+/// A state of the rig addressed as it arrived, whatever its session (`bellows rig check` watches
+/// the rig's trips with it).
+struct RigStateSeen {
+  double received_s = -1.0;  // the I/O thread's clock; < 0: none
+  std::int64_t session_id = 0, binding = 0, command_seq = 0;
+  std::int32_t fault_bits = 0;
+  SensorReading reading{};   // its sensor values (time_s the rig's)
+};
+
 class LcmDevice final : public Device, public LcmEndpoint {
  public:
   /// `session_id`: nonzero, unique per run (random_session_id()).
@@ -105,6 +122,25 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// this rig: ..." or "" when there is none.
   std::string diagnosis() const;
 
+  // ---- `bellows rig check` (one thread, not the engine's) ----
+  /// The limits the rig addressed announced last; false while none arrived.
+  bool read_announced_limits(RigAnnouncedLimits& out) { return limits_seen_.read(out) || out.received_s >= 0.0; }
+  /// Holds back every command while `hold` (the engine keeps ticking): the rig hears nothing, as
+  /// when an engine stalls, so that its own command timeout can be seen to act. While held, the
+  /// first state of the rig addressed carrying a trip bit (command timeout, angle range) is kept.
+  void hold_commands(bool hold) { hold_commands_.store(hold, std::memory_order_release); }
+  /// Whether the I/O thread holds them now (it acts on hold_commands() at its next turn).
+  bool commands_held() const { return commands_held_.load(std::memory_order_acquire); }
+  /// When the last command went out (the I/O thread's clock, -1: none yet) and its seq.
+  double last_command_sent_s() const { return last_sent_s_.load(std::memory_order_acquire); }
+  std::int64_t last_command_seq() const { return last_sent_seq_.load(std::memory_order_acquire); }
+  /// The first trip state seen since the commands were held (false: none yet).
+  bool read_trip_seen(RigStateSeen& out) { return trip_seen_.read(out) || out.received_s >= 0.0; }
+  /// The latest state of the rig addressed, whatever its session.
+  bool read_rig_state(RigStateSeen& out) { return rig_seen_.read(out) || out.received_s >= 0.0; }
+  /// Announcements of limits ignored: undecodable, unauthenticated, invalid, or of another rig.
+  std::uint64_t limits_ignored() const { return limits_ignored_.load(std::memory_order_relaxed); }
+
  private:
   struct Outgoing {
     ValveCommand valves{};
@@ -112,6 +148,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   };
 
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
+  void on_limits(const void* data, std::size_t size);
   /// A state of this session with trip bits: the rig's reason, for the engine (once per trip).
   /// `offered`: the rig's new offer (session 0) that dropped this session, its reasons in its bits.
   void report_trip(const io_joints_state_t& state, bool offered);
@@ -144,6 +181,15 @@ class LcmDevice final : public Device, public LcmEndpoint {
   bool last_armed_ = false;
   io_joints_command_t command_{};
   std::vector<std::uint8_t> buffer_;
+  io_rig_limits_t limits_received_{};
+  bool hold_seen_ = false;     // the I/O thread has acted on hold_commands(true)
+  bool trip_kept_ = false;     // the first trip since then is in trip_seen_
+  LatestValue<RigAnnouncedLimits> limits_seen_;  // I/O -> rig check
+  LatestValue<RigStateSeen> trip_seen_, rig_seen_;
+  std::atomic<bool> hold_commands_{false}, commands_held_{false};
+  std::atomic<double> last_sent_s_{-1.0};
+  std::atomic<std::int64_t> last_sent_seq_{0};
+  std::atomic<std::uint64_t> limits_ignored_{0};
 
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};

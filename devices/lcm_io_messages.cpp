@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "engine/base/errors.hpp"
 
@@ -154,6 +155,12 @@ bool valid_state(const io_joints_state_t& s) {
     if (s.angle_rad[j] != 0.0 || !row_zero(s.chamber_bar[j], kActuatorCount)) return false;
   }
   return true;
+}
+
+bool valid_rig_limits(const io_rig_limits_t& l) {
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  return l.rig_id != 0 && l.seq > 0 && valid_joint_count(l.joint_count) && positive(l.period_s) && positive(l.command_timeout_s) &&
+         positive(l.pressure_ceiling_bar) && positive(l.angle_limit_rad) && l.angle_limit_rad <= std::numbers::pi;
 }
 
 ValveCommand to_valves(const io_joints_command_t& c) {

@@ -47,6 +47,10 @@ bool valid_command(const io_joints_command_t& command);
 /// 1..MAX_JOINTS and every row beyond it zero. Sensor values are the engine's guards' to judge.
 bool valid_state(const io_joints_state_t& state);
 
+/// Limits a rig may announce: a rig, a sequence number, a joint count in 1..MAX_JOINTS, every value
+/// finite and positive, the angle range at most pi.
+bool valid_rig_limits(const io_rig_limits_t& limits);
+
 /// The duties of the command's joints when armed, else every joint vented.
 ValveCommand to_valves(const io_joints_command_t& command);
 /// Valves of 1..kMaxJoints joints (InputError otherwise) into `command`, rows beyond zeroed.

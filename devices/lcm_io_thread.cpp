@@ -49,6 +49,9 @@ std::unique_ptr<lcm::LCM> open_lcm_quietly(const std::string& url, std::string& 
 
 // Upper bound on one wait, so that a stop request is seen promptly even on an idle bus.
 constexpr double kMaxWait_s = 0.05;
+// Messages already queued that one turn of the loop handles before it services its endpoints
+// (bounded, so that a flood cannot keep it from servicing them).
+constexpr int kMaxDrained = 64;
 
 timespec to_timespec(double seconds) {
   timespec t{};
@@ -135,6 +138,13 @@ void LcmIoThread::serve(const std::function<bool()>& should_stop, RealtimeMode m
 
   const int fd = bus ? bus->getFileno() : -1;
   while (!should_stop()) {
+    // What arrived while this thread was away first: a host that descheduled it (a loaded machine)
+    // must not make a rig time out on commands, or a device miss states, already in the socket.
+    for (int i = 0; fd >= 0 && i < kMaxDrained; ++i) {
+      pollfd queued{fd, POLLIN, 0};
+      if (poll(&queued, 1, 0) <= 0 || (queued.revents & POLLIN) == 0) break;
+      bus->handle();
+    }
     const double now = monotonic_s();
     double next = now + kMaxWait_s;
     for (LcmEndpoint* endpoint : endpoints_) next = std::min(next, endpoint->service(bus.get(), now));

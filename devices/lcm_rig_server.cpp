@@ -29,6 +29,12 @@ RigServer::RigServer(Device& arm, int joints, double integration_step_s, RigServ
   binding_ = random_nonzero_id();
   binding_shown_.store(binding_, std::memory_order_relaxed);
   state_.rig_id = rig_id_;
+  limits_.rig_id = rig_id_;
+  limits_.joint_count = static_cast<std::int8_t>(joints_);
+  limits_.period_s = params_.period_s;
+  limits_.command_timeout_s = params_.command_timeout_s;
+  limits_.pressure_ceiling_bar = params_.limits.pressure_ceiling_bar;
+  limits_.angle_limit_rad = params_.limits.angle_limit_rad;
   commanded_ = ValveCommand::vented(joints_);
   buffer_.resize(max_io_message_bytes());
 }
@@ -178,6 +184,7 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
   if (origin_s_ < 0.0) {
     origin_s_ = now_s;
     next_publish_s_ = now_s;
+    next_limits_s_ = now_s;
   }
   advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
   if (pending_fresh_) {
@@ -190,10 +197,14 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     pending_fresh_ = false;
     apply_limits(true);
   }
-  if (session_ != 0 && now_s - last_command_s_ > params_.command_timeout_s) {
+  if (session_ != 0 && params_.command_timeout_enforced && now_s - last_command_s_ > params_.command_timeout_s) {
     say("the commands of session " + std::to_string(session_) + " stopped: vented, session dropped");
     release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT});
     bump(timeouts_);
+  }
+  if (now_s >= next_limits_s_) {
+    if (bus != nullptr) publish_limits(*bus, now_s);
+    next_limits_s_ = now_s + kIoLimitsPeriod_s;
   }
   if (now_s >= next_publish_s_) {
     if (bus != nullptr) publish_state(*bus, now_s);
@@ -204,7 +215,8 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
       next_publish_s_ += behind * params_.period_s;
     }
   }
-  return session_ != 0 ? std::min(next_publish_s_, last_command_s_ + params_.command_timeout_s) : next_publish_s_;
+  const double next_s = std::min(next_publish_s_, next_limits_s_);
+  return session_ != 0 && params_.command_timeout_enforced ? std::min(next_s, last_command_s_ + params_.command_timeout_s) : next_s;
 }
 
 void RigServer::finish(lcm::LCM* bus, double now_s) {
@@ -229,6 +241,13 @@ void RigServer::publish_state(lcm::LCM& bus, double now_s) {
   state_.unauthenticated_commands = static_cast<std::int64_t>(c.unauthenticated);
   const std::size_t size = encode_io_state(state_, params_.key, buffer_);
   if (bus.publish(kIoStateChannel, buffer_.data(), static_cast<unsigned int>(size)) == 0) bump(states_published_);
+}
+
+void RigServer::publish_limits(lcm::LCM& bus, double now_s) {
+  ++limits_.seq;
+  limits_.utime = static_cast<std::int64_t>(now_s * 1e6);
+  const std::size_t size = encode_signed(limits_, params_.key, buffer_);
+  bus.publish(kIoLimitsChannel, buffer_.data(), static_cast<unsigned int>(size));
 }
 
 RigServerStats RigServer::stats() const {

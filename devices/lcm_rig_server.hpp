@@ -20,6 +20,10 @@
 // for an arm of another joint count (either message type) is counted as `other_joints`, logged
 // once per binding, and never binds or drives the arm (a vent addressed to this rig is obeyed, as
 // every vent is).
+//
+// Limits: at its start and then every kIoLimitsPeriod_s it publishes an io_rig_limits_t on
+// BELLOWS_IO_LIMITS (its period, command timeout, ceiling and angle range), which `bellows rig check
+// --device lcm` compares with the engine's configuration.
 #pragma once
 
 #include <atomic>
@@ -43,6 +47,9 @@ struct RigServerParameters {
   std::int64_t seq_window = 100;     // [lcm] seq_window
   RigLimits limits;                  // RigLimits::from(configuration)
   LcmKey key;                        // [lcm] key_file; none: nothing checked or signed
+  /// false: a drill (`io-sim --no-command-timeout`): the rig announces its timeout but never vents
+  /// when the commands stop, as a driver that forgot to (`rig check --device lcm` must catch it).
+  bool command_timeout_enforced = true;
   /// Called on the I/O thread with one line per notable event (a session bound or dropped, the
   /// first refusal of each kind per binding, a limit acted on). May be empty.
   std::function<void(const std::string&)> log;
@@ -92,6 +99,7 @@ class RigServer final : public LcmEndpoint {
   void notice(Notice kind, const std::string& line);
   void say(const std::string& line) const;
   void publish_state(lcm::LCM& bus, double now_s);
+  void publish_limits(lcm::LCM& bus, double now_s);
 
   Device& arm_;
   const int joints_;
@@ -122,6 +130,8 @@ class RigServer final : public LcmEndpoint {
   double next_publish_s_ = 0.0;
   std::int64_t state_seq_ = 0;
   io_joints_state_t state_{};
+  double next_limits_s_ = 0.0;
+  io_rig_limits_t limits_{};
   std::vector<std::uint8_t> buffer_;
 
   ReceiveCounters counters_;

@@ -20,22 +20,55 @@ constexpr std::string_view kTemporaryMarker = ".tmp-";  // unpredictable_tempora
   throw InputError("cannot " + what + " " + path.string() + ": " + std::strerror(error_number));
 }
 
+DirectoryHandle folder_of(const std::filesystem::path& path) {
+  const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
+  const std::string name = path.filename().string();
+  if (name.empty() || name == "." || name == "..") throw InputError("cannot write " + path.string() + ": not a file name");
+  try {
+    return DirectoryHandle::open(directory);
+  } catch (const InputError& error) {
+    throw InputError("cannot create " + path.string() + ": " + error.what());
+  }
+}
+
 }  // namespace
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view contents, DirectorySync directory_sync,
                        Replace replace) {
   // The folder is the operator's choice (a link in its path is followed); the file itself is
   // written by the one safe writer, inside that folder's descriptor.
-  const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
-  const std::string name = path.filename().string();
-  if (name.empty() || name == "." || name == "..") throw InputError("cannot write " + path.string() + ": not a file name");
-  std::optional<DirectoryHandle> folder;
-  try {
-    folder.emplace(DirectoryHandle::open(directory));
-  } catch (const InputError& error) {
-    throw InputError("cannot create " + path.string() + ": " + error.what());
+  write_file_atomic_at(folder_of(path), path.filename().string(), contents, directory_sync, replace);
+}
+
+AtomicOutputFile::AtomicOutputFile(const std::filesystem::path& path, Replace replace)
+    : path_(path), replace_(replace), folder_(folder_of(path)), buffer_(std::make_unique<char[]>(kStreamBuffer)) {
+  file_.emplace(folder_, path.filename().string());
+  const cookie_io_functions_t functions{nullptr, &AtomicOutputFile::write_cookie, nullptr, nullptr};
+  stream_ = ::fopencookie(this, "w", functions);
+  if (stream_ == nullptr) throw InputError("cannot open a stream on " + path.string() + ": " + std::strerror(errno));
+  std::setvbuf(stream_, buffer_.get(), _IOFBF, kStreamBuffer);  // few, large writes (glibc ignores a size without a buffer)
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (stream_ != nullptr) std::fclose(stream_);  // not committed: whatever it flushes is removed with the temporary
+}
+
+ssize_t AtomicOutputFile::write_cookie(void* cookie, const char* data, std::size_t size) {
+  auto* self = static_cast<AtomicOutputFile*>(cookie);
+  if (self->write_error_ == 0) self->write_error_ = write_all(self->file_->fd(), std::string_view(data, size));
+  if (self->write_error_ != 0) {
+    errno = self->write_error_;
+    return -1;
   }
-  write_file_atomic_at(*folder, name, contents, directory_sync, replace);
+  return static_cast<ssize_t>(size);
+}
+
+void AtomicOutputFile::commit() {
+  const int flushed = std::fflush(stream_);
+  std::fclose(stream_);
+  stream_ = nullptr;
+  if (write_error_ != 0 || flushed != 0) file_->fail("write", write_error_ != 0 ? write_error_ : EIO);
+  file_->publish(replace_);
 }
 
 PrivateTemporaryDirectory::PrivateTemporaryDirectory(const DirectoryHandle& folder, const std::string& name)

@@ -230,24 +230,39 @@ void publish_file_at(const DirectoryHandle& from_directory, const std::string& f
   throw InputError("cannot rename a file to " + shown(directory.path() / name) + ": " + std::strerror(error_number));
 }
 
+TemporaryFile::TemporaryFile(const DirectoryHandle& directory, const std::string& name)
+    : directory_(directory), name_(name), temporary_(unpredictable_temporary_name(name)) {
+  // O_EXCL | O_NOFOLLOW: created here and now, never opened through whatever a name might already be.
+  fd_ = FileDescriptor(::openat(directory.fd(), temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
+  if (fd_.get() < 0) {
+    const int error_number = errno;
+    throw InputError("cannot create " + shown(directory.path() / temporary_) + ": " + std::strerror(error_number));
+  }
+}
+
+TemporaryFile::~TemporaryFile() {
+  if (!published_) ::unlinkat(directory_.fd(), temporary_.c_str(), 0);
+}
+
+void TemporaryFile::fail(const std::string& what, int error_number) {
+  ::unlinkat(directory_.fd(), temporary_.c_str(), 0);
+  published_ = true;  // nothing left to remove
+  throw InputError("cannot " + what + " " + shown(directory_.path() / temporary_) + ": " + std::strerror(error_number));
+}
+
+void TemporaryFile::publish(Replace replace, DirectorySync directory_sync) {
+  if (::fsync(fd_.get()) != 0) fail("flush", errno);
+  if (::close(fd_.release()) != 0) fail("close", errno);
+  published_ = true;  // publish_file_at removes it if the rename fails
+  publish_file_at(directory_, temporary_, directory_, name_, replace);  // a link at `name` is replaced, never followed
+  if (directory_sync == DirectorySync::kNow) sync(directory_);
+}
+
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
                           DirectorySync directory_sync, Replace replace) {
-  const std::string temporary = unpredictable_temporary_name(name);
-  const auto fail = [&](const std::string& what, int error_number) {
-    ::unlinkat(directory.fd(), temporary.c_str(), 0);
-    throw InputError("cannot " + what + " " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
-  };
-  // O_EXCL | O_NOFOLLOW: created here and now, never opened through whatever a name might already be.
-  FileDescriptor fd(::openat(directory.fd(), temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
-  if (fd.get() < 0) {
-    const int error_number = errno;
-    throw InputError("cannot create " + shown(directory.path() / temporary) + ": " + std::strerror(error_number));
-  }
-  if (const int error_number = write_all(fd.get(), contents); error_number != 0) fail("write", error_number);
-  if (::fsync(fd.get()) != 0) fail("flush", errno);
-  if (::close(fd.release()) != 0) fail("close", errno);
-  publish_file_at(directory, temporary, directory, name, replace);  // a link at `name` is replaced, never followed
-  if (directory_sync == DirectorySync::kNow) sync(directory);
+  TemporaryFile file(directory, name);
+  if (const int error_number = write_all(file.fd(), contents); error_number != 0) file.fail("write", error_number);
+  file.publish(replace, directory_sync);
 }
 
 void sync(const DirectoryHandle& directory) {

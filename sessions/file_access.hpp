@@ -89,6 +89,33 @@ enum class DirectorySync { kNow, kLater /* the caller calls sync() once for a ba
 /// owns such as a manifest), or must refuse: "<path> exists already (--force replaces it)".
 enum class Replace { kAllowed, kRefused };
 
+/// The one safe writer's temporary: `name`'s hidden temporary of an unpredictable name
+/// (unpredictable_temporary_name) in `directory`, created now with O_CREAT | O_EXCL | O_NOFOLLOW
+/// (so never through a link planted in advance). Write to fd() (write_all, or a stream over it),
+/// then publish(): fsync, close, rename over `name` (a link there is replaced, never followed; with
+/// Replace::kRefused, renameat2(RENAME_NOREPLACE): an existing name is refused, also one that
+/// appeared meanwhile), fsync of the directory. Not published (an error, an exception): removed.
+/// `directory` must outlive it.
+class TemporaryFile {
+ public:
+  TemporaryFile(const DirectoryHandle& directory, const std::string& name);
+  ~TemporaryFile();
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  int fd() const { return fd_.get(); }
+  /// Throws InputError "cannot write <temporary>: <why>" (what the temporary is removed after).
+  [[noreturn]] void fail(const std::string& what, int error_number);
+  /// Throws InputError naming the file and the reason; the temporary is gone either way.
+  void publish(Replace replace, DirectorySync directory_sync = DirectorySync::kNow);
+
+ private:
+  const DirectoryHandle& directory_;
+  std::string name_;
+  std::string temporary_;
+  FileDescriptor fd_;
+  bool published_ = false;
+};
+
 /// The one safe writer of bellows (the session store's files and every output outside it):
 /// writes `name` in `directory` atomically and durably. A hidden temporary of an unpredictable
 /// name (unpredictable_temporary_name) is created with O_CREAT | O_EXCL | O_NOFOLLOW (so never
@@ -96,6 +123,7 @@ enum class Replace { kAllowed, kRefused };
 /// replaces a link, never follows it; with Replace::kRefused, renameat2(RENAME_NOREPLACE): an
 /// existing name is refused, also one that appeared meanwhile), and the directory is flushed.
 /// A crash at any moment leaves the old file or the new one, never a mix.
+/// (A TemporaryFile written whole and published.)
 void write_file_atomic_at(const DirectoryHandle& directory, const std::string& name, std::string_view contents,
                           DirectorySync directory_sync = DirectorySync::kNow, Replace replace = Replace::kAllowed);
 

@@ -1,5 +1,6 @@
 // MATLAB exports (MAT v5 or v7.3) of a session through libmatio; see session_export.hpp.
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -173,8 +174,11 @@ MatVar iterations_struct(const Session& session) {
 void write_named(mat_t* file, MatVar var, const char* name, const fs::path& path) {
   // Top-level variables need a name; Mat_VarFree releases it with the rest.
   var->name = strdup(name);
+  errno = 0;
   if (Mat_VarWrite(file, var.get(), MAT_COMPRESSION_ZLIB) != 0) {
-    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string());
+    // libmatio says only that it failed; the system's reason (a full disk) is in errno, if anywhere.
+    const int why = errno;
+    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string() + (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
   }
 }
 
@@ -216,21 +220,8 @@ MatVar black_boxes_struct(const Session& session) {
   return out;
 }
 
-}  // namespace
-
-fs::path export_session_mat(const Session& session, const fs::path& path, MatVersion version, bool force) {
-  check_export_targets(session, {path}, ".mat", force);
-  // HDF5 (under MAT v7.3) prints its own error stack to stderr by default; our errors say it in
-  // one line instead.
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  const fs::path directory = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  const DirectoryHandle folder = DirectoryHandle::open(directory);
-  // libmatio writes by path: into a folder made for it alone, so no planted link is written through.
-  const PrivateTemporaryDirectory work(folder, path.filename().string());
-  const std::string name = path.filename().string();
-  const fs::path temporary = work.path() / name;
-  mat_t* file = Mat_CreateVer(temporary.c_str(), nullptr, version == MatVersion::kV73 ? MAT_FT_MAT73 : MAT_FT_MAT5);
-  if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
+/// Writes the session's variables into `file` and closes it; InputError naming `path` if libmatio fails.
+void finish_mat_file(mat_t* file, const Session& session, const fs::path& path) {
   try {
     write_named(file, session_struct(session), "session", path);
     write_named(file, iterations_struct(session), "iterations", path);
@@ -239,14 +230,67 @@ fs::path export_session_mat(const Session& session, const fs::path& path, MatVer
     Mat_Close(file);
     throw;
   }
-  Mat_Close(file);
-  // libmatio does not sync: flush it ourselves before the rename makes it visible.
+  errno = 0;
+  if (Mat_Close(file) != 0) {
+    const int why = errno;
+    throw InputError("cannot write " + path.string() + " (libmatio could not finish it)" + (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
+  }
+}
+
+/// MAT v5: libmatio writes through its own stdio into memory (a memfd, reached by its
+/// /proc/self/fd name), and the one safe writer writes those bytes out (exclusive temporary,
+/// fsync, rename, fsync of the folder): nothing of libmatio's touches the folder.
+void export_mat5(const Session& session, const fs::path& path, Replace replace) {
+  const FileDescriptor memory(::memfd_create("bellows-mat-export", MFD_CLOEXEC));
+  if (memory.get() < 0) throw EnvironmentError(std::string("cannot make the MAT file in memory: ") + std::strerror(errno));
+  const std::string in_memory = "/proc/self/fd/" + std::to_string(memory.get());
+  mat_t* file = Mat_CreateVer(in_memory.c_str(), nullptr, MAT_FT_MAT5);
+  if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
+  finish_mat_file(file, session, path);
+  std::string bytes;
+  char buffer[1 << 16];
+  for (off_t at = 0;;) {
+    const ssize_t got = ::pread(memory.get(), buffer, sizeof buffer, at);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw EnvironmentError("cannot read the MAT file back from memory: " + std::string(std::strerror(errno)));
+    if (got == 0) break;
+    bytes.append(buffer, static_cast<std::size_t>(got));
+    at += got;
+  }
+  write_file_atomic(path, bytes, DirectorySync::kNow, replace);
+}
+
+/// MAT v7.3 (for sessions beyond v5's 2 GB a variable: not held in memory): HDF5 needs a real
+/// path (it resolves links, so a memfd's name will not do), so libmatio writes into a folder made
+/// for it alone (0700, unpredictable name) beside the output, where nothing can be planted, and
+/// the safe writer's last steps publish it: fsync, rename (refused over an existing file without
+/// --force), fsync of the folder.
+void export_mat73(const Session& session, const fs::path& path, Replace replace) {
+  const fs::path directory = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  const DirectoryHandle folder = DirectoryHandle::open(directory);
+  const PrivateTemporaryDirectory work(folder, path.filename().string());
+  const std::string name = path.filename().string();
+  mat_t* file = Mat_CreateVer((work.path() / name).c_str(), nullptr, MAT_FT_MAT73);
+  if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
+  finish_mat_file(file, session, path);
   {
     const std::optional<FileDescriptor> fd = open_regular_file_at(work.handle(), name, O_RDONLY);
     if (!fd || ::fsync(fd->get()) != 0) throw InputError("cannot flush " + path.string() + ": " + std::strerror(errno));
   }
-  publish_file_at(work.handle(), name, folder, name, force ? Replace::kAllowed : Replace::kRefused);
+  publish_file_at(work.handle(), name, folder, name, replace);
   sync(folder);
+}
+
+}  // namespace
+
+fs::path export_session_mat(const Session& session, const fs::path& path, MatVersion version, bool force) {
+  check_export_targets(session, {path}, ".mat", force);
+  // HDF5 (under MAT v7.3) prints its own error stack to stderr by default; our errors say it in
+  // one line instead.
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
+  if (version == MatVersion::kV73) export_mat73(session, path, replace);
+  else export_mat5(session, path, replace);
   return path;
 }
 

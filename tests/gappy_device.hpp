@@ -13,7 +13,8 @@ namespace bellows::testing {
 
 class GappyDevice final : public Device {
  public:
-  explicit GappyDevice(Device& arm) : arm_(arm) {}
+  /// `own_time`: a rig whose time passes on its own (as a remote one): a missed deadline is no warning.
+  explicit GappyDevice(Device& arm, bool own_time = false) : arm_(arm), own_time_(own_time) {}
 
   /// Readings of reads [from, from + count) (counted from the first read, 0-based) are missing.
   void lose_readings(long from, long count) { gaps_.emplace_back(from, from + count); }
@@ -43,7 +44,7 @@ class GappyDevice final : public Device {
   void write_valves(const ValveCommand& command) override { arm_.write_valves(command); }
   void vent() override { arm_.vent(); }
   void advance(double dt_s) override { arm_.advance(dt_s); }
-  bool time_follows_ticks() const override { return arm_.time_follows_ticks(); }
+  bool time_follows_ticks() const override { return !own_time_ && arm_.time_follows_ticks(); }
   const char* name() const override { return "gappy"; }
   bool take_fault(DeviceFault& fault) override {
     if (!has_pending_) return false;
@@ -60,6 +61,7 @@ class GappyDevice final : public Device {
   bool has_last_ = false;
   DeviceFault pending_{};
   bool has_pending_ = false;
+  bool own_time_ = false;
 };
 
 }  // namespace bellows::testing

@@ -83,6 +83,43 @@ TEST(EngineAllocations, RidingThroughMissingReadingsAndADevicesFaultAllocateNoth
   EXPECT_EQ(allocations, 0);
 }
 
+// A late loop on a rig with its own time: the missed periods held (issue 22), and at the limit the
+// fault with its sentence; neither allocates.
+TEST(EngineAllocations, ALateLoopRiddenThroughAndFaultingAllocatesNothing) {
+  const Configuration config;
+  SimulatedArm arm(config.plant, 1);
+  testing::GappyDevice device(arm, true);
+  EngineCore core(device, config.controller, config.timing, config.safety);
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  Eigen::VectorXd correction = Eigen::VectorXd::Constant(paper.learning_samples(), 0.01);
+  TrialRecord record;
+  record.prepare(paper.learning_samples(), config.timing.ticks_per_sample);
+  const double tick_s = config.timing.tick_s;
+  long long ticks = 0;
+  const auto tick = [&](int missed) {  // the rig's time goes on through the missed periods
+    device.advance(missed * tick_s);
+    ticks += missed;
+    core.tick(static_cast<double>(ticks) * tick_s, static_cast<double>(ticks) * tick_s, missed);
+    device.advance(tick_s);
+    ++ticks;
+  };
+  EXPECT_TRUE(core.send(EngineCommand::select_trajectory(paper)));
+  EXPECT_TRUE(core.send(EngineCommand::of(CommandKind::kArm)));
+  for (int i = 0; i < 10; ++i) tick(0);
+  const EngineCommand start = EngineCommand::start_trial(paper, correction, record, 10, 1);
+  long allocations = 0;
+  {
+    CountAllocations counter;
+    EXPECT_TRUE(core.send(start));
+    for (int i = 0; i < 400; ++i) tick(i % 50 == 49 ? config.safety.stale_ticks - 1 : 0);  // ridden through
+    tick(config.safety.stale_ticks);  // the limit: vents and faults with its sentence
+    allocations = counter.allocations();
+  }
+  EXPECT_GT(core.held_ticks(), 0u);
+  EXPECT_EQ(core.fault(), FaultCode::kMissedDeadlines);
+  EXPECT_EQ(allocations, 0);
+}
+
 TEST(EngineAllocations, TicksOfThreeJointsAllocateNothing) {
   const Configuration config;
   SimulatedArmChain arm(pneumatic_chain_of(config.plant, ArmParameters{"arm3"}), 1);

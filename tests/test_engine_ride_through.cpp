@@ -1,7 +1,8 @@
 // The engine rides through missing readings (issue 22): a tick without a fresh reading holds every
 // valve closed and runs no controller, the trial goes on and records the sample as held (error 0,
 // nothing learned from it); [safety] stale_ticks of them in a row fault, named by the device. A
-// device's own fault (the rig's trip) is latched with the device's words and joint.
+// device's own fault (the rig's trip) is latched with the device's words and joint. On a rig whose
+// time is its own, periods the loop missed are held the same way and count towards that limit.
 #include <cstring>
 #include <set>
 #include <string>
@@ -18,8 +19,18 @@ namespace bellows {
 namespace {
 
 struct GappyEngine {
-  explicit GappyEngine(const Configuration& c = Configuration{})
-      : config(c), arm(c.plant, 1), device(arm), core(device, c.controller, c.timing, c.safety), clock(core, device) {}
+  explicit GappyEngine(const Configuration& c = Configuration{}, bool own_time = false)
+      : config(c), arm(c.plant, 1), device(arm, own_time), core(device, c.controller, c.timing, c.safety), clock(core, device) {}
+  /// One tick of a loop that woke `missed` periods late: the rig's time went on meanwhile.
+  void step_late(int missed) {
+    const double tick_s = config.timing.tick_s;
+    device.advance(missed * tick_s);
+    clock.set_ticks(clock.ticks() + missed);
+    const double now = clock.now_s();
+    core.tick(now, now, missed);
+    device.advance(tick_s);
+    clock.set_ticks(clock.ticks() + 1);
+  }
   std::vector<EngineEvent> drain() {
     std::vector<EngineEvent> events;
     EngineEvent e;
@@ -27,7 +38,8 @@ struct GappyEngine {
     return events;
   }
   /// Arms and runs one trial of `trajectory` to its end (or a fault); the record is returned.
-  void run_trial(const Trajectory& trajectory, TrialRecord& record) {
+  /// With `late_at` >= 0, the loop's wake-up `late_at` ticks into the trial comes `missed` periods late.
+  void run_trial(const Trajectory& trajectory, TrialRecord& record, long late_at = -1, int missed = 0) {
     correction = Eigen::VectorXd::Zero(trajectory.learning_samples());
     record.prepare(trajectory.learning_samples(), config.timing.ticks_per_sample);
     EXPECT_TRUE(core.send(EngineCommand::select_trajectory(trajectory)));
@@ -35,7 +47,20 @@ struct GappyEngine {
     clock.step(20);
     EXPECT_TRUE(core.send(EngineCommand::start_trial(trajectory, correction, record, 10, 7)));
     const long ticks = 10 + static_cast<long>(trajectory.learning_samples()) * config.timing.ticks_per_sample + 20;
-    for (long i = 0; i < ticks && core.state() != EngineState::kFault; ++i) clock.step();
+    for (long i = 0; i < ticks && core.state() != EngineState::kFault; ++i) {
+      if (i == late_at) {
+        step_late(missed);
+      } else {
+        clock.step();
+      }
+    }
+  }
+  /// The engine time of the trial's end (its kTrialComplete event), -1 without one.
+  double trial_end_s() {
+    for (const EngineEvent& event : drain()) {
+      if (event.kind == EventKind::kTrialComplete) return event.time_s;
+    }
+    return -1.0;
   }
   Configuration config;
   SimulatedArm arm;
@@ -150,6 +175,90 @@ TEST(EngineRideThrough, ADeviceFaultWhileVentedIsTakenButNotLatched) {
   EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
   e.clock.step(10);
   EXPECT_EQ(e.core.state(), EngineState::kArmed);  // the old report does not fire on arming
+}
+
+// Missed deadlines on a rig whose time is its own (docs/architecture.md): the periods the loop
+// missed passed on the rig without a command; below the limits they are held like missing readings.
+TEST(EngineLateLoop, ALateWakeUpBelowTheLimitRidesThroughAsHeldTicksOnTheRigsClock) {
+  const Trajectory paper = library_trajectory("paper", 0.02);
+  TrialRecord clean;
+  GappyEngine reference(Configuration{}, true);
+  reference.run_trial(paper, clean);
+  const double clean_end_s = reference.trial_end_s();
+  ASSERT_TRUE(clean.complete);
+
+  GappyEngine e(Configuration{}, true);
+  ASSERT_FALSE(e.device.time_follows_ticks());
+  const int missed = e.config.safety.stale_ticks - 1;  // 35 ms: the longest late wake-up that rides through
+  TrialRecord record;
+  e.run_trial(paper, record, 600, missed);
+  ASSERT_TRUE(record.complete) << "faulted: " << fault_name(e.core.fault());
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
+  EXPECT_EQ(e.core.held_ticks(), static_cast<std::uint64_t>(missed));  // the reading after it is fresh
+  EXPECT_EQ(e.core.missed_deadline_warnings(), 0u);                    // a rig's: no warnings, a ride-through
+  // The samples in the missed periods are held (at least one of 7 ticks, 4 ticks a sample), not learned from.
+  EXPECT_GE(record.held_samples, missed / e.config.timing.ticks_per_sample);
+  for (int k = 0; k <= paper.learning_samples(); ++k) {
+    if (record.held[static_cast<std::size_t>(k)] != 0) {
+      EXPECT_EQ(record.samples.error_rad(k), 0.0) << k;
+    }
+  }
+  // The trial's clock kept the rig's time: it ends when the clean one did, not `missed` ticks later.
+  EXPECT_NEAR(e.trial_end_s(), clean_end_s, 1e-9);
+  EXPECT_NEAR(record.rms_error_deg(), clean.rms_error_deg(), 0.15 * clean.rms_error_deg());
+}
+
+TEST(EngineLateLoop, ALateWakeUpAsLongAsTheStaleLimitVentsAndFaultsInTheTickItWakesIn) {
+  GappyEngine e(Configuration{}, true);
+  const int limit = e.config.safety.stale_ticks;
+  TrialRecord record;
+  e.run_trial(library_trajectory("paper", 0.02), record, 600, limit);
+  ASSERT_EQ(e.core.state(), EngineState::kFault);
+  EXPECT_EQ(e.core.fault(), FaultCode::kMissedDeadlines);
+  EXPECT_FALSE(record.complete);
+  bool fault_seen = false;
+  for (const EngineEvent& event : e.drain()) {
+    if (event.kind != EventKind::kFault) continue;
+    fault_seen = true;
+    EXPECT_NE(std::strstr(event.detail.data(), "the rig went 40 ms without the loop's commands, 40 ms of it because the loop was late"),
+              nullptr)
+        << event.detail.data();
+  }
+  EXPECT_TRUE(fault_seen);
+  TickRecord tick;
+  e.core.read_snapshot(tick);
+  EXPECT_EQ(tick.state, EngineState::kFault);
+  EXPECT_EQ(tick.valves.joint[0].outlet_duty[0], 1.0);  // vented in the tick it woke in
+  EXPECT_EQ(tick.valves.joint[0].inlet_duty[0], 0.0);
+}
+
+TEST(EngineLateLoop, MissedPeriodsAndMissingReadingsAddUpToTheStaleLimitNamedByTheLargerPart) {
+  const int limit = SafetyParameters{}.stale_ticks;
+  struct Case {
+    int lost, missed;
+    FaultCode named;
+  };
+  // Mostly the loop's lateness: missed-deadlines; mostly the link's silence: the device's word.
+  for (const Case c : {Case{limit / 2, limit - limit / 2, FaultCode::kMissedDeadlines}, Case{limit - 2, 2, FaultCode::kSensorStale}}) {
+    GappyEngine e(Configuration{}, true);
+    EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+    e.clock.step(20);
+    e.device.lose_readings(e.device.reads(), c.lost);
+    e.clock.step(c.lost);
+    ASSERT_EQ(e.core.state(), EngineState::kArmed) << c.lost << " readings lost are below the limit";
+    e.step_late(c.missed);  // the reading after the gap is fresh, but the rig went `limit` ticks without control
+    EXPECT_EQ(e.core.state(), EngineState::kFault) << c.lost << " + " << c.missed;
+    EXPECT_EQ(e.core.fault(), c.named) << c.lost << " + " << c.missed;
+  }
+  // One tick less of either: rides through.
+  GappyEngine e(Configuration{}, true);
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step(20);
+  e.device.lose_readings(e.device.reads(), limit / 2);
+  e.clock.step(limit / 2);
+  e.step_late(limit - limit / 2 - 1);
+  e.clock.step(20);
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
 }
 
 TEST(FaultVocabulary, EveryCodeHasAStableNameAndASentence) {

@@ -114,7 +114,11 @@ TEST_F(IlcCommands, IdentifyRecoversTheCreepFreeArmAndWritesTheModelSection) {
   EXPECT_GT(report["validation_fit_percent"].get<double>(), 95.0);
 
   const auto lab = write("lab.toml", "# rig 2\n[model]\nkappa = 7.91  # paper\n");
-  const Result written = bellows("identify --write-model " + lab.string());
+  // It holds a model (the paper's kappa): replaced only with --force (issue 24), never in silence.
+  const Result refused = bellows("identify --write-model " + lab.string());
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.err.find("holds a model already ([model] kappa = 7.91)"), std::string::npos) << refused.err;
+  const Result written = bellows("identify --force --write-model " + lab.string());
   ASSERT_EQ(written.status, 0) << written.err;
   const std::string text = read_file(lab);
   EXPECT_NE(text.find("# rig 2"), std::string::npos) << text;

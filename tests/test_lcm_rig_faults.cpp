@@ -1,10 +1,12 @@
 // The faults a lab meets first on an LCM rig, as processes in a private network namespace (issue
 // 25): chambers swapped with the rig's range inside the engine's guard end with the rig's own trip
 // named (exit 3, in the JSON and the session), with the range outside the guard with the engine's
-// `angle-limit`, never `sensor-stale`; `rig check` passes against io-sim and names the swap against
-// `--swapped-chambers`; a clean run reports no link errors (the rig's offers counted apart).
+// `angle-limit`, never `sensor-stale`; `rig check` passes against io-sim (its limits announced, its
+// command timeout provoked) and names the swap against `--swapped-chambers`, and names each limit
+// of an io-sim that breaks them; a clean run reports no link errors (the rig's offers counted apart).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -116,7 +118,12 @@ TEST(LcmRigFaults, ACleanRunReportsNoLinkErrorsAndCountsTheOffersApart) {
 TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambers) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-rig-check");
-  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n").string();
+  // Loaded-machine settings: the rig's timeout (provoked by the check) long and its tolerance wide,
+  // so that a build beside the suite stalling a thread is not taken for the rig's fault.
+  const std::string config =
+      testing::write_file(dir, "tolerant.toml",
+                          "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n[rig_check]\ntimeout_tolerance_s = 0.5\n")
+          .string();
   for (const bool swapped : {false, true}) {
     std::vector<std::string> rig_argv = {kBellows, "io-sim", "--config", config};
     if (swapped) rig_argv.push_back("--swapped-chambers");
@@ -128,15 +135,65 @@ TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambe
     ASSERT_TRUE(rig.wait(30.0).has_value());
     ASSERT_TRUE(status.has_value()) << "rig check did not finish";
     const nlohmann::json report = report_of(check);
+    // The rig's own limits pass either way: what io-sim announces is this configuration's, and its
+    // command timeout, provoked, trips naming this session, vents, and the engine names it.
+    EXPECT_EQ(report["limits"]["all_pass"], true) << report["limits"].dump() << check.err();
+    EXPECT_NEAR(report["limits"]["announced"]["pressure_ceiling_bar"].get<double>(), 1.75, 1e-9);
+    EXPECT_EQ(report["limits"]["timeout"]["engine_fault"], "rig-timeout") << report["limits"].dump();
+    EXPECT_EQ(report["limits"]["timeout"]["trip_session_is_ours"], true);
+    char provoked[64];
+    std::snprintf(provoked, sizeof provoked, "  %-26s pass  tripped", "command timeout (provoked)");
+    EXPECT_NE(check.err().find(provoked), std::string::npos) << check.err();
     if (!swapped) {
       EXPECT_EQ(*status, 0) << check.err();
       EXPECT_EQ(report["all_pass"], true) << report.dump();
+      EXPECT_NE(check.err().find("rig check: every valve passed, every limit passed"), std::string::npos) << check.err();
     } else {
       EXPECT_NE(*status, 0) << check.err();
       EXPECT_EQ(report["all_pass"], false);
       EXPECT_NE(check.err().find("are swapped"), std::string::npos) << check.err();
     }
   }
+}
+
+// The rig's own limits, each broken: io-sim with a lower p_max (its ceiling 1.55 bar, below the
+// engine's guard 1.65), an angle range of 90 deg (inside the engine's guard 95) and a command timeout
+// it announces but never acts on. The check names each, exit 5; the valves still pass.
+TEST(LcmRigFaults, RigCheckNamesEachLimitOfARigThatBreaksThem) {
+  ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
+  const auto dir = testing::make_temp_dir("bellows-lcm-rig-limits");
+  const std::string tolerant = "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 0.5\n[rig_check]\ntimeout_tolerance_s = 0.3\n";
+  const std::string config = testing::write_file(dir, "engine.toml", tolerant).string();
+  const std::string rig_config =
+      testing::write_file(dir, "rig.toml",
+                          "[controller]\np_max_bar = 1.2\n[safety]\nangle_limit_deg = 85\nmissed_deadline_streak = 1000\n[lcm]\n"
+                          "rig_timeout_s = 0.5\nrig_angle_limit_deg = 90\n[trajectory]\nmax_abs_angle_deg = 80\n")
+          .string();
+  Child rig({kBellows, "io-sim", "--config", rig_config, "--no-command-timeout"}, dir / "rig.out", dir / "rig.err");
+  Child check({kBellows, "rig", "check", "--device", "lcm", "--yes", "--json", "--no-save", "--config", config}, dir / "check.out",
+              dir / "check.err");
+  const auto status = check.wait(120.0);
+  rig.signal(SIGTERM);
+  ASSERT_TRUE(rig.wait(30.0).has_value());
+  ASSERT_TRUE(status.has_value()) << "rig check did not finish";
+  EXPECT_EQ(*status, 5) << check.err();
+  EXPECT_NE(rig.err().find("drill: no command timeout"), std::string::npos) << rig.err();
+  const std::string err = check.err();
+  EXPECT_NE(err.find("FAIL pressure ceiling: the rig vents chambers above 1.550 bar absolute, this configuration expects 1.750 bar"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("at or below the engine's own guard 1.650 bar"), std::string::npos) << err;
+  EXPECT_NE(err.find("FAIL angle range: the rig's angle range is 90.0 deg"), std::string::npos) << err;
+  EXPECT_NE(err.find("inside the engine's guard 95.0 deg"), std::string::npos) << err;
+  EXPECT_NE(err.find("FAIL command timeout (provoked): the rig did not vent by itself"), std::string::npos) << err;
+  char announced_timeout[64];
+  std::snprintf(announced_timeout, sizeof announced_timeout, "  %-26s pass  500.0 ms", "command timeout");
+  EXPECT_NE(err.find(announced_timeout), std::string::npos) << "announced as configured: " << err;
+  EXPECT_NE(err.find("rig check: every valve passed, 3 limit checks failed"), std::string::npos) << err;
+  const nlohmann::json report = report_of(check);
+  EXPECT_EQ(report["all_pass"], false);
+  EXPECT_EQ(report["limits"]["all_pass"], false);
+  EXPECT_EQ(report["limits"]["timeout"]["tripped"], false);
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ struct TelemetryBench {
 
   /// Everything the publisher sends for the ticks so far, on memq://.
   std::vector<Recorded> published() {
-    TelemetryPublisher publisher(tap, 7, "");
+    TelemetryPublisher publisher(tap, 7, nullptr);
     lcm::LCM bus("memq://");
     BusRecorder recorder(kTelemetryChannel);
     recorder.attach(bus);

@@ -211,6 +211,9 @@ struct RigCheckParameters {
   double valve_pulse_s = 0.03;    // the valve under test alone, fully open
   double min_change_bar = 0.01;   // a chamber "moved": at least this much, and this much more than the other
   int zero_readings = 20;         // `--zero-angle` averages this many fresh readings (0.1 s at 200 Hz), the arm at rest
+  // `rig check --device lcm`: the rig's command timeout, provoked, must act within [lcm] rig_timeout_s
+  // +- this (its state period, the transport and both hosts' scheduling)
+  double timeout_tolerance_s = 0.025;
 };
 
 /// A LabJack T7 over Modbus TCP (docs/labjack-t7.md); the engine itself knows no Modbus.

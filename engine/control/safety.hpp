@@ -24,8 +24,13 @@ struct SafetyParameters {
   // Ticks in a row without a fresh reading: held (valves closed) below it, a fault at it. 8 ticks =
   // 40 ms at 200 Hz: below the rig's own 50 ms command timeout, and a chamber filling at the full
   // inlet flow gains < 0.1 bar in it (docs/architecture.md, "Riding through missing readings").
+  // Missed periods count as such ticks too (the rig had no command in them), and are held the same
+  // way (the trial's clock goes on, nothing learned from them).
   int stale_ticks = 8;
-  int missed_deadline_streak = 5;         // consecutive ticks that missed their deadline
+  // Missed deadlines in a row (late wake-ups, summed) before a fault, on a rig whose time is its
+  // own: 8 periods = 40 ms, the stale limit's time and reasons (the rig runs on its last command
+  // meanwhile). Below it the loop rides through (docs/architecture.md, missed deadlines).
+  int missed_deadline_streak = 8;
   double heartbeat_timeout_s = 1.0;       // console silent for longer: fault
   double black_box_s = 2.0;               // ticks kept for the fault record
 

@@ -288,7 +288,13 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
 
   const SensorReading reading = device_.read_sensors();
   const bool fresh = reading.time_s > last_reading_time_s_;  // else: no reading this tick (device.hpp)
-  stale_count_ = fresh ? 0 : stale_count_ + 1;
+  // On a rig whose time is its own, the periods the loop missed passed there without a command:
+  // each is a tick without a reading, held like one (the trial's clock goes on, nothing learned).
+  const int skipped = time_follows_ticks_ ? 0 : std::max(0, missed_deadlines);
+  const int unattended = stale_count_ + skipped + (fresh ? 0 : 1);  // ticks the rig went uncontrolled
+  const int late_ticks = skipped_in_gap_ + skipped;                  // of them, the loop's
+  skipped_in_gap_ = fresh ? 0 : late_ticks;
+  stale_count_ = fresh ? 0 : unattended;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
   if (std::isfinite(reading.joint[0].angle_rad)) last_angle_rad_ = reading.joint[0].angle_rad;
   count_missed_deadlines(missed_deadlines, now_s);
@@ -297,11 +303,19 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   DeviceFault device_fault;
   const bool device_faulted = device_.take_fault(device_fault);
   if (valves_live(state()) && device_faulted) enter_fault(device_fault, now_s);
-  if (valves_live(state()) && stale_count_ >= safety_.stale_ticks) {
-    // The stale limit: the device names why (a lost link, or frozen sensors).
+  if (valves_live(state()) && unattended >= safety_.stale_ticks) {
+    // The stale limit, on the time the rig went without a command from a fresh reading: the
+    // device names why (a lost link, or frozen sensors), unless the late loop made most of it.
     DeviceFault silence;
-    device_.explain_silence(stale_count_ * timing_.tick_s, silence);
-    if (silence.code == FaultCode::kNone) silence.code = FaultCode::kSensorStale;
+    if (2 * late_ticks >= unattended) {
+      silence.set(FaultCode::kMissedDeadlines, -1,
+                  "the rig went %.0f ms without the loop's commands, %.0f ms of it because the loop was late "
+                  "([safety] stale_ticks): lighten the machine's load, or use --rt enforce",
+                  unattended * timing_.tick_s * 1e3, late_ticks * timing_.tick_s * 1e3);
+    } else {
+      device_.explain_silence(unattended * timing_.tick_s, silence);
+      if (silence.code == FaultCode::kNone) silence.code = FaultCode::kSensorStale;
+    }
     enter_fault(silence, now_s);
   }
   if (valves_live(state())) {
@@ -319,6 +333,11 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   if (valves_live(state())) {
     if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
       start_control_trial();
+    }
+    if (!manual_) {
+      // The periods the loop missed, held as they passed on the rig (fewer than the limits above).
+      for (int i = 0; i < skipped; ++i) control_.tick_held(reading);
+      held_ticks_.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
     }
     if (manual_) {
       // The pulse's ticks, then `after`; its end is reported after `settle_ticks` of `after` (the

@@ -142,6 +142,7 @@ void RealtimeLoop::run(int priority, RealtimeMode mode) {
   timespec deadline = start;
   std::uint64_t tick = 0;
   int missed_since_last = 0;
+  const bool follows_ticks = device_.time_follows_ticks();
   while (running_.load(std::memory_order_acquire)) {
     if (period_ns > 0) {
       clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr);
@@ -161,6 +162,8 @@ void RealtimeLoop::run(int priority, RealtimeMode mode) {
     timespec wall{};
     clock_gettime(CLOCK_MONOTONIC, &wall);
     // The engine decides what a missed deadline means for its device (Device::time_follows_ticks()).
+    // A rig whose time is its own lived through the missed periods: engine time keeps its pace.
+    if (!follows_ticks) tick += static_cast<std::uint64_t>(missed_since_last);
     core_.tick(static_cast<double>(tick) * tick_s, static_cast<double>(diff_ns(wall, start)) * 1e-9, missed_since_last);
     device_.advance(tick_s);
     missed_since_last = 0;

@@ -4,11 +4,13 @@
 // fail a call of the save under test. It runs `BELLOWS_DRIVER_TRIALS` trials (default 2) saved
 // unarmed, arms the shim (BELLOWS_FAULT_ARMED=1), runs one more trial (the console learns its
 // correction after saving it: two saves), waits for the saves, then quits like an operator (q,
-// and q again if asked). It prints what the operator would read, one `key: value` line each, and
+// and q again if asked); BELLOWS_DRIVER_SKIP_ARMED_TRIAL=1 quits without it (the session as it was
+// before the save under test, for the tests' reference). It prints what the operator would read, one `key: value` line each, and
 // exits as the console does: 4 when quitting leaves work the disk did not take, else 0.
 //   console_save_driver DATA_DIR
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include <gtest/gtest.h>  // console_fixture.hpp's helpers assert
@@ -40,10 +42,14 @@ int main(int argc, char** argv) {
   if (f.state().experiment.saved_trials != before || f.state().experiment.unsaved()) return 3;  // all on disk, unarmed
   std::printf("session: %s\n", f.state().experiment.session_location.c_str());
   std::fflush(stdout);
+  const char* skip_text = std::getenv("BELLOWS_DRIVER_SKIP_ARMED_TRIAL");  // "1": quit here (the state before the save)
+  const bool armed_trial = skip_text == nullptr || std::strcmp(skip_text, "1") != 0;
   ::setenv("BELLOWS_FAULT_ARMED", "1", 1);  // the save under test: the next trial's
-  f.key('n');
-  if (!f.pump_until([&] { return f.idle(); })) return 3;
-  settle();
+  if (armed_trial) {
+    f.key('n');
+    if (!f.pump_until([&] { return f.idle(); })) return 3;
+    settle();
+  }
   ::setenv("BELLOWS_FAULT_ARMED", "0", 1);
   std::printf("status: %s\n", f.state().status.c_str());
   for (const bellows::ui::LogEntry& entry : f.state().log.entries()) {  // what the operator read in the log
