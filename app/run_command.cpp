@@ -214,6 +214,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
       if (s.iteration > 0) s.learned_with = learned_with(config);  // iteration 0 applies what it was given
       io.post_trial(s, session.correction_bar());  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
+      if (const std::string note = session.learning().take_note(); !note.empty()) recording.note("model-refit", note);
       // On disk before the line says it is done.
       if (chain != nullptr) recording.save(session, s, chain, core, clock);
       else recording.save(session, s, arm, core, clock);

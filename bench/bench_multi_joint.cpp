@@ -22,6 +22,7 @@
 #include "engine/model/arm_chain.hpp"
 #include "engine/model/arm_chain_linearization.hpp"
 #include "engine/model/arm_model.hpp"
+#include "engine/learning/noilc_learned.hpp"
 #include "engine/learning/noilc_mimo.hpp"
 #include "engine/learning/noilc_mimo_constrained.hpp"
 #include "engine/learning/noilc_mimo_dense.hpp"
@@ -97,7 +98,8 @@ void BM_MultiJointSetup(benchmark::State& state) {
 BENCHMARK(BM_MultiJointSetup)->Args({3, 400})->Args({3, 12000})->Unit(benchmark::kMicrosecond);
 
 // The bounded update, cold: a large random error against +-0.05 bar bounds on every joint, restarted
-// from the same u_j every time (many entries end on a bound), as BM_ConstrainedUpdate for one joint.
+// from the same u_j and a zero ADMM dual every time (many entries end on a bound), as
+// BM_ConstrainedUpdate for one joint.
 void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
   MultiJointNoilcConstrained law;
@@ -110,6 +112,7 @@ void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
   TrialData data(n, joints);
   data.e_j *= 10.0;
   for (auto _ : state) {
+    law.forget_warm_start();
     benchmark::DoNotOptimize(law.solve(data.u_j, data.e_j, data.u_next));
     benchmark::DoNotOptimize(data.u_next.data());
   }
@@ -117,6 +120,27 @@ void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
   state.counters["active_entries"] = law.last_report().active_entries;
 }
 BENCHMARK(BM_MultiJointConstrainedUpdate)->Args({3, 400})->Unit(benchmark::kMicrosecond);
+
+// noilc-learned for J joints between two trials: refit from the last trial and the update, on the
+// closed loop of the coupled model (5J prior states, J x 6 learned ones). As BM_LearnedUpdateAndRefit.
+void BM_MultiJointLearnedUpdateAndRefit(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
+  const Configuration config;
+  const MultiJointModel model = coupled_model(joints);
+  LearnedModelNoilc law(closed_loop_prior(model.A, model.B, kSampleTime_s, config.model.volume_gain_per_rad, config.controller),
+                        learned_noilc_settings(config.ilc), n);
+  TrialData a(n, joints), b(n, joints);
+  b.u_j = 0.5 * a.u_j.array() + 0.01;
+  bool flip = false;
+  for (auto _ : state) {
+    const TrialData& d = flip ? b : a;
+    flip = !flip;
+    law.update(d.u_j, a.e_j, a.u_next);
+    benchmark::DoNotOptimize(a.u_next.data());
+  }
+  state.counters["refitted"] = law.last_report().refitted ? 1.0 : 0.0;
+}
+BENCHMARK(BM_MultiJointLearnedUpdateAndRefit)->Args({1, 400})->Args({3, 400})->Args({1, 12000})->Args({3, 12000})->Unit(benchmark::kMicrosecond);
 
 void BM_MultiJointDenseUpdate(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));

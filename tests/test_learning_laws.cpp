@@ -32,7 +32,7 @@ TEST(LearningLaws, FactoryBuildsEveryNamedLawAndNoilcIsTheDefault) {
     EXPECT_EQ(law->samples(), 50);
     EXPECT_FALSE(learning_law_description(name).empty());
   }
-  EXPECT_EQ(learning_law_names().size(), 6u);
+  EXPECT_EQ(learning_law_names().size(), 7u);
 }
 
 TEST(LearningLaws, FactoryRejectsUnknownNamesAndBadParametersNamingTheKey) {
@@ -64,6 +64,10 @@ TEST(LearningLaws, FrequencyResponseMatchesTheUpdateAwayFromTheTrialEnds) {
   constexpr int kSamples = 1200;
   for (const std::string& name : learning_law_names()) {
     const auto law = make(name, kSamples);
+    if (name == "noilc-learned") {  // its model changes with the trials: not linear and time-invariant
+      EXPECT_FALSE(law->frequency_response(0.3).has_value());
+      continue;
+    }
     for (double theta : {0.05, 0.3, 1.0, 2.5}) {
       const auto response = law->frequency_response(theta);
       ASSERT_TRUE(response.has_value()) << name;

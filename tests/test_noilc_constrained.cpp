@@ -15,6 +15,7 @@
 #include "engine/operator/learning_session.hpp"
 #include "engine/learning/noilc_constrained.hpp"
 #include "engine/learning/noilc_dense.hpp"
+#include "engine/learning/noilc_riccati.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {
@@ -157,6 +158,57 @@ TEST(NoilcConstrained, LeavesOutTheErrorsAfterInputsOnTheLimit) {
   plain.update(u_j, p.e_j, expected);
   EXPECT_EQ(unmasked.last_report().unweighted_errors, 0);
   EXPECT_LT((actual - expected).cwiseAbs().maxCoeff(), 1e-8);
+}
+
+// What "left out" means (docs/learning-laws.md): the errors are set to zero, so the update keeps those
+// outputs where they are; it is not the update with zero weight in M there, which would be free to move
+// them. Checked with no bound active, against the Riccati law on the zeroed error and the dense
+// zero-weight optimum.
+TEST(NoilcConstrained, LimitShapedErrorsAreZeroedNotUnweighted) {
+  std::mt19937 random(21);
+  const int n = 120;
+  const RandomProblem p = random_problem(n, random);
+  IlcParameters parameters;
+  const double limit = 50.0;  // far away: the free optimum is feasible
+  Eigen::VectorXd u_j = 0.01 * p.u_j;
+  u_j(40) = limit;  // reached the limit in the trial: outputs 40..43 are left out
+  NormOptimalConstrained constrained(paper_model(), parameters, n);
+  constrained.set_input_context(Eigen::VectorXd::Zero(n), limit);
+  Eigen::VectorXd actual(n);
+  constrained.update(u_j, p.e_j, actual);
+  ASSERT_EQ(constrained.last_report().unweighted_errors, 4);
+  ASSERT_EQ(constrained.last_report().admm_iterations, 0);
+  Eigen::VectorXd zeroed = p.e_j;
+  zeroed.segment(40, 4).setZero();
+  NormOptimalRiccati riccati(paper_model(), parameters, n);
+  Eigen::VectorXd expected(n);
+  riccati.update(u_j, zeroed, expected);
+  EXPECT_LT((actual - expected).norm(), 1e-10 * expected.norm());
+  // The zero-weight alternative: M = diag(m, with 0 at entries 40..43), the measured error.
+  const Eigen::MatrixXd P = paper_model().lifted(n);
+  Eigen::VectorXd mask = Eigen::VectorXd::Constant(n, parameters.m);
+  mask.segment(40, 4).setZero();
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+  const double T = paper_model().sample_time_s;
+  for (int t = 0; t + 1 < n; ++t) {
+    D(t, t) = -1.0 / T;
+    D(t, t + 1) = 1.0 / T;
+  }
+  D.row(n - 1) = D.row(n - 2);
+  const Eigen::MatrixXd H = P.transpose() * mask.asDiagonal() * P + parameters.s * Eigen::MatrixXd::Identity(n, n) +
+                            parameters.w * D.transpose() * D;
+  const Eigen::VectorXd v = H.ldlt().solve(P.transpose() * mask.asDiagonal() * p.e_j - parameters.w * D.transpose() * D * u_j);
+  const Eigen::VectorXd unweighted = u_j + v;
+  EXPECT_GT((unweighted - actual).norm(), 0.05 * (actual - u_j).norm());
+  // And the zero-weight optimum is what the dense form gives on the error with M zeroed there: a sanity
+  // check of the oracle itself (with no entry masked it is the paper's law).
+  Eigen::VectorXd all = Eigen::VectorXd::Constant(n, parameters.m);
+  const Eigen::MatrixXd H_all = P.transpose() * all.asDiagonal() * P + parameters.s * Eigen::MatrixXd::Identity(n, n) +
+                                parameters.w * D.transpose() * D;
+  const Eigen::VectorXd v_all = H_all.ldlt().solve(P.transpose() * p.e_j - parameters.w * D.transpose() * D * u_j);
+  Eigen::VectorXd paper(n);
+  riccati.update(u_j, p.e_j, paper);
+  EXPECT_LT((u_j + v_all - paper).norm(), 1e-8 * paper.norm());
 }
 
 TEST(NoilcConstrained, RejectsBadParametersAndBounds) {

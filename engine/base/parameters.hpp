@@ -108,6 +108,13 @@ struct IlcParameters {
   // (Last, so that aggregate initializers of the fields above keep their order.) Several joints: the model of the J-joint norm-optimal update (engine/config/joint_learning_factory):
   // "coupled" (the chain linearized stretched out) or "independent" (each joint's own model).
   std::string joint_model = "coupled";
+  // noilc-learned: norm-optimal ILC on the closed-loop model refined from the session's trials
+  // (engine/learning/noilc_learned; defaults tuned on the paper, steps and sine trajectories).
+  double learned_s = 0.1;            // S = s I of its update (M and W are m and w above)
+  double learned_forgetting = 1.0;   // weight of an older trial's data per trial in the refit (1: all trials count)
+  double learned_ridge = 1e-3;       // ridge of the refit, relative to the data's scale
+  double learned_guard = 0.25;       // a trial whose ||e||^2 rose by more than this over the best falls back
+  int learned_taps = 4;              // FIR taps of the learned correction per joint
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's

@@ -107,6 +107,11 @@ std::vector<ParameterBinding> make_bindings() {
       number("ilc", "inverse_gain", "", "inverse: learning gain in (0, 1]", pos(1.0), [](C& c) { return &c.ilc.inverse_gain; }),
       number("ilc", "inverse_q_cutoff_hz", "Hz", "inverse: cutoff of the zero-phase Q-filter", pos(1e4), [](C& c) { return &c.ilc.inverse_q_cutoff_hz; }),
       number("ilc", "prediction_model_error", "", "convergence prediction: relative error of kappa and omega0 on the grid", fraction(), [](C& c) { return &c.ilc.prediction_model_error; }),
+      number("ilc", "learned_s", "", "noilc-learned: weight S = s I on the change of correction", upto(1e6), [](C& c) { return &c.ilc.learned_s; }),
+      number("ilc", "learned_forgetting", "", "noilc-learned: weight of an older trial in the model's refit, per trial", Range{0.0, 1.0, true, false}, [](C& c) { return &c.ilc.learned_forgetting; }),
+      number("ilc", "learned_ridge", "", "noilc-learned: ridge of the refit, relative to the data's scale", pos(1e6), [](C& c) { return &c.ilc.learned_ridge; }),
+      number("ilc", "learned_guard", "", "noilc-learned: a trial whose squared error rose more than this fraction over the best falls back to the prior", upto(100.0), [](C& c) { return &c.ilc.learned_guard; }),
+      whole("ilc", "learned_taps", "noilc-learned: FIR taps of the model's learned correction per joint", count(32), [](C& c) { return &c.ilc.learned_taps; }),
       whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", count(21), [](C& c) { return &c.ilc.prediction_grid_points; }),
       // [identify]
       number("identify", "amplitude_deg", "deg", "excitation amplitude of the reference angle", pos(90.0), [](C& c) { return &c.identify.amplitude_deg; }),

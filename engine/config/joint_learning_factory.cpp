@@ -7,6 +7,7 @@
 #include "engine/model/coupled_joint_dynamics.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/learning_law_factory.hpp"
+#include "engine/learning/noilc_learned.hpp"
 #include "engine/learning/noilc_mimo.hpp"
 #include "engine/learning/noilc_mimo_constrained.hpp"
 
@@ -71,6 +72,27 @@ class JointNormOptimalConstrained final : public JointLearning {
   Eigen::MatrixXd lower_, upper_;
 };
 
+/// noilc-learned for J joints: the closed loop of the J-joint model ([ilc] joint_model) as the prior.
+class JointNormOptimalLearned final : public JointLearning {
+ public:
+  JointNormOptimalLearned(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples) : core_(prior, settings, samples) {}
+  void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
+              Eigen::Ref<Eigen::MatrixXd> u_next) override {
+    core_.update(u_j, e_j, u_next);
+  }
+  void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) override {
+    core_.set_input_context(feedback_bar, input_limit_bar);
+  }
+  void set_held_outputs(const std::vector<unsigned char>& held) override { core_.set_held_outputs(held); }
+  std::string name() const override { return "noilc-learned"; }
+  int samples() const override { return core_.samples(); }
+  int joints() const override { return core_.joints(); }
+  std::string take_note() override { return core_.take_note(); }
+
+ private:
+  LearnedModelNoilc core_;
+};
+
 /// Any other law, one per joint, each on its joint's own model.
 class PerJointLearning final : public JointLearning {
  public:
@@ -81,6 +103,9 @@ class PerJointLearning final : public JointLearning {
   }
   void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) override {
     for (int j = 0; j < joints(); ++j) laws_[static_cast<std::size_t>(j)]->set_input_context(feedback_bar.col(j), input_limit_bar);
+  }
+  void set_held_outputs(const std::vector<unsigned char>& held) override {
+    for (const auto& law : laws_) law->set_held_outputs(held);
   }
   std::string name() const override { return laws_.front()->name(); }
   int samples() const override { return laws_.front()->samples(); }
@@ -133,6 +158,12 @@ std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, 
     if (law == "noilc") return std::make_unique<JointNormOptimal>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
     if (law == "noilc-constrained") {
       return std::make_unique<JointNormOptimalConstrained>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
+    }
+    if (law == "noilc-learned") {
+      const MultiJointModel joints_model = joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified);
+      return std::make_unique<JointNormOptimalLearned>(
+          closed_loop_prior(joints_model.A, joints_model.B, sample_s, config.model.volume_gain_per_rad, config.controller),
+          learned_noilc_settings(config.ilc), samples);
     }
     std::vector<std::unique_ptr<LearningLaw>> laws;
     for (const DiscreteArmModel& joint : independent_joint_models(chain, sample_s)) laws.push_back(make_learning_law(config, joint, samples));

@@ -28,8 +28,12 @@ class JointLearning {
   /// u_ilc| the set-point clamp lets through; before update(). Laws that keep the correction inside
   /// the pressure limits use it.
   virtual void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& /*feedback_bar*/, double /*input_limit_bar*/) {}
+  /// As LearningLaw::set_held_outputs (one row per sample, for every joint); before update().
+  virtual void set_held_outputs(const std::vector<unsigned char>& /*held*/) {}
   /// The single-joint law underneath when J = 1 (for the convergence prediction), else null.
   virtual const LearningLaw* single_joint_law() const { return nullptr; }
+  /// As LearningLaw::take_note: a note for the session's events since the last call, then forgotten.
+  virtual std::string take_note() { return {}; }
 };
 
 /// One joint: `law` on the only column, exactly as the single-joint product has always learned.
@@ -44,7 +48,9 @@ class SingleJointLearning final : public JointLearning {
   int samples() const override { return law_.samples(); }
   int joints() const override { return 1; }
   void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) override;
+  void set_held_outputs(const std::vector<unsigned char>& held) override { law_.set_held_outputs(held); }
   const LearningLaw* single_joint_law() const override { return &law_; }
+  std::string take_note() override { return law_.take_note(); }
 
  private:
   std::unique_ptr<LearningLaw> owned_;  // null when borrowed

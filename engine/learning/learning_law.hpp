@@ -6,6 +6,7 @@
 #include <complex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -33,11 +34,19 @@ class LearningLaw {
   /// correction within the pressure limits use it, the others ignore it.
   virtual void set_input_context(const Eigen::Ref<const Eigen::VectorXd>& /*feedback_bar*/, double /*input_limit_bar*/) {}
 
+  /// Which samples k = 0..N of the last trial were held (no fresh reading: error 0, TrialRecord::held).
+  /// Called before update(); laws that learn a model from the trials leave those outputs out.
+  virtual void set_held_outputs(const std::vector<unsigned char>& /*held*/) {}
+
   /// The law's frequency response at `theta_rad_per_sample` in (0, pi], for convergence prediction;
   /// empty for laws that are not linear and time-invariant away from the trial's ends.
   virtual std::optional<LawFrequencyResponse> frequency_response(double /*theta_rad_per_sample*/) const {
     return std::nullopt;
   }
+
+  /// What the law has to say for the session's events since the last call (a model refit, a fall-back),
+  /// then forgotten; empty for laws that never say anything.
+  virtual std::string take_note() { return {}; }
 };
 
 }  // namespace bellows

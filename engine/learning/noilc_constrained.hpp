@@ -10,8 +10,9 @@
 // always the projected iterate, so the returned correction is feasible whatever the iteration count.
 //
 // With a trial context (set_input_context), the errors of the outputs within `limit_recovery_s` after
-// an input whose set point sat on the pressure limit in that trial carry no weight: there the valves'
-// flow limit and the bellows' bounce-back shaped the response, which the linear model mispredicts;
+// an input whose set point sat on the pressure limit in that trial are set to zero (not given zero
+// weight in M: the update keeps those outputs where they are rather than being free to move them):
+// there the valves' flow limit and the bellows' bounce-back shaped the response, which the linear model mispredicts;
 // fitting those errors by pushing the neighbouring samples makes tracking worse on the arm
 // (docs/learning-laws.md has the measurements). Without a context (set_bounds) the update is the
 // plain bounded optimum.
@@ -47,6 +48,8 @@ class NormOptimalConstrained final : public LearningLaw {
   const Eigen::VectorXd& lower_bound() const { return lower_; }
   const Eigen::VectorXd& upper_bound() const { return upper_; }
   const Report& last_report() const { return report_; }
+  /// Forgets the last update's ADMM dual: the next update starts cold (as the first after construction).
+  void forget_warm_start() { dual_.setZero(); }
   std::size_t memory_bytes() const;
 
  private:

@@ -9,7 +9,8 @@
 // form is the single-joint one with matrix-valued stages: the state is augmented with v(t-1), the
 // scalar curvature becomes a J x J matrix whose Cholesky factor is taken per stage in setup().
 // setup() allocates (gains for N stages); solve() allocates nothing and is one backward and one
-// forward pass: O(N J^3) time, O(N J^2) memory. docs/learning-laws.md ("Several joints").
+// forward pass: O(N J^2) time (stage matrices J x 3J applied to vectors; only setup() is O(N J^3)),
+// O(N J^2) memory. docs/learning-laws.md ("Several joints").
 //
 // Data are N x J matrices, one column per joint (column j = that joint's trial, as for one joint).
 #pragma once

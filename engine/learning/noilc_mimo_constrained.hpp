@@ -41,6 +41,8 @@ class MultiJointNoilcConstrained {
 
   const MultiJointConstrainedReport& last_report() const { return report_; }
   const MultiJointNoilcInfo& info() const { return free_.info(); }
+  /// Forgets the last solve's ADMM dual: the next solve starts cold (as the first after setup()).
+  void forget_warm_start() { dual_.setZero(); }
 
  private:
   MultiJointAdmmSettings admm_;

@@ -121,6 +121,7 @@ void LearningSession::learn() {
   const int n = record_.learning_samples;
   for (int j = 0; j < record_.joints(); ++j) feedback_bar_.col(j) = record_.joint_samples(j).u_pid_bar.head(n);
   learning_.set_input_context(feedback_bar_, controller_.p_max_bar - controller_.gas.ambient_bar);
+  learning_.set_held_outputs(record_.held);
   learning_.update(corrections_, record_.normalized_joint_errors(), next_corrections_);
   corrections_.swap(next_corrections_);
   ++iteration_;
