@@ -99,6 +99,21 @@ for device in "${DEVICES[@]}"; do
   # The chamber pressure row: "chamber A" as the engine reads it, or the rig's raw input "chamber_a"
   # once its volts arrive (which one the first frame shows is a race).
   e2e_wait_for 'chamber( A|_a) '
+  if [ "$device" = t7 ]; then
+    # The zero-angle question (a T7 with a rig profile only; issue 23: a test per prompt): command
+    # letters are named as no answer and leave it open, Esc closes it, the profile is unchanged.
+    profile_before="$(sha256sum < "$E2E_DIR/t7-rig.toml")"
+    zero_letters='brdaxtcwlsofgHjTRv?zmue'  # every command key but the answers y, n (and q)
+    e2e_keys z
+    e2e_wait_for 'Zero the angle here\?'
+    e2e_keys -l -- "$zero_letters"
+    e2e_wait_for 'e is not an answer here'
+    e2e_screen | grep -qF 'Zero the angle here?' || e2e_fail "t7: a letter closed the zero-angle question"
+    e2e_keys Escape
+    e2e_wait_for 'Bellows +SAFE '
+    ! e2e_screen | grep -qF 'Zero the angle here?' || e2e_fail "t7: Esc left the zero-angle question open"
+    [ "$(sha256sum < "$E2E_DIR/t7-rig.toml")" = "$profile_before" ] || e2e_fail "t7: the rig profile changed"
+  fi
   e2e_keys v
   e2e_wait_for 'Valve test: open each valve alone\?'
   e2e_keys y

@@ -269,10 +269,11 @@ TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
   EXPECT_EQ(f.state().law_name, "noilc-dense");
   f.key(key::kRight);
-  f.key(key::kRight);  // noilc-constrained, pd
+  f.key(key::kRight);
+  f.key(key::kRight);  // noilc-constrained, noilc-learned, pd
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
   EXPECT_EQ(f.state().law_name, "pd");
-  for (int i = 0; i < 4; ++i) f.key(key::kLeft);  // noilc-constrained, noilc-dense, noilc, and round to the last
+  for (int i = 0; i < 5; ++i) f.key(key::kLeft);  // noilc-learned, noilc-constrained, noilc-dense, noilc, round to the last
   ASSERT_EQ(learning_law_names().back(), "inverse");
   EXPECT_EQ(f.state().config.ilc.law, "inverse");
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
