@@ -74,8 +74,9 @@ TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
   // later saves write it to the millisecond.
   ASSERT_FALSE(engine_times.empty());
   for (const auto& [text, engine_time_s] : engine_times) {
+    const std::string& saved_text = text;  // clang 14 cannot capture a structured binding
     const auto reopened = std::find_if(copy.events.begin(), copy.events.end(),
-                                       [&](const ui::LogEntry& e) { return e.text == text; });
+                                       [&](const ui::LogEntry& e) { return e.text == saved_text; });
     ASSERT_NE(reopened, copy.events.end()) << text;
     EXPECT_NEAR(reopened->engine_time_s, engine_time_s, 0.0005) << text;
   }
