@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <map>
 
@@ -38,7 +39,9 @@ namespace {
 constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
-int main(int argc, char** argv) {
+// A function-try-block: an exception while the command line is built (a bug) or while an error is
+// reported still ends in one line and status 1, never std::terminate's abort.
+int main(int argc, char** argv) try {
   bellows::bound_allocator_retention();
   bellows::check_standard_output_at_exit();
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm", "bellows"};  // not argv[0]: no build path
@@ -368,4 +371,7 @@ int main(int argc, char** argv) {
     std::cerr << "bellows: internal error: " << bellows::printable(error.what(), bellows::kPrintableLine) << std::endl;
     return 1;
   }
+} catch (...) {
+  std::fputs("bellows: internal error while starting or reporting an error\n", stderr);
+  return 1;
 }
