@@ -64,8 +64,9 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors (and the JSON with --json)")->excludes(verbose);
   run_cmd->add_option("--clock", run.clock,
                       "sim: simulated time, as fast as possible; wall: the real-time loop (default: wall on a rig "
-                      "(--device lcm, t7), sim on the simulated arm)")
-      ->check(CLI::IsMember({"sim", "wall"}));
+                      "(--device lcm, t7), sim on the simulated arm); lockstep: --device lcm, each tick waits for the "
+                      "rig's answer (a stepped simulator: io-sim --stepped)")
+      ->check(CLI::IsMember({"sim", "wall", "lockstep"}));
   run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
@@ -173,6 +174,9 @@ int main(int argc, char** argv) {
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
   io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
+  io_sim_cmd->add_flag("--stepped", io_sim.stepped,
+                       "Lockstep for `run --clock lockstep`: the arm's time advances one period per command, answered at once "
+                       "(no real rig can; the session drops after [lcm] lockstep_timeout_s without commands)");
   io_sim_cmd->add_flag("--no-command-timeout", io_sim.no_command_timeout,
                        "Drill: the rig announces its [lcm] rig_timeout_s but never vents when the commands stop");
 

@@ -141,6 +141,7 @@ struct TimingParameters {
 struct LcmParameters {
   double rig_timeout_s = 0.05;     // a rig vents by itself when commands stop for this long
   double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
+  double lockstep_timeout_s = 1.0; // `run --clock lockstep`: a tick waits this long for the rig's answer
   std::string key_file;            // shared key authenticating commands and states ("": none)
   int seq_window = 100;            // largest step a rig accepts between a session's sequence numbers
   double rig_pressure_margin_bar = 0.35;  // a rig vents a chamber above [controller] p_max_bar + this
