@@ -114,7 +114,7 @@ struct IlcParameters {
   double learned_forgetting = 1.0;   // weight of an older trial's data per trial in the refit (1: all trials count)
   double learned_ridge = 1e-3;       // ridge of the refit, relative to the data's scale
   double learned_guard = 0.25;       // a trial whose ||e||^2 rose by more than this over the best falls back
-  int learned_taps = 4;              // FIR taps of the learned correction per joint
+  int learned_taps = 8;              // FIR taps of the learned correction per joint
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's
