@@ -12,8 +12,7 @@ std::string program_version() { return BELLOWS_VERSION; }
 std::string utc_now() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
-  const auto millis =
-      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const auto millis = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
   std::tm utc{};
   ::gmtime_r(&seconds, &utc);
   char stamp[40];
@@ -28,7 +27,8 @@ Eigen::MatrixXd IterationData::next_corrections_bar() const {
   out.col(0) = next_correction_bar;
   for (int joint = 1; joint < joints(); ++joint) {
     const Eigen::VectorXd& column = more_joint_next_correction_bar[static_cast<std::size_t>(joint - 1)];
-    if (column.size() != out.rows()) throw std::invalid_argument("IterationData: the joints' corrections differ in length");
+    if (column.size() != out.rows())
+      throw std::invalid_argument("IterationData: the joints' corrections differ in length");
     out.col(joint) = column;
   }
   return out;

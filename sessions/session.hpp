@@ -42,10 +42,10 @@ struct SessionEvent {
 
 /// A fault's black box as the manifest lists it; its ticks are in session_layout::black_box_file().
 struct BlackBoxEntry {
-  std::string time_utc;  // when it was saved
-  int iteration = 0;     // the iteration running or next to run when the fault fired
-  std::string fault;     // fault_name(), e.g. "overpressure"
-  int ticks = 0;         // rows in the file: the ticks before the fault and the fault tick
+  std::string time_utc;     // when it was saved
+  int iteration = 0;        // the iteration running or next to run when the fault fired
+  std::string fault;        // fault_name(), e.g. "overpressure"
+  int ticks = 0;            // rows in the file: the ticks before the fault and the fault tick
   std::string sha256 = {};  // the file's digest as saved; empty in sessions saved before digests
 };
 
@@ -76,7 +76,7 @@ struct SessionManifest {
   int schema_version = kSessionSchemaVersion;
   std::string program_version;
   std::string name;
-  std::string device;                                      // Device::name(), e.g. "sim"
+  std::string device;  // Device::name(), e.g. "sim"
   // The arm's joints J: every iteration file holds J joints' columns, the trajectory J columns.
   // Written only when J > 1 (a one-joint manifest is what it always was); absent: one joint.
   int joints = 1;
@@ -89,12 +89,12 @@ struct SessionManifest {
   // saved before it was recorded.
   std::string model_source;
   std::string trajectory_name;
-  int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
+  int trajectory_samples = 0;     // N learning samples (the file holds N + 1)
   std::string trajectory_sha256;  // empty in sessions saved before digests were kept
   std::vector<IterationEntry> iterations;
   std::vector<SessionEvent> events;
   std::vector<BlackBoxEntry> black_boxes;  // numbered 0, 1, ... in the order the faults fired
-  std::optional<ResumeState> resume;  // present once an iteration has completed
+  std::optional<ResumeState> resume;       // present once an iteration has completed
   // Where the first trial's correction came from when it was not zero (a learning transfer: its
   // sources, method and prediction); null for a run that started with feedback only.
   nlohmann::ordered_json first_correction;
@@ -105,7 +105,7 @@ struct SessionManifest {
 /// 2..J's are `more_joint_next_correction_bar`, as TrialRecord keeps its joints.
 struct IterationData {
   TrialRecord record;
-  Eigen::VectorXd next_correction_bar;  // N values, joint 1
+  Eigen::VectorXd next_correction_bar;                               // N values, joint 1
   std::vector<Eigen::VectorXd> more_joint_next_correction_bar = {};  // joints 2..J; empty: one joint
 
   int joints() const { return 1 + static_cast<int>(more_joint_next_correction_bar.size()); }
@@ -132,7 +132,7 @@ struct Session {
   std::string dropped;
   SessionManifest manifest;
   Trajectory trajectory;
-  std::vector<IterationData> iterations;  // in the order of manifest.iterations
+  std::vector<IterationData> iterations;             // in the order of manifest.iterations
   std::vector<std::vector<TickRecord>> black_boxes;  // in the order of manifest.black_boxes, oldest tick first
 };
 

@@ -160,8 +160,8 @@ TEST(SessionStore, SaveAndLoadGiveBackEveryFieldAndSample) {
   expect_same_session(loaded, saved);
   // Saving what was loaded writes the same files again.
   save_session(loaded, dir / "copy");
-  for (const std::string& file : std::vector<std::string>{session_layout::samples_file(2), session_layout::telemetry_file(3),
-                                                         session_layout::kTrajectory}) {
+  for (const std::string& file : std::vector<std::string>{
+           session_layout::samples_file(2), session_layout::telemetry_file(3), session_layout::kTrajectory}) {
     EXPECT_EQ(testing::read_text(dir / "copy" / file), testing::read_text(dir / "s" / file)) << file;
   }
 }
@@ -371,8 +371,9 @@ TEST(SessionLock, IsReleasedWhenTheHolderDiesEvenByKill) {
   }
   char byte;
   ASSERT_EQ(::read(ready[0], &byte, 1), 1);
-  EXPECT_NE(error_of([&] { SessionLock lock(dir / "s", "parent"); }).find("is in use by child (pid " + std::to_string(child)),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { SessionLock lock(dir / "s", "parent"); }).find("is in use by child (pid " + std::to_string(child)),
+      std::string::npos);
   ::kill(child, SIGKILL);
   ::waitpid(child, nullptr, 0);
   EXPECT_NO_THROW(SessionLock(dir / "s", "parent"));

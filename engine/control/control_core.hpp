@@ -47,7 +47,7 @@ class ControlCore {
   /// Its JointState fields are joint 1's (what single-joint session files store, unchanged).
   struct State : JointState {
     int tick_in_sample = 0;
-    int joints = 1;                                      // J
+    int joints = 1;                                        // J
     std::array<JointState, kMaxJoints - 1> more_joints{};  // joints 2..J
   };
 

@@ -44,8 +44,8 @@ double normalized_fit_percent(const Eigen::VectorXd& measured, const Eigen::Vect
 
 struct ArmModelFit {
   ModelParameters model;
-  ModelParameters initial;     // the ARX estimate the refinement started from
-  double fit_percent = 0.0;    // on the fitted data
+  ModelParameters initial;   // the ARX estimate the refinement started from
+  double fit_percent = 0.0;  // on the fitted data
   double rms_residual_deg = 0.0;
   int iterations = 0;
   bool converged = false;

@@ -39,7 +39,8 @@ Eigen::VectorXd TrialRecord::normalized_error() const {
 
 Eigen::MatrixXd TrialRecord::normalized_joint_errors() const {
   Eigen::MatrixXd errors(learning_samples, joints());
-  for (int j = 0; j < joints(); ++j) errors.col(j) = joint_samples(j).error_rad.tail(learning_samples) / std::numbers::pi;
+  for (int j = 0; j < joints(); ++j)
+    errors.col(j) = joint_samples(j).error_rad.tail(learning_samples) / std::numbers::pi;
   return errors;
 }
 

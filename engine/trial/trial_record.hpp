@@ -28,11 +28,11 @@ struct TrialTicks {
 };
 
 struct TrialRecord {
-  TrialSamples samples;  // joint 1
-  TrialTicks ticks;      // joint 1
+  TrialSamples samples;                               // joint 1
+  TrialTicks ticks;                                   // joint 1
   std::vector<TrialSamples> more_joint_samples = {};  // joints 2..J; empty: one joint
   std::vector<TrialTicks> more_joint_ticks = {};      // joints 2..J, like more_joint_samples
-  int learning_samples = 0;  // N
+  int learning_samples = 0;                           // N
   bool complete = false;
   // Samples k = 0..N taken on a tick without a fresh reading (1: held; ControlCore::tick_held):
   // their error is 0 and nothing is learned from them. Shared by every joint (one reading for all).
@@ -50,7 +50,9 @@ struct TrialRecord {
   const TrialSamples& joint_samples(int joint) const {
     return joint == 0 ? samples : more_joint_samples[static_cast<std::size_t>(joint - 1)];
   }
-  TrialTicks& joint_ticks(int joint) { return joint == 0 ? ticks : more_joint_ticks[static_cast<std::size_t>(joint - 1)]; }
+  TrialTicks& joint_ticks(int joint) {
+    return joint == 0 ? ticks : more_joint_ticks[static_cast<std::size_t>(joint - 1)];
+  }
   const TrialTicks& joint_ticks(int joint) const {
     return joint == 0 ? ticks : more_joint_ticks[static_cast<std::size_t>(joint - 1)];
   }
