@@ -306,6 +306,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     report["dropped_events"] = core.dropped_events();
     report["dropped_telemetry"] = core.dropped_telemetry();
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
+    if (io.device_parameters().kind == "t7") report["t7"] = io.opened().report();  // late answers and readings
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
       report["loop"] = {
