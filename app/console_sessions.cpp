@@ -34,6 +34,7 @@ ui::LogSource source_of(const std::string& name) {
   if (name == "operator") return ui::LogSource::kOperator;
   if (name == "engine" || name == "fault") return ui::LogSource::kEngine;
   if (name == "learner") return ui::LogSource::kLearner;
+  if (name == "device") return ui::LogSource::kDevice;
   return ui::LogSource::kSession;
 }
 

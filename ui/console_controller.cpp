@@ -78,6 +78,12 @@ void ConsoleController::log(LogSource source, std::string text, bool important, 
   ++revision_;
 }
 
+void ConsoleController::device_said(std::string line) {
+  constexpr std::string_view kPrefix = "bellows: ";  // the program's name, which a log line needs not
+  if (line.rfind(kPrefix, 0) == 0) line.erase(0, kPrefix.size());
+  log(LogSource::kDevice, std::move(line));
+}
+
 void ConsoleController::set_status(std::string text, bool important) {
   state_.status = std::move(text);
   state_.status_important = important;

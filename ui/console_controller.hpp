@@ -100,6 +100,9 @@ class ConsoleController {
   void handle_key(int key, double now_s);
   /// Heartbeat, engine events, snapshot, telemetry, background tasks, loop statistics.
   void update(double now_s);
+  /// A line the device's I/O thread wrote to stderr (a rig link that stopped answering, and that
+  /// it answers again): into the log, as the device's, instead of across the screen.
+  void device_said(std::string line);
   void resize(int width, int height);
   /// Latches the engine's emergency stop (vents in its next tick, whatever its queue holds) and
   /// stops any trials. Never waits: the status says "vented" once the engine has acted.

@@ -11,7 +11,7 @@
 
 namespace bellows::ui {
 
-enum class LogSource { kOperator, kEngine, kLearner, kSession };
+enum class LogSource { kOperator, kEngine, kLearner, kSession, kDevice };
 
 const char* to_string(LogSource source);
 
@@ -69,6 +69,8 @@ inline const char* to_string(LogSource source) {
       return "learner";
     case LogSource::kSession:
       return "session";
+    case LogSource::kDevice:
+      return "device";
   }
   return "?";
 }
