@@ -164,6 +164,8 @@ class ConsoleController {
   void log(LogSource source, std::string text, bool important = false, double engine_time_s = -2.0,
            bool routine = false);
   void set_status(std::string text, bool important = false);
+  /// As log(), saved as a session event of `kind` (not a console-log line).
+  void log_event(const char* kind, LogSource source, std::string text);
 
   // Operator side (console_keys.cpp).
   bool handle_dialog_key(int key);
@@ -275,7 +277,12 @@ class ConsoleController {
     LearnedWith learned_with;  // the law and weights it was built with
   };
   BackgroundTask<BuiltLaw> law_build_;
-  BackgroundTask<Eigen::MatrixXd> law_update_;
+  struct LawUpdate {
+    Eigen::MatrixXd next;                   // the correction learned
+    std::string note;                       // what the law said (a model refit): a session event
+    std::optional<ModelCheck> model_check;  // the trial against its model's prediction
+  };
+  BackgroundTask<LawUpdate> law_update_;
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::string> rename_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;
