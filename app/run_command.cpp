@@ -317,6 +317,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
           {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
           {"rt", loop->rt_description()},
           {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
+          {"cpu_idle_not_held", idle_hold.why_not()},
           {"speed", options.speed}};
       if (const DeviceHealth h = device.health(); h.has_link) {  // the link's figures, e.g. the T7's Modbus round trip
         report["loop"]["link"] = {
