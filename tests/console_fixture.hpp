@@ -125,9 +125,11 @@ struct ConsoleFixture {
       if (std::chrono::steady_clock::now() - wall_start > std::chrono::seconds(120)) return false;
       // Engine time stands still while the learner works or a save runs, so that runs are
       // deterministic: a batch's next trial waits for the autosave, and on a loaded machine a save
-      // to disk can take longer than the engine time this loop would otherwise race through.
+      // to disk (or a transfer's offer) can take longer than the engine time this loop would
+      // otherwise race through.
       const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning ||
-                           console->state().learner_busy || !console->state().law_ready || !console->saves_settled();
+                           console->state().learner_busy || !console->state().law_ready || !console->saves_settled() ||
+                           console->transfer_offer_pending();
       if (waiting) std::this_thread::sleep_for(std::chrono::microseconds(200));
       else clock.step(5);
       console->update(clock.now_s());

@@ -110,6 +110,8 @@ class ConsoleController {
   /// Nothing left to save and no save running (autosave caught up, or saving is not available or
   /// failed: then `state().status` says why).
   bool saves_settled() const;
+  /// A learning transfer's offer is being computed (in the background) for the chosen trajectory.
+  bool transfer_offer_pending() const { return transfer_task_.busy(); }
 
   const ConsoleState& state() const { return state_; }
   bool quit_requested() const { return quit_requested_; }
