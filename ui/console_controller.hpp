@@ -301,6 +301,10 @@ class ConsoleController {
   std::size_t saving_events_ = 0;
   bool saving_settings_changed_ = false;
   std::uint64_t saving_next_revision_ = 0;
+  // Bumped whenever state_.experiment is replaced (a trajectory chosen, a session opened): a save
+  // that finishes after it belongs to the experiment the operator left, never to the new one.
+  std::uint64_t experiment_serial_ = 0;
+  std::uint64_t saving_experiment_serial_ = 0;
 };
 
 }  // namespace bellows::ui
