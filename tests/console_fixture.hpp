@@ -27,6 +27,7 @@ class MemorySessions final : public ui::SessionGateway {
   bool available() const override { return true; }
   /// Like the store: a new session, or what was added to the session named by the snapshot.
   std::string save(const ui::SessionSnapshot& snapshot) override {
+    while (hold_saves) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a save still running
     const std::lock_guard<std::mutex> guard(mutex);
     const std::string location = snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size())
                                                                               : snapshot.experiment.session_location;
@@ -73,6 +74,7 @@ class MemorySessions final : public ui::SessionGateway {
   std::map<std::string, ui::SessionSnapshot> saved;
   std::atomic<int> saves{0};  // the tests read and set these while workers save
   std::atomic<bool> fail_saves{false};
+  std::atomic<bool> hold_saves{false};
   std::mutex mutex;
 };
 
