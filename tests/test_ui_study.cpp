@@ -36,7 +36,7 @@ TEST(UiStudy, TheDifferenceOfTwoIterationsAndItsRms) {
   EXPECT_EQ(d.other_iteration, 0);
   // Trial i applies 0.01 i bar everywhere and leaves the error set point * 0.5 / (i + 1).
   EXPECT_NEAR(d.rms_du_bar, 0.02, 1e-12);
-  const TrialSamples& r = s.experiment.trials[0].record.samples;
+  const TrialSamples& r = s.experiment.trials[0].record.joint_samples(0);
   double sum = 0.0;
   for (int k = 1; k <= r.error_rad.size() - 1; ++k) {
     const double de = r.setpoint_rad(k) * (0.5 / 3 - 0.5) / kDeg;
