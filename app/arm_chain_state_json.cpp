@@ -19,7 +19,7 @@ Json joint_values(const JointVector& values) {
 
 /// One array of `joints` entries (the path says which field when it is not).
 JsonReader joint_array(const JsonReader& r, const char* key, int joints) {
-  const JsonReader array = r[key];
+  JsonReader array = r[key];  // not const: returned by move
   if (array.size() != static_cast<std::size_t>(joints)) {
     array.fail("expected " + std::to_string(joints) + " entries, one per joint of the arm, found " +
                std::to_string(array.size()));

@@ -60,7 +60,7 @@ class SimulatedChainDevice final : public OpenedDevice {
 class LcmRig final : public OpenedDevice {
  public:
   LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
-      : device_(session_id, std::move(key), rig_silence_s, joints), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
+      : device_(session_id, key, rig_silence_s, joints), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
     io_.start(rt, kDeviceIoPriority);
   }
   ~LcmRig() override { io_.stop(); }

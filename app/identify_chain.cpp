@@ -254,6 +254,7 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
       session.record("identify-fit", line);
     }
     std::vector<ModelParameters> fitted;
+    fitted.reserve(joints.size());
     for (const JointFit& j : joints) fitted.push_back(j.fit.model);
     independent = independent_dynamics(fitted);
     progress << "fitting the coupled model (" << 2 * J << " states) on the " << J << " identification trials" << std::endl;

@@ -127,7 +127,7 @@ void check_write_model_target(const IdentifyOptions& options, const std::string&
 }
 
 std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model) {
-  const std::string text = with_table_values(toml_text, "model",
+  std::string text = with_table_values(toml_text, "model",  // not const: returned by move
                                              {{"kappa", toml_number(model.kappa_rad_per_bar)},
                                               {"omega0", toml_number(model.omega0_rad_per_s)},
                                               {"damping", toml_number(model.damping)}},

@@ -54,6 +54,8 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   params.seq_window = config.lcm.seq_window;
   params.limits = RigLimits::from(config);
   params.command_timeout_enforced = !options.no_command_timeout;
+  params.stepped = options.stepped;
+  if (options.stepped) params.command_timeout_s = config.lcm.lockstep_timeout_s;  // the engine's wait for an answer
   params.key = load_lcm_key(config.lcm.key_file, std::filesystem::path(options.config_path).parent_path());
   params.log = [&progress](const std::string& line) { progress << "io-sim: " << line << std::endl; };
   const bool keyed = params.key.present();
@@ -63,10 +65,11 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   io.on_open([&] {
     const std::string which = joints == 1 ? std::string() : " '" + config.arm.name() + "' of " + std::to_string(joints) + " joints";
     progress << "io-sim: serving the simulated arm" << which << " on " << url << " (rig " << rig.stats().rig_id << ", state every "
-             << config.timing.tick_s * 1e3 << " ms, vents after " << config.lcm.rig_timeout_s * 1e3
+             << config.timing.tick_s * 1e3 << " ms, vents after " << (options.stepped ? config.lcm.lockstep_timeout_s : config.lcm.rig_timeout_s) * 1e3
              << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
              << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
-             << ")" << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "")
+             << ")" << (options.stepped ? "; stepped: its time advances one period per command (run --clock lockstep)" : "")
+             << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "")
              << (options.no_command_timeout ? "; drill: no command timeout (it never vents by itself)" : "") << std::endl;
   });
   const double start_s = monotonic_s();

@@ -18,6 +18,7 @@ struct IoSimOptions {
   double duration_s = 0.0;      // 0: until a signal
   bool json = false;            // counters as one JSON object on `out` at exit
   bool swapped_chambers = false;  // drill: the tubes of chambers A and B swapped (devices/swapped_chambers.hpp)
+  bool stepped = false;             // lockstep: one period of physics per command, answered at once (run --clock lockstep)
   bool no_command_timeout = false;  // drill: the rig announces its [lcm] rig_timeout_s but never vents when commands stop
 };
 

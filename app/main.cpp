@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <map>
 
@@ -38,7 +39,9 @@ namespace {
 constexpr double kLongestRunSeconds = 365.0 * 24 * 3600;
 }  // namespace
 
-int main(int argc, char** argv) {
+// A function-try-block: an exception while the command line is built (a bug) or while an error is
+// reported still ends in one line and status 1, never std::terminate's abort.
+int main(int argc, char** argv) try {
   bellows::bound_allocator_retention();
   bellows::check_standard_output_at_exit();
   CLI::App app{"bellows: iterative learning control for a pneumatic soft robotic arm", "bellows"};  // not argv[0]: no build path
@@ -64,8 +67,9 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors (and the JSON with --json)")->excludes(verbose);
   run_cmd->add_option("--clock", run.clock,
                       "sim: simulated time, as fast as possible; wall: the real-time loop (default: wall on a rig "
-                      "(--device lcm, t7), sim on the simulated arm)")
-      ->check(CLI::IsMember({"sim", "wall"}));
+                      "(--device lcm, t7), sim on the simulated arm); lockstep: --device lcm, each tick waits for the "
+                      "rig's answer (a stepped simulator: io-sim --stepped)")
+      ->check(CLI::IsMember({"sim", "wall", "lockstep"}));
   run_cmd->add_option("--speed", run.speed, "Wall clock with the simulated arm: 1, 2, 5, 10 or max")
       ->capture_default_str()
       ->check(CLI::IsMember({"1", "2", "5", "10", "max"}));
@@ -173,6 +177,9 @@ int main(int argc, char** argv) {
       ->check(bellows::finite_seconds(kLongestRunSeconds));
   io_sim_cmd->add_flag("--json", io_sim.json, "At exit, print the counters as one JSON object on stdout");
   io_sim_cmd->add_flag("--swapped-chambers", io_sim.swapped_chambers, "Drill: the tubes of chambers A and B swapped");
+  io_sim_cmd->add_flag("--stepped", io_sim.stepped,
+                       "Lockstep for `run --clock lockstep`: the arm's time advances one period per command, answered at once "
+                       "(no real rig can; the session drops after [lcm] lockstep_timeout_s without commands)");
   io_sim_cmd->add_flag("--no-command-timeout", io_sim.no_command_timeout,
                        "Drill: the rig announces its [lcm] rig_timeout_s but never vents when the commands stop");
 
@@ -364,4 +371,7 @@ int main(int argc, char** argv) {
     std::cerr << "bellows: internal error: " << bellows::printable(error.what(), bellows::kPrintableLine) << std::endl;
     return 1;
   }
+} catch (...) {
+  std::fputs("bellows: internal error while starting or reporting an error\n", stderr);
+  return 1;
 }

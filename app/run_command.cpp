@@ -87,11 +87,16 @@ std::string trajectory_name(const RunOptions& options, const ArmParameters& arm)
 }  // namespace
 
 std::string resolve_clock(const std::string& given, const std::string& device_kind) {
-  if (!given.empty() && given != "sim" && given != "wall") throw InputError("--clock must be sim or wall");
+  if (!given.empty() && given != "sim" && given != "wall" && given != "lockstep") throw InputError("--clock must be sim, wall or lockstep");
   const bool rig = device_kind != "sim";
+  if (given == "lockstep" && device_kind != "lcm") {
+    throw InputError("--clock lockstep waits for an LCM rig's answers (a stepped simulator, io-sim --stepped): it needs --device lcm, not " +
+                     device_kind);
+  }
   if (rig && given == "sim") {
     throw InputError("--clock sim cannot drive --device " + device_kind +
-                     ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out)");
+                     ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out, or --clock lockstep "
+                     "against a stepped simulator, io-sim --stepped)");
   }
   if (!given.empty()) return given;
   return rig ? "wall" : "sim";
@@ -107,7 +112,7 @@ double parse_speed(const std::string& speed) {
 
 int run_command(const RunOptions& given_options, std::ostream& out, std::ostream& progress) {
   if (given_options.iterations < 0) throw InputError("--iterations must not be negative");
-  if (!given_options.clock.empty()) resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
+  if (!given_options.clock.empty() && given_options.clock != "lockstep") resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
   if (!given_options.lcm_url.empty()) check_lcm_url(given_options.lcm_url, "--lcm");  // before a session exists
   const double speed = parse_speed(given_options.speed);
   RunRecording recording(given_options);  // with --resume: the saved configuration, trajectory and state
@@ -150,7 +155,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   std::unique_ptr<EngineDriver> driver;
   SimulatedClock* clock = nullptr;
   RealtimeLoop* loop = nullptr;
-  if (options.clock == "sim") {
+  if (options.clock == "sim" || options.clock == "lockstep") {  // lockstep: the engine's time follows the rig's answers
     auto simulated = io.simulated_clock(core);
     clock = simulated.get();
     driver = std::move(simulated);
@@ -201,7 +206,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   std::string failure;
   std::string failure_name;
   try {
-    if (std::string why = io.wait_for_rig(stop_requested()); !why.empty()) {
+    if (std::string why = io.wait_for_rig(stop_requested(), options.clock == "lockstep" ? clock : nullptr); !why.empty()) {
       failure = std::move(why);
       failure_name = fault_name(FaultCode::kRigUnavailable);
       status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault

@@ -57,13 +57,14 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     throw InputError("the LCM log '" + options.lcm_log_file + "' exists already; nothing is overwritten, name a new file");
   }
   if (kind != "sim") {
-    if (options.clock != "wall") resolve_clock("sim", kind);  // throws (run_command resolved the clock already)
+    if (options.clock == "sim") resolve_clock("sim", kind);  // throws (run_command resolved the clock already)
     if (speed != 1.0) throw InputError("--device " + kind + " runs in real time: --speed must be 1");
     if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with --device " + kind);
   }
   if (kind == "lcm" || telemetry_) session_id_ = LcmDevice::random_session_id();
   device_ = open_device(device_parameters_, config, seed, options.rt, session_id_,
                         std::filesystem::path(options.config_path).parent_path());
+  if (options.clock == "lockstep") device_->lcm_device()->set_lockstep(config.lcm.lockstep_timeout_s);  // before the engine
 }
 
 RunIo::~RunIo() { stop(); }
@@ -97,7 +98,12 @@ void RunIo::start_telemetry(const std::filesystem::path& session_directory) {
   publisher_io_->start(RealtimeMode::kOff, 0);  // telemetry is not real-time
 }
 
-std::string RunIo::wait_for_rig(const std::atomic<bool>& stop) {
+std::string RunIo::wait_for_rig(const std::atomic<bool>& stop, SimulatedClock* lockstep) {
+  if (lockstep != nullptr) {  // no loop ticks the engine: these ticks send the commands that bind a rig
+    const LcmDevice& rig = *device_->lcm_device();
+    const double deadline_s = monotonic_s() + config_.lcm.connect_timeout_s;
+    while (!rig.connected() && !stop.load(std::memory_order_relaxed) && monotonic_s() < deadline_s) lockstep->step(1);
+  }
   return device_->wait_until_served(config_.lcm.connect_timeout_s, stop);
 }
 

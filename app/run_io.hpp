@@ -51,7 +51,7 @@ class RunIo {
   /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
   /// tick and before simulated_clock().
   void add_telemetry_tap(EngineCore& core);
-  /// The simulated clock for `--clock sim`. With telemetry it waits for the publisher whenever the
+  /// The simulated clock for `--clock sim` and `--clock lockstep`. With telemetry it waits for the publisher whenever the
   /// tap is full, so that a log holds every tick (simulated time has no deadline to miss).
   std::unique_ptr<SimulatedClock> simulated_clock(EngineCore& core);
   /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
@@ -59,7 +59,9 @@ class RunIo {
   void start_telemetry(const std::filesystem::path& session_directory);
   /// With a rig (lcm, t7): waits (the engine loop running) until a rig serves this session. Returns
   /// an empty string when it does, else why not; gives up early when `stop` is set.
-  std::string wait_for_rig(const std::atomic<bool>& stop);
+  /// `lockstep` (`--clock lockstep`): the simulated clock this thread ticks until a rig serves the
+  /// engine (nothing else sends its commands); null on the wall clock.
+  std::string wait_for_rig(const std::atomic<bool>& stop, SimulatedClock* lockstep = nullptr);
   /// Operator thread, after each completed trial.
   void post_trial(const IterationSummary& summary, const Eigen::VectorXd& correction_bar);
   /// After the engine loop stopped: the device's last vent on the bus, the rest of the telemetry,

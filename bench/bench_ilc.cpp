@@ -11,7 +11,6 @@
 #include "engine/operator/learning_session.hpp"
 #include "engine/learning/noilc_constrained.hpp"
 #include "engine/learning/noilc_dense.hpp"
-#include "engine/learning/noilc_learned.hpp"
 #include "engine/learning/noilc_riccati.hpp"
 
 namespace bellows {
@@ -91,27 +90,8 @@ void BM_ConstrainedUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_ConstrainedUpdate)->Arg(400)->Arg(12000)->Unit(benchmark::kMicrosecond);
 
-// noilc-learned between two trials: the model's refit from the last trial (the prior's response to the
-// change of correction, the correction's regressors, the ridge solve, the Riccati sweep on the refit
-// model until its gains settle) and the update. The corrections alternate so that every call refits.
-void BM_LearnedUpdateAndRefit(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  Configuration config;
-  const DiscreteArmModel arm = model();
-  NoilcLearnedLaw law(closed_loop_prior(arm.A, arm.B, arm.sample_time_s, config.model.volume_gain_per_rad, config.controller),
-                      learned_noilc_settings(config.ilc), n);
-  TrialData a(n), b(n);
-  b.u_j = (0.5 * a.u_j).array() + 0.01;
-  bool flip = false;
-  for (auto _ : state) {
-    const TrialData& d = flip ? b : a;
-    flip = !flip;
-    law.update(d.u_j, a.e_j, a.u_next);
-    benchmark::DoNotOptimize(a.u_next.data());
-  }
-  state.counters["refitted"] = law.core().last_report().refitted ? 1.0 : 0.0;
-}
-BENCHMARK(BM_LearnedUpdateAndRefit)->Arg(400)->Arg(12000)->Unit(benchmark::kMicrosecond);
+// noilc-learned's update and refit: one benchmark for J = 1 and J = 3, BM_MultiJointLearnedUpdateAndRefit
+// in bench_multi_joint.cpp (the one-joint law is the same LearnedModelNoilc).
 
 // The constraint-aware update as it runs between trials: the paper scenario on the simulated arm
 // after 40 trials (bounds active at the jumps), warm-started by the updates before it.

@@ -122,7 +122,10 @@ void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
 BENCHMARK(BM_MultiJointConstrainedUpdate)->Args({3, 400})->Unit(benchmark::kMicrosecond);
 
 // noilc-learned for J joints between two trials: refit from the last trial and the update, on the
-// closed loop of the coupled model (5J prior states, J x 6 learned ones). As BM_LearnedUpdateAndRefit.
+// closed loop of the coupled model (5J prior states, J x (taps + 2) learned ones); J = 1 is the one-joint
+// law (NoilcLearnedLaw wraps the same LearnedModelNoilc). The corrections alternate so that every call
+// refits: the prior's response to the change of correction, the regressors, the ridge solve, the Riccati
+// sweep on the refit model, the update.
 void BM_MultiJointLearnedUpdateAndRefit(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
   const Configuration config;

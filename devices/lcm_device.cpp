@@ -2,9 +2,11 @@
 #include "engine/rt/single_writer_counter.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
 
 #include "devices/lcm_channels.hpp"
 #include "engine/base/errors.hpp"
@@ -18,6 +20,10 @@ namespace {
 constexpr double kOutboxPoll_s = 0.001;
 // health(): the link counts as up while a valid state arrived this recently (20 ticks at 200 Hz).
 constexpr double kLinkAlive_s = 0.1;
+// Lockstep: how often advance() looks whether the rig's answer has arrived (far under a round trip).
+constexpr double kAnswerPoll_s = 0.0001;
+
+void sleep_s(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
 
 
 }  // namespace
@@ -43,6 +49,7 @@ SensorReading LcmDevice::read_sensors() {
 void LcmDevice::write_valves(const ValveCommand& command) {
   Outgoing out;
   out.armed = true;
+  out.generation = ++written_;
   // A command for another joint count than the arm's is meant for another arm: every joint goes
   // out vented, and the engine's guard faults on readings of the arm's joint count.
   out.valves = ValveCommand::vented(joints_);
@@ -59,7 +66,23 @@ void LcmDevice::write_valves(const ValveCommand& command) {
   outbox_.write(out);
 }
 
-void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(joints_), false}); }
+void LcmDevice::vent() { outbox_.write(Outgoing{ValveCommand::vented(joints_), false, ++written_}); }
+
+void LcmDevice::set_lockstep(double answer_timeout_s) {
+  if (!(answer_timeout_s > 0.0)) throw InputError("the lockstep answer timeout must be positive");
+  lockstep_ = true;
+  answer_timeout_s_ = answer_timeout_s;
+}
+
+void LcmDevice::advance(double dt_s) {
+  if (!lockstep_) return;  // a real rig's time passes on its own
+  const double start_s = monotonic_s();
+  while (answered_.load(std::memory_order_acquire) < written_) {
+    if (!serving_us_.load(std::memory_order_acquire)) return sleep_s(dt_s);  // no rig steps with us yet: its pace
+    if (monotonic_s() - start_s > answer_timeout_s_) return;                // no answer: a tick without a reading
+    sleep_s(kAnswerPoll_s);
+  }
+}
 
 // ---- I/O thread ----
 
@@ -123,6 +146,7 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
       last_rig_time_s_ = -INFINITY;
       reported_trip_bits_ = 0;
     }
+    serving_us_.store(bound_, std::memory_order_release);
     return counters_.offer();  // what every engine hears before it binds: counted apart, not an error
   }
   if (s.session_id != session_id_) {  // a rig serving someone else
@@ -131,6 +155,7 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
   }
   if (s.rig_id != rig_id_ || s.binding != binding_) return counters_.foreign();  // not the binding this session made
   bound_ = true;
+  serving_us_.store(true, std::memory_order_release);
   if (s.seq <= last_state_seq_ || !(s.time_s > last_rig_time_s_)) return counters_.out_of_order();
   if (s.command_seq < last_echoed_seq_) return counters_.invalid();
   rig_foreign_commands_.store(s.foreign_commands, std::memory_order_relaxed);
@@ -153,6 +178,7 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
   counters_.accepted();
   pending_ = to_reading(s);
   pending_fresh_ = true;
+  if (s.command_seq >= awaited_seq_) answer_generation_ = awaited_generation_;  // lockstep: the tick's answer
 }
 
 void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
@@ -256,6 +282,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
     pending_.time_s = std::max(now_s - origin_s_, std::nextafter(last_reading_time_s_, INFINITY));
     last_reading_time_s_ = pending_.time_s;
     inbox_.write(pending_);
+    answered_.store(answer_generation_, std::memory_order_release);  // after the reading it answers with
     pending_fresh_ = false;
     last_state_s_.store(now_s, std::memory_order_relaxed);
     connected_.store(true, std::memory_order_release);
@@ -291,6 +318,8 @@ void LcmDevice::publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s) {
   if (!outgoing.armed) bump(vent_commands_sent_);
   last_sent_seq_.store(seq_, std::memory_order_relaxed);
   last_sent_s_.store(now_s, std::memory_order_release);
+  awaited_seq_ = seq_;
+  awaited_generation_ = outgoing.generation;
 }
 
 DeviceHealth LcmDevice::health() const {

@@ -95,10 +95,22 @@ class LcmDevice final : public Device, public LcmEndpoint {
   SensorReading read_sensors() override;
   void write_valves(const ValveCommand& command) override;
   void vent() override;
-  void advance(double) override {}  // a real rig's time passes on its own
+  /// A real rig's time passes on its own: nothing to do. In lockstep, waits for the rig's answer.
+  void advance(double dt_s) override;
+  /// In lockstep the rig's time waits for the engine's commands: a late tick harms nothing physical.
+  bool time_follows_ticks() const override { return lockstep_; }
   const char* name() const override { return "lcm"; }
   bool take_fault(DeviceFault& fault) override;
   void explain_silence(double silent_s, DeviceFault& fault) const override;
+
+  /// Lockstep (`run --clock lockstep`, against a stepped simulator, `io-sim --stepped`): the engine's
+  /// ticks follow the rig's answers, so a stall of either process delays the trial but changes none
+  /// of its numbers. advance() returns once a state echoing this tick's command has reached the
+  /// inbox, or after `answer_timeout_s` (the next tick then has no fresh reading: the stale guard
+  /// counts it as any other); while no rig serves this engine, it waits one tick, the rig's pace of
+  /// offers. No real rig waits for its commands: a real rig runs on the wall clock.
+  /// Before the engine is made (it reads time_follows_ticks() once); engine thread.
+  void set_lockstep(double answer_timeout_s);
 
   // ---- LcmEndpoint: I/O thread only ----
   void attach(lcm::LCM& bus) override;
@@ -145,6 +157,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   struct Outgoing {
     ValveCommand valves{};
     bool armed = false;
+    std::uint64_t generation = 0;  // the engine's count of valve states written, this one included
   };
 
   void publish(lcm::LCM& bus, const Outgoing& outgoing, double now_s);
@@ -161,6 +174,9 @@ class LcmDevice final : public Device, public LcmEndpoint {
   LatestValue<SensorReading> inbox_;    // I/O -> engine
   LatestValue<DeviceFault> trips_;      // I/O -> engine: the rig's own trips
   SensorReading reading_{};             // engine thread's copy
+  std::uint64_t written_ = 0;           // engine thread: valve states written to the outbox
+  bool lockstep_ = false;               // set_lockstep(), before the engine ticks
+  double answer_timeout_s_ = 0.0;
 
   // I/O thread state.
   io_joints_state_t received_{};
@@ -181,6 +197,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
   bool last_armed_ = false;
   io_joints_command_t command_{};
   std::vector<std::uint8_t> buffer_;
+  // Lockstep: the generation of the valve state the last command carried, its seq, and the
+  // generation a state echoing it answers (handed over with that state's reading).
+  std::uint64_t awaited_generation_ = 0, answer_generation_ = 0;
+  std::int64_t awaited_seq_ = 0;
   io_rig_limits_t limits_received_{};
   bool hold_seen_ = false;     // the I/O thread has acted on hold_commands(true)
   bool trip_kept_ = false;     // the first trip since then is in trip_seen_
@@ -193,6 +213,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};
+  std::atomic<bool> serving_us_{false};          // the rig addressed serves this session (bound_, shown)
+  std::atomic<std::uint64_t> answered_{0};       // generation whose answer reached the inbox
   std::atomic<double> last_state_s_{-1.0};
   std::atomic<double> io_turn_s_{INFINITY};  // monotonic_s() of the I/O thread's last service() turn
   std::atomic<double> rig_silent_s_{INFINITY};  // since the addressed rig's last valid state of any kind (I/O clock)

@@ -168,12 +168,13 @@ void RigServer::release(std::int32_t fault_bits) {
   std::fill(std::begin(reported_), std::end(reported_), false);
 }
 
-void RigServer::advance_to(double now_s) {
+void RigServer::advance_to(double now_s) { advance_by(now_s - origin_s_ - device_time_s_); }
+
+void RigServer::advance_by(double dt_s) {
   // The limits are checked at every integration step, as a driver checks them at every sensor read.
-  const double step_s = integration_step_s_;
-  const double target_s = now_s - origin_s_;
+  const double target_s = device_time_s_ + dt_s;
   while (target_s > device_time_s_) {
-    const double dt = std::min(step_s, target_s - device_time_s_);
+    const double dt = std::min(integration_step_s_, target_s - device_time_s_);
     arm_.advance(dt);
     device_time_s_ += dt;
     apply_limits(false);
@@ -186,9 +187,10 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     next_publish_s_ = now_s;
     next_limits_s_ = now_s;
   }
-  advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
+  if (!params_.stepped) advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
   if (pending_fresh_) {
     commanded_ = to_valves(pending_);
+    const bool step = params_.stepped && pending_in_sequence_;
     if (pending_in_sequence_) {  // only the session's own commands keep it bound
       applied_seq_ = pending_.seq;
       last_command_s_ = now_s;
@@ -196,6 +198,10 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     }
     pending_fresh_ = false;
     apply_limits(true);
+    if (step) {  // lockstep: one period under this command, and its answer at once
+      advance_by(params_.period_s);
+      if (bus != nullptr && session_ != 0) publish_state(*bus, now_s);
+    }
   }
   if (session_ != 0 && params_.command_timeout_enforced && now_s - last_command_s_ > params_.command_timeout_s) {
     say("the commands of session " + std::to_string(session_) + " stopped: vented, session dropped");
@@ -206,8 +212,9 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     if (bus != nullptr) publish_limits(*bus, now_s);
     next_limits_s_ = now_s + kIoLimitsPeriod_s;
   }
+  const bool answers_only = params_.stepped && session_ != 0;  // its time stands still between commands
   if (now_s >= next_publish_s_) {
-    if (bus != nullptr) publish_state(*bus, now_s);
+    if (bus != nullptr && !answers_only) publish_state(*bus, now_s);
     next_publish_s_ += params_.period_s;
     if (next_publish_s_ <= now_s) {  // woke too late: skip ahead rather than bursting
       const double behind = std::floor((now_s - next_publish_s_) / params_.period_s) + 1.0;
@@ -220,13 +227,17 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
 }
 
 void RigServer::finish(lcm::LCM* bus, double now_s) {
-  if (bus != nullptr && origin_s_ >= 0.0) advance_to(now_s);
+  if (bus != nullptr && origin_s_ >= 0.0 && !params_.stepped) advance_to(now_s);
   release(io_state_t::FAULT_NO_SESSION);
   if (bus != nullptr && origin_s_ >= 0.0) publish_state(*bus, now_s);
 }
 
 void RigServer::publish_state(lcm::LCM& bus, double now_s) {
-  fill_state(arm_.read_sensors(), state_);
+  // A stepped rig's offers repeat its last reading: a sensor read draws the simulated arm's noise,
+  // and the number of offers depends on the wall clock, which must not change a lockstep run.
+  if (!params_.stepped || session_ != 0 || !reading_taken_) last_reading_ = arm_.read_sensors();
+  reading_taken_ = true;
+  fill_state(last_reading_, state_);
   state_.seq = ++state_seq_;
   const bool tripped = tripped_states_left_ > 0 && session_ == 0;
   if (tripped) --tripped_states_left_;

@@ -1,7 +1,8 @@
 // The simulated arm served as a rig over LCM (`bellows io-sim`): the reference for anyone writing a
 // driver for real hardware (docs/lcm-protocol.md).
 //
-// On its own clock, every `period_s`, it publishes an io_state_t. While free it holds the safe
+// On its own clock, every `period_s`, it publishes an io_state_t (a stepped simulator instead
+// answers each command at once: RigServerParameters::stepped). While free it holds the safe
 // state (inlets closed, outlets open) and offers a random binding in its states; a session binds
 // with a vent command addressed to this rig that echoes the offer, and from then on the rig applies
 // that session's commands only, as soon as they arrive (the arm's physics integrated up to that
@@ -50,6 +51,12 @@ struct RigServerParameters {
   /// false: a drill (`io-sim --no-command-timeout`): the rig announces its timeout but never vents
   /// when the commands stop, as a driver that forgot to (`rig check --device lcm` must catch it).
   bool command_timeout_enforced = true;
+  /// A simulator's lockstep (`io-sim --stepped`, for `run --clock lockstep`): the arm's physics
+  /// advances by one `period_s` under each command of the session served, and the state answering
+  /// it goes out at once; between commands the rig's time stands still, and while serving it
+  /// publishes only those answers. The command timeout counts on the wall clock as ever (set it to
+  /// the engine's [lcm] lockstep_timeout_s). No real rig can wait for its commands.
+  bool stepped = false;
   /// Called on the I/O thread with one line per notable event (a session bound or dropped, the
   /// first refusal of each kind per binding, a limit acted on). May be empty.
   std::function<void(const std::string&)> log;
@@ -93,7 +100,8 @@ class RigServer final : public LcmEndpoint {
   enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kOtherJoints, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
 
   void obey_vent(const io_joints_command_t& vent);  // a vent addressed to this rig, outside its session's sequence
-  void advance_to(double now_s);
+  void advance_to(double now_s);  // free-running: the physics catches up with the wall clock
+  void advance_by(double dt_s);   // in integration steps, the limits checked after each
   void apply_limits(bool write);
   void release(std::int32_t fault_bits);  // vent, drop the session, offer a new binding
   void notice(Notice kind, const std::string& line);
@@ -130,6 +138,8 @@ class RigServer final : public LcmEndpoint {
   double next_publish_s_ = 0.0;
   std::int64_t state_seq_ = 0;
   io_joints_state_t state_{};
+  SensorReading last_reading_{};  // the last state's
+  bool reading_taken_ = false;
   double next_limits_s_ = 0.0;
   io_rig_limits_t limits_{};
   std::vector<std::uint8_t> buffer_;

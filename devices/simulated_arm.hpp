@@ -2,6 +2,8 @@
 // ISO 6358 flow, angle-dependent volumes with the full gas law, a second-order arm with creep and
 // hard stops, a quantized encoder and noisy pressure sensors. Fixed internal step, deterministic
 // for a given seed; its whole state can be read and written, so a run can be resumed exactly.
+// RK4 at the fixed [plant] integration_step_s (0.1 ms), each step ending at the next valve edge so
+// that the PWM timing is exact. Faults can be injected from another thread (a lock-free hand-over).
 // One joint: its readings say joint_count 1; a command for another joint count vents it.
 #pragma once
 

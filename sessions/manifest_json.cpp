@@ -50,7 +50,7 @@ PressureController::State pressure_state_from_json(const JsonReader& r, int filt
 /// A file's digest: optional (sessions saved before digests have none), else 64 hex digits.
 std::string digest_from_json(const JsonReader& r, const char* key) {
   if (!r.has(key)) return "";
-  const std::string digest = r[key].text();
+  std::string digest = r[key].text();  // not const: returned by move
   if (!is_sha256_hex(digest)) r[key].fail("expected a SHA-256 digest: 64 lowercase hex digits");
   return digest;
 }

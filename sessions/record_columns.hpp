@@ -4,6 +4,7 @@
 // how its values are written (radians as degrees, times rounded to the nanosecond) and which member
 // of the record holds it. The session's CSV writer and reader, the consistency checks and the
 // CSV/JSON/MAT exports all take their columns from here (docs/session-format.md lists the same).
+// It lives in sessions/, not engine/: it is about files.
 //
 // Several joints (issue 14): one file per iteration still, with one block of columns per joint.
 // Joint 1's columns keep their names (a one-joint file is exactly what it always was); joint j > 1

@@ -134,6 +134,27 @@ TEST(EngineRideThrough, ALossAsLongAsTheStaleLimitVentsAndFaultsNamedByTheDevice
   EXPECT_EQ(tick.valves.joint[0].outlet_duty[1], 1.0);
 }
 
+TEST(EngineRideThrough, ASilenceWhileSafeIsNotCountedAgainstTheTickThatArms) {
+  // A rig that was not serving yet (no reading while the engine was safe, its valves vented) and
+  // answers in the tick that arms: only ticks with live valves count towards the stale limit.
+  GappyEngine e;
+  const int limit = e.config.safety.stale_ticks;
+  e.device.lose_readings(1, 5 * limit);
+  e.clock.step(1 + 5 * limit);
+  ASSERT_EQ(e.core.state(), EngineState::kSafe);
+  ASSERT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step();  // the first fresh reading, in the tick that arms
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
+  EXPECT_EQ(e.core.fault(), FaultCode::kNone);
+  // From the arm on, the limit acts as ever.
+  e.device.lose_readings(e.device.reads(), limit);
+  e.clock.step(limit - 1);
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
+  e.clock.step();
+  EXPECT_EQ(e.core.state(), EngineState::kFault);
+  EXPECT_EQ(e.core.fault(), FaultCode::kSensorStale);
+}
+
 TEST(EngineRideThrough, ADevicesOwnFaultIsLatchedWithItsWordsAndJoint) {
   GappyEngine e;
   EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));

@@ -118,17 +118,18 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   LcmIoThread bus(kDefaultLcmUrl, {&heckler});
   bus.start(RealtimeMode::kOff, 0);
 
-  // This test compares learning, not deadline keeping: on a loaded 2-core CI machine a wall-clock
-  // run can stall for more than 5 ticks (25 ms) or its readings for more than 3; the guards for
-  // both have tests of their own (rig killed below, memq staleness, missed-deadline streak).
+  // This test compares learning, not deadline keeping: in lockstep (`io-sim --stepped`, `run --clock
+  // lockstep`) each tick waits for the rig's answer and the rig's time for the engine's command, so a
+  // loaded machine stalling either process delays the run but changes none of its numbers. The
+  // free-running rig on the wall clock has tests of its own (the clean run, the rig killed below,
+  // the stale limit, the missed-deadline streak) and its learning a benchmark (bench/rig_links.sh).
   // The rig and the engine share a key: what the heckler forges is refused for want of it.
   const auto key = testing::write_file(dir, "rig.key", std::string(32, 'q'));
   chmod(key.c_str(), 0600);
-  const std::string config =
-      testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nkey_file = \"rig.key\"\n").string();
-  Child rig({kBellows, "io-sim", "--seed", "5", "--json", "--config", config}, dir / "rig.out", dir / "rig.err");
+  const std::string config = testing::write_file(dir, "keyed.toml", "[lcm]\nkey_file = \"rig.key\"\n").string();
+  Child rig({kBellows, "io-sim", "--stepped", "--seed", "5", "--json", "--config", config}, dir / "rig.out", dir / "rig.err");
   ASSERT_TRUE(rig.started());
-  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "3", "--json", "--seed", "5",
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "lockstep", "--iterations", "3", "--json", "--seed", "5",
              "--config", config},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(run.started());
@@ -139,12 +140,8 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   ASSERT_TRUE(rig.wait(30.0).has_value()) << "io-sim did not stop on SIGTERM";
   bus.stop();
 
-  // The same seed in-process. Its time follows the engine's ticks on either clock, so the simulated
-  // clock gives the same trials without 36 s of waiting.
-  const std::string plain_config =
-      testing::write_file(dir, "plain.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n").string();
-  Child local({kBellows, "run", "--no-save", "--iterations", "3", "--json", "--seed", "5", "--config", plain_config},
-              dir / "local.out", dir / "local.err");
+  // The same seed in-process, on the simulated clock.
+  Child local({kBellows, "run", "--no-save", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out", dir / "local.err");
   const auto local_status = local.wait(300.0);
   ASSERT_TRUE(local_status.has_value());
   ASSERT_EQ(*local_status, 0) << local.err();
@@ -156,8 +153,10 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   const std::vector<double> reference = rms_sequence(local_report);
   ASSERT_EQ(remote.size(), 4u);
   ASSERT_EQ(reference.size(), 4u);
+  // Not bit-identical: the rig reads its sensors (and draws the simulated arm's noise) at each
+  // integration step and for every state, the in-process engine once per tick.
   for (std::size_t i = 0; i < remote.size(); ++i) {
-    EXPECT_NEAR(remote[i], reference[i], 0.15 * reference[i]) << "iteration " << i;
+    EXPECT_NEAR(remote[i], reference[i], 0.01 * reference[i]) << "iteration " << i;
     std::cerr << "iteration " << i << ": rms over LCM " << remote[i] << " deg, in-process " << reference[i] << " deg\n";
   }
   EXPECT_LT(remote[3], remote[0]);
@@ -180,10 +179,11 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   EXPECT_NE(run.err().find("another sender publishes rig states on this bus"), std::string::npos) << run.err();
   EXPECT_NE(rig.err().find("not signed with this [lcm] key_file"), std::string::npos) << rig.err();
   EXPECT_EQ(rig_report["sessions_served"], 1);
-  // The rig applied (nearly) every tick's command: a command is skipped only when two ticks' valve
-  // states meet in the device's latest-value buffer before its I/O thread sends one.
-  const auto ticks = remote_report["loop"]["ticks"].get<double>();
-  EXPECT_GT(rig_report["commands"]["accepted"].get<double>(), 0.9 * ticks);
+  // In lockstep the rig applied a command for every tick of the four trials, and never timed out.
+  const std::uint64_t trial_ticks = 4 * remote_report["samples"].get<std::uint64_t>() * Configuration{}.timing.ticks_per_sample;
+  EXPECT_GE(rig_report["commands"]["accepted"].get<std::uint64_t>(), trial_ticks) << rig_report.dump();
+  EXPECT_EQ(rig_report["timeouts"], 0);
+  EXPECT_EQ(remote_report["clock"], "lockstep");
 }
 
 TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
@@ -194,9 +194,15 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   LcmIoThread bus(kDefaultLcmUrl, {&recorder});
   bus.start(RealtimeMode::kOff, 0);
 
+  // A stale limit of 120 ms (24 ticks), not the default 40 ms: the limit acting after the kill is
+  // this test's subject, and a loaded machine's stalls of 20-80 ms before it must not end the trial
+  // first (the default's exact tick count has in-process tests: EngineRideThrough).
+  const int stale_ticks = 24;
+  const std::string config = testing::write_file(dir, "loaded.toml", "[safety]\nstale_ticks = " + std::to_string(stale_ticks) +
+                                                                          "\nmissed_deadline_streak = 1000\n").string();
   Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
   Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
-             kDefaultLcmUrl, "--lcm-log", "--name", "killed"},
+             kDefaultLcmUrl, "--lcm-log", "--name", "killed", "--config", config},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(rig.started() && run.started());
   // Mid-trial: half a second into the first trajectory.
@@ -230,7 +236,6 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   // fresh reading (periods the loaded loop missed count: the rig had no command in them either, and
   // the publisher may drop ticks), during the trial (the ticks between held every valve closed),
   // and its valve command is the vented one.
-  const int stale_ticks = SafetyParameters{}.stale_ticks;
   lcm::LogFile file(log, "r");
   ASSERT_TRUE(file.good());
   std::vector<telemetry_t> ticks;
@@ -380,6 +385,10 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   // A rig runs on the wall clock (the default for it); the simulated clock cannot drive it.
   expect_refused_in_one_line("run --device lcm --clock sim", "--clock sim cannot drive --device lcm");
   expect_refused_in_one_line("run --clock sim --device t7 --t7 127.0.0.1:1", "--clock sim cannot drive --device t7");
+  // Lockstep waits for an LCM rig's answers: nothing else answers.
+  expect_refused_in_one_line("run --clock lockstep", "--clock lockstep waits for an LCM rig's answers");
+  expect_refused_in_one_line("run --clock lockstep --device t7 --t7 127.0.0.1:1", "it needs --device lcm, not t7");
+  expect_refused_in_one_line("run --device lcm --clock lockstep --speed 2", "--speed");
   expect_refused_in_one_line("run --device lcm --clock wall --speed 2", "--speed must be 1");
   expect_refused_in_one_line("run --device rig", "--device");
   // The environment refusing (a bus that cannot be opened) has its own status.

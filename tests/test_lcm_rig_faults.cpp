@@ -105,7 +105,7 @@ TEST(LcmRigFaults, ACleanRunReportsNoLinkErrorsAndCountsTheOffersApart) {
   const auto dir = testing::make_temp_dir("bellows-lcm-clean");
   // The machine's stalls are not this test's subject: ride-through, the stale limit and the rig's
   // command timeout have theirs.
-  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n").string();
+  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n").string();
   const RigRun r = run_against_rig(dir, {}, config, {"--iterations", "0", "--no-save", "--config", config});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json& rig = r.report["lcm"]["rig"];
@@ -119,10 +119,14 @@ TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambe
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-rig-check");
   // Loaded-machine settings: the rig's timeout (provoked by the check) long and its tolerance wide,
-  // so that a build beside the suite stalling a thread is not taken for the rig's fault.
+  // so that a build beside the suite stalling a thread is not taken for the rig's fault; pulses of
+  // 0.1 s and a stale limit of 200 ms, so that a stalled tick neither eats most of a 30 ms pulse (a
+  // good valve read as dead) nor vents the check before the last valve (missed-deadlines, seen
+  // under the suite's load beside helpers' builds).
   const std::string config =
       testing::write_file(dir, "tolerant.toml",
-                          "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 2.0\n[rig_check]\ntimeout_tolerance_s = 0.5\n")
+                          "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n[rig_check]\n"
+                          "timeout_tolerance_s = 0.5\nvalve_pulse_s = 0.1\n")
           .string();
   for (const bool swapped : {false, true}) {
     std::vector<std::string> rig_argv = {kBellows, "io-sim", "--config", config};
@@ -162,7 +166,10 @@ TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambe
 TEST(LcmRigFaults, RigCheckNamesEachLimitOfARigThatBreaksThem) {
   ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP();
   const auto dir = testing::make_temp_dir("bellows-lcm-rig-limits");
-  const std::string tolerant = "[safety]\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = 0.5\n[rig_check]\ntimeout_tolerance_s = 0.3\n";
+  // Loaded-machine settings (as below): pulses of 0.1 s and a stale limit of 200 ms, so that a stalled
+  // tick neither eats most of a 30 ms pulse nor vents the check (missed-deadlines) before a valve.
+  const std::string tolerant = "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 0.5\n"
+                               "[rig_check]\ntimeout_tolerance_s = 0.3\nvalve_pulse_s = 0.1\n";
   const std::string config = testing::write_file(dir, "engine.toml", tolerant).string();
   const std::string rig_config =
       testing::write_file(dir, "rig.toml",

@@ -62,11 +62,11 @@ class T7Processes : public ::testing::Test {
   }
 
   /// The runs tolerate a loaded test machine's scheduling (CI runs tests two at a time beside
-  /// builds): a 0.5 s answer, 400 stale ticks, long missed-deadline streaks. The guards have their
+  /// builds): a 0.5 s answer, a 0.5 s command timeout of the link, 400 stale ticks, long missed-deadline streaks. The guards have their
   /// own tests; the link's timing is the benchmark's business (bench/t7_round_trip.sh).
   std::unique_ptr<Child> start_run(int iterations, const std::string& name) {
     const std::filesystem::path config =
-        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
     return std::make_unique<Child>(
         std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try",  // a rig: the wall clock
                                  "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},
@@ -266,7 +266,7 @@ TEST_F(T7Processes, RigCheckPassesEveryValveOnTheStrictT7Pro) {
   auto sim = start_sim();
   const std::filesystem::path config = testing::write_file(
       dir_, "loaded.toml",
-      "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n"
+      "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n"
       "[rig_check]\nvalve_pulse_s = 0.1\n");
   const testing::ProcessResult r =
       run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", config.string(), "--no-save", "--yes"});
@@ -316,7 +316,7 @@ TEST_F(T7Processes, IdentifyOnAT7StoresTheModelInTheProfileAndRecordsASession) {
   const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", paper_profile_text());
   const std::filesystem::path config = testing::write_file(
       dir_, "identify.toml",
-      "[identify]\nduration_s = 6.0\n[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+      "[identify]\nduration_s = 6.0\n[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
   auto sim = start_sim();
   const testing::ProcessResult r =
       run_cli({"identify", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",
@@ -355,7 +355,7 @@ TEST_F(T7Processes, RunLearnsWithTheRigProfilesIdentifiedModel) {
   text += "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
   const std::filesystem::path profile = testing::write_file(dir_, "bench-rig.toml", text);
   const std::filesystem::path config = testing::write_file(
-      dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+      dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
   auto sim = start_sim();
   const testing::ProcessResult r =
       run_cli({"run", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",

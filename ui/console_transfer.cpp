@@ -40,7 +40,7 @@ TransferSourceNote transfer_note_of(const Experiment& experiment, std::string na
 
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
                                      const std::string& device, const std::string& rig_profile,
-                                     std::shared_ptr<const Trajectory> target, int max_saved,
+                                     const std::shared_ptr<const Trajectory>& target, int max_saved,
                                      const std::vector<std::string>& taught_locations,
                                      const std::vector<TransferSourceNote>& taught_notes) {
   TransferOffer offer;

@@ -42,7 +42,7 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 /// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so the same trials are not used twice.
 TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
                                      const std::string& device, const std::string& rig_profile,
-                                     std::shared_ptr<const Trajectory> target, int max_saved = 4,
+                                     const std::shared_ptr<const Trajectory>& target, int max_saved = 4,
                                      const std::vector<std::string>& taught_locations = {},
                                      const std::vector<TransferSourceNote>& taught_notes = {});
 /// `experiment`'s trials as a transfer source's note (what a session records about it).

@@ -156,7 +156,8 @@ void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSe
   canvas.put(area.x, top, y_label(r.y_max), Role::kDim);
   canvas.put(area.x, top + rows - 1, y_label(r.y_min), Role::kDim);
   if (log_labels && rows >= 5) {  // a log axis: its middle too (the geometric mean)
-    canvas.put(area.x, top + (rows - 1) / 2, y_label(r.y_max - (r.y_max - r.y_min) * static_cast<double>((rows - 1) / 2) / (rows - 1)), Role::kDim);
+    const int middle_row = (rows - 1) / 2;  // a whole row: the label names that row's value
+    canvas.put(area.x, top + middle_row, y_label(r.y_max - (r.y_max - r.y_min) * middle_row / (rows - 1)), Role::kDim);
   }
   if (!log_labels && r.y_min < 0.0 && r.y_max > 0.0) {
     const int zero_row = static_cast<int>(std::lround((r.y_max / (r.y_max - r.y_min)) * (rows - 1)));

@@ -44,6 +44,7 @@ attr_t colour_attributes(Role role, short& pair) {
 
 // Without colours every role that matters still differs: states in reverse video, keys too.
 attr_t mono_attributes(Role role) {
+  // NOLINTBEGIN(bugprone-branch-clone): a table, one role a line; equal attributes are the design
   switch (role) {
     case Role::kNormal: return A_NORMAL;
     case Role::kDim: return A_DIM;
@@ -61,6 +62,7 @@ attr_t mono_attributes(Role role) {
     case Role::kSeries3: return A_UNDERLINE;
     case Role::kCursor: return A_REVERSE;
   }
+  // NOLINTEND(bugprone-branch-clone)
   return A_NORMAL;
 }
 

@@ -114,7 +114,7 @@ struct IlcParameters {
   double learned_forgetting = 1.0;   // weight of an older trial's data per trial in the refit (1: all trials count)
   double learned_ridge = 1e-3;       // ridge of the refit, relative to the data's scale
   double learned_guard = 0.25;       // a trial whose ||e||^2 rose by more than this over the best falls back
-  int learned_taps = 4;              // FIR taps of the learned correction per joint
+  int learned_taps = 8;              // FIR taps of the learned correction per joint
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's
@@ -141,6 +141,7 @@ struct TimingParameters {
 struct LcmParameters {
   double rig_timeout_s = 0.05;     // a rig vents by itself when commands stop for this long
   double connect_timeout_s = 5.0;  // `run --device lcm` waits this long for a rig to answer
+  double lockstep_timeout_s = 1.0; // `run --clock lockstep`: a tick waits this long for the rig's answer
   std::string key_file;            // shared key authenticating commands and states ("": none)
   int seq_window = 100;            // largest step a rig accepts between a session's sequence numbers
   double rig_pressure_margin_bar = 0.35;  // a rig vents a chamber above [controller] p_max_bar + this

@@ -139,6 +139,7 @@ std::vector<ParameterBinding> make_bindings() {
       number("trajectory", "max_abs_angle_deg", "deg", "joint range every trajectory must stay inside", pos(180.0), [](C& c) { return &c.trajectory.max_abs_angle_deg; }),
       number("lcm", "rig_timeout_s", "s", "a rig vents by itself when commands stop for this long", pos(60.0), [](C& c) { return &c.lcm.rig_timeout_s; }),
       number("lcm", "connect_timeout_s", "s", "run --device lcm waits this long for a rig to answer", pos(3600.0), [](C& c) { return &c.lcm.connect_timeout_s; }),
+      number("lcm", "lockstep_timeout_s", "s", "run --clock lockstep: a tick waits this long for the rig's answer (else it has no reading); io-sim --stepped drops a session silent this long", pos(60.0), [](C& c) { return &c.lcm.lockstep_timeout_s; }),
       whole("lcm", "seq_window", "largest step a rig accepts between a session's command sequence numbers", count(1000000), [](C& c) { return &c.lcm.seq_window; }),
       number("lcm", "rig_pressure_margin_bar", "bar", "a rig vents a chamber above [controller] p_max_bar plus this, at least [safety] pressure_margin_bar", upto(10.0), [](C& c) { return &c.lcm.rig_pressure_margin_bar; }),
       number("lcm", "rig_angle_limit_deg", "deg", "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", pos(180.0), [](C& c) { return &c.lcm.rig_angle_limit_deg; }),

@@ -1,5 +1,7 @@
 // Learning that carries over: the first correction for a new trajectory, computed from trials of
-// other trajectories on the same arm (issue 13; docs/learning-laws.md, "Transfer").
+// other trajectories on the same arm (issue 13; docs/learning-laws.md, "Transfer"). Its callers:
+// app/transfer_sources loads the saved sessions (`run --transfer-from`), ui/console_transfer offers
+// the result in the console.
 //
 // Every method predicts the *total* input the arm needs to follow a reference, u_tot = F(r), as a
 // linear map of the reference fitted by ridge least squares, and subtracts what the target's PID will

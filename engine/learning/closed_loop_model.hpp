@@ -36,7 +36,7 @@ ClosedLoopPrior closed_loop_prior(const Eigen::MatrixXd& A, const Eigen::MatrixX
 
 /// The learned part's shape: per joint, the FIR taps and the low-passes' time constants.
 struct CorrectionShape {
-  int taps = 4;
+  int taps = 8;
   std::vector<double> lowpass_time_constants_s{0.25, 1.0};
   int per_joint() const { return taps + static_cast<int>(lowpass_time_constants_s.size()); }
 };

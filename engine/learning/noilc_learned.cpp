@@ -57,8 +57,7 @@ void LearnedModelNoilc::set_held_outputs(const std::vector<unsigned char>& held)
   }
 }
 
-void LearnedModelNoilc::refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& dy, const Eigen::MatrixXd& learnable) {
-  const Eigen::MatrixXd residual = dy - prior_model_.simulate(du);  // what the prior leaves unexplained
+void LearnedModelNoilc::refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual, const Eigen::MatrixXd& learnable) {
   const double T = prior_.sample_time_s;
   const int p = settings_.shape.per_joint();
   for (int i = 0; i < joints(); ++i) {
@@ -114,13 +113,12 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, con
     const Eigen::MatrixXd du = u_j - u_previous_;
     const Eigen::MatrixXd dy = e_previous_ - e_j;  // e = yD - y: the change of output
     const double measured = dy.norm();
-    const auto miss = [&](const StateSpaceModel& m) {
-      return measured > 0.0 ? (dy - m.simulate(du)).norm() / measured : 0.0;
-    };
+    const auto miss = [&](const Eigen::MatrixXd& predicted) { return measured > 0.0 ? (dy - predicted).norm() / measured : 0.0; };
+    const Eigen::MatrixXd predicted = model_.simulate(du), prior_predicted = prior_model_.simulate(du);
     report_.measured_change = measured;
-    report_.predicted_change = model_.simulate(du).norm();
-    report_.prediction_miss = miss(model_);
-    report_.prior_miss = miss(prior_model_);
+    report_.predicted_change = predicted.norm();
+    report_.prediction_miss = miss(predicted);
+    report_.prior_miss = miss(prior_predicted);
     if (cost > (1.0 + settings_.guard) * best_cost_) {
       report_.fell_back = true;
       from_best = true;
@@ -138,19 +136,32 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, con
                     "to the prior, the next update starts from the best trial with step %.3g",
                     trial, 100.0 * (cost / best_cost_ - 1.0), step_);
       note_ = text;
-    } else if (settings_.refit && du.squaredNorm() > 0.0) {
-      const Eigen::MatrixXd learnable = learnable_.cwiseProduct(learnable_previous_);
-      report_.left_out = static_cast<int>(learnable.size() - static_cast<Eigen::Index>(learnable.sum()));
-      refit(du, dy, learnable);
-      rebuild();
-      report_.refitted = true;
-      report_.refit_miss = miss(model_);
-      step_ = std::min(1.0, 2.0 * step_);  // a trial that did not get worse earns the step back
+    } else {
+      // Within the guard but no descent (the cost is above the best trial's: at the noise floor, or
+      // a model that mispredicts the last stretch): the trial's data are learned from (it is a fair
+      // measurement), but the next update starts from the best trial with half the step, so the
+      // learning stays a descent on the measured cost without forgetting what the model learned.
+      const bool descended = cost <= best_cost_;
+      if (!descended) {
+        from_best = true;
+        report_.no_descent = true;
+        step_ = std::max(kSmallestStep, 0.5 * step_);
+      }
+      if (settings_.refit && du.squaredNorm() > 0.0) {
+        const Eigen::MatrixXd learnable = learnable_.cwiseProduct(learnable_previous_);
+        report_.left_out = static_cast<int>(learnable.size() - static_cast<Eigen::Index>(learnable.sum()));
+        refit(du, dy - prior_predicted, learnable);
+        rebuild();
+        report_.refitted = true;
+        report_.refit_miss = miss(model_.simulate(du));
+      }
+      if (descended) step_ = std::min(1.0, 2.0 * step_);  // a trial that descended earns the step back
       std::snprintf(text, sizeof text,
-                    "noilc-learned: model refit from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
-                    "the prior alone %.0f %%, the refit %.0f %%)",
-                    trial, report_.predicted_change, measured, 100.0 * report_.prediction_miss, 100.0 * report_.prior_miss,
-                    100.0 * report_.refit_miss);
+                    "noilc-learned: model %s from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
+                    "the prior alone %.0f %%, the refit %.0f %%)%s",
+                    report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured, 100.0 * report_.prediction_miss,
+                    100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
+                    descended ? "" : "; no descent: the next update starts from the best trial with a smaller step");
       note_ = text;
     }
   }

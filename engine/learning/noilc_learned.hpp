@@ -56,6 +56,7 @@ struct LearnedNoilcReport {
   int trial = 0;                   // updates made so far
   bool refitted = false;           // the model was refit from the last trial
   bool fell_back = false;          // the last trial got worse: back to the prior and the best trial
+  bool no_descent = false;         // the last trial's cost was above the best's (within the guard)
   double step = 1.0;               // the fraction of the norm-optimal step taken
   double measured_change = 0.0;    // ||e_j - e_{j-1}|| (normalized units)
   double predicted_change = 0.0;   // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
@@ -88,7 +89,8 @@ class LearnedModelNoilc {
   void set_held_outputs(const std::vector<unsigned char>& held);
 
  private:
-  void refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& dy, const Eigen::MatrixXd& learnable);
+  /// residual: the change of output the prior leaves unexplained, dy - P_prior du.
+  void refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual, const Eigen::MatrixXd& learnable);
   void rebuild();
   void leave_out_limited_outputs(const Eigen::Ref<const Eigen::MatrixXd>& u_j);
 

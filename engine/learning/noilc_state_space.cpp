@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+
+#include <Eigen/SparseCore>
 
 #include "engine/base/errors.hpp"
 
@@ -46,13 +49,15 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
   output_to_state_ = m_ * C_.transpose();
   // Augmented model z = [dx; v(t-1)]: Ab = [[A, 0], [0, 0]], Bb = [B; I], Cb = [C, 0] (noilc_mimo).
   const Eigen::Index augmented = n + J;
-  Eigen::MatrixXd Ab = Eigen::MatrixXd::Zero(augmented, augmented);
-  Ab.topLeftCorner(n, n) = A_;
   Eigen::MatrixXd Bb(augmented, J);
   Bb << B_, Eigen::MatrixXd::Identity(J, J);
   Eigen::MatrixXd Cb = Eigen::MatrixXd::Zero(J, augmented);
   Cb.leftCols(n) = C_;
   const Eigen::MatrixXd output_weight = m_ * Cb.transpose() * Cb;
+  // A is sparse (the closed loop's blocks, the correction's shift register and low-passes): the
+  // sweep's products with it cost O(nonzeros x n) instead of O(n^3), which is what keeps a refit's
+  // set-up within the time between trials for J joints.
+  const Eigen::SparseMatrix<double> A_sparse = A_.sparseView();
   Eigen::MatrixXd P = output_weight;  // P_N
   tail_.clear();
   bool settled = false;
@@ -64,7 +69,9 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
     Eigen::MatrixXd curvature = Bb.transpose() * PB;
     curvature.diagonal().array() += s_ + W;
     curvature = (0.5 * (curvature + curvature.transpose())).eval();
-    Eigen::MatrixXd cross = PB.transpose() * Ab;
+    // Ab = [[A, 0], [0, 0]]: cross = PB' Ab = [PB_x' A, 0] and Ab' P Ab = [[A' P_xx A, 0], [0, 0]].
+    Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(J, augmented);
+    cross.leftCols(n) = PB.topRows(n).transpose() * A_sparse;
     cross.rightCols(J).diagonal().array() -= W;
     const Eigen::LLT<Eigen::MatrixXd> factor(curvature);
     if (factor.info() != Eigen::Success || !curvature.allFinite()) {
@@ -73,7 +80,10 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
     Stage stage;
     stage.inverse = factor.solve(Eigen::MatrixXd::Identity(J, J));
     stage.gain = -stage.inverse * cross;
-    P = Q + Ab.transpose() * P * Ab - cross.transpose() * stage.inverse * cross;
+    const Eigen::MatrixXd PA = P.topLeftCorner(n, n) * A_sparse;
+    Eigen::MatrixXd next = Q - cross.transpose() * stage.inverse * cross;
+    next.topLeftCorner(n, n) += A_sparse.transpose() * PA;
+    P = std::move(next);
     P = (0.5 * (P + P.transpose())).eval();
     return stage;
   };

@@ -97,18 +97,20 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       return;
     }
   });
+  // The fault by its name too: "a fault is latched" alone does not say which.
+  const std::string named = status.fault != FaultCode::kNone ? std::string(" (") + fault_name(status.fault) + ")" : std::string();
   switch (status.phase) {
     case TrialPhase::kDone:
       return;
     case TrialPhase::kNotSent:
       throw std::runtime_error("identification: the engine's command queue is full");
     case TrialPhase::kRefused:
-      throw EngineFault(status.fault, "identification refused by the engine: " + status.message);
+      throw EngineFault(status.fault, "identification refused by the engine: " + status.message + named);
     case TrialPhase::kCancelled:
       if (!left_bound.empty()) throw InputError(left_bound);
       throw Cancelled("identification stopped by a signal, valves vented");
     default:
-      throw EngineFault(status.fault, "identification aborted: " + status.message);
+      throw EngineFault(status.fault, "identification aborted: " + status.message + named);
   }
 }
 

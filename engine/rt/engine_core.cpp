@@ -298,8 +298,11 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   const int skipped = time_follows_ticks_ ? 0 : std::max(0, missed_deadlines);
   const int unattended = stale_count_ + skipped + (fresh ? 0 : 1);  // ticks the rig went uncontrolled
   const int late_ticks = skipped_in_gap_ + skipped;                  // of them, the loop's
-  skipped_in_gap_ = fresh ? 0 : late_ticks;
-  stale_count_ = fresh ? 0 : unattended;
+  // Only ticks with live valves count: a rig vented while the engine is safe is not uncontrolled,
+  // and the tick that arms must not inherit the silence of a rig that was not serving yet.
+  const bool counting = !fresh && valves_live(state());
+  skipped_in_gap_ = counting ? late_ticks : 0;
+  stale_count_ = counting ? unattended : 0;
   last_reading_time_s_ = std::max(last_reading_time_s_, reading.time_s);
   if (std::isfinite(reading.joint[0].angle_rad)) last_angle_rad_ = reading.joint[0].angle_rad;
   count_missed_deadlines(missed_deadlines, now_s);
