@@ -89,7 +89,8 @@ void restore_chain_state(SimulatedArmChain& arm, const Json& json, const std::st
       if (!(pressure > 0.0)) chambers[j].fail("pressures must be positive");
     }
     for (double duty : {s.duties[j].inlet[0], s.duties[j].inlet[1], s.duties[j].outlet[0], s.duties[j].outlet[1]}) {
-      if (!(duty >= 0.0 && duty <= 1.0)) r.fail("a duty cycle of joint " + std::to_string(j + 1) + " is outside [0, 1]");
+      if (!(duty >= 0.0 && duty <= 1.0))
+        r.fail("a duty cycle of joint " + std::to_string(j + 1) + " is outside [0, 1]");
     }
   }
   s.pwm_phase_s = r["pwm_phase_s"].number();

@@ -56,7 +56,8 @@ void restore_arm_state(SimulatedArm& arm, const nlohmann::ordered_json& json, co
   if (noise.size() != s.noise.size()) noise.fail("expected " + std::to_string(s.noise.size()) + " words");
   for (std::size_t i = 0; i < s.noise.size(); ++i) s.noise[i] = noise[i].hex_word();
   if (s.noise == GaussianNoise::State{}) noise.fail("an all-zero generator state never changes; it cannot be right");
-  for (double duty : {s.command.inlet_duty[0], s.command.inlet_duty[1], s.command.outlet_duty[0], s.command.outlet_duty[1]}) {
+  for (double duty :
+       {s.command.inlet_duty[0], s.command.inlet_duty[1], s.command.outlet_duty[0], s.command.outlet_duty[1]}) {
     if (duty < 0.0 || duty > 1.0) r.fail("a duty cycle is outside [0, 1]");
   }
   for (double pressure : s.chamber_Pa) {

@@ -23,7 +23,8 @@ std::string listed_values(const CLI::Option& option) {
   const std::string shown = CLI::Formatter().make_option_opts(&option);
   std::string list;
   char separator = ',';
-  if (const std::size_t open = shown.find('{'), close = shown.find('}', open); open != std::string::npos && close != std::string::npos) {
+  if (const std::size_t open = shown.find('{'), close = shown.find('}', open);
+      open != std::string::npos && close != std::string::npos) {
     list = shown.substr(open + 1, close - open - 1);
   } else if (const std::size_t colon = shown.find(':'); colon != std::string::npos) {
     list = shown.substr(colon + 1, shown.find_first_of("= ", colon) - colon - 1);
@@ -46,7 +47,8 @@ void collect(const CLI::App& app, const std::string& path, Tables& t) {
     for (const std::string& name : option->get_lnames()) names += " --" + name;
     for (const std::string& name : option->get_snames()) names += " -" + name;
     if (option->get_expected_max() > 0) {  // flags expect no value
-      const std::string first = option->get_lnames().empty() ? "-" + option->get_snames()[0] : "--" + option->get_lnames()[0];
+      const std::string first =
+          option->get_lnames().empty() ? "-" + option->get_snames()[0] : "--" + option->get_lnames()[0];
       valued += " " + first;
       if (const std::string values = listed_values(*option); !values.empty()) t.choices[path + " " + first] = values;
     }

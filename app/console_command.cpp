@@ -92,7 +92,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   }
   std::unique_ptr<OpenedDevice> rig;
   try {
-    rig = open_device(config.device, config, seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
+    rig = open_device(config.device, config, seed, options.rt, 0,
+                      std::filesystem::path(options.config_path).parent_path());
   } catch (const BellowsError& error) {
     if (options.session_dir.empty()) throw;
     throw InputError("session " + options.session_dir + " was recorded on the device '" + config.device.kind +
@@ -140,19 +141,23 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
       return zero_rig_angle(opened, path, read_rad);
     };
   }
-  setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location, int iterations) {
-    return write_console_figures(location, iterations, root, [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
+  setup.environment.write_figures = [root = default_figures_root(), &sessions](const std::string& location,
+                                                                               int iterations) {
+    return write_console_figures(location, iterations, root,
+                                 [&sessions](const std::function<void()>& read) { sessions.read_quietly(read); });
   };
   if (simulated_time) {
     setup.environment.capture_trial_end = [&core, &opened = *rig, &simulated_clock] {
-      return std::any(capture_resume_state(core, opened.simulated_arm(), opened.simulated_arm_chain(), &simulated_clock));
+      return std::any(
+          capture_resume_state(core, opened.simulated_arm(), opened.simulated_arm_chain(), &simulated_clock));
     };
   }
   if (simulated_time && setup.session) {
     const std::string location = setup.session->experiment.session_location;
     setup.environment.arm_where_saved = [&core, &opened = *rig, &simulated_clock, location]() -> std::string {
       const SessionManifest manifest = load_manifest(location);
-      if (!can_restore_exactly(manifest)) return "the session holds no engine state to continue from (recorded on the wall clock)";
+      if (!can_restore_exactly(manifest))
+        return "the session holds no engine state to continue from (recorded on the wall clock)";
       if (core.ticks() != 0) return "the engine has run since the session was opened";
       restore_resume_state(manifest, opened.simulated_arm(), opened.simulated_arm_chain(), core, &simulated_clock,
                            "session " + location + ": manifest.json");
@@ -174,12 +179,13 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
                 "loop: %llu ticks, missed %llu, latency p50 %.0f p99 %.0f max %.0f us (%s%s); "
                 "console: %llu frames (%.1f/s), UI thread CPU %.1f%%\n",
                 report.seconds, iteration_range(report.iterations).c_str(),
-                report.best_rms_deg >= 0.0 ? (", best RMS " + std::to_string(report.best_rms_deg).substr(0, 6) + " deg").c_str() : "",
+                report.best_rms_deg >= 0.0
+                    ? (", best RMS " + std::to_string(report.best_rms_deg).substr(0, 6) + " deg").c_str()
+                    : "",
                 static_cast<unsigned long long>(report.ticks), static_cast<unsigned long long>(report.loop.missed),
                 report.loop.p50_us, report.loop.p99_us, report.loop.max_us,
                 simulated_time ? "simulated clock" : loop.rt_description().c_str(),
-                idle_hold.held_us() ? ", cores out of deep idle" : "",
-                static_cast<unsigned long long>(report.frames),
+                idle_hold.held_us() ? ", cores out of deep idle" : "", static_cast<unsigned long long>(report.frames),
                 report.seconds > 0 ? static_cast<double>(report.frames) / report.seconds : 0.0,
                 report.seconds > 0 ? 100.0 * report.ui_cpu_s / report.seconds : 0.0);
   out << line;
@@ -189,7 +195,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
     out << "loop: " << report.missed_warnings
         << " deadlines missed, counted as warnings (the simulated arm's time follows the engine's ticks)\n";
   }
-  if (report.dropped_events > 0) out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
+  if (report.dropped_events > 0)
+    out << "bellows: " << report.dropped_events << " engine events dropped (the event queue was full)\n";
   out << std::flush;
   if (report.stopped_by_signal) return 128 + stop_signal();
   // The operator quit with work the disk did not take (a failed save, confirmed): the environment

@@ -67,14 +67,14 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
         const auto colon = line.find(": ", from);
         if (line.size() < 10 || colon == std::string::npos) continue;
         const std::string source = line.substr(from, colon - from);
-        out.push_back({line.substr(0, 8), engine_time_s, source_of(source), line.substr(colon + 2), source == "fault", false,
-                       e.time_utc, e.iteration});
+        out.push_back({line.substr(0, 8), engine_time_s, source_of(source), line.substr(colon + 2), source == "fault",
+                       false, e.time_utc, e.iteration});
       }
       continue;
     }
     const bool known = e.kind == "operator" || e.kind == "engine" || e.kind == "session" || e.kind == "fault";
-    out.push_back({local_clock_of(e.time_utc), e.engine_time_s, source_of(e.kind), known ? e.message : e.kind + ": " + e.message,
-                   e.kind == "fault", false, e.time_utc, e.iteration});
+    out.push_back({local_clock_of(e.time_utc), e.engine_time_s, source_of(e.kind),
+                   known ? e.message : e.kind + ": " + e.message, e.kind == "fault", false, e.time_utc, e.iteration});
   }
   return out;
 }
@@ -108,7 +108,8 @@ ui::SessionSnapshot snapshot_of(Session& loaded, const std::filesystem::path& di
     trial.iteration = static_cast<int>(i);
     const TrialRecord& record = loaded.iterations[i].record;
     trial.correction_bar.resize(n, record.joint_count());
-    for (int j = 0; j < record.joint_count(); ++j) trial.correction_bar.col(j) = record.joint_samples(j).u_ilc_bar.head(n);
+    for (int j = 0; j < record.joint_count(); ++j)
+      trial.correction_bar.col(j) = record.joint_samples(j).u_ilc_bar.head(n);
     trial.summary = loaded.manifest.iterations[i].summary;
     if (trial.summary.joint_rms_deg.size() != record.joint_count()) {  // each joint's RMS, from its record
       trial.summary.joint_rms_deg.resize(record.joint_count());
@@ -142,7 +143,9 @@ std::string local_date_of(const std::string& utc) {
 
 StoreSessionGateway::StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info,
                                          const std::string& data_dir, std::string model_source)
-    : device_name_(std::move(device_name)), device_info_(std::move(device_info)), model_source_(std::move(model_source)) {
+    : device_name_(std::move(device_name)),
+      device_info_(std::move(device_info)),
+      model_source_(std::move(model_source)) {
   if (!data_dir.empty()) {
     data_dir_ = data_dir;
     return;
@@ -160,10 +163,10 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
   if (!e.trajectory) throw InputError("nothing to save: no trajectory");
   // A session this gateway created whose first save then failed is continued, not created twice.
   const bool continuing =
-      writer_ && (e.session_location.empty()
-                      ? unconfirmed_events_ != kConfirmed && writer_->manifest().trajectory_name == e.trajectory->name &&
-                            writer_->manifest().iterations.empty()
-                      : writer_->directory() == e.session_location);
+      writer_ && (e.session_location.empty() ? unconfirmed_events_ != kConfirmed &&
+                                                   writer_->manifest().trajectory_name == e.trajectory->name &&
+                                                   writer_->manifest().iterations.empty()
+                                             : writer_->directory() == e.session_location);
   const std::size_t saved_events = e.session_location.empty() && continuing ? unconfirmed_events_ : e.saved_events;
 
   // Log entries not yet in the session: the snapshot holds the newest ones of `events_total`.
@@ -181,7 +184,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     batch.emplace(*writer_);
     first_trial = writer_->manifest().iterations.size();
     if (first_trial > end) throw InputError("the session on disk has more iterations than the console");
-    if (first_trial < first) throw std::logic_error("StoreSessionGateway::save: unsaved iterations missing from the snapshot");
+    if (first_trial < first)
+      throw std::logic_error("StoreSessionGateway::save: unsaved iterations missing from the snapshot");
     if (e.settings_changed) writer_->set_configuration(snapshot.config);
     std::string lines;
     for (std::size_t i = first_new; i < held; ++i) {
@@ -225,7 +229,8 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     // On the wall clock the controllers' state is not captured (a resume arms afresh); on --clock
     // sim the trial carries the state it ended in (app/run_recording.hpp).
     const auto* end_state = std::any_cast<ResumeState>(&trial_at(i).end_state);
-    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next, end_state != nullptr ? *end_state : ResumeState{});
+    writer_->save_iteration(trial_at(i).record, trial_at(i).summary, next,
+                            end_state != nullptr ? *end_state : ResumeState{});
   }
   for (std::size_t i = writer_->manifest().black_boxes.size(); i < e.faults.size(); ++i) {
     writer_->save_black_box(e.faults[i].fault, e.faults[i].ticks);

@@ -26,7 +26,8 @@ class StoreSessionGateway final : public ui::SessionGateway {
   /// `device_info`: what a new session records about it (seed, bus, address, rig profile).
   /// `data_dir`: where sessions live (--data-dir); empty: the default (XDG_DATA_HOME, HOME).
   /// `model_source`: where a new session's [model] came from (app/learning_model).
-  explicit StoreSessionGateway(std::string device_name, nlohmann::ordered_json device_info = nlohmann::ordered_json::object(),
+  explicit StoreSessionGateway(std::string device_name,
+                               nlohmann::ordered_json device_info = nlohmann::ordered_json::object(),
                                const std::string& data_dir = {}, std::string model_source = "configuration");
 
   bool available() const override { return !data_dir_.empty(); }

@@ -60,13 +60,16 @@ class SimulatedChainDevice final : public OpenedDevice {
 class LcmRig final : public OpenedDevice {
  public:
   LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
-      : device_(session_id, key, rig_silence_s, joints), io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
+      : device_(session_id, key, rig_silence_s, joints),
+        io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
     io_.start(rt, kDeviceIoPriority);
   }
   ~LcmRig() override { io_.stop(); }
   Device& device() override { return device_; }
   LcmDevice* lcm_device() override { return &device_; }
-  nlohmann::ordered_json session_info() const override { return {{"lcm", io_.url()}, {"session_id", device_.session_id()}}; }
+  nlohmann::ordered_json session_info() const override {
+    return {{"lcm", io_.url()}, {"session_id", device_.session_id()}};
+  }
   std::string where() const override { return io_.url(); }
   void stop() override { io_.stop(); }
 
@@ -79,18 +82,21 @@ class LcmRig final : public OpenedDevice {
         const LcmDeviceStats s = device_.stats();
         char why[320];
         if (s.states.unauthenticated > 0 && s.states.accepted == 0) {
-          std::snprintf(why, sizeof why, "a rig answers on %s but its states fail authentication (%llu): a different [lcm] key_file?",
+          std::snprintf(why, sizeof why,
+                        "a rig answers on %s but its states fail authentication (%llu): a different [lcm] key_file?",
                         io_.url().c_str(), static_cast<unsigned long long>(s.states.unauthenticated));
         } else if (s.states.other_joints > 0 && s.states.accepted == 0) {
           std::snprintf(why, sizeof why, "%s", device_.diagnosis().c_str());  // a rig of another arm, in one line
         } else if (s.states.old_version > 0 && s.states.accepted == 0) {
-          std::snprintf(why, sizeof why, "a rig answers on %s in protocol version 1, which this bellows no longer speaks: update it",
+          std::snprintf(why, sizeof why,
+                        "a rig answers on %s in protocol version 1, which this bellows no longer speaks: update it",
                         io_.url().c_str());
         } else if (s.states.foreign > 0 && s.last_foreign_session != 0) {
           std::snprintf(why, sizeof why, "a rig answers on %s but serves another session (%lld)", io_.url().c_str(),
                         static_cast<long long>(s.last_foreign_session));
         } else {
-          std::snprintf(why, sizeof why, "no rig answered on %s within %g s (is `bellows io-sim` or a rig driver running?)",
+          std::snprintf(why, sizeof why,
+                        "no rig answered on %s within %g s (is `bellows io-sim` or a rig driver running?)",
                         io_.url().c_str(), timeout_s);
         }
         return why;
@@ -102,17 +108,18 @@ class LcmRig final : public OpenedDevice {
 
   nlohmann::json report() const override {
     const LcmDeviceStats s = device_.stats();
-    return {{"url", io_.url()},
-            {"rig_id", s.rig_id},
-            {"states", receive_counts_json(s.states)},
-            {"rig_fault_states", s.rig_fault_states},
-            {"last_fault_bits", s.last_fault_bits},
-            {"commands_sent", s.commands_sent},
-            {"vent_commands_sent", s.vent_commands_sent},
-            {"publish_errors", s.publish_errors},
-            {"authenticated", s.keyed},
-            {"commands_not_ours", s.commands_not_ours},
-            {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}}};
+    return {
+        {"url", io_.url()},
+        {"rig_id", s.rig_id},
+        {"states", receive_counts_json(s.states)},
+        {"rig_fault_states", s.rig_fault_states},
+        {"last_fault_bits", s.last_fault_bits},
+        {"commands_sent", s.commands_sent},
+        {"vent_commands_sent", s.vent_commands_sent},
+        {"publish_errors", s.publish_errors},
+        {"authenticated", s.keyed},
+        {"commands_not_ours", s.commands_not_ours},
+        {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}}};
   }
 
  private:
@@ -141,8 +148,8 @@ class T7Rig final : public OpenedDevice {
     if (device_->wait_for_reading(timeout_s, stop)) return "";
     if (stop.load(std::memory_order_relaxed)) return "interrupted while waiting for the T7";
     const std::string why = device_->link_error();
-    return "no reading from the T7 at " + device_->address() + " within " + std::to_string(timeout_s).substr(0, 4) + " s" +
-           (why.empty() ? std::string() : " (" + why + ")");
+    return "no reading from the T7 at " + device_->address() + " within " + std::to_string(timeout_s).substr(0, 4) +
+           " s" + (why.empty() ? std::string() : " (" + why + ")");
   }
 
   nlohmann::json report() const override {
@@ -159,18 +166,22 @@ class T7Rig final : public OpenedDevice {
 
 std::unique_ptr<OpenedDevice> open_t7(const DeviceParameters& device, const Configuration& config, RealtimeMode rt) {
   if (device.t7_address.empty()) throw InputError("--device t7 needs --t7 HOST[:PORT]");
-  return std::make_unique<T7Rig>(open_t7_device({device.t7_address, device.rig_profile, rt != RealtimeMode::kOff}, config));
+  return std::make_unique<T7Rig>(
+      open_t7_device({device.t7_address, device.rig_profile, rt != RealtimeMode::kOff}, config));
 }
 
 }  // namespace
 
 void add_device_options(CLI::App& command, DeviceOptions& options, bool with_lcm) {
-  command.add_option("--device", options.kind,
-                     "The rig: sim (the simulated arm), lcm (a rig over LCM), t7 (a LabJack T7); default [device] kind")
+  command
+      .add_option("--device", options.kind,
+                  "The rig: sim (the simulated arm), lcm (a rig over LCM), t7 (a LabJack T7); default [device] kind")
       ->check(CLI::IsMember({"sim", "lcm", "t7"}));
-  if (with_lcm) command.add_option("--lcm", options.lcm_url, "--device lcm: the rig's LCM bus URL (default [device] lcm)");
+  if (with_lcm)
+    command.add_option("--lcm", options.lcm_url, "--device lcm: the rig's LCM bus URL (default [device] lcm)");
   command.add_option("--t7", options.t7_address, "--device t7: the T7's address HOST[:PORT] (port 502 by default)");
-  command.add_option("--rig-profile", options.rig_profile, "--device t7: the rig profile file (default: the paper's rig)");
+  command.add_option("--rig-profile", options.rig_profile,
+                     "--device t7: the rig profile file (default: the paper's rig)");
 }
 
 DeviceParameters resolve_device(const DeviceOptions& given, const DeviceParameters& configured) {

@@ -38,11 +38,12 @@ struct ChainTrials {
   std::vector<JointIdentificationData> estimation, validation;
 };
 
-std::string trial_line(const Configuration& config, const Trajectory& excitation, int joint, int joints, const std::string& signal,
-                       bool held_out) {
+std::string trial_line(const Configuration& config, const Trajectory& excitation, int joint, int joints,
+                       const std::string& signal, bool held_out) {
   char line[240];
-  std::snprintf(line, sizeof line, "joint %d of %d: %s trial (%s, +-%g deg, %g s), the other joints held", joint + 1, joints,
-                held_out ? "held-out" : "identification", signal.c_str(), config.identify.amplitude_deg, excitation.duration_s());
+  std::snprintf(line, sizeof line, "joint %d of %d: %s trial (%s, +-%g deg, %g s), the other joints held", joint + 1,
+                joints, held_out ? "held-out" : "identification", signal.c_str(), config.identify.amplitude_deg,
+                excitation.duration_s());
   return line;
 }
 
@@ -51,7 +52,8 @@ TrialRecord simulated_chain_trial(const Configuration& config, const Trajectory&
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
   TrialRecord record;
-  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
+  run_identification_trial(clock, excitation, config.timing, config.identify.max_abs_angle_deg, record,
+                           &stop_requested());
   arm.vent();
   return record;
 }
@@ -60,8 +62,8 @@ TrialRecord simulated_chain_trial(const Configuration& config, const Trajectory&
 /// trial's), a rig (lcm) all on one real-time loop, vented however it ends. The first trial is the
 /// session's iteration 0; the session begins once the device serves.
 void record_chain_trials(const Configuration& config, const DeviceParameters& device, const IdentifyOptions& options,
-                         const std::string& signal, const std::string& held_out, IdentifySession& session, ChainTrials& trials,
-                         std::ostream& progress) {
+                         const std::string& signal, const std::string& held_out, IdentifySession& session,
+                         ChainTrials& trials, std::ostream& progress) {
   const int J = arm_joint_count(config.arm);
   const auto take = [&](std::size_t index, const TrialRecord& record) {
     if (index == 0) session.save_estimation_trial(config, signal, record);
@@ -69,9 +71,11 @@ void record_chain_trials(const Configuration& config, const DeviceParameters& de
     if (index > 0) {
       const bool later = index >= static_cast<std::size_t>(J);
       char line[200];
-      std::snprintf(line, sizeof line, "joint %d %s trial (%s): %lld samples every %g s (kept for the fit, not saved as an iteration)",
-                    static_cast<int>(index) % J + 1, later ? "held-out" : "identification", (later ? held_out : signal).c_str(),
-                    static_cast<long long>(data.angle_rad.rows()), data.sample_time_s);
+      std::snprintf(line, sizeof line,
+                    "joint %d %s trial (%s): %lld samples every %g s (kept for the fit, not saved as an iteration)",
+                    static_cast<int>(index) % J + 1, later ? "held-out" : "identification",
+                    (later ? held_out : signal).c_str(), static_cast<long long>(data.angle_rad.rows()),
+                    data.sample_time_s);
       session.record("identify-trial", line);
     }
     (index < static_cast<std::size_t>(J) ? trials.estimation : trials.validation).push_back(std::move(data));
@@ -94,8 +98,8 @@ void record_chain_trials(const Configuration& config, const DeviceParameters& de
     }
     return;
   }
-  const std::unique_ptr<OpenedDevice> rig =
-      open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0,
+                                                        std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   RealtimeLoop loop(core, rig->device(), 1.0);
   loop.start(options.rt);
@@ -113,7 +117,8 @@ void record_chain_trials(const Configuration& config, const DeviceParameters& de
   for (std::size_t i = 0; i < trials.excitations.size(); ++i) {
     say(i);
     TrialRecord record;
-    run_identification_trial(loop, trials.excitations[i], config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
+    run_identification_trial(loop, trials.excitations[i], config.timing, config.identify.max_abs_angle_deg, record,
+                             &stop_requested());
     take(i, record);
   }
 }
@@ -193,28 +198,31 @@ std::string with_identified_model(const std::string& toml_text, const std::strin
     }
     text = with_table_values(text, "identified_joint" + std::to_string(i + 1), values, "fitted by bellows identify");
   }
-  text = with_table_values(text, "ilc", {{"joint_model", "\"identified\""}}, "the coupled model bellows identify fitted");
+  text =
+      with_table_values(text, "ilc", {{"joint_model", "\"identified\""}}, "the coupled model bellows identify fitted");
   Configuration check;
   apply_config_toml(text, source_name, check);  // never write a file the loader would reject
-  if (check.ilc.joint_model != "identified" ||
-      check.identified.joint[0].per_bar_rad_per_s2[0] != std::stod(toml_number(identified.joint[0].per_bar_rad_per_s2[0]))) {
-    throw InputError("config " + source_name + ": [identified_joint1] could not be updated in place (dotted or inline keys?)");
+  if (check.ilc.joint_model != "identified" || check.identified.joint[0].per_bar_rad_per_s2[0] !=
+                                                   std::stod(toml_number(identified.joint[0].per_bar_rad_per_s2[0]))) {
+    throw InputError("config " + source_name +
+                     ": [identified_joint1] could not be updated in place (dotted or inline keys?)");
   }
   return text;
 }
 
-int identify_chain_command(const IdentifyOptions& options, const Configuration& config, const std::string& write_model_text,
-                           std::ostream& out, std::ostream& progress) {
+int identify_chain_command(const IdentifyOptions& options, const Configuration& config,
+                           const std::string& write_model_text, std::ostream& out, std::ostream& progress) {
   const DeviceParameters device = resolve_device(options.device, config.device);
   require_driven_arm(config.arm, device.kind);  // the T7 carries one joint
-  const bool write_model_exists = !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
+  const bool write_model_exists =
+      !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
   if (!options.write_model_path.empty()) {  // checked before any trial runs
     Configuration written;
     apply_config_toml(write_model_text, options.write_model_path, written);
     if (written.arm.name() != config.arm.name()) {
       throw InputError("--write-model " + options.write_model_path + ": its arm is " +
-                       (written.arm.has_chain() ? written.arm.name() : std::string("one joint")) + ", not " + config.arm.name() +
-                       "; write the coupled model into the arm's configuration");
+                       (written.arm.has_chain() ? written.arm.name() : std::string("one joint")) + ", not " +
+                       config.arm.name() + "; write the coupled model into the arm's configuration");
     }
   }
   const ChainParameters chain = chain_of(config.arm);
@@ -241,23 +249,26 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
       JointFit& j = joints[static_cast<std::size_t>(k)];
       const ChainLink& link = chain.links[static_cast<std::size_t>(k)];
       j.table = {link.kappa_rad_per_bar, link.omega0_straight_rad_per_s, link.damping_ratio};
-      j.fit = fit_arm_model(single_joint_data(trials.estimation[static_cast<std::size_t>(k)], k), j.table, &stop_requested());
+      j.fit = fit_arm_model(single_joint_data(trials.estimation[static_cast<std::size_t>(k)], k), j.table,
+                            &stop_requested());
       const IdentificationData held = single_joint_data(trials.validation[static_cast<std::size_t>(k)], k);
       j.validation_fit_percent = normalized_fit_percent(held.angle_rad, simulate_arm_angle(j.fit.model, held));
       j.table_validation_fit_percent = normalized_fit_percent(held.angle_rad, simulate_arm_angle(j.table, held));
       char line[320];
-      std::snprintf(line, sizeof line,
-                    "joint %d: kappa %.6g rad/bar, omega0 %.6g 1/s, damping %.6g: fit %.1f %%, %.1f %% on the held-out trial "
-                    "(the arm's own row: %.1f %%)",
-                    k + 1, j.fit.model.kappa_rad_per_bar, j.fit.model.omega0_rad_per_s, j.fit.model.damping, j.fit.fit_percent,
-                    j.validation_fit_percent, j.table_validation_fit_percent);
+      std::snprintf(
+          line, sizeof line,
+          "joint %d: kappa %.6g rad/bar, omega0 %.6g 1/s, damping %.6g: fit %.1f %%, %.1f %% on the held-out trial "
+          "(the arm's own row: %.1f %%)",
+          k + 1, j.fit.model.kappa_rad_per_bar, j.fit.model.omega0_rad_per_s, j.fit.model.damping, j.fit.fit_percent,
+          j.validation_fit_percent, j.table_validation_fit_percent);
       session.record("identify-fit", line);
     }
     std::vector<ModelParameters> fitted;
     fitted.reserve(joints.size());
     for (const JointFit& j : joints) fitted.push_back(j.fit.model);
     independent = independent_dynamics(fitted);
-    progress << "fitting the coupled model (" << 2 * J << " states) on the " << J << " identification trials" << std::endl;
+    progress << "fitting the coupled model (" << 2 * J << " states) on the " << J << " identification trials"
+             << std::endl;
     coupled = fit_coupled_model(trials.estimation, independent, &stop_requested());
     coupled_validation = joint_fit_percent(coupled.dynamics, trials.validation);
     independent_validation = joint_fit_percent(independent, trials.validation);
@@ -268,29 +279,35 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
                                      discretize_joint_dynamics(linearization, sample_s), markov_samples);
     const Eigen::MatrixXd lin_gain = linearization.static_gain_rad_per_bar();
     static_gain_relative_gap = (coupled.dynamics.static_gain_rad_per_bar() - lin_gain).norm() / lin_gain.norm();
-    session.record("identify-fit", "coupled model: fit " + percents(coupled.fit_percent) + ", " + percents(coupled_validation) +
-                                       " on the held-out trials (linearization " + percents(linearization_validation) +
-                                       ", independent joints " + percents(independent_validation) + ")");
+    session.record("identify-fit", "coupled model: fit " + percents(coupled.fit_percent) + ", " +
+                                       percents(coupled_validation) + " on the held-out trials (linearization " +
+                                       percents(linearization_validation) + ", independent joints " +
+                                       percents(independent_validation) + ")");
     char gap[200];
-    std::snprintf(gap, sizeof gap, "coupled model vs the linearization stretched out: %.1f %% (Markov parameters), %.1f %% (static gain)",
-                  100.0 * markov_relative_gap, 100.0 * static_gain_relative_gap);
+    std::snprintf(
+        gap, sizeof gap,
+        "coupled model vs the linearization stretched out: %.1f %% (Markov parameters), %.1f %% (static gain)",
+        100.0 * markov_relative_gap, 100.0 * static_gain_relative_gap);
     session.record("identify-gap", gap);
     if (!options.write_model_path.empty()) {
       // Created (a file that appeared meanwhile is refused), or the file read before the trials, edited.
-      write_file_atomic(options.write_model_path,
-                        with_identified_model(write_model_text, options.write_model_path, identified_parameters(coupled.dynamics), J),
-                        DirectorySync::kNow, write_model_exists ? Replace::kAllowed : Replace::kRefused);
-      progress << "wrote [identified_joint1.." << J << "] and [ilc] joint_model = \"identified\" to " << options.write_model_path
-               << std::endl;
-      session.record("model-written", "[identified_joint1.." + std::to_string(J) + "] and [ilc] joint_model written into the configuration " +
+      write_file_atomic(
+          options.write_model_path,
+          with_identified_model(write_model_text, options.write_model_path, identified_parameters(coupled.dynamics), J),
+          DirectorySync::kNow, write_model_exists ? Replace::kAllowed : Replace::kRefused);
+      progress << "wrote [identified_joint1.." << J << "] and [ilc] joint_model = \"identified\" to "
+               << options.write_model_path << std::endl;
+      session.record("model-written", "[identified_joint1.." + std::to_string(J) +
+                                          "] and [ilc] joint_model written into the configuration " +
                                           options.write_model_path);
     }
   } catch (const std::exception& error) {
     session.record("fault", error.what());  // the trials so far stay in the session
     throw;
   }
-  session.record("finish", options.write_model_path.empty() ? "identified; the model was written nowhere (--write-model FILE)"
-                                                            : "identified; the coupled model is in " + options.write_model_path);
+  session.record("finish", options.write_model_path.empty()
+                               ? "identified; the model was written nowhere (--write-model FILE)"
+                               : "identified; the coupled model is in " + options.write_model_path);
   if (options.json) {
     nlohmann::json per_joint = nlohmann::json::array();
     for (int k = 0; k < J; ++k) {
@@ -329,9 +346,13 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
         {"coupled_model", coupled_json},
         {"independent_validation_fit_percent", vector_json(independent_validation)},
         {"linearization", linearization_json},
-        {"linearization_gap", {{"markov_relative", markov_relative_gap}, {"markov_samples", markov_samples},
-                               {"sample_time_s", sample_s}, {"static_gain_relative", static_gain_relative_gap}}},
-        {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
+        {"linearization_gap",
+         {{"markov_relative", markov_relative_gap},
+          {"markov_samples", markov_samples},
+          {"sample_time_s", sample_s},
+          {"static_gain_relative", static_gain_relative_gap}}},
+        {"written_to",
+         options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
         {"written_as", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json("config")},
         {"session", session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path())}};
     out << report.dump() << std::endl;
@@ -340,25 +361,28 @@ int identify_chain_command(const IdentifyOptions& options, const Configuration& 
   char text[400];
   for (int k = 0; k < J; ++k) {
     const JointFit& j = joints[static_cast<std::size_t>(k)];
-    std::snprintf(text, sizeof text,
-                  "joint %d: kappa %.4f rad/bar  omega0 %.4f 1/s  damping %.4f  fit %.1f %% on %s, %.1f %% on held-out %s "
-                  "(the arm's own row: %.1f %%), rms residual %.3f deg%s\n",
-                  k + 1, j.fit.model.kappa_rad_per_bar, j.fit.model.omega0_rad_per_s, j.fit.model.damping, j.fit.fit_percent,
-                  signal.c_str(), j.validation_fit_percent, held_out.c_str(), j.table_validation_fit_percent, j.fit.rms_residual_deg,
-                  j.fit.converged ? "" : " (not converged)");
+    std::snprintf(
+        text, sizeof text,
+        "joint %d: kappa %.4f rad/bar  omega0 %.4f 1/s  damping %.4f  fit %.1f %% on %s, %.1f %% on held-out %s "
+        "(the arm's own row: %.1f %%), rms residual %.3f deg%s\n",
+        k + 1, j.fit.model.kappa_rad_per_bar, j.fit.model.omega0_rad_per_s, j.fit.model.damping, j.fit.fit_percent,
+        signal.c_str(), j.validation_fit_percent, held_out.c_str(), j.table_validation_fit_percent,
+        j.fit.rms_residual_deg, j.fit.converged ? "" : " (not converged)");
     out << text;
   }
   out << "coupled model (" << 2 * J << " states): fit " << percents(coupled.fit_percent) << " on " << signal << ", "
-      << percents(coupled_validation) << " on held-out " << held_out << " (linearization " << percents(linearization_validation)
-      << ", independent joints " << percents(independent_validation) << ")";
-  std::snprintf(text, sizeof text, ", rms residual %.3f deg, %d iterations%s\n", coupled.rms_residual_deg, coupled.iterations,
-                coupled.converged ? "" : " (not converged)");
+      << percents(coupled_validation) << " on held-out " << held_out << " (linearization "
+      << percents(linearization_validation) << ", independent joints " << percents(independent_validation) << ")";
+  std::snprintf(text, sizeof text, ", rms residual %.3f deg, %d iterations%s\n", coupled.rms_residual_deg,
+                coupled.iterations, coupled.converged ? "" : " (not converged)");
   out << text;
-  std::snprintf(text, sizeof text, "gap to the linearization stretched out: %.1f %% (Markov parameters, %d samples of %g s), %.1f %% (static gain)\n",
+  std::snprintf(text, sizeof text,
+                "gap to the linearization stretched out: %.1f %% (Markov parameters, %d samples of %g s), %.1f %% "
+                "(static gain)\n",
                 100.0 * markov_relative_gap, markov_samples, sample_s, 100.0 * static_gain_relative_gap);
   out << text;
-  out << "static gain rad/bar: identified " << matrix_text(coupled.dynamics.static_gain_rad_per_bar()) << ", linearized "
-      << matrix_text(linearization.static_gain_rad_per_bar()) << "\n";
+  out << "static gain rad/bar: identified " << matrix_text(coupled.dynamics.static_gain_rad_per_bar())
+      << ", linearized " << matrix_text(linearization.static_gain_rad_per_bar()) << "\n";
   return 0;
 }
 

@@ -21,8 +21,8 @@ namespace bellows {
 /// `config` has an [arm] chain. `write_model_text`: the existing text of options.write_model_path
 /// ("" when it does not exist yet). Throws InputError (a rig profile to write into, a device that
 /// cannot drive the arm), EnvironmentError, EngineFault, Cancelled as identify_command does.
-int identify_chain_command(const IdentifyOptions& options, const Configuration& config, const std::string& write_model_text,
-                           std::ostream& out, std::ostream& progress);
+int identify_chain_command(const IdentifyOptions& options, const Configuration& config,
+                           const std::string& write_model_text, std::ostream& out, std::ostream& progress);
 
 /// `toml_text` with [identified_joint1..J] set to `identified`'s first J rows and [ilc] joint_model =
 /// "identified", everything else kept (app/toml_key_edit). Checked as a configuration (InputError

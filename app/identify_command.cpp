@@ -38,10 +38,12 @@ struct TrialFit {
 };
 
 // One trial on `signal`'s excitation; the identification trial (the first) goes into the session.
-TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal, IdentifySession* session) {
+TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal,
+                      IdentifySession* session) {
   const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
   TrialRecord record;
-  run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record, &stop_requested());
+  run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record,
+                           &stop_requested());
   TrialFit fit{signal, identification_data(record, config.controller, config.timing.tick_s)};
   if (session != nullptr) session->save_estimation_trial(config, signal, record);
   return fit;
@@ -64,7 +66,8 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
                                                 const IdentifyOptions& options, const std::string& estimation_signal,
                                                 const std::string& validation_signal, IdentifySession& session,
                                                 std::ostream& progress) {
-  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0,
+                                                        std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   RealtimeLoop loop(core, rig->device(), 1.0);
   loop.start(options.rt);
@@ -78,10 +81,12 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
   } stop_loop{loop, *rig};
   require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
   session.begin(config, device.kind, rig->session_info(),
-                identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()), validation_signal);
+                identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()),
+                validation_signal);
   if (!session.path().empty()) progress << "session " << session.path() << std::endl;
   if (!session.not_recorded().empty()) progress << "bellows: " << session.not_recorded() << std::endl;
-  progress << "identification trial (" << estimation_signal << ") on " << device.kind << " " << rig->where() << std::endl;
+  progress << "identification trial (" << estimation_signal << ") on " << device.kind << " " << rig->where()
+           << std::endl;
   TrialFit estimation = record_trial(loop, config, estimation_signal, &session);
   progress << "validation trial (" << validation_signal << ")" << std::endl;
   TrialFit validation = record_trial(loop, config, validation_signal, nullptr);
@@ -99,16 +104,19 @@ std::string model_held_in(const std::string& toml_text, bool rig_profile, bool s
   std::vector<std::string> held;
   if (several_joints) {
     for (const auto& [key, node] : table) {
-      if (key.str().rfind("identified_joint", 0) == 0 && node.is_table()) held.push_back("[" + std::string(key.str()) + "]");
+      if (key.str().rfind("identified_joint", 0) == 0 && node.is_table())
+        held.push_back("[" + std::string(key.str()) + "]");
     }
   } else if (const toml::table* model = table["model"].as_table()) {
     // The keys identify writes: a profile's (units in the names) or a configuration's.
-    const std::vector<std::string> keys = rig_profile ? std::vector<std::string>{"kappa_rad_per_bar", "omega0_rad_per_s", "damping"}
-                                                      : std::vector<std::string>{"kappa", "omega0", "damping"};
+    const std::vector<std::string> keys =
+        rig_profile ? std::vector<std::string>{"kappa_rad_per_bar", "omega0_rad_per_s", "damping"}
+                    : std::vector<std::string>{"kappa", "omega0", "damping"};
     for (const std::string& key : keys) {
       if (const toml::node* value = model->get(key)) {
         const std::optional<double> number = value->value<double>();
-        held.push_back((held.empty() ? "[model] " : "") + key + " = " + (number ? toml_number(*number) : std::string("...")));
+        held.push_back((held.empty() ? "[model] " : "") + key + " = " +
+                       (number ? toml_number(*number) : std::string("...")));
       }
     }
   }
@@ -117,21 +125,22 @@ std::string model_held_in(const std::string& toml_text, bool rig_profile, bool s
   return out;
 }
 
-void check_write_model_target(const IdentifyOptions& options, const std::string& toml_text, bool exists, bool rig_profile,
-                              bool several_joints) {
+void check_write_model_target(const IdentifyOptions& options, const std::string& toml_text, bool exists,
+                              bool rig_profile, bool several_joints) {
   if (!exists || options.force) return;
   if (const std::string held = model_held_in(toml_text, rig_profile, several_joints); !held.empty()) {
-    throw InputError("--write-model " + printable(options.write_model_path, kPrintableField) + " holds a model already (" + held +
-                     "): --force replaces it (the rest of the file is kept)");
+    throw InputError("--write-model " + printable(options.write_model_path, kPrintableField) +
+                     " holds a model already (" + held + "): --force replaces it (the rest of the file is kept)");
   }
 }
 
-std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model) {
+std::string with_model_section(const std::string& toml_text, const std::string& source_name,
+                               const ModelParameters& model) {
   std::string text = with_table_values(toml_text, "model",  // not const: returned by move
-                                             {{"kappa", toml_number(model.kappa_rad_per_bar)},
-                                              {"omega0", toml_number(model.omega0_rad_per_s)},
-                                              {"damping", toml_number(model.damping)}},
-                                             "fitted by bellows identify");
+                                       {{"kappa", toml_number(model.kappa_rad_per_bar)},
+                                        {"omega0", toml_number(model.omega0_rad_per_s)},
+                                        {"damping", toml_number(model.damping)}},
+                                       "fitted by bellows identify");
   Configuration check;
   apply_config_toml(text, source_name, check);  // never write a file the loader would reject
   if (check.model.kappa_rad_per_bar != std::stod(toml_number(model.kappa_rad_per_bar))) {
@@ -163,12 +172,14 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
       }
     }
   }
-  const bool write_model_exists = !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
+  const bool write_model_exists =
+      !options.write_model_path.empty() && std::filesystem::exists(options.write_model_path);
   if (!options.signal.empty()) config.identify.signal = options.signal;
   if (config.arm.has_chain()) {  // every joint, and the coupled model (app/identify_chain)
     if (into_profile) {
-      throw InputError("--write-model " + options.write_model_path + ": a rig profile holds one joint's [model]; the coupled model of " +
-                       config.arm.name() + " goes into its configuration");
+      throw InputError("--write-model " + options.write_model_path +
+                       ": a rig profile holds one joint's [model]; the coupled model of " + config.arm.name() +
+                       " goes into its configuration");
     }
     check_write_model_target(options, existing_text, write_model_exists, false, true);
     return identify_chain_command(options, config, existing_text, out, progress);
@@ -185,7 +196,8 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
   try {
     if (device.kind == "sim") {
       session.begin(config, device.kind, {{"seed", options.seed}},
-                    identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()), held_out_signal);
+                    identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()),
+                    held_out_signal);
       if (!session.path().empty()) progress << "session " << session.path() << std::endl;
       if (!session.not_recorded().empty()) progress << "bellows: " << session.not_recorded() << std::endl;
       progress << "fitting " << plant_source << std::endl;
@@ -201,29 +213,35 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
     session.note_validation_trial(held_out_signal, validation.data);
     fit = fit_arm_model(estimation.data, config.model, &stop_requested());
     validation_fit = normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(fit.model, validation.data));
-    nominal_validation_fit = normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
-    session.note_fit(fit.model, config.model, fit.fit_percent, validation_fit, fit.rms_residual_deg, fit.iterations, fit.converged);
+    nominal_validation_fit =
+        normalized_fit_percent(validation.data.angle_rad, simulate_arm_angle(config.model, validation.data));
+    session.note_fit(fit.model, config.model, fit.fit_percent, validation_fit, fit.rms_residual_deg, fit.iterations,
+                     fit.converged);
 
     if (!options.write_model_path.empty()) {
       if (into_profile) {
         write_rig_profile_model(options.write_model_path, fit.model);
         progress << "wrote [model] to the rig profile " << options.write_model_path << std::endl;
-        session.record("model-written", "[model] kappa_rad_per_bar, omega0_rad_per_s, damping written into the rig profile " +
-                                            options.write_model_path);
+        session.record("model-written",
+                       "[model] kappa_rad_per_bar, omega0_rad_per_s, damping written into the rig profile " +
+                           options.write_model_path);
       } else {
         // Created (a file that appeared meanwhile is refused), or the file read above, edited.
-        write_file_atomic(options.write_model_path, with_model_section(existing_text, options.write_model_path, fit.model),
-                          DirectorySync::kNow, write_model_exists ? Replace::kAllowed : Replace::kRefused);
+        write_file_atomic(options.write_model_path,
+                          with_model_section(existing_text, options.write_model_path, fit.model), DirectorySync::kNow,
+                          write_model_exists ? Replace::kAllowed : Replace::kRefused);
         progress << "wrote [model] to " << options.write_model_path << std::endl;
-        session.record("model-written", "[model] kappa, omega0, damping written into the configuration " + options.write_model_path);
+        session.record("model-written",
+                       "[model] kappa, omega0, damping written into the configuration " + options.write_model_path);
       }
     }
   } catch (const std::exception& error) {
     session.record("fault", error.what());  // the trials so far stay in the session
     throw;
   }
-  session.record("finish", options.write_model_path.empty() ? "identified; the model was written nowhere (--write-model FILE)"
-                                                            : "identified; the model is in " + options.write_model_path);
+  session.record("finish", options.write_model_path.empty()
+                               ? "identified; the model was written nowhere (--write-model FILE)"
+                               : "identified; the model is in " + options.write_model_path);
   if (options.json) {
     const nlohmann::json report = {
         {"device", device.kind},
@@ -240,7 +258,8 @@ int identify_command(const IdentifyOptions& options, std::ostream& out, std::ost
         {"rms_residual_deg", fit.rms_residual_deg},
         {"iterations", fit.iterations},
         {"converged", fit.converged},
-        {"written_to", options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
+        {"written_to",
+         options.write_model_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(options.write_model_path)},
         {"written_as", options.write_model_path.empty() ? nlohmann::json(nullptr)
                                                         : nlohmann::json(into_profile ? "rig_profile" : "config")},
         {"session", session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path())}};

@@ -39,12 +39,13 @@ std::string model_held_in(const std::string& toml_text, bool rig_profile, bool s
 /// exists gets the model added, the rest of it kept; one that holds a model already
 /// (model_held_in) is refused without --force ("... holds a model already (...): --force replaces
 /// it"), so that an identification never silently replaces an earlier one.
-void check_write_model_target(const IdentifyOptions& options, const std::string& toml_text, bool exists, bool rig_profile,
-                              bool several_joints);
+void check_write_model_target(const IdentifyOptions& options, const std::string& toml_text, bool exists,
+                              bool rig_profile, bool several_joints);
 
 /// `toml_text` with [model] kappa, omega0 and damping set to `model`: existing keys are replaced in
 /// place, missing ones added, everything else (comments, order, other sections) kept. The result is
 /// checked as a configuration; throws InputError naming `source_name` if it is not valid.
-std::string with_model_section(const std::string& toml_text, const std::string& source_name, const ModelParameters& model);
+std::string with_model_section(const std::string& toml_text, const std::string& source_name,
+                               const ModelParameters& model);
 
 }  // namespace bellows

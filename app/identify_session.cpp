@@ -14,15 +14,16 @@ constexpr const char* kPurpose = "bellows identify";
 
 std::string model_text(const ModelParameters& m) {
   char text[160];
-  std::snprintf(text, sizeof text, "kappa %.6g rad/bar, omega0 %.6g 1/s, damping %.6g", m.kappa_rad_per_bar, m.omega0_rad_per_s,
-                m.damping);
+  std::snprintf(text, sizeof text, "kappa %.6g rad/bar, omega0 %.6g 1/s, damping %.6g", m.kappa_rad_per_bar,
+                m.omega0_rad_per_s, m.damping);
   return text;
 }
 
 }  // namespace
 
-void IdentifySession::begin(const Configuration& config, const std::string& device, const nlohmann::ordered_json& device_info,
-                            const Trajectory& excitation, const std::string& validation_signal) {
+void IdentifySession::begin(const Configuration& config, const std::string& device,
+                            const nlohmann::ordered_json& device_info, const Trajectory& excitation,
+                            const std::string& validation_signal) {
   if (no_save_ || writer_) return;
   try {
     check_trial_cost(config, excitation.learning_samples());  // what loading the session would check
@@ -42,41 +43,47 @@ void IdentifySession::begin(const Configuration& config, const std::string& devi
                   kPurpose, excitation.joints(), config.identify.signal.c_str(), config.identify.amplitude_deg,
                   config.identify.duration_s, validation_signal.c_str(), config.arm.name().c_str());
   } else {
-    std::snprintf(line, sizeof line,
-                  "%s: an identification trial (%s, +-%g deg, %g s), then a held-out %s trial; fitting kappa, omega0 and "
-                  "damping from %s",
-                  kPurpose, excitation.name.c_str(), config.identify.amplitude_deg, config.identify.duration_s,
-                  validation_signal.c_str(), model_text(config.model).c_str());
+    std::snprintf(
+        line, sizeof line,
+        "%s: an identification trial (%s, +-%g deg, %g s), then a held-out %s trial; fitting kappa, omega0 and "
+        "damping from %s",
+        kPurpose, excitation.name.c_str(), config.identify.amplitude_deg, config.identify.duration_s,
+        validation_signal.c_str(), model_text(config.model).c_str());
   }
   header.events.push_back({utc_now(), 0, "start", line});
   const std::filesystem::path data_dir = data_dir_.empty() ? default_data_dir() : std::filesystem::path(data_dir_);
   writer_.emplace(SessionWriter::create(data_dir, name_, std::move(header), excitation, kPurpose));
 }
 
-void IdentifySession::save_estimation_trial(const Configuration& config, const std::string& signal, const TrialRecord& record) {
+void IdentifySession::save_estimation_trial(const Configuration& config, const std::string& signal,
+                                            const TrialRecord& record) {
   if (!writer_) return;
   const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(record.learning_samples, record.joint_count());  // N x J
   const IterationSummary summary =
       summarize_trial(0, record, no_correction, config.controller.gas.ambient_bar, config.controller.p_max_bar);
   writer_->save_iteration(record, summary, no_correction, ResumeState{});
   char line[200];
-  std::snprintf(line, sizeof line, "identification trial (%s): %d samples, tracking RMS %.3f deg; iteration 0 holds it%s",
-                signal.c_str(), record.learning_samples, summary.rms_deg,
+  std::snprintf(line, sizeof line,
+                "identification trial (%s): %d samples, tracking RMS %.3f deg; iteration 0 holds it%s", signal.c_str(),
+                record.learning_samples, summary.rms_deg,
                 record.joint_count() > 1 ? " (joint 1 excited; the other joints' trials are in the events)" : "");
   writer_->record_event("identify-trial", line);
 }
 
 void IdentifySession::note_validation_trial(const std::string& signal, const IdentificationData& data) {
   char line[200];
-  std::snprintf(line, sizeof line, "held-out trial (%s): %lld samples every %g s (kept for the fit's validation, not saved as an iteration)",
-                signal.c_str(), static_cast<long long>(data.angle_rad.size()), data.sample_time_s);
+  std::snprintf(
+      line, sizeof line,
+      "held-out trial (%s): %lld samples every %g s (kept for the fit's validation, not saved as an iteration)",
+      signal.c_str(), static_cast<long long>(data.angle_rad.size()), data.sample_time_s);
   record("identify-trial", line);
 }
 
 void IdentifySession::note_fit(const ModelParameters& model, const ModelParameters& configured, double fit_percent,
                                double validation_fit_percent, double rms_residual_deg, int iterations, bool converged) {
   char line[400];
-  std::snprintf(line, sizeof line, "%s: fit %.1f %%, %.1f %% on the held-out trial, rms residual %.3f deg, %d iterations%s (was %s)",
+  std::snprintf(line, sizeof line,
+                "%s: fit %.1f %%, %.1f %% on the held-out trial, rms residual %.3f deg, %d iterations%s (was %s)",
                 model_text(model).c_str(), fit_percent, validation_fit_percent, rms_residual_deg, iterations,
                 converged ? "" : ", not converged", model_text(configured).c_str());
   record("identify-fit", line);

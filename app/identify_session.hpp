@@ -23,7 +23,8 @@ namespace bellows {
 class IdentifySession {
  public:
   /// Nothing is recorded with `no_save`; otherwise the session is created by begin().
-  IdentifySession(bool no_save, std::string data_dir, std::string name) : no_save_(no_save), data_dir_(std::move(data_dir)), name_(std::move(name)) {}
+  IdentifySession(bool no_save, std::string data_dir, std::string name)
+      : no_save_(no_save), data_dir_(std::move(data_dir)), name_(std::move(name)) {}
 
   /// Creates the session (once the device serves): `excitation` becomes its trajectory.
   /// Throws InputError when it cannot be created. An excitation longer than a session of this
@@ -35,8 +36,8 @@ class IdentifySession {
   /// The held-out trial: an event (its record is on another excitation, not the session's trajectory).
   void note_validation_trial(const std::string& signal, const IdentificationData& data);
   /// The fit (`fit_percent` on the identification trial, `validation_fit_percent` on the held-out one).
-  void note_fit(const ModelParameters& model, const ModelParameters& configured, double fit_percent, double validation_fit_percent,
-                double rms_residual_deg, int iterations, bool converged);
+  void note_fit(const ModelParameters& model, const ModelParameters& configured, double fit_percent,
+                double validation_fit_percent, double rms_residual_deg, int iterations, bool converged);
   /// Never throws (the failure itself is what the caller reports).
   void record(const std::string& kind, const std::string& message) noexcept;
 

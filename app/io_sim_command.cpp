@@ -63,14 +63,18 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   LcmIoThread io(url, {&rig});
 
   io.on_open([&] {
-    const std::string which = joints == 1 ? std::string() : " '" + config.arm.name() + "' of " + std::to_string(joints) + " joints";
-    progress << "io-sim: serving the simulated arm" << which << " on " << url << " (rig " << rig.stats().rig_id << ", state every "
-             << config.timing.tick_s * 1e3 << " ms, vents after " << (options.stepped ? config.lcm.lockstep_timeout_s : config.lcm.rig_timeout_s) * 1e3
-             << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar << " bar and beyond "
-             << config.lcm.rig_angle_limit_deg << " deg; " << (keyed ? "commands authenticated" : "no key: commands NOT authenticated")
-             << ")" << (options.stepped ? "; stepped: its time advances one period per command (run --clock lockstep)" : "")
+    const std::string which =
+        joints == 1 ? std::string() : " '" + config.arm.name() + "' of " + std::to_string(joints) + " joints";
+    progress << "io-sim: serving the simulated arm" << which << " on " << url << " (rig " << rig.stats().rig_id
+             << ", state every " << config.timing.tick_s * 1e3 << " ms, vents after "
+             << (options.stepped ? config.lcm.lockstep_timeout_s : config.lcm.rig_timeout_s) * 1e3
+             << " ms without commands, chambers above " << RigLimits::from(config).pressure_ceiling_bar
+             << " bar and beyond " << config.lcm.rig_angle_limit_deg << " deg; "
+             << (keyed ? "commands authenticated" : "no key: commands NOT authenticated") << ")"
+             << (options.stepped ? "; stepped: its time advances one period per command (run --clock lockstep)" : "")
              << (options.swapped_chambers ? "; drill: chambers A and B swapped" : "")
-             << (options.no_command_timeout ? "; drill: no command timeout (it never vents by itself)" : "") << std::endl;
+             << (options.no_command_timeout ? "; drill: no command timeout (it never vents by itself)" : "")
+             << std::endl;
   });
   const double start_s = monotonic_s();
   io.run(
@@ -84,11 +88,12 @@ int io_sim_command(const IoSimOptions& options, std::ostream& out, std::ostream&
   progress << "io-sim: " << s.commands.accepted << " commands applied, " << s.commands.ignored() << " ignored ("
            << s.commands.foreign << " of other sessions, " << s.commands.out_of_order << " out of sequence, "
            << s.commands.unauthenticated << " unauthenticated, " << s.commands.old_version << " of protocol version 1"
-           << (s.commands.other_joints > 0 ? ", " + std::to_string(s.commands.other_joints) + " for an arm of another joint count" : "")
-           << "), "
-           << s.sessions_served << " sessions, " << s.timeouts << " timeouts, " << s.pressure_limit_trips << " + "
-           << s.angle_limit_trips << " pressure + angle limit trips, " << s.states_published << " states published; valves vented"
-           << std::endl;
+           << (s.commands.other_joints > 0
+                   ? ", " + std::to_string(s.commands.other_joints) + " for an arm of another joint count"
+                   : "")
+           << "), " << s.sessions_served << " sessions, " << s.timeouts << " timeouts, " << s.pressure_limit_trips
+           << " + " << s.angle_limit_trips << " pressure + angle limit trips, " << s.states_published
+           << " states published; valves vented" << std::endl;
   if (options.json) {
     nlohmann::json report = {{"rig_id", s.rig_id},
                              {"joints", joints},

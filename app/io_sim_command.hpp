@@ -11,15 +11,17 @@
 namespace bellows {
 
 struct IoSimOptions {
-  std::string config_path;      // [plant], [arm] preset (the arm of several joints served), [timing] tick_s, [controller] p_max_bar, [lcm] (timeout, window, limits, key_file)
-  std::uint64_t seed = 1;       // of the arm's sensor noise
-  std::string lcm_url;          // empty: the default bus
+  std::string config_path;  // [plant], [arm] preset (the arm of several joints served), [timing] tick_s, [controller]
+                            // p_max_bar, [lcm] (timeout, window, limits, key_file)
+  std::uint64_t seed = 1;   // of the arm's sensor noise
+  std::string lcm_url;      // empty: the default bus
   RealtimeMode rt = RealtimeMode::kTry;
-  double duration_s = 0.0;      // 0: until a signal
-  bool json = false;            // counters as one JSON object on `out` at exit
+  double duration_s = 0.0;        // 0: until a signal
+  bool json = false;              // counters as one JSON object on `out` at exit
   bool swapped_chambers = false;  // drill: the tubes of chambers A and B swapped (devices/swapped_chambers.hpp)
-  bool stepped = false;             // lockstep: one period of physics per command, answered at once (run --clock lockstep)
-  bool no_command_timeout = false;  // drill: the rig announces its [lcm] rig_timeout_s but never vents when commands stop
+  bool stepped = false;  // lockstep: one period of physics per command, answered at once (run --clock lockstep)
+  bool no_command_timeout =
+      false;  // drill: the rig announces its [lcm] rig_timeout_s but never vents when commands stop
 };
 
 /// Serves until stopped. Progress lines go to `progress`. Throws InputError for bad input or a bus

@@ -10,12 +10,14 @@ namespace {
 
 std::string model_values(const ModelParameters& m) {
   char text[160];
-  std::snprintf(text, sizeof text, "kappa %g, omega0 %g, damping %g", m.kappa_rad_per_bar, m.omega0_rad_per_s, m.damping);
+  std::snprintf(text, sizeof text, "kappa %g, omega0 %g, damping %g", m.kappa_rad_per_bar, m.omega0_rad_per_s,
+                m.damping);
   return text;
 }
 
 bool same_identified(const ModelParameters& a, const ModelParameters& b) {
-  return a.kappa_rad_per_bar == b.kappa_rad_per_bar && a.omega0_rad_per_s == b.omega0_rad_per_s && a.damping == b.damping;
+  return a.kappa_rad_per_bar == b.kappa_rad_per_bar && a.omega0_rad_per_s == b.omega0_rad_per_s &&
+         a.damping == b.damping;
 }
 
 }  // namespace

@@ -31,7 +31,8 @@ constexpr const char* kScriptName = "figures.gp";
 
 fs::path default_paper_rms_path() { return fs::path(BELLOWS_PAPER_RMS_CSV).lexically_normal(); }
 
-PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory_name, const std::string& paper, bool no_paper) {
+PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory_name, const std::string& paper,
+                           bool no_paper) {
   if (no_paper && !paper.empty()) throw InputError("--paper and --no-paper exclude each other");
   if (no_paper) return {};
   fs::path file = paper;
@@ -40,8 +41,10 @@ PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory
     file = default_paper_rms_path();
     std::error_code error;
     if (file.empty() || !fs::is_regular_file(file, error)) {
-      return {{}, "paper's RMS curve: not overlaid, " + (file.empty() ? std::string("no default file") : file.string() + " is not there") +
-                      " (--paper FILE gives one)"};
+      return {{},
+              "paper's RMS curve: not overlaid, " +
+                  (file.empty() ? std::string("no default file") : file.string() + " is not there") +
+                  " (--paper FILE gives one)"};
     }
   }
   request.paper_rms = read_paper_rms(file);
@@ -61,16 +64,18 @@ Session read_figure_session(const fs::path& directory, const FigureRequest& requ
   return session;
 }
 
-std::vector<fs::path> write_session_figures(const Session& session, const FigureRequest& request, const fs::path& directory,
-                                            bool force) {
+std::vector<fs::path> write_session_figures(const Session& session, const FigureRequest& request,
+                                            const fs::path& directory, bool force) {
   const std::vector<Figure> figures = session_figures(session, request);  // checks the request first
   if (!session.directory.empty() && is_inside(directory, session.directory)) {
-    throw InputError("will not write figures inside the session " + session.directory.string() + " (choose another --output)");
+    throw InputError("will not write figures inside the session " + session.directory.string() +
+                     " (choose another --output)");
   }
   std::error_code error;
   const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
   if (!fs::is_directory(parent, error)) {
-    throw InputError("cannot write figures into " + directory.string() + ": the folder " + parent.string() + " does not exist");
+    throw InputError("cannot write figures into " + directory.string() + ": the folder " + parent.string() +
+                     " does not exist");
   }
   if (fs::exists(directory, error) && !fs::is_directory(directory, error)) {
     throw InputError("cannot write figures into " + directory.string() + ": it is not a directory");
@@ -86,7 +91,8 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
   if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
   const DirectoryHandle folder = DirectoryHandle::open(directory);
   const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
-  write_file_atomic_at(folder, kScriptName, gnuplot_script(figures, request.formats, request.style), DirectorySync::kNow, replace);
+  write_file_atomic_at(folder, kScriptName, gnuplot_script(figures, request.formats, request.style),
+                       DirectorySync::kNow, replace);
   // gnuplot opens its outputs by name (truncating, following links): it draws into a folder made
   // for it alone, and each figure leaves it by the safe writer's last steps (fsync, a rename that
   // replaces only with --force, fsync of the folder), so a crash leaves whole figures or none.
@@ -96,7 +102,8 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
     const std::string name = files[f].filename().string();
     const std::optional<FileDescriptor> drawn = open_regular_file_at(drawing.handle(), name, O_RDONLY);
     struct stat info {};
-    if (!drawn || ::fstat(drawn->get(), &info) != 0 || info.st_size == 0) throw InputError("gnuplot wrote no " + files[f].string());
+    if (!drawn || ::fstat(drawn->get(), &info) != 0 || info.st_size == 0)
+      throw InputError("gnuplot wrote no " + files[f].string());
     if (::fsync(drawn->get()) != 0) throw InputError("cannot flush " + files[f].string() + ": " + std::strerror(errno));
   }
   for (std::size_t f = 1; f < files.size(); ++f) {
@@ -120,7 +127,8 @@ int sessions_plot_command(const PlotOptions& options, std::ostream& out) {
   request.pressure_trial = options.trial;
   request.formats = options.formats;
   request.style = options.style;
-  const PaperCurve paper = add_paper_curve(request, load_manifest(session_dir).trajectory_name, options.paper, options.no_paper);
+  const PaperCurve paper =
+      add_paper_curve(request, load_manifest(session_dir).trajectory_name, options.paper, options.no_paper);
   const Session session = read_figure_session(session_dir, request);
   const fs::path directory =
       options.output.empty() ? fs::path(session.directory.filename().string() + "_figures") : fs::path(options.output);
@@ -128,8 +136,12 @@ int sessions_plot_command(const PlotOptions& options, std::ostream& out) {
   if (options.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const fs::path& file : files) list.push_back(file.string());
-    out << nlohmann::json{{"directory", directory.string()}, {"style", request.style}, {"paper", paper.file.string()}, {"paper_note", paper.note},
-                          {"files", list}}.dump()
+    out << nlohmann::json{{"directory", directory.string()},
+                          {"style", request.style},
+                          {"paper", paper.file.string()},
+                          {"paper_note", paper.note},
+                          {"files", list}}
+               .dump()
         << std::endl;
     return 0;
   }

@@ -15,16 +15,16 @@
 namespace bellows {
 
 struct PlotOptions {
-  std::string data_dir;            // empty: the default data directory
-  std::string session;             // a directory, or a session name in the data directory
-  std::string output;              // the folder; empty: <session name>_figures here
-  std::vector<int> iterations;     // angle, error and u_ilc figures; empty: the default choice
-  int trial = -1;                  // the pressures figure; -1: the last iteration
+  std::string data_dir;         // empty: the default data directory
+  std::string session;          // a directory, or a session name in the data directory
+  std::string output;           // the folder; empty: <session name>_figures here
+  std::vector<int> iterations;  // angle, error and u_ilc figures; empty: the default choice
+  int trial = -1;               // the pressures figure; -1: the last iteration
   std::vector<std::string> formats = {"png", "svg"};
-  std::string style = "screen";    // screen, paper-column, paper-wide (app/plot_style.hpp)
-  std::string paper;               // the paper's RMS curve (CSV); empty: the default one for the paper trajectory
+  std::string style = "screen";  // screen, paper-column, paper-wide (app/plot_style.hpp)
+  std::string paper;             // the paper's RMS curve (CSV); empty: the default one for the paper trajectory
   bool no_paper = false;
-  bool force = false;              // replace existing figures
+  bool force = false;  // replace existing figures
   bool json = false;
 };
 
@@ -43,7 +43,8 @@ struct PaperCurve {
 /// Puts the paper's RMS curve into `request`: from `paper` when given, none when `no_paper`, else
 /// the default one for a session of the paper trajectory when it is there. Throws InputError for a
 /// file that cannot be read.
-PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory_name, const std::string& paper, bool no_paper);
+PaperCurve add_paper_curve(FigureRequest& request, const std::string& trajectory_name, const std::string& paper,
+                           bool no_paper);
 
 /// What the figures need of the saved session in `directory`, read from its files: the manifest
 /// (every iteration's RMS), the trajectory and the records of figure_iterations() only, so a long

@@ -35,7 +35,8 @@ std::string write_console_figures(const std::string& session_location, int itera
   if (error) throw InputError("cannot create " + root.string() + ": " + error.message());
   const std::string stem = fs::path(session_location).filename().string() + suffix;
   fs::path directory = root / stem;
-  for (int n = 2; fs::exists(directory, error); ++n) directory = root / (stem + "_" + std::to_string(n));  // drawn again
+  for (int n = 2; fs::exists(directory, error); ++n)
+    directory = root / (stem + "_" + std::to_string(n));  // drawn again
   write_session_figures(session, request, directory, false);
   const bool paper_missing = paper.file.empty() && !paper.note.empty();
   return directory.string() + (paper_missing ? "; " + paper.note : std::string());

@@ -18,8 +18,8 @@ using QuietRead = std::function<void(const std::function<void()>&)>;
 /// `2024-05-01_12-00-00_paper_iteration_0012` (`_2`, `_3`, ... when drawn again). Returns what
 /// the console logs: the folder, and for the paper trajectory whether the paper's curve is in it.
 /// Throws InputError / EnvironmentError with the reason.
-std::string write_console_figures(const std::string& session_location, int iterations, const std::filesystem::path& root,
-                                  const QuietRead& quietly);
+std::string write_console_figures(const std::string& session_location, int iterations,
+                                  const std::filesystem::path& root, const QuietRead& quietly);
 
 /// Where the console writes figures: `figures` beside the default session data directory
 /// (~/.local/share/bellows/figures); empty when there is no such directory.

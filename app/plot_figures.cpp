@@ -92,7 +92,8 @@ struct FigureBuilder {
     std::string& p = f.plot;
     if (style.titles && !title.empty()) p += "set title " + gp_quoted(title) + " noenhanced\n";
     p += "set xlabel " + gp_quoted(xlabel) + "\nset ylabel " + gp_quoted(ylabel) + "\n";
-    p += "set grid linetype 1 linecolor rgb '#dddddd' linewidth 0.5\nset border linewidth 0.8\nset tics nomirror out scale 0.6\n";
+    p += "set grid linetype 1 linecolor rgb '#dddddd' linewidth 0.5\nset border linewidth 0.8\nset tics nomirror out "
+         "scale 0.6\n";
     p += "set border 3\n";
     p += layout_commands(layout);
     if (log_y) p += "set logscale y\n" + log_tics(layout.y) + "set format y '%g'\n";
@@ -131,7 +132,8 @@ const IterationData& iteration_of(const Session& session, int iteration, const c
                      std::to_string(static_cast<int>(session.iterations.size()) - 1));
   }
   const IterationData& data = session.iterations[static_cast<std::size_t>(iteration)];
-  if (data.record.learning_samples == 0) throw std::logic_error("figures: iteration " + std::to_string(iteration) + " was not loaded");
+  if (data.record.learning_samples == 0)
+    throw std::logic_error("figures: iteration " + std::to_string(iteration) + " was not loaded");
   return data;
 }
 
@@ -147,7 +149,8 @@ std::vector<IterationColumns> iteration_columns(const Session& session, const st
   for (int j : iterations) {
     const TrialRecord& record = iteration_of(session, j, "iteration").record;
     const TrialSamples& s = record.joint_samples(0);
-    out.push_back({j, rounded_times(record.sample_time_s), degrees_of(s.angle_rad), s.u_ilc_bar, degrees_of(s.error_rad)});
+    out.push_back(
+        {j, rounded_times(record.sample_time_s), degrees_of(s.angle_rad), s.u_ilc_bar, degrees_of(s.error_rad)});
   }
   return out;
 }
@@ -155,14 +158,16 @@ std::vector<IterationColumns> iteration_columns(const Session& session, const st
 std::string iteration_blocks(const std::vector<IterationColumns>& columns) {
   std::string out;
   for (const IterationColumns& c : columns) {
-    out += data_block("iteration_" + std::to_string(c.iteration), {&c.time_s, &c.angle_deg, &c.u_ilc_bar, &c.error_deg});
+    out +=
+        data_block("iteration_" + std::to_string(c.iteration), {&c.time_s, &c.angle_deg, &c.u_ilc_bar, &c.error_deg});
   }
   return out;
 }
 
 AxisRange time_range(const Session& session) { return {0.0, session.trajectory.duration_s()}; }
 
-Figure rms_figure(const Session& session, const FigureRequest& request, const FigureStyle& style, const std::vector<int>& chosen) {
+Figure rms_figure(const Session& session, const FigureRequest& request, const FigureStyle& style,
+                  const std::vector<int>& chosen) {
   const auto n = static_cast<Eigen::Index>(session.manifest.iterations.size());
   Eigen::VectorXd iteration(n), rms(n);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -178,11 +183,22 @@ Figure rms_figure(const Session& session, const FigureRequest& request, const Fi
     chosen_rms(i) = session.manifest.iterations[static_cast<std::size_t>(j)].summary.rms_deg;
     chosen_colour(i) = static_cast<double>(std::stoi(iteration_colour(static_cast<int>(i)).substr(1), nullptr, 16));
   }
-  std::string data = data_block("rms", {&iteration, &rms}) + data_block("rms_drawn", {&chosen_iteration, &chosen_rms, &chosen_colour});
+  std::string data =
+      data_block("rms", {&iteration, &rms}) + data_block("rms_drawn", {&chosen_iteration, &chosen_rms, &chosen_colour});
   const std::string name = style.titles ? "bellows: " + session.manifest.name : "bellows";
-  FigureBuilder b{style, "RMS tracking error per iteration", "iteration", "RMS error [deg]", {-0.4, static_cast<double>(n - 1) + 0.4}, true, {}, {}, {}};
+  FigureBuilder b{style,
+                  "RMS tracking error per iteration",
+                  "iteration",
+                  "RMS error [deg]",
+                  {-0.4, static_cast<double>(n - 1) + 0.4},
+                  true,
+                  {},
+                  {},
+                  {}};
   if (n <= 16) b.extra = "set xtics 1\n";
-  b.add({"$rms using 1:2 with linespoints linewidth 1.5 linecolor rgb '#000000' pointtype 7 pointsize 0.5", name, {&iteration, &rms}});
+  b.add({"$rms using 1:2 with linespoints linewidth 1.5 linecolor rgb '#000000' pointtype 7 pointsize 0.5",
+         name,
+         {&iteration, &rms}});
   Eigen::VectorXd paper_x, paper_y;
   if (request.paper_rms && !request.paper_rms->empty()) {
     const auto p = static_cast<Eigen::Index>(request.paper_rms->size());
@@ -192,11 +208,14 @@ Figure rms_figure(const Session& session, const FigureRequest& request, const Fi
       paper_y(i) = (*request.paper_rms)[static_cast<std::size_t>(i)].second;
     }
     data += data_block("paper", {&paper_x, &paper_y});
-    b.add({"$paper using 1:2 with linespoints linewidth 1.5 linecolor rgb '#777777' dashtype 2 pointtype 6 pointsize 0.6", "paper",
-           {&paper_x, &paper_y}});
+    b.add(
+        {"$paper using 1:2 with linespoints linewidth 1.5 linecolor rgb '#777777' dashtype 2 pointtype 6 pointsize 0.6",
+         "paper",
+         {&paper_x, &paper_y}});
   }
   b.add({"keyentry with points pointtype 7 pointsize 1.1 linecolor rgb '#777777'", kDrawnIterationsTitle, {}});
-  b.add({"$rms_drawn using 1:2:3 with points pointtype 7 pointsize 1.1 linecolor rgb variable", "", {}});  // last: on top
+  b.add(
+      {"$rms_drawn using 1:2:3 with points pointtype 7 pointsize 1.1 linecolor rgb variable", "", {}});  // last: on top
   return b.build("rms", std::move(data));
 }
 
@@ -205,34 +224,66 @@ Figure angle_figure(const Session& session, const std::vector<IterationColumns>&
   Eigen::VectorXd time_s(trajectory.learning_samples() + 1);
   for (Eigen::Index k = 0; k < time_s.size(); ++k) time_s(k) = static_cast<double>(k) * trajectory.sample_time_s;
   const Eigen::VectorXd times = rounded_times(time_s), angle = degrees_of(trajectory.joint(0));
-  FigureBuilder b{style, "Joint angle and set point: " + session.manifest.name, "time [s]", "angle θ [deg]", time_range(session), false, {}, {}, {}};
-  b.add({"$setpoint using 1:2 with lines linewidth 1.2 linecolor rgb '#000000' dashtype 2", "set point", {&times, &angle}}, true);
+  FigureBuilder b{style,
+                  "Joint angle and set point: " + session.manifest.name,
+                  "time [s]",
+                  "angle θ [deg]",
+                  time_range(session),
+                  false,
+                  {},
+                  {},
+                  {}};
+  b.add({"$setpoint using 1:2 with lines linewidth 1.2 linecolor rgb '#000000' dashtype 2",
+         "set point",
+         {&times, &angle}},
+        true);
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const IterationColumns& c = columns[i];
-    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:2 with lines" + iteration_look(static_cast<int>(i), 1.5),
-           "iteration " + std::to_string(c.iteration), {&c.time_s, &c.angle_deg}});
+    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:2 with lines" +
+               iteration_look(static_cast<int>(i), 1.5),
+           "iteration " + std::to_string(c.iteration),
+           {&c.time_s, &c.angle_deg}});
   }
   return b.build("angle", data_block("setpoint", {&times, &angle}) + iteration_blocks(columns));
 }
 
 Figure error_figure(const Session& session, const std::vector<IterationColumns>& columns, const FigureStyle& style) {
-  FigureBuilder b{style, "Tracking error: " + session.manifest.name, "time [s]", "error e = r − θ [deg]", time_range(session), false,
-                  "set xzeroaxis linetype 1 linecolor rgb '#777777' linewidth 0.8\n", {}, {}};
+  FigureBuilder b{style,
+                  "Tracking error: " + session.manifest.name,
+                  "time [s]",
+                  "error e = r − θ [deg]",
+                  time_range(session),
+                  false,
+                  "set xzeroaxis linetype 1 linecolor rgb '#777777' linewidth 0.8\n",
+                  {},
+                  {}};
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const IterationColumns& c = columns[i];
-    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:4 with lines" + iteration_look(static_cast<int>(i), 1.5),
-           "iteration " + std::to_string(c.iteration), {&c.time_s, &c.error_deg}});
+    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:4 with lines" +
+               iteration_look(static_cast<int>(i), 1.5),
+           "iteration " + std::to_string(c.iteration),
+           {&c.time_s, &c.error_deg}});
   }
   return b.build("error", {});  // reuses the angle figure's $iteration_J blocks
 }
 
-Figure correction_figure(const Session& session, const std::vector<IterationColumns>& columns, const FigureStyle& style) {
-  FigureBuilder b{style, "Learned correction u_ilc: " + session.manifest.name, "time [s]", "ILC correction u_{ILC} [bar]",
-                  time_range(session), false, "set xzeroaxis linetype 1 linecolor rgb '#777777' linewidth 0.8\n", {}, {}};
+Figure correction_figure(const Session& session, const std::vector<IterationColumns>& columns,
+                         const FigureStyle& style) {
+  FigureBuilder b{style,
+                  "Learned correction u_ilc: " + session.manifest.name,
+                  "time [s]",
+                  "ILC correction u_{ILC} [bar]",
+                  time_range(session),
+                  false,
+                  "set xzeroaxis linetype 1 linecolor rgb '#777777' linewidth 0.8\n",
+                  {},
+                  {}};
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const IterationColumns& c = columns[i];
-    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:3 with steps" + iteration_look(static_cast<int>(i), 1.5),
-           "iteration " + std::to_string(c.iteration), {&c.time_s, &c.u_ilc_bar}});
+    b.add({"$iteration_" + std::to_string(c.iteration) + " using 1:3 with steps" +
+               iteration_look(static_cast<int>(i), 1.5),
+           "iteration " + std::to_string(c.iteration),
+           {&c.time_s, &c.u_ilc_bar}});
   }
   return b.build("u_ilc", {});  // reuses the angle figure's $iteration_J blocks
 }
@@ -242,24 +293,43 @@ Figure pressure_figure(const Session& session, int trial, const FigureStyle& sty
   const TrialTicks& t = record.joint_ticks(0);
   const Eigen::VectorXd& supply_bar = record.supply_bar;
   const Eigen::VectorXd time_s = rounded_times(record.tick_time_s);
-  std::string data = data_block("pressures", {&time_s, &t.pressure_a_bar, &t.pressure_b_bar, &t.setpoint_a_bar, &t.setpoint_b_bar, &supply_bar});
-  FigureBuilder b{style, "Pressures, iteration " + std::to_string(trial) + ": " + session.manifest.name, "time [s]",
-                  "pressure [bar abs]", time_range(session), false, {}, {}, {}};
-  b.add({"$pressures using 1:2 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberAColour) + "'", "A measured",
+  std::string data = data_block(
+      "pressures", {&time_s, &t.pressure_a_bar, &t.pressure_b_bar, &t.setpoint_a_bar, &t.setpoint_b_bar, &supply_bar});
+  FigureBuilder b{style,
+                  "Pressures, iteration " + std::to_string(trial) + ": " + session.manifest.name,
+                  "time [s]",
+                  "pressure [bar abs]",
+                  time_range(session),
+                  false,
+                  {},
+                  {},
+                  {}};
+  b.add({"$pressures using 1:2 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberAColour) + "'",
+         "A measured",
          {&time_s, &t.pressure_a_bar}});
-  b.add({"$pressures using 1:4 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberAColour) + "' dashtype 2", "A set point",
-         {&time_s, &t.setpoint_a_bar}}, true);
-  b.add({"$pressures using 1:3 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberBColour) + "'", "B measured",
+  b.add(
+      {"$pressures using 1:4 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberAColour) + "' dashtype 2",
+       "A set point",
+       {&time_s, &t.setpoint_a_bar}},
+      true);
+  b.add({"$pressures using 1:3 with lines linewidth 1.5 linecolor rgb '" + std::string(kChamberBColour) + "'",
+         "B measured",
          {&time_s, &t.pressure_b_bar}});
-  b.add({"$pressures using 1:5 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberBColour) + "' dashtype 2", "B set point",
-         {&time_s, &t.setpoint_b_bar}}, true);
+  b.add(
+      {"$pressures using 1:5 with steps linewidth 0.8 linecolor rgb '" + std::string(kChamberBColour) + "' dashtype 2",
+       "B set point",
+       {&time_s, &t.setpoint_b_bar}},
+      true);
   // The supply (3 bar on the paper's rig) squeezed the chambers into the bottom of the axis: drawn
   // only when it is near their range, else named in the legend's title.
   const double low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
-  const double high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(), t.setpoint_b_bar.maxCoeff()});
+  const double high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(),
+                                t.setpoint_b_bar.maxCoeff()});
   const double supply = supply_bar.size() > 0 ? supply_bar.mean() : 0.0;
   if (supply <= high + 0.25 * (high - low)) {
-    b.add({"$pressures using 1:6 with lines linewidth 1 linecolor rgb '#999999' dashtype 3", "supply", {&time_s, &supply_bar}});
+    b.add({"$pressures using 1:6 with lines linewidth 1 linecolor rgb '#999999' dashtype 3",
+           "supply",
+           {&time_s, &supply_bar}});
     b.legend_heading = "chambers";
   } else {
     char heading[64];
@@ -294,8 +364,9 @@ std::vector<Figure> session_figures(const Session& session, const FigureRequest&
   std::vector<int> iterations = request.iterations.empty() ? default_plot_iterations(count) : request.iterations;
   const std::vector<IterationColumns> columns = iteration_columns(session, iterations);  // checks them
   const int trial = request.pressure_trial < 0 ? count - 1 : request.pressure_trial;
-  return {rms_figure(session, request, style, iterations), angle_figure(session, columns, style), error_figure(session, columns, style),
-          correction_figure(session, columns, style), pressure_figure(session, trial, style)};
+  return {rms_figure(session, request, style, iterations), angle_figure(session, columns, style),
+          error_figure(session, columns, style), correction_figure(session, columns, style),
+          pressure_figure(session, trial, style)};
 }
 
 std::vector<fs::path> figure_files(const std::vector<Figure>& figures, const std::vector<std::string>& formats,
@@ -307,7 +378,8 @@ std::vector<fs::path> figure_files(const std::vector<Figure>& figures, const std
   return out;
 }
 
-std::string gnuplot_script(const std::vector<Figure>& figures, const std::vector<std::string>& formats, const std::string& style_name) {
+std::string gnuplot_script(const std::vector<Figure>& figures, const std::vector<std::string>& formats,
+                           const std::string& style_name) {
   const FigureStyle style = figure_style(style_name);
   std::string out = "# Written by bellows sessions plot (style " + style.name +
                     "); `gnuplot figures.gp` in this folder draws them again.\nset encoding utf8\n";

@@ -21,8 +21,8 @@ namespace bellows {
 struct FigureRequest {
   std::vector<int> iterations;  // angle, error and u_ilc figures; empty: default_plot_iterations()
   int pressure_trial = -1;      // the pressures figure; -1: the last iteration
-  std::vector<std::string> formats = {"png", "svg"};  // png, svg, pdf
-  std::string style = "screen";                        // figure_style(): screen, paper-column, paper-wide
+  std::vector<std::string> formats = {"png", "svg"};                // png, svg, pdf
+  std::string style = "screen";                                     // figure_style(): screen, paper-column, paper-wide
   std::optional<std::vector<std::pair<double, double>>> paper_rms;  // (iteration, rms_deg) overlay
 };
 
@@ -45,7 +45,8 @@ std::vector<int> figure_iterations(const FigureRequest& request, int count);
 std::vector<Figure> session_figures(const Session& session, const FigureRequest& request);
 
 /// The files `figures` become in `directory`, one per figure and format.
-std::vector<std::filesystem::path> figure_files(const std::vector<Figure>& figures, const std::vector<std::string>& formats,
+std::vector<std::filesystem::path> figure_files(const std::vector<Figure>& figures,
+                                                const std::vector<std::string>& formats,
                                                 const std::filesystem::path& directory);
 
 /// One gnuplot script drawing every figure in every format of `style` into the folder it runs in.

@@ -17,7 +17,8 @@ namespace bellows {
 
 void run_gnuplot(const std::filesystem::path& script, const std::filesystem::path& directory) {
   int pipe_fds[2];
-  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw EnvironmentError(std::string("cannot start gnuplot: ") + std::strerror(errno));
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)
+    throw EnvironmentError(std::string("cannot start gnuplot: ") + std::strerror(errno));
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
@@ -52,7 +53,8 @@ void run_gnuplot(const std::filesystem::path& script, const std::filesystem::pat
     std::size_t end = output.find_last_not_of("\n ");
     if (end != std::string::npos) {
       const std::size_t start = output.rfind('\n', end);
-      line = output.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+      line = output.substr(start == std::string::npos ? 0 : start + 1,
+                           end - (start == std::string::npos ? 0 : start + 1) + 1);
     }
     throw InputError("gnuplot failed on " + script.string() + (line.empty() ? "" : ": " + line));
   }

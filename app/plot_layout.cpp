@@ -46,10 +46,13 @@ struct Candidate {
 
 /// How `candidate`'s box sits over `series` in x and [low, high]: the points it covers and the top
 /// of the range that would leave it clear.
-void measure(Candidate& c, const std::vector<SeriesPoints>& series, AxisRange x, double low, double high, double margin, bool log_y) {
+void measure(Candidate& c, const std::vector<SeriesPoints>& series, AxisRange x, double low, double high, double margin,
+             bool log_y) {
   const double x_span = x.high - x.low;
   const bool centre = c.box.columns > 1;
-  const double box_x0 = centre ? x.low + 0.5 * (1.0 - c.box.width) * x_span : c.right ? x.high - c.box.width * x_span : x.low;
+  const double box_x0 = centre    ? x.low + 0.5 * (1.0 - c.box.width) * x_span
+                        : c.right ? x.high - c.box.width * x_span
+                                  : x.low;
   const double box_x1 = box_x0 + c.box.width * x_span;
   // A little beyond the box: a line passing just outside it still looks crowded.
   const double box_y0 = c.top ? high - c.box.height * (high - low) : low;
@@ -59,7 +62,9 @@ void measure(Candidate& c, const std::vector<SeriesPoints>& series, AxisRange x,
   for (const SeriesPoints& s : series) {
     for (Eigen::Index k = 0; k < s.y->size(); ++k) {
       const double px = (*s.x)(k), py = (*s.y)(k);
-      if (!std::isfinite(py) || (log_y && py <= 0.0) || px < box_x0 - kBoxClearance * x_span || px > box_x1 + kBoxClearance * x_span) continue;
+      if (!std::isfinite(py) || (log_y && py <= 0.0) || px < box_x0 - kBoxClearance * x_span ||
+          px > box_x1 + kBoxClearance * x_span)
+        continue;
       const double ty = transformed(py, log_y);
       column_top = std::max(column_top, ty);
       const double clearance = kBoxClearance * (high - low);
@@ -74,8 +79,8 @@ void measure(Candidate& c, const std::vector<SeriesPoints>& series, AxisRange x,
 
 }  // namespace
 
-PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, const LegendSize& legend, const FigureStyle& style,
-                       bool log_y) {
+PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, const LegendSize& legend,
+                       const FigureStyle& style, bool log_y) {
   double low = std::numeric_limits<double>::infinity(), high = -low;
   for (const SeriesPoints& s : series) {
     for (Eigen::Index k = 0; k < s.y->size(); ++k) {
@@ -96,8 +101,10 @@ PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, con
   // A column in a corner where it covers no point; else the top raised for whichever needs the
   // least: that column at the top, or the entries side by side in rows across the top.
   const LegendBox column = legend_box(legend, style, 1);
-  std::vector<Candidate> candidates = {{"top right", true, true, column}, {"top left", false, true, column},
-                                       {"bottom right", true, false, column}, {"bottom left", false, false, column}};
+  std::vector<Candidate> candidates = {{"top right", true, true, column},
+                                       {"top left", false, true, column},
+                                       {"bottom right", true, false, column},
+                                       {"bottom left", false, false, column}};
   for (int columns = 2; columns <= legend.rows; ++columns) {
     const LegendBox across = legend_box(legend, style, columns);
     if (across.width > 1.0) break;
@@ -127,21 +134,24 @@ PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, con
 
 std::string layout_commands(const PlotLayout& layout) {
   char text[600];
-  std::snprintf(text, sizeof text,
-                "set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n"
-                "set key inside %s %s reverse Left samplen 2 spacing 1.0 width 1 opaque box linecolor rgb '#b0b0b0'%s\n",
-                layout.x.low, layout.x.high, layout.y.low, layout.y.high, layout.key_corner.c_str(),
-                layout.key_columns > 1 ? ("horizontal maxcols " + std::to_string(layout.key_columns)).c_str() : "vertical",
-                layout.key_heading.empty() ? "" : (" title '" + layout.key_heading + "' noenhanced").c_str());
+  std::snprintf(
+      text, sizeof text,
+      "set xrange [%.9g:%.9g]\nset yrange [%.9g:%.9g]\n"
+      "set key inside %s %s reverse Left samplen 2 spacing 1.0 width 1 opaque box linecolor rgb '#b0b0b0'%s\n",
+      layout.x.low, layout.x.high, layout.y.low, layout.y.high, layout.key_corner.c_str(),
+      layout.key_columns > 1 ? ("horizontal maxcols " + std::to_string(layout.key_columns)).c_str() : "vertical",
+      layout.key_heading.empty() ? "" : (" title '" + layout.key_heading + "' noenhanced").c_str());
   return text;
 }
 
 std::string log_tics(AxisRange range) {
   std::vector<double> tics;
-  for (const std::vector<double>& steps : {std::vector<double>{1, 2, 5}, {1, 1.5, 2, 3, 4, 5, 6, 8}, {1, 1.2, 1.4, 1.6, 1.8, 2, 2.5, 3, 3.5, 4, 5, 6, 7, 8, 9}}) {
+  for (const std::vector<double>& steps : {std::vector<double>{1, 2, 5},
+                                           {1, 1.5, 2, 3, 4, 5, 6, 8},
+                                           {1, 1.2, 1.4, 1.6, 1.8, 2, 2.5, 3, 3.5, 4, 5, 6, 7, 8, 9}}) {
     tics.clear();
-    for (int power = static_cast<int>(std::floor(std::log10(range.low))) - 1; power <= static_cast<int>(std::ceil(std::log10(range.high)));
-         ++power) {
+    for (int power = static_cast<int>(std::floor(std::log10(range.low))) - 1;
+         power <= static_cast<int>(std::ceil(std::log10(range.high))); ++power) {
       for (double step : steps) {
         const double tic = step * std::pow(10.0, power);
         if (tic >= range.low && tic <= range.high) tics.push_back(tic);

@@ -24,22 +24,22 @@ struct SeriesPoints {
 };
 
 struct LegendSize {
-  int rows = 0;             // entries
-  int widest_title = 0;     // characters of the longest entry
-  int heading_chars = 0;    // characters of the legend's own title (0: none, no row for it)
+  int rows = 0;           // entries
+  int widest_title = 0;   // characters of the longest entry
+  int heading_chars = 0;  // characters of the legend's own title (0: none, no row for it)
 };
 
 struct PlotLayout {
   AxisRange x, y;
-  std::string key_corner;  // "top right", "top left", "bottom right", "bottom left", "top center"
-  int key_columns = 1;     // more than one: the entries side by side across the top
-  std::string key_heading; // the legend's own title ("": none)
+  std::string key_corner;   // "top right", "top left", "bottom right", "bottom left", "top center"
+  int key_columns = 1;      // more than one: the entries side by side across the top
+  std::string key_heading;  // the legend's own title ("": none)
 };
 
 /// The layout of a figure of `series` over `x` in `style` (a log y axis when `log_y`: margins and
 /// the legend's room measured in decades).
-PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, const LegendSize& legend, const FigureStyle& style,
-                       bool log_y);
+PlotLayout plot_layout(const std::vector<SeriesPoints>& series, AxisRange x, const LegendSize& legend,
+                       const FigureStyle& style, bool log_y);
 
 /// gnuplot's commands for `layout`: the ranges and the legend inside the axes.
 std::string layout_commands(const PlotLayout& layout);

@@ -47,18 +47,20 @@ std::string figure_terminal(const FigureStyle& s, const std::string& format) {
   if (format == "png") {
     const double scale = s.png_dpi / 72.0;
     char text[240];
-    std::snprintf(text, sizeof text,
-                  "set terminal pngcairo size %.0f,%.0f enhanced font 'DejaVu Sans,%.3g' linewidth %.3g pointscale %.3g",
-                  s.width_in * s.png_dpi, s.height_in * s.png_dpi, s.font_pt * s.png_dpi / 96.0, s.line_scale * scale, scale);
+    std::snprintf(
+        text, sizeof text,
+        "set terminal pngcairo size %.0f,%.0f enhanced font 'DejaVu Sans,%.3g' linewidth %.3g pointscale %.3g",
+        s.width_in * s.png_dpi, s.height_in * s.png_dpi, s.font_pt * s.png_dpi / 96.0, s.line_scale * scale, scale);
     return text;
   }
   if (format == "pdf") {
-    return formatted("set terminal pdfcairo size %.3gin,%.3gin enhanced font 'DejaVu Sans,%.3g' linewidth %.3g", s.width_in, s.height_in,
-                     s.font_pt * 1.5, s.line_scale * 2.0);  // pdfcairo's line is half a point wide
+    return formatted("set terminal pdfcairo size %.3gin,%.3gin enhanced font 'DejaVu Sans,%.3g' linewidth %.3g",
+                     s.width_in, s.height_in, s.font_pt * 1.5,
+                     s.line_scale * 2.0);  // pdfcairo's line is half a point wide
   }
   if (format == "svg") {
-    return formatted("set terminal svg size %.0f,%.0f dynamic enhanced font 'DejaVu Sans,%.3g' linewidth %.3g", s.width_in * 72.0,
-                     s.height_in * 72.0, s.font_pt, s.line_scale);
+    return formatted("set terminal svg size %.0f,%.0f dynamic enhanced font 'DejaVu Sans,%.3g' linewidth %.3g",
+                     s.width_in * 72.0, s.height_in * 72.0, s.font_pt, s.line_scale);
   }
   throw InputError("figure format must be png, svg or pdf, not '" + format + "'");
 }

@@ -10,13 +10,13 @@
 namespace bellows {
 
 struct FigureStyle {
-  std::string name;        // screen, paper-column, paper-wide
-  double width_in = 0.0;   // the figure's size as printed (PDF, SVG); PNG: times png_dpi
+  std::string name;       // screen, paper-column, paper-wide
+  double width_in = 0.0;  // the figure's size as printed (PDF, SVG); PNG: times png_dpi
   double height_in = 0.0;
-  double font_pt = 0.0;    // every text: tick labels, axis labels, legend
+  double font_pt = 0.0;  // every text: tick labels, axis labels, legend
   double png_dpi = 0.0;
-  double line_scale = 1.0; // gnuplot's linewidth factor at 72 dpi
-  bool titles = true;      // a title above each figure (a paper's caption does that job)
+  double line_scale = 1.0;  // gnuplot's linewidth factor at 72 dpi
+  bool titles = true;       // a title above each figure (a paper's caption does that job)
 };
 
 /// The preset named `name` (screen, paper-column, paper-wide). Throws InputError for another name.

@@ -30,7 +30,6 @@
 namespace bellows {
 namespace {
 
-
 std::string line_of(const char* pattern, auto... values) {
   char text[400];
   std::snprintf(text, sizeof text, pattern, values...);
@@ -49,9 +48,11 @@ nlohmann::json reading_json(const SensorReading& r) {
 void print_inputs(const RawInputs& raw, const SensorReading& r, const std::string& device, std::ostream& progress) {
   if (raw.count == 0) {
     progress << "inputs (" << device << ": no volts, the values the engine reads):\n"
-             << line_of("  angle        %9.3f deg\n  chamber A    %9.4f bar\n  chamber B    %9.4f bar\n"
-                        "  supply       %9.4f bar\n  temperature  %9.2f K\n",
-                        r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1], r.supply_bar, r.temperature_K);
+             << line_of(
+                    "  angle        %9.3f deg\n  chamber A    %9.4f bar\n  chamber B    %9.4f bar\n"
+                    "  supply       %9.4f bar\n  temperature  %9.2f K\n",
+                    r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1],
+                    r.supply_bar, r.temperature_K);
     return;
   }
   progress << "inputs (" << device << "): raw volts -> calibrated value\n";
@@ -73,28 +74,35 @@ nlohmann::json zero_the_angle(EngineDriver& driver, OpenedDevice& rig, const Dev
   std::optional<std::uint64_t> fresh_tick;  // the engine's tick of the last fresh reading
   TickRecord tick;
   while (count < readings) {
-    if (stop_requested().load(std::memory_order_relaxed)) throw InputError("--zero-angle stopped: the profile is unchanged");
+    if (stop_requested().load(std::memory_order_relaxed))
+      throw InputError("--zero-angle stopped: the profile is unchanged");
     driver.await();
     if (!driver.core().read_snapshot(tick)) continue;
     if (!fresh_tick) fresh_tick = tick.tick;
     if (!(tick.reading.time_s > last_time_s)) {  // fresh readings only
       if (tick.tick - *fresh_tick > patience_ticks) {
-        throw EnvironmentError(line_of("--zero-angle: no fresh reading from %s for %.1f s ([t7] connect_timeout_s): the profile is unchanged",
-                                       rig.where().c_str(), patience_s));
+        throw EnvironmentError(line_of(
+            "--zero-angle: no fresh reading from %s for %.1f s ([t7] connect_timeout_s): the profile is unchanged",
+            rig.where().c_str(), patience_s));
       }
       continue;
     }
     fresh_tick = tick.tick;
     last_time_s = tick.reading.time_s;
-    if (!std::isfinite(tick.reading.joint[0].angle_rad)) throw InputError("--zero-angle: the angle reads not-a-number: check its input");
+    if (!std::isfinite(tick.reading.joint[0].angle_rad))
+      throw InputError("--zero-angle: the angle reads not-a-number: check its input");
     sum_rad += tick.reading.joint[0].angle_rad;
     ++count;
   }
   const double previous_rad = rig.angle_zero_rad().value_or(0.0);
   const double read_rad = sum_rad / count;
-  progress << "angle zero: " << zero_rig_angle(rig, device.rig_profile, read_rad) << " (mean of " << count << " readings)\n";
-  return {{"profile", device.rig_profile}, {"read_deg", read_rad * kDegPerRad}, {"readings", count},
-          {"previous_rad", previous_rad}, {"angle_zero_rad", rig.angle_zero_rad().value_or(0.0)}};
+  progress << "angle zero: " << zero_rig_angle(rig, device.rig_profile, read_rad) << " (mean of " << count
+           << " readings)\n";
+  return {{"profile", device.rig_profile},
+          {"read_deg", read_rad * kDegPerRad},
+          {"readings", count},
+          {"previous_rad", previous_rad},
+          {"angle_zero_rad", rig.angle_zero_rad().value_or(0.0)}};
 }
 
 // The session a rig check is recorded in, like a run's: its manifest holds the device (with its
@@ -114,8 +122,10 @@ class RigCheckSession {
                                                       : options.inputs_only ? ": the inputs"
                                                                             : ": the inputs and the valve test")});
     // A session has a trajectory: the one `bellows run` learns by default.
-    const Trajectory trajectory = resolve_trajectory(RunOptions{}.trajectory, config.timing.sample_s(), config.trajectory);
-    const std::filesystem::path data_dir = options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
+    const Trajectory trajectory =
+        resolve_trajectory(RunOptions{}.trajectory, config.timing.sample_s(), config.trajectory);
+    const std::filesystem::path data_dir =
+        options.data_dir.empty() ? default_data_dir() : std::filesystem::path(options.data_dir);
     writer_.emplace(SessionWriter::create(data_dir, options.session_name, std::move(header), trajectory, kPurpose));
   }
   void record(const std::string& kind, const std::string& message) {
@@ -142,7 +152,8 @@ int check_rig_limits(EngineDriver& driver, LcmDevice& device, const Configuratio
   std::vector<LimitVerdict> verdicts = judge_announced_limits(have ? &announced : nullptr, config, device.joints());
   TimeoutObservation timeout;
   if (valves_finished) {
-    progress << "command timeout: the chambers take a little air, every valve closed, then the engine falls silent ..." << std::endl;
+    progress << "command timeout: the chambers take a little air, every valve closed, then the engine falls silent ..."
+             << std::endl;
     timeout = provoke_command_timeout(driver, device, config, link_lag_s(device.health()), &stop_requested());
   } else {
     timeout.not_provoked = "the valve test stopped early";
@@ -157,16 +168,18 @@ int check_rig_limits(EngineDriver& driver, LcmDevice& device, const Configuratio
       ++failed;
       progress << "FAIL " << v.name << ": " << v.problem << "\n";
     }
-    session.record("rig-limit-check", v.pass() ? v.name + " pass: " + v.found + ", expected " + v.expected : v.name + " FAIL: " + v.problem);
+    session.record("rig-limit-check", v.pass() ? v.name + " pass: " + v.found + ", expected " + v.expected
+                                               : v.name + " FAIL: " + v.problem);
   }
   if (timeout.tripped) {
-    progress << line_of("  the rig's trip: fault_bits %d, session %s, command_seq %lld (last sent %lld); chambers %.3f/%.3f -> "
-                        "%.3f/%.3f bar; served again after %.0f ms; the engine said %s: %s\n",
-                        timeout.trip.fault_bits, timeout.trip.session_id == timeout.session_id ? "this one" : "another",
-                        static_cast<long long>(timeout.trip.command_seq), static_cast<long long>(timeout.last_command_seq),
-                        timeout.before.joint[0].chamber_bar[0], timeout.before.joint[0].chamber_bar[1],
-                        timeout.after.joint[0].chamber_bar[0], timeout.after.joint[0].chamber_bar[1], timeout.served_again_s * 1e3,
-                        fault_name(timeout.engine_fault), timeout.engine_detail.c_str());
+    progress << line_of(
+        "  the rig's trip: fault_bits %d, session %s, command_seq %lld (last sent %lld); chambers %.3f/%.3f -> "
+        "%.3f/%.3f bar; served again after %.0f ms; the engine said %s: %s\n",
+        timeout.trip.fault_bits, timeout.trip.session_id == timeout.session_id ? "this one" : "another",
+        static_cast<long long>(timeout.trip.command_seq), static_cast<long long>(timeout.last_command_seq),
+        timeout.before.joint[0].chamber_bar[0], timeout.before.joint[0].chamber_bar[1],
+        timeout.after.joint[0].chamber_bar[0], timeout.after.joint[0].chamber_bar[1], timeout.served_again_s * 1e3,
+        fault_name(timeout.engine_fault), timeout.engine_detail.c_str());
   }
   report["limits"] = limits_json(verdicts, have ? &announced : nullptr, &timeout);
   return failed;
@@ -176,8 +189,8 @@ void record_inputs(const RawInputs& raw, const SensorReading& r, RigCheckSession
   if (raw.count == 0) {
     session.record("rig-input", line_of("no volts (simulated): angle %.3f deg, chamber A %.4f bar, chamber B %.4f bar, "
                                         "supply %.4f bar, temperature %.2f K",
-                                        r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0], r.joint[0].chamber_bar[1], r.supply_bar,
-                                        r.temperature_K));
+                                        r.joint[0].angle_rad * kDegPerRad, r.joint[0].chamber_bar[0],
+                                        r.joint[0].chamber_bar[1], r.supply_bar, r.temperature_K));
     return;
   }
   for (int i = 0; i < raw.count; ++i) {
@@ -193,10 +206,12 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   require_single_joint_arm(config.arm, "`bellows rig check` tests the valves of one joint's rig");
   const DeviceParameters device = resolve_device(options.device, config.device);
   if (options.zero_angle && (device.kind != "t7" || device.rig_profile.empty())) {  // before anything opens
-    throw InputError("--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
-                     "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
+    throw InputError(
+        "--zero-angle writes the rig profile's angle_zero_rad: it needs --device t7 and --rig-profile FILE "
+        "(the built-in paper-rig profile cannot be written; copy profiles/paper-rig.toml)");
   }
-  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0, std::filesystem::path(options.config_path).parent_path());
+  const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0,
+                                                        std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
   std::unique_ptr<EngineDriver> driver;
   RealtimeLoop* loop = nullptr;
@@ -242,7 +257,8 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   report["session"] = session.path().empty() ? nlohmann::json(nullptr) : nlohmann::json(session.path());
   if (!session.path().empty()) progress << "session: " << session.path() << "\n";
   if (options.zero_angle) {
-    report["angle_zero"] = zero_the_angle(*driver, *rig, device, config.rig_check.zero_readings, config.t7.connect_timeout_s, config.timing.tick_s, progress);
+    report["angle_zero"] = zero_the_angle(*driver, *rig, device, config.rig_check.zero_readings,
+                                          config.t7.connect_timeout_s, config.timing.tick_s, progress);
     session.record("angle-zero", line_of("angle_zero_rad %.6f -> %.6f (the arm read %+.3f deg) in %s",
                                          report["angle_zero"]["previous_rad"].get<double>(),
                                          report["angle_zero"]["angle_zero_rad"].get<double>(),
@@ -257,9 +273,10 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
 
   const RigCheckParameters& check = config.rig_check;
   if (!options.yes) {
-    progress << line_of("The valve test opens each valve alone for %.3f s (inlet A, inlet B, outlet A, outlet B); the "
-                        "arm will move. Clear it, then type y to go on: ",
-                        check.valve_pulse_s)
+    progress << line_of(
+                    "The valve test opens each valve alone for %.3f s (inlet A, inlet B, outlet A, outlet B); the "
+                    "arm will move. Clear it, then type y to go on: ",
+                    check.valve_pulse_s)
              << std::flush;
     std::string answer;
     std::getline(in, answer);
@@ -269,8 +286,8 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
     }
   }
   const ValveTestReport result =
-      run_valve_test(*driver, check, config.safety, config.controller.gas.ambient_bar,
-                     config.model.volume_gain_per_rad, &stop_requested(), link_lag_s(rig->device().health()));
+      run_valve_test(*driver, check, config.safety, config.controller.gas.ambient_bar, config.model.volume_gain_per_rad,
+                     &stop_requested(), link_lag_s(rig->device().health()));
   report["valves"] = nlohmann::json::array();
   int failed = 0;
   progress << "valves:\n";
@@ -282,8 +299,8 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
       ++failed;
       progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << "\n";
     }
-    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)", valve_name(v.valve),
-                                                  v.own_change_bar, v.other_change_bar)
+    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)",
+                                                  valve_name(v.valve), v.own_change_bar, v.other_change_bar)
                                         : std::string(valve_name(v.valve)) + " FAIL: " + v.problem);
     report["valves"].push_back({{"valve", valve_name(v.valve)},
                                 {"pass", v.pass},
@@ -296,14 +313,18 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   // An LCM rig's own limits: what it announces, and its command timeout provoked (after the valves:
   // a rig whose valves are wrong is named first).
   LcmDevice* lcm = rig->lcm_device();
-  const int limits_failed = lcm != nullptr && stop_signal() == 0
-                                ? check_rig_limits(*driver, *lcm, config, result.aborted.empty(), session, report, progress)
-                                : 0;
-  const std::string valves_outcome = failed == 0 ? "every valve passed" : line_of("%d of %d valves failed", failed, kValveCount);
+  const int limits_failed =
+      lcm != nullptr && stop_signal() == 0
+          ? check_rig_limits(*driver, *lcm, config, result.aborted.empty(), session, report, progress)
+          : 0;
+  const std::string valves_outcome =
+      failed == 0 ? "every valve passed" : line_of("%d of %d valves failed", failed, kValveCount);
   const std::string limits_outcome =
-      lcm == nullptr ? "" : limits_failed == 0 ? ", every limit passed" : line_of(", %d limit check%s failed", limits_failed, limits_failed == 1 ? "" : "s");
-  session.record("finish", (result.aborted.empty() ? std::string() : "stopped early: " + result.aborted + "; ") + valves_outcome +
-                               limits_outcome);
+      lcm == nullptr       ? ""
+      : limits_failed == 0 ? ", every limit passed"
+                           : line_of(", %d limit check%s failed", limits_failed, limits_failed == 1 ? "" : "s");
+  session.record("finish", (result.aborted.empty() ? std::string() : "stopped early: " + result.aborted + "; ") +
+                               valves_outcome + limits_outcome);
   progress << "rig check: " << valves_outcome << limits_outcome << std::endl;
   const bool all_pass = result.all_pass() && limits_failed == 0;
   report["aborted"] = result.aborted;

@@ -29,30 +29,32 @@ namespace bellows {
 
 /// One line of the check: what was found, and why it fails (`problem` empty: it passed).
 struct LimitVerdict {
-  std::string name;     // "pressure ceiling", "command timeout (provoked)", ...
-  std::string found;    // "1.750 bar"
-  std::string expected; // "[controller] p_max_bar 1.40 + [lcm] rig_pressure_margin_bar 0.35; the engine's guard 1.650 bar"
+  std::string name;   // "pressure ceiling", "command timeout (provoked)", ...
+  std::string found;  // "1.750 bar"
+  std::string
+      expected;  // "[controller] p_max_bar 1.40 + [lcm] rig_pressure_margin_bar 0.35; the engine's guard 1.650 bar"
   std::string problem;
   bool pass() const { return problem.empty(); }
 };
 
 /// The announced limits against `config` (pure). `announced` null: the rig announced none, one
 /// failed verdict saying so.
-std::vector<LimitVerdict> judge_announced_limits(const RigAnnouncedLimits* announced, const Configuration& config, int joints);
+std::vector<LimitVerdict> judge_announced_limits(const RigAnnouncedLimits* announced, const Configuration& config,
+                                                 int joints);
 
 /// What the provoked timeout showed.
 struct TimeoutObservation {
-  std::string not_provoked;      // not empty: why the engine could not set it up (nothing judged)
+  std::string not_provoked;  // not empty: why the engine could not set it up (nothing judged)
   std::int64_t session_id = 0;
   std::int64_t last_command_seq = 0;  // the last command before the silence
   bool tripped = false;
-  double delay_s = 0.0;          // from the last command to the first trip state's arrival
-  double silent_for_s = 0.0;     // how long the engine waited without a trip
-  RigStateSeen trip{};           // the first trip state
-  SensorReading before{};        // the chambers holding their air, just before the silence
-  SensorReading after{};         // the rig's latest state once it had had [rig_check] vent_s to vent
+  double delay_s = 0.0;       // from the last command to the first trip state's arrival
+  double silent_for_s = 0.0;  // how long the engine waited without a trip
+  RigStateSeen trip{};        // the first trip state
+  SensorReading before{};     // the chambers holding their air, just before the silence
+  SensorReading after{};      // the rig's latest state once it had had [rig_check] vent_s to vent
   bool served_again = false;
-  double served_again_s = 0.0;   // after the engine spoke again
+  double served_again_s = 0.0;                // after the engine spoke again
   FaultCode engine_fault = FaultCode::kNone;  // what the engine named
   std::string engine_detail;
 };

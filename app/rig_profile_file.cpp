@@ -59,7 +59,10 @@ void read_input(const Reader& r, const toml::table& t, const std::string& sectio
     else if (key == "volts_max_V") c.volts_max_V = r.number(v, where);
     else if (key == "resolution_index") c.resolution_index = r.whole(v, where);
     else if (key == "settling_us") c.settling_us = r.number(v, where);
-    else r.fail(where, "unknown key (ain, part, range_V, gain_per_V, offset, volts_min_V, volts_max_V, resolution_index, settling_us)");
+    else
+      r.fail(where,
+             "unknown key (ain, part, range_V, gain_per_V, offset, volts_min_V, volts_max_V, resolution_index, "
+             "settling_us)");
   }
   if (!has_ain) r.fail(section + " ain", "missing");
 }
@@ -72,8 +75,8 @@ RigProfile parse_rig_profile(const std::string& toml_text, const std::string& so
     root = toml::parse(toml_text, source_name);
   } catch (const toml::parse_error& error) {
     std::ostringstream where;
-    where << "rig profile " << source_name << ":" << error.source().begin.line << ":" << error.source().begin.column << ": "
-          << error.description();
+    where << "rig profile " << source_name << ":" << error.source().begin.line << ":" << error.source().begin.column
+          << ": " << error.description();
     throw InputError(where.str());
   }
   const Reader r(source_name);
@@ -147,6 +150,8 @@ const std::string& paper_rig_profile_text() {
 
 RigProfile paper_rig_profile() { return parse_rig_profile(paper_rig_profile_text(), "paper-rig (built in)"); }
 
-RigProfile rig_profile_or_default(const std::string& path) { return path.empty() ? paper_rig_profile() : load_rig_profile(path); }
+RigProfile rig_profile_or_default(const std::string& path) {
+  return path.empty() ? paper_rig_profile() : load_rig_profile(path);
+}
 
 }  // namespace bellows

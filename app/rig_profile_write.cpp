@@ -36,20 +36,22 @@ bool same(double written, double meant) { return std::abs(written - meant) <= 1e
 bool is_rig_profile_file(const std::string& path) { return has_table_header(read_file(path), "valves"); }
 
 void write_rig_profile_angle_zero(const std::string& path, double angle_zero_rad) {
-  if (!std::isfinite(angle_zero_rad)) throw InputError("rig profile " + path + ": angle_zero_rad: the angle read is not a number");
+  if (!std::isfinite(angle_zero_rad))
+    throw InputError("rig profile " + path + ": angle_zero_rad: the angle read is not a number");
   write_profile(path, "", {{"angle_zero_rad", toml_number(angle_zero_rad)}}, "zeroed by bellows",
                 [&](const RigProfile& p) { return same(p.angle_zero_rad, angle_zero_rad); });
 }
 
 std::string zero_rig_angle(OpenedDevice& opened, const std::string& path, double read_rad) {
   const std::optional<double> in_use = opened.angle_zero_rad();
-  if (!in_use) throw InputError("this device has no angle zero to set (zeroing is for --device t7 with --rig-profile FILE)");
+  if (!in_use)
+    throw InputError("this device has no angle zero to set (zeroing is for --device t7 with --rig-profile FILE)");
   const double zero_rad = *in_use + read_rad;
   write_rig_profile_angle_zero(path, zero_rad);
   opened.set_angle_zero_rad(zero_rad);
   char text[400];
-  std::snprintf(text, sizeof text, "angle_zero_rad %.6f -> %.6f (the arm read %+.3f deg), written to %s", *in_use, zero_rad,
-                read_rad * 180.0 / std::numbers::pi, path.c_str());
+  std::snprintf(text, sizeof text, "angle_zero_rad %.6f -> %.6f (the arm read %+.3f deg), written to %s", *in_use,
+                zero_rad, read_rad * 180.0 / std::numbers::pi, path.c_str());
   return text;
 }
 
@@ -60,7 +62,8 @@ void write_rig_profile_model(const std::string& path, const ModelParameters& mod
                  {"damping", toml_number(model.damping)}},
                 "fitted by bellows identify", [&](const RigProfile& p) {
                   return p.model && same(p.model->kappa_rad_per_bar, model.kappa_rad_per_bar) &&
-                         same(p.model->omega0_rad_per_s, model.omega0_rad_per_s) && same(p.model->damping, model.damping);
+                         same(p.model->omega0_rad_per_s, model.omega0_rad_per_s) &&
+                         same(p.model->damping, model.damping);
                 });
 }
 

@@ -35,13 +35,14 @@ namespace bellows {
 namespace {
 
 nlohmann::json to_json(const IterationSummary& s) {
-  return {{"iteration", s.iteration},
-          {"rms_deg", s.rms_deg},
-          {"joint_rms_deg", std::vector<double>(s.joint_rms_deg.data(), s.joint_rms_deg.data() + s.joint_rms_deg.size())},
-          {"max_abs_error_deg", s.max_abs_error_deg},
-          {"max_abs_correction_bar", s.max_abs_correction_bar},
-          {"saturated_samples", s.saturated_samples},
-          {"held_samples", s.held_samples}};
+  return {
+      {"iteration", s.iteration},
+      {"rms_deg", s.rms_deg},
+      {"joint_rms_deg", std::vector<double>(s.joint_rms_deg.data(), s.joint_rms_deg.data() + s.joint_rms_deg.size())},
+      {"max_abs_error_deg", s.max_abs_error_deg},
+      {"max_abs_correction_bar", s.max_abs_correction_bar},
+      {"saturated_samples", s.saturated_samples},
+      {"held_samples", s.held_samples}};
 }
 
 /// The session's event for a trial that rode through missing readings: which samples were held
@@ -60,11 +61,13 @@ std::string held_samples_line(const IterationSummary& s, const TrialRecord& reco
 
 /// --transfer-from: the first correction learned from saved sessions (before anything starts, so that
 /// a session that does not fit is refused with nothing created).
-std::optional<TransferReport> transfer_for(const RunOptions& options, const Configuration& config, const Trajectory& trajectory,
-                                           bool resuming) {
+std::optional<TransferReport> transfer_for(const RunOptions& options, const Configuration& config,
+                                           const Trajectory& trajectory, bool resuming) {
   if (options.transfer_from.empty()) return std::nullopt;
   if (resuming) throw InputError("--transfer-from gives a new session its first correction; a resumed session has one");
-  if (trajectory.joints() > 1) throw InputError("--transfer-from learns one joint's correction; trajectory '" + trajectory.name + "' has " + std::to_string(trajectory.joints()));
+  if (trajectory.joints() > 1)
+    throw InputError("--transfer-from learns one joint's correction; trajectory '" + trajectory.name + "' has " +
+                     std::to_string(trajectory.joints()));
   const TransferMethod method = parse_transfer_method(options.transfer_method);
   std::filesystem::path data_dir;
   try {
@@ -74,7 +77,8 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
   }
   const DeviceParameters device = resolve_device(options.device, config.device);
   const std::string rig_profile = device.kind == "t7" ? rig_profile_or_default(device.rig_profile).name : std::string();
-  const std::vector<Session> sessions = load_transfer_sessions(options.transfer_from, data_dir, config, device.kind, rig_profile);
+  const std::vector<Session> sessions =
+      load_transfer_sessions(options.transfer_from, data_dir, config, device.kind, rig_profile);
   return compute_transfer(sessions, config, trajectory, method);
 }
 
@@ -87,16 +91,20 @@ std::string trajectory_name(const RunOptions& options, const ArmParameters& arm)
 }  // namespace
 
 std::string resolve_clock(const std::string& given, const std::string& device_kind) {
-  if (!given.empty() && given != "sim" && given != "wall" && given != "lockstep") throw InputError("--clock must be sim, wall or lockstep");
+  if (!given.empty() && given != "sim" && given != "wall" && given != "lockstep")
+    throw InputError("--clock must be sim, wall or lockstep");
   const bool rig = device_kind != "sim";
   if (given == "lockstep" && device_kind != "lcm") {
-    throw InputError("--clock lockstep waits for an LCM rig's answers (a stepped simulator, io-sim --stepped): it needs --device lcm, not " +
-                     device_kind);
+    throw InputError(
+        "--clock lockstep waits for an LCM rig's answers (a stepped simulator, io-sim --stepped): it needs --device "
+        "lcm, not " +
+        device_kind);
   }
   if (rig && given == "sim") {
-    throw InputError("--clock sim cannot drive --device " + device_kind +
-                     ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out, or --clock lockstep "
-                     "against a stepped simulator, io-sim --stepped)");
+    throw InputError(
+        "--clock sim cannot drive --device " + device_kind +
+        ": a real rig's time passes on its own (a rig runs on the wall clock; leave --clock out, or --clock lockstep "
+        "against a stepped simulator, io-sim --stepped)");
   }
   if (!given.empty()) return given;
   return rig ? "wall" : "sim";
@@ -112,12 +120,13 @@ double parse_speed(const std::string& speed) {
 
 int run_command(const RunOptions& given_options, std::ostream& out, std::ostream& progress) {
   if (given_options.iterations < 0) throw InputError("--iterations must not be negative");
-  if (!given_options.clock.empty() && given_options.clock != "lockstep") resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
+  if (!given_options.clock.empty() && given_options.clock != "lockstep")
+    resolve_clock(given_options.clock, "sim");  // a bad word before anything is read
   if (!given_options.lcm_url.empty()) check_lcm_url(given_options.lcm_url, "--lcm");  // before a session exists
   const double speed = parse_speed(given_options.speed);
   RunRecording recording(given_options);  // with --resume: the saved configuration, trajectory and state
   const Session* resumed = recording.resuming() ? &recording.resumed() : nullptr;
-  Configuration config = resumed != nullptr          ? resumed->manifest.configuration
+  Configuration config = resumed != nullptr                  ? resumed->manifest.configuration
                          : given_options.config_path.empty() ? Configuration{}
                                                              : load_config_file(given_options.config_path);
   const DeviceParameters device_wanted = resolve_device(given_options.device, config.device);
@@ -138,11 +147,13 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   }
   const double sample_s = config.timing.sample_s();
   const Trajectory trajectory =
-      resumed != nullptr ? resumed->trajectory : resolve_trajectory(trajectory_name(options, config.arm), sample_s, config.trajectory);
+      resumed != nullptr ? resumed->trajectory
+                         : resolve_trajectory(trajectory_name(options, config.arm), sample_s, config.trajectory);
   require_driven_joints(trajectory, config.arm);
   const std::uint64_t seed = resumed != nullptr ? recording.resumed_seed() : options.seed;
   const DiscreteArmModel model = discretize_arm_model(config.model, sample_s);
-  const std::unique_ptr<JointLearning> law = make_joint_learning(config, model, trajectory.joints(), trajectory.learning_samples());
+  const std::unique_ptr<JointLearning> law =
+      make_joint_learning(config, model, trajectory.joints(), trajectory.learning_samples());
   const std::optional<TransferReport> transfer = transfer_for(options, config, trajectory, resumed != nullptr);
 
   RunIo io(options, speed, seed, config);  // the simulated arm, or a rig over LCM
@@ -166,18 +177,19 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   }
   LearningSession session(*driver, *law, trajectory, config.timing, config.controller);
   session.set_stop_flag(&stop_requested());
-  SimulatedArmChain* chain = io.simulated_arm_chain();  // the simulated arm of several joints, or null
+  SimulatedArmChain* chain = io.simulated_arm_chain();                   // the simulated arm of several joints, or null
   if (chain != nullptr) recording.restore(chain, core, clock, session);  // before the first tick
   else recording.restore(arm, core, clock, session);
   Configuration recorded = config;  // the device as opened, whatever [device] said
   recorded.device = io.device_parameters();
   if (transfer) session.set_correction(transfer->result.correction_bar, 0);  // zero when it fell back
-  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(), learning_model.source,
+  recording.start(recorded, trajectory, device.name(), seed, options.iterations, io.opened().session_info(),
+                  learning_model.source,
                   transfer ? nlohmann::ordered_json::parse(transfer_json(*transfer).dump()) : nlohmann::ordered_json());
   const int trials = recording.trials(options.iterations);
   const int first_iteration = resumed != nullptr ? static_cast<int>(resumed->iterations.size()) : 0;
   RunProgressReport said(progress, choose_progress_style(options.verbose, options.quiet, options.progress_on_terminal),
-                           first_iteration, first_iteration + trials - 1);
+                         first_iteration, first_iteration + trials - 1);
   if (const std::string line = learning_model_line(learning_model); !line.empty()) said.note(line);
   if (transfer) said.note(transfer_line(*transfer));
   if (!recording.directory().empty()) said.note("session " + recording.directory().string());
@@ -191,7 +203,8 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     // Stopped by a signal: the first trial sees the flag too, vents and records why.
   }
   if (!prediction.warning.empty()) said.note("warning: " + prediction.warning);
-  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar, trajectory.learning_samples());
+  LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar,
+                          trajectory.learning_samples());
   if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
     for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
       monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
@@ -206,7 +219,8 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   std::string failure;
   std::string failure_name;
   try {
-    if (std::string why = io.wait_for_rig(stop_requested(), options.clock == "lockstep" ? clock : nullptr); !why.empty()) {
+    if (std::string why = io.wait_for_rig(stop_requested(), options.clock == "lockstep" ? clock : nullptr);
+        !why.empty()) {
       failure = std::move(why);
       failure_name = fault_name(FaultCode::kRigUnavailable);
       status = stop_signal() != 0 ? 128 + stop_signal() : kExitEnvironment;  // the rig, not a fault
@@ -217,7 +231,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     for (int i = 0; failure.empty() && i < trials; ++i) {
       IterationSummary s = session.run_trial();
       if (s.iteration > 0) s.learned_with = learned_with(config);  // iteration 0 applies what it was given
-      io.post_trial(s, session.correction_bar());  // the correction this trial applied
+      io.post_trial(s, session.correction_bar());                  // the correction this trial applied
       session.learn();  // also after the last trial: the saved session resumes with this correction
       if (const std::string note = session.learning().take_note(); !note.empty()) recording.note("model-refit", note);
       // On disk before the line says it is done.
@@ -238,7 +252,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     said.error("bellows: " + failure + " (" + fault_name(fault.code()) + ")");
     recording.fault(failure + " (" + fault_name(fault.code()) + ")", core);
   } catch (const std::exception& error) {
-    said.finish();  // main() says what went wrong on a line of its own
+    said.finish();                      // main() says what went wrong on a line of its own
     if (loop != nullptr) loop->stop();  // vents
     else device.vent();
     recording.fault(error.what());
@@ -258,31 +272,34 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     said.note(warning.str());
   }
   if (core.dropped_events() > 0) {  // a loss like any other: said, and kept with the session
-    said.error("bellows: " + std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
-    recording.note("dropped-events", std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
+    said.error("bellows: " + std::to_string(core.dropped_events()) +
+               " engine events dropped (the event queue was full)");
+    recording.note("dropped-events",
+                   std::to_string(core.dropped_events()) + " engine events dropped (the event queue was full)");
   }
   if (core.missed_deadline_warnings() > 0) {
     said.note("bellows: " + std::to_string(core.missed_deadline_warnings()) +
-                " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)");
+              " deadlines missed (a warning: the simulated arm's time follows the engine's ticks)");
   }
   if (status == 0) recording.finish(trials);
   if (!log_error.empty() && status == 0) status = kExitEnvironment;  // the session is whole; the log is not there
 
   if (options.json) {
-    nlohmann::json report = {{"device", device.name()},
-                             {"rig_profile", io.opened().rig_profile_name()},
-                             {"trajectory", trajectory.name},
-                             {"law", law->name()},
-                             {"joints", trajectory.joints()},
-                             {"model", learning_model_json(learning_model)},
-                             {"seed", seed},
-                             {"clock", options.clock},
-                             {"samples", trajectory.learning_samples()},
-                             {"prediction", prediction_json(prediction)},
-                             {"windup", windup_json(monitor.windup())},
-                             {"session", recording.directory().empty() ? nlohmann::json(nullptr)
-                                                                       : nlohmann::json(recording.directory().string())},
-                             {"iterations", iterations}};
+    nlohmann::json report = {
+        {"device", device.name()},
+        {"rig_profile", io.opened().rig_profile_name()},
+        {"trajectory", trajectory.name},
+        {"law", law->name()},
+        {"joints", trajectory.joints()},
+        {"model", learning_model_json(learning_model)},
+        {"seed", seed},
+        {"clock", options.clock},
+        {"samples", trajectory.learning_samples()},
+        {"prediction", prediction_json(prediction)},
+        {"windup", windup_json(monitor.windup())},
+        {"session",
+         recording.directory().empty() ? nlohmann::json(nullptr) : nlohmann::json(recording.directory().string())},
+        {"iterations", iterations}};
     if (trajectory.joints() > 1) report["arm"] = {{"name", config.arm.name()}, {"joint_model", config.ilc.joint_model}};
     if (transfer) report["transfer"] = transfer_json(*transfer);
     if (!failure.empty()) report["fault"] = {{"name", failure_name}, {"message", failure}};
@@ -291,22 +308,26 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
-      report["loop"] = {{"ticks", core.ticks()},
-                        {"missed", l.missed},
-                        {"missed_warnings", core.missed_deadline_warnings()},
-                        {"held_ticks", core.held_ticks()},
-                        {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
-                        {"rt", loop->rt_description()},
-                        {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
-                        {"speed", options.speed}};
+      report["loop"] = {
+          {"ticks", core.ticks()},
+          {"missed", l.missed},
+          {"missed_warnings", core.missed_deadline_warnings()},
+          {"held_ticks", core.held_ticks()},
+          {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
+          {"rt", loop->rt_description()},
+          {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
+          {"speed", options.speed}};
       if (const DeviceHealth h = device.health(); h.has_link) {  // the link's figures, e.g. the T7's Modbus round trip
-        report["loop"]["link"] = {{"round_trip_ms", {{"p50", h.round_trip_p50_ms}, {"p99", h.round_trip_p99_ms}, {"max", h.round_trip_max_ms}}},
-                                  {"exchanges", h.exchanges},
-                                  {"errors", h.link_errors},
-                                  {"stale_readings", h.stale_readings}};
+        report["loop"]["link"] = {
+            {"round_trip_ms",
+             {{"p50", h.round_trip_p50_ms}, {"p99", h.round_trip_p99_ms}, {"max", h.round_trip_max_ms}}},
+            {"exchanges", h.exchanges},
+            {"errors", h.link_errors},
+            {"stale_readings", h.stale_readings}};
       }
     }
-    out << report.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace) << std::endl;  // no raw text on a terminal
+    out << report.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace)
+        << std::endl;  // no raw text on a terminal
   }
   return status;
 }

@@ -47,24 +47,28 @@ RunIo::RunIo(const RunOptions& options, double speed, std::uint64_t seed, const 
     : options_(options), config_(config), telemetry_(!options.lcm_url.empty() || options.lcm_log) {
   device_parameters_ = resolve_device(options.device, config.device);
   const std::string& kind = device_parameters_.kind;
-  if (kind == "lcm" && device_parameters_.lcm_url.empty()) device_parameters_.lcm_url = options.lcm_url;  // --lcm: the bus of both
+  if (kind == "lcm" && device_parameters_.lcm_url.empty())
+    device_parameters_.lcm_url = options.lcm_url;  // --lcm: the bus of both
   if (options.lcm_log && options.lcm_log_file.empty() && options.no_save) {
     throw InputError("--lcm-log without a FILE writes into the session directory: name a FILE with --no-save");
   }
   std::error_code missing;  // a link counts as existing, also a dangling one: nothing is written through it
   if (options.lcm_log && !options.lcm_log_file.empty() &&
       std::filesystem::symlink_status(options.lcm_log_file, missing).type() != std::filesystem::file_type::not_found) {
-    throw InputError("the LCM log '" + options.lcm_log_file + "' exists already; nothing is overwritten, name a new file");
+    throw InputError("the LCM log '" + options.lcm_log_file +
+                     "' exists already; nothing is overwritten, name a new file");
   }
   if (kind != "sim") {
     if (options.clock == "sim") resolve_clock("sim", kind);  // throws (run_command resolved the clock already)
     if (speed != 1.0) throw InputError("--device " + kind + " runs in real time: --speed must be 1");
-    if (!options.resume_dir.empty()) throw InputError("--resume continues a session on the simulated arm; it cannot go with --device " + kind);
+    if (!options.resume_dir.empty())
+      throw InputError("--resume continues a session on the simulated arm; it cannot go with --device " + kind);
   }
   if (kind == "lcm" || telemetry_) session_id_ = LcmDevice::random_session_id();
   device_ = open_device(device_parameters_, config, seed, options.rt, session_id_,
                         std::filesystem::path(options.config_path).parent_path());
-  if (options.clock == "lockstep") device_->lcm_device()->set_lockstep(config.lcm.lockstep_timeout_s);  // before the engine
+  if (options.clock == "lockstep")
+    device_->lcm_device()->set_lockstep(config.lcm.lockstep_timeout_s);  // before the engine
 }
 
 RunIo::~RunIo() { stop(); }
@@ -87,7 +91,8 @@ std::unique_ptr<SimulatedClock> RunIo::simulated_clock(EngineCore& core) {
 
 void RunIo::start_telemetry(const std::filesystem::path& session_directory) {
   if (tap_ == nullptr) return;
-  if (options_.lcm_log) log_path_ = !options_.lcm_log_file.empty() ? options_.lcm_log_file : free_log_name(session_directory);
+  if (options_.lcm_log)
+    log_path_ = !options_.lcm_log_file.empty() ? options_.lcm_log_file : free_log_name(session_directory);
   if (!log_path_.empty()) {
     // The one safe writer: the log is written into its exclusive temporary (never through a name
     // planted in advance) and appears under its name, whole, when the run ends (finish_log()).
@@ -135,13 +140,10 @@ nlohmann::json RunIo::report() const {
   if (device_parameters_.kind == "lcm") lcm["rig"] = device_->report();
   if (publisher_) {
     const TelemetryPublisherStats s = publisher_->stats();
-    lcm["telemetry"] = {{"ticks", s.ticks},
-                        {"dropped_ticks", s.dropped_ticks},
-                        {"events", s.events},
-                        {"trials", s.trials},
-                        {"log_events", s.log_events},
-                        {"errors", s.errors}};
-    if (!log_path_.empty()) lcm["telemetry"]["log"] = log_error_.empty() ? nlohmann::json(log_path_) : nlohmann::json(nullptr);
+    lcm["telemetry"] = {{"ticks", s.ticks},   {"dropped_ticks", s.dropped_ticks}, {"events", s.events},
+                        {"trials", s.trials}, {"log_events", s.log_events},       {"errors", s.errors}};
+    if (!log_path_.empty())
+      lcm["telemetry"]["log"] = log_error_.empty() ? nlohmann::json(log_path_) : nlohmann::json(nullptr);
     if (!log_error_.empty()) lcm["telemetry"]["log_error"] = log_error_;
   }
   return lcm;

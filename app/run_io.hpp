@@ -51,8 +51,8 @@ class RunIo {
   /// Adds the telemetry tap, if telemetry is asked for. After the EngineCore is built, before any
   /// tick and before simulated_clock().
   void add_telemetry_tap(EngineCore& core);
-  /// The simulated clock for `--clock sim` and `--clock lockstep`. With telemetry it waits for the publisher whenever the
-  /// tap is full, so that a log holds every tick (simulated time has no deadline to miss).
+  /// The simulated clock for `--clock sim` and `--clock lockstep`. With telemetry it waits for the publisher whenever
+  /// the tap is full, so that a log holds every tick (simulated time has no deadline to miss).
   std::unique_ptr<SimulatedClock> simulated_clock(EngineCore& core);
   /// Starts the publisher. `session_directory` (empty without a session) receives the LCM log when
   /// --lcm-log names no file. Before the first tick.

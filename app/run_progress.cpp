@@ -71,8 +71,8 @@ void RunProgressReport::iteration(const IterationSummary& s) {
   const int done = s.iteration - first_iteration_ + 1;
   const int left = last_iteration_ - s.iteration;
   char line[160];
-  std::snprintf(line, sizeof line, "iteration %d of %d..%d  rms %.3f deg%s  %s", s.iteration, first_iteration_, last_iteration_,
-                s.rms_deg, joints_text(s).c_str(),
+  std::snprintf(line, sizeof line, "iteration %d of %d..%d  rms %.3f deg%s  %s", s.iteration, first_iteration_,
+                last_iteration_, s.rms_deg, joints_text(s).c_str(),
                 left > 0 ? ("ETA " + duration_text(elapsed_s / std::max(done, 1) * left)).c_str()
                          : ("done in " + duration_text(elapsed_s)).c_str());
   out_ << '\r' << line << "\x1b[K" << std::flush;

@@ -67,7 +67,8 @@ RunRecording::RunRecording(const RunOptions& options) : options_(options), resum
   }
   const std::filesystem::path directory = resolve_session_dir(options.resume_dir, data_dir);
   writer_.emplace(SessionWriter::open(directory, kPurpose, resumed_));
-  if (const std::string dropped = dropped_line(resumed_); !dropped.empty()) std::cerr << "bellows: " << dropped << std::endl;
+  if (const std::string dropped = dropped_line(resumed_); !dropped.empty())
+    std::cerr << "bellows: " << dropped << std::endl;
   if (resumed_.manifest.device != "sim") {
     throw InputError("session " + directory.string() + " was recorded on the device '" + resumed_.manifest.device +
                      "'; bellows run drives the simulated arm only");
@@ -99,23 +100,24 @@ void RunRecording::start(const Configuration& config, const Trajectory& trajecto
   header.model_source = model_source;
   header.first_correction = first_correction;
   header.events.push_back({utc_now(), 0, "start",
-                           std::string(kPurpose) + ": trajectory " + trajectory.name + ", " + std::to_string(iterations) +
-                               " iterations, seed " + std::to_string(seed)});
-  writer_.emplace(SessionWriter::create(data_dir_of(options_), options_.session_name, std::move(header), trajectory,
-                                        kPurpose));
+                           std::string(kPurpose) + ": trajectory " + trajectory.name + ", " +
+                               std::to_string(iterations) + " iterations, seed " + std::to_string(seed)});
+  writer_.emplace(
+      SessionWriter::create(data_dir_of(options_), options_.session_name, std::move(header), trajectory, kPurpose));
 }
 
 void RunRecording::require_joints(int joints, const std::string& arm) const {
   if (resumed_.manifest.joints != joints) {
     throw InputError("session " + resumed_.directory.string() + " was recorded with an arm of " +
                      std::to_string(resumed_.manifest.joints) + " joint" + (resumed_.manifest.joints == 1 ? "" : "s") +
-                     "; this run drives " + arm + " of " + std::to_string(joints) + " (its [arm] preset must be the session's)");
+                     "; this run drives " + arm + " of " + std::to_string(joints) +
+                     " (its [arm] preset must be the session's)");
   }
 }
 
 void RunRecording::record_resumption() {
-  writer_->record_event("resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) +
-                                      " more iterations");
+  writer_->record_event(
+      "resume", std::string(kPurpose) + " --resume: " + std::to_string(options_.iterations) + " more iterations");
 }
 
 void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* clock, LearningSession& learning) {
@@ -124,7 +126,8 @@ void RunRecording::restore(SimulatedArm* arm, EngineCore& core, SimulatedClock* 
   const SessionManifest& m = resumed_.manifest;
   if (!resumed_.iterations.empty()) {  // else nothing completed: start afresh
     if (can_restore_exactly(m) && arm != nullptr) {
-      restore_resume_state(m, arm, nullptr, core, clock, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+      restore_resume_state(m, arm, nullptr, core, clock,
+                           "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
     }
     learning.set_correction(resumed_corrections_bar(), static_cast<int>(m.iterations.size()));
     learning.set_history(resumed_history());
@@ -147,7 +150,8 @@ void RunRecording::restore(SimulatedArmChain* arm, EngineCore& core, SimulatedCl
   const SessionManifest& m = resumed_.manifest;
   if (arm != nullptr) require_joints(arm->joints(), "a simulated arm");
   if (!resumed_.iterations.empty() && can_restore_exactly(m) && arm != nullptr) {
-    restore_resume_state(m, nullptr, arm, core, clock, "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
+    restore_resume_state(m, nullptr, arm, core, clock,
+                         "session " + resumed_.directory.string() + ": " + session_layout::kManifest);
   }
   record_resumption();
 }
@@ -177,8 +181,9 @@ void RunRecording::save(const LearningSession& learning, const IterationSummary&
   save(learning.last_record(), learning.joint_corrections_bar(), summary, arm, core, clock);
 }
 
-void RunRecording::save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar, const IterationSummary& summary,
-                        const SimulatedArmChain* arm, EngineCore& core, const SimulatedClock* clock) {
+void RunRecording::save(const TrialRecord& record, const Eigen::MatrixXd& corrections_bar,
+                        const IterationSummary& summary, const SimulatedArmChain* arm, EngineCore& core,
+                        const SimulatedClock* clock) {
   if (!writer_) return;
   // As above: between trials, on the engine's thread.
   writer_->save_iteration(record, summary, corrections_bar, capture_resume_state(core, nullptr, arm, clock));
@@ -214,9 +219,12 @@ void RunRecording::note(const std::string& kind, const std::string& message) noe
 }
 
 void RunRecording::finish(int trials_run) {
-  if (writer_) writer_->record_event("finish", std::string(kPurpose) + ": " + std::to_string(trials_run) + " trials done");
+  if (writer_)
+    writer_->record_event("finish", std::string(kPurpose) + ": " + std::to_string(trials_run) + " trials done");
 }
 
-std::filesystem::path RunRecording::directory() const { return writer_ ? writer_->directory() : std::filesystem::path(); }
+std::filesystem::path RunRecording::directory() const {
+  return writer_ ? writer_->directory() : std::filesystem::path();
+}
 
 }  // namespace bellows

@@ -37,8 +37,8 @@ bool can_restore_exactly(const SessionManifest& manifest);
 /// Before the engine's first tick: the arm (or chain), the clock and the engine (ARMED, with its
 /// controllers' state) where the session stopped. `source` prefixes errors ("session DIR:
 /// manifest.json"). Throws InputError for a state that does not fit the arm.
-void restore_resume_state(const SessionManifest& manifest, SimulatedArm* arm, SimulatedArmChain* chain, EngineCore& core,
-                          SimulatedClock* clock, const std::string& source);
+void restore_resume_state(const SessionManifest& manifest, SimulatedArm* arm, SimulatedArmChain* chain,
+                          EngineCore& core, SimulatedClock* clock, const std::string& source);
 
 class RunRecording {
  public:

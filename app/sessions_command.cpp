@@ -112,11 +112,10 @@ int sessions_list_command(const SessionsOptions& options, std::ostream& out, std
   if (options.json) {
     Json all = Json::array();
     for (const SessionListing& listing : listings) {
-      all.push_back(listing.error.empty()
-                        ? listing_json(listing.directory, listing.manifest)
-                        : Json{{"name", listing.directory.filename().string()},
-                               {"directory", listing.directory.string()},
-                               {"error", listing.error}});
+      all.push_back(listing.error.empty() ? listing_json(listing.directory, listing.manifest)
+                                          : Json{{"name", listing.directory.filename().string()},
+                                                 {"directory", listing.directory.string()},
+                                                 {"error", listing.error}});
     }
     out << json_text(all) << std::endl;
     return 0;
@@ -164,9 +163,10 @@ void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, c
     const TickRecord& t = ticks[i];
     std::snprintf(line, sizeof line, "    %9.3f  %-8s %9.2f %9.2f %8.3f %8.3f %8.3f  %.2f/%.2f, %.2f/%.2f%s", t.time_s,
                   to_string(t.state), t.reading.joint[0].angle_rad * 180.0 / std::numbers::pi,
-                  t.joint(0).desired_rad * 180.0 / std::numbers::pi, t.reading.joint[0].chamber_bar[0], t.reading.joint[0].chamber_bar[1],
-                  t.reading.supply_bar, t.valves.joint[0].inlet_duty[0], t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1],
-                  t.valves.joint[0].outlet_duty[1], t.fault != FaultCode::kNone ? (std::string("  <- ") + fault_name(t.fault)).c_str() : "");
+                  t.joint(0).desired_rad * 180.0 / std::numbers::pi, t.reading.joint[0].chamber_bar[0],
+                  t.reading.joint[0].chamber_bar[1], t.reading.supply_bar, t.valves.joint[0].inlet_duty[0],
+                  t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1], t.valves.joint[0].outlet_duty[1],
+                  t.fault != FaultCode::kNone ? (std::string("  <- ") + fault_name(t.fault)).c_str() : "");
     out << line << "\n";
   }
 }
@@ -175,7 +175,8 @@ void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, c
 
 int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   const Session session = load_session(session_dir_of(options));  // checks every file
-  if (const std::string dropped = dropped_line(session); !dropped.empty()) std::cerr << "bellows: " << dropped << std::endl;
+  if (const std::string dropped = dropped_line(session); !dropped.empty())
+    std::cerr << "bellows: " << dropped << std::endl;
   const SessionManifest& m = session.manifest;
   const Configuration& c = m.configuration;
   const double best = best_rms_deg(m);
@@ -187,12 +188,16 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
     Json black_boxes = Json::array();
     for (std::size_t i = 0; i < m.black_boxes.size(); ++i) {
       const BlackBoxEntry& b = m.black_boxes[i];
-      black_boxes.push_back({{"fault", b.fault}, {"iteration", b.iteration}, {"time_utc", b.time_utc}, {"ticks", b.ticks},
+      black_boxes.push_back({{"fault", b.fault},
+                             {"iteration", b.iteration},
+                             {"time_utc", b.time_utc},
+                             {"ticks", b.ticks},
                              {"file", session_layout::black_box_file(static_cast<int>(i))}});
     }
     const Json report = {{"name", m.name},
-                         {"integrity", {{"verified_files", session.integrity.verified_files},
-                                        {"unverified_files", session.integrity.unverified_files}}},
+                         {"integrity",
+                          {{"verified_files", session.integrity.verified_files},
+                           {"unverified_files", session.integrity.unverified_files}}},
                          {"directory", session.directory.string()},
                          {"schema_version", m.schema_version},
                          {"program_version", m.program_version},
@@ -205,10 +210,11 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
                            {"joints", m.joints},
                            {"learning_samples", m.trajectory_samples},
                            {"sample_time_s", c.timing.sample_s()}}},
-                         {"model", {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
-                                    {"omega0_rad_per_s", c.model.omega0_rad_per_s},
-                                    {"damping", c.model.damping},
-                                    {"source", m.model_source.empty() ? Json(nullptr) : Json(m.model_source)}}},
+                         {"model",
+                          {{"kappa_rad_per_bar", c.model.kappa_rad_per_bar},
+                           {"omega0_rad_per_s", c.model.omega0_rad_per_s},
+                           {"damping", c.model.damping},
+                           {"source", m.model_source.empty() ? Json(nullptr) : Json(m.model_source)}}},
                          {"learning", configuration_to_json(c).at("ilc")},
                          {"best_rms_deg", best < 0.0 ? Json(nullptr) : Json(best)},
                          {"iterations", iterations},
@@ -230,7 +236,8 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
       << "model        kappa " << format("%g", c.model.kappa_rad_per_bar) << " rad/bar, omega0 "
       << format("%g", c.model.omega0_rad_per_s) << " 1/s, damping " << format("%g", c.model.damping)
       << (m.model_source.empty() ? std::string() : " (from the " + shown(m.model_source) + ")") << "\n"
-      << "learning     " << shown(c.ilc.law) << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w << "\n"
+      << "learning     " << shown(c.ilc.law) << ", m = " << c.ilc.m << ", s = " << c.ilc.s << ", w = " << c.ilc.w
+      << "\n"
       << "iterations   " << iteration_range(static_cast<long long>(m.iterations.size()));
   if (best >= 0.0) out << ", best RMS " << format("%.3f", best) << " deg";
   out << "\n\n";
@@ -247,7 +254,8 @@ int sessions_show_command(const SessionsOptions& options, std::ostream& out) {
   if (!m.events.empty()) out << "\nevents\n";
   for (const SessionEvent& e : m.events) {
     // A console-log event holds several log lines, "HH:MM:SS source: text": one row each, indented.
-    const std::string head = "  " + short_time(e.time_utc) + "  iteration " + std::to_string(e.iteration) + "  " + shown(e.kind) + ": ";
+    const std::string head =
+        "  " + short_time(e.time_utc) + "  iteration " + std::to_string(e.iteration) + "  " + shown(e.kind) + ": ";
     // Bounded: an edited manifest's message of a million lines must not flood the terminal.
     constexpr int kMostLinesPerEvent = 100;
     std::istringstream lines(e.message);
@@ -284,8 +292,9 @@ int sessions_export_command(const SessionsOptions& options, std::ostream& out) {
     throw InputError("--mat-version must be 5 or 7.3, not '" + options.mat_version + "'");
   }
   const Session session = load_session(session_dir_of(options));
-  const fs::path output =
-      options.output.empty() ? fs::path(session.directory.filename().string() + "." + options.format) : fs::path(options.output);
+  const fs::path output = options.output.empty()
+                              ? fs::path(session.directory.filename().string() + "." + options.format)
+                              : fs::path(options.output);
   const MatVersion version = options.mat_version == "7.3" ? MatVersion::kV73 : MatVersion::kV5;
   const std::vector<fs::path> files =
       options.format == "csv" ? export_session_csv(session, output, options.force)
@@ -293,7 +302,8 @@ int sessions_export_command(const SessionsOptions& options, std::ostream& out) {
   if (options.json) {
     Json paths = Json::array();
     for (const fs::path& file : files) paths.push_back(file.string());
-    out << Json{{"format", options.format}, {"iterations", session.iterations.size()}, {"files", paths}}.dump() << std::endl;
+    out << Json{{"format", options.format}, {"iterations", session.iterations.size()}, {"files", paths}}.dump()
+        << std::endl;
     return 0;
   }
   for (const fs::path& file : files) out << "wrote " << file.string() << "\n";
@@ -350,7 +360,8 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
   std::string description = "session " + shown_directory;
   try {
     const SessionManifest m = parse_manifest(*manifest_text, session_layout::kManifest);
-    description += " (iterations " + iteration_range(static_cast<long long>(m.iterations.size())) + ", started " + short_time(m.started_utc) + ")";
+    description += " (iterations " + iteration_range(static_cast<long long>(m.iterations.size())) + ", started " +
+                   short_time(m.started_utc) + ")";
   } catch (const InputError&) {
     description += " (damaged)";
   }
@@ -377,7 +388,8 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
   if (error) throw InputError("cannot remove " + shown_directory + ": " + error.message());
   remove_session_entries(session);  // through the directory's own descriptor: it moved with it
   if (::rmdir(hidden.c_str()) != 0) {
-    throw InputError("cannot remove " + printable(hidden.string()) + " (renamed from " + shown_directory + "): " + std::strerror(errno));
+    throw InputError("cannot remove " + printable(hidden.string()) + " (renamed from " + shown_directory +
+                     "): " + std::strerror(errno));
   }
   sync_directory(parent);
   if (options.json) {

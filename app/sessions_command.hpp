@@ -14,7 +14,7 @@ struct SessionsOptions {
   std::string data_dir;  // empty: the default data directory
   std::string session;   // show, export: a directory, or a session name in the data directory
   std::string format = "csv";
-  std::string output;    // export: the file to write; empty: <session name>.<format> here
+  std::string output;       // export: the file to write; empty: <session name>.<format> here
   std::string mat_version;  // export --format mat: "5" (also when empty) or "7.3"
   bool force = false;       // export: replace existing files
   bool yes = false;         // rm: no confirmation question

@@ -33,10 +33,14 @@ int stop_signal() { return g_signal.load(std::memory_order_relaxed); }
 
 const char* stop_signal_name() {
   switch (stop_signal()) {
-    case SIGINT: return "SIGINT";
-    case SIGTERM: return "SIGTERM";
-    case SIGHUP: return "SIGHUP";
-    case 0: return "no signal";
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    case 0:
+      return "no signal";
   }
   return "a signal";
 }

@@ -37,7 +37,8 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   sim.silent_after_s = options.silent_after_s;
   sim.stall_after_s = options.stall_after_s;
   sim.stall_s = options.stall_s;
-  if (options.product != "t7" && options.product != "t7-pro") throw InputError("--product must be t7 or t7-pro, not '" + options.product + "'");
+  if (options.product != "t7" && options.product != "t7-pro")
+    throw InputError("--product must be t7 or t7-pro, not '" + options.product + "'");
   sim.product = options.product == "t7" ? t7::Product::kT7 : t7::Product::kT7Pro;
   sim.nagle = options.nagle;
   sim.answer_after_s = options.answer_after_s;
@@ -49,20 +50,24 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
     for (ValveRole role : kValveRoles) {
       if (options.dead_valve == to_string(role)) sim.dead_valve = role;
     }
-    if (!sim.dead_valve) throw InputError("--dead-valve must be inlet_a, inlet_b, outlet_a or outlet_b, not '" + options.dead_valve + "'");
+    if (!sim.dead_valve)
+      throw InputError("--dead-valve must be inlet_a, inlet_b, outlet_a or outlet_b, not '" + options.dead_valve + "'");
   }
   T7SimServer server(sim);
-  out << "t7-sim: a simulated " << t7::to_string(sim.product) << " (rig profile " << sim.profile.name << ") on " << sim.host << ":" << server.port();
+  out << "t7-sim: a simulated " << t7::to_string(sim.product) << " (rig profile " << sim.profile.name << ") on "
+      << sim.host << ":" << server.port();
   if (sim.swapped_chambers) out << "; drill: chambers swapped";
   if (sim.dead_valve) out << "; drill: " << to_string(*sim.dead_valve) << " dead";
   if (sim.no_supply) out << "; drill: no supply";
   if (sim.silent_after_s >= 0.0) out << "; drill: silent after " << sim.silent_after_s << " s";
-  if (sim.stall_after_s >= 0.0) out << "; drill: one answer " << sim.stall_s << " s late after " << sim.stall_after_s << " s";
+  if (sim.stall_after_s >= 0.0)
+    out << "; drill: one answer " << sim.stall_s << " s late after " << sim.stall_after_s << " s";
   if (sim.nagle) out << "; drill: Nagle";
   if (sim.silent_reads) out << "; drill: reads unanswered";
   if (sim.halve_roll_after_s >= 0.0) out << "; drill: clock 0's roll halved after " << sim.halve_roll_after_s << " s";
   if (sim.answer_after_s > 0.0) out << "; drill: every answer " << sim.answer_after_s << " s late";
-  if (sim.trickle_after_s >= 0.0) out << "; drill: answers trickle after " << sim.trickle_after_s << " s, " << sim.trickle_byte_s << " s a byte";
+  if (sim.trickle_after_s >= 0.0)
+    out << "; drill: answers trickle after " << sim.trickle_after_s << " s, " << sim.trickle_byte_s << " s a byte";
   out << std::endl;
   sched_param param{};
   param.sched_priority = kSimPriority;

@@ -11,14 +11,14 @@ namespace bellows {
 
 struct T7SimCommandOptions {
   std::string listen = "127.0.0.1:5020";  // HOST[:PORT]
-  std::string config_path;   // [plant]
-  std::string rig_profile;   // "": the paper rig's
+  std::string config_path;                // [plant]
+  std::string rig_profile;                // "": the paper rig's
   std::uint64_t seed = 1;
-  double duration_s = 0.0;   // 0: until a signal
-  std::string status_path;   // the status file ("": none)
+  double duration_s = 0.0;  // 0: until a signal
+  std::string status_path;  // the status file ("": none)
   // Drills.
   bool swapped_chambers = false;
-  std::string dead_valve;    // inlet_a, inlet_b, outlet_a, outlet_b
+  std::string dead_valve;  // inlet_a, inlet_b, outlet_a, outlet_b
   bool no_supply = false;
   double silent_after_s = -1.0;
   double stall_after_s = -1.0;

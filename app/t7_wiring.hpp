@@ -10,13 +10,13 @@
 
 namespace bellows {
 
-inline constexpr int kDefaultT7Port = 502;       // Modbus TCP
-inline constexpr int kDefaultT7SimPort = 5020;   // `bellows t7-sim` (unprivileged)
+inline constexpr int kDefaultT7Port = 502;      // Modbus TCP
+inline constexpr int kDefaultT7SimPort = 5020;  // `bellows t7-sim` (unprivileged)
 
 struct T7Options {
-  std::string address;       // --t7 HOST[:PORT]
-  std::string rig_profile;   // --rig-profile FILE; "": the paper rig's, built in
-  bool realtime = true;      // ask for SCHED_FIFO for the Modbus I/O thread
+  std::string address;      // --t7 HOST[:PORT]
+  std::string rig_profile;  // --rig-profile FILE; "": the paper rig's, built in
+  bool realtime = true;     // ask for SCHED_FIFO for the Modbus I/O thread
 };
 
 /// Splits "HOST[:PORT]" ("[v6]:PORT" too). Throws InputError naming the address when it is malformed.

@@ -37,14 +37,17 @@ std::string toml_number(double value) {
 }
 
 std::string with_table_values(const std::string& text, const std::string& table,
-                              const std::vector<std::pair<std::string, std::string>>& values, const std::string& comment) {
+                              const std::vector<std::pair<std::string, std::string>>& values,
+                              const std::string& comment) {
   std::vector<std::string> lines;
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
-  const auto line_for = [&](const std::pair<std::string, std::string>& kv) { return kv.first + " = " + kv.second + "  # " + comment; };
+  const auto line_for = [&](const std::pair<std::string, std::string>& kv) {
+    return kv.first + " = " + kv.second + "  # " + comment;
+  };
 
   std::vector<bool> written(values.size(), false);
-  bool inside = table.empty();             // the top level comes first
+  bool inside = table.empty();              // the top level comes first
   long insert_at = table.empty() ? 0 : -1;  // where missing keys go
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const std::string t(trim(lines[i]));

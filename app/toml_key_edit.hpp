@@ -15,7 +15,8 @@ namespace bellows {
 /// after the table's header (the top level: before the first header), a missing table is appended.
 /// `value` is TOML text as written (a number: "0.25"). Each line it writes ends with `# comment`.
 std::string with_table_values(const std::string& text, const std::string& table,
-                              const std::vector<std::pair<std::string, std::string>>& values, const std::string& comment);
+                              const std::vector<std::pair<std::string, std::string>>& values,
+                              const std::string& comment);
 
 /// Whether `text` has the header line of table `table` ("[valves]", a comment after it allowed).
 bool has_table_header(const std::string& text, const std::string& table);

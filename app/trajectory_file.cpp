@@ -55,7 +55,8 @@ int joints_of_header(const std::string& header, const std::string& where) {
   if (header == "time_s,angle_deg") return 1;
   const std::vector<std::string> fields = split_fields(header);
   if (fields.size() < 2 || trim(fields[0]) != "time_s" || trim(fields[1]) != joint_column(1)) {
-    throw InputError(where + ": the header must be 'time_s,angle_deg' or 'time_s,q1_deg,...' (one column per joint), found '" +
+    throw InputError(where +
+                     ": the header must be 'time_s,angle_deg' or 'time_s,q1_deg,...' (one column per joint), found '" +
                      printable(header) + "'");
   }
   for (std::size_t column = 2; column < fields.size(); ++column) {
@@ -114,7 +115,8 @@ Trajectory parse_trajectory_csv(const std::string& text, const std::string& sour
     }
     times.push_back(parse_number(fields[0], where));
     for (int joint = 0; joint < joints; ++joint) {
-      angles[static_cast<std::size_t>(joint)].push_back(parse_number(fields[static_cast<std::size_t>(joint) + 1], where));
+      angles[static_cast<std::size_t>(joint)].push_back(
+          parse_number(fields[static_cast<std::size_t>(joint) + 1], where));
     }
   }
   const std::string name = std::filesystem::path(source_name).stem().string();

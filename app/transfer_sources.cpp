@@ -9,7 +9,8 @@ namespace bellows {
 namespace {
 
 std::string describe(const Session& session) {
-  const std::string name = session.manifest.name.empty() ? session.directory.filename().string() : session.manifest.name;
+  const std::string name =
+      session.manifest.name.empty() ? session.directory.filename().string() : session.manifest.name;
   return "session '" + name + "'";
 }
 
@@ -31,19 +32,21 @@ TransferSource transfer_source_from_session(const Session& session) {
 
 void check_transfer_source(const Session& session, const Configuration& target, const std::string& device,
                            const std::string& rig_profile) {
-  if (const std::string why = transfer_mismatch(session.manifest.configuration, session.manifest.device, target, device);
+  if (const std::string why =
+          transfer_mismatch(session.manifest.configuration, session.manifest.device, target, device);
       !why.empty()) {
     throw InputError("cannot transfer from " + describe(session) + ": " + why);
   }
   if (const std::string why = rig_profile_mismatch(rig_profile_of(session.manifest), rig_profile); !why.empty()) {
     throw InputError("cannot transfer from " + describe(session) + ": " + why);
   }
-  if (session.iterations.empty()) throw InputError("cannot transfer from " + describe(session) + ": it has no completed trial");
+  if (session.iterations.empty())
+    throw InputError("cannot transfer from " + describe(session) + ": it has no completed trial");
 }
 
-std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names, const std::filesystem::path& data_dir,
-                                            const Configuration& target, const std::string& device,
-                                            const std::string& rig_profile) {
+std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names,
+                                            const std::filesystem::path& data_dir, const Configuration& target,
+                                            const std::string& device, const std::string& rig_profile) {
   std::vector<Session> sessions;
   for (const std::string& name : names) {
     Session session = load_session(resolve_session_dir(name, data_dir));
@@ -53,15 +56,16 @@ std::vector<Session> load_transfer_sessions(const std::vector<std::string>& name
   return sessions;
 }
 
-TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config, const Trajectory& target,
-                                TransferMethod method) {
+TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config,
+                                const Trajectory& target, TransferMethod method) {
   TransferReport report;
   std::vector<TransferSource> sources;
   for (const Session& session : sessions) {
     sources.push_back(transfer_source_from_session(session));
     const IterationEntry* last = session.manifest.iterations.empty() ? nullptr : &session.manifest.iterations.back();
     report.sources.push_back({sources.back().name, session.directory.string(), session.trajectory.name,
-                              static_cast<int>(sources.back().trials.size()), last != nullptr ? last->summary.rms_deg : 0.0});
+                              static_cast<int>(sources.back().trials.size()),
+                              last != nullptr ? last->summary.rms_deg : 0.0});
   }
   TransferSettings settings;
   settings.method = method;
@@ -75,11 +79,15 @@ nlohmann::json transfer_json(const TransferReport& report) {
   const TransferResult& r = report.result;
   nlohmann::json sources = nlohmann::json::array();
   for (const TransferSourceInfo& s : report.sources) {
-    sources.push_back({{"session", s.name}, {"directory", s.directory}, {"trajectory", s.trajectory}, {"trials", s.trials},
+    sources.push_back({{"session", s.name},
+                       {"directory", s.directory},
+                       {"trajectory", s.trajectory},
+                       {"trials", s.trials},
                        {"last_rms_deg", s.last_rms_deg}});
   }
   nlohmann::json methods = nlohmann::json::object();
-  for (const auto& [name, ratio] : r.method_ratios) methods[name] = std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr);
+  for (const auto& [name, ratio] : r.method_ratios)
+    methods[name] = std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr);
   const bool applied = r.status == TransferStatus::kTransferred;
   return {{"sources", sources},
           {"method", r.method},
@@ -88,8 +96,10 @@ nlohmann::json transfer_json(const TransferReport& report) {
           {"prediction",
            {{"feedback_only_rms_deg", r.predicted_feedback_only_rms_deg},
             {"rms_deg", r.predicted_rms_deg},
-            {"ratio", r.predicted_feedback_only_rms_deg > 0.0 ? r.predicted_rms_deg / r.predicted_feedback_only_rms_deg : 1.0}}},
-          {"validation_ratio", std::isfinite(r.validation_ratio) ? nlohmann::json(r.validation_ratio) : nlohmann::json(nullptr)},
+            {"ratio",
+             r.predicted_feedback_only_rms_deg > 0.0 ? r.predicted_rms_deg / r.predicted_feedback_only_rms_deg : 1.0}}},
+          {"validation_ratio",
+           std::isfinite(r.validation_ratio) ? nlohmann::json(r.validation_ratio) : nlohmann::json(nullptr)},
           {"method_validation_ratios", methods},
           {"clamped_samples", r.clamped_samples},
           {"max_abs_correction_bar", r.correction_bar.size() > 0 ? r.correction_bar.cwiseAbs().maxCoeff() : 0.0}};
@@ -101,8 +111,8 @@ std::string transfer_line(const TransferReport& report) {
   const TransferResult& r = report.result;
   char line[256];
   if (r.status == TransferStatus::kTransferred) {
-    std::snprintf(line, sizeof line, ": %s, predicted first trial %.2f deg RMS (feedback only %.2f deg)", r.method.c_str(),
-                  r.predicted_rms_deg, r.predicted_feedback_only_rms_deg);
+    std::snprintf(line, sizeof line, ": %s, predicted first trial %.2f deg RMS (feedback only %.2f deg)",
+                  r.method.c_str(), r.predicted_rms_deg, r.predicted_feedback_only_rms_deg);
     return "transfer from " + names + line;
   }
   return "transfer from " + names + ": none, the first trial runs with feedback only: " + r.reason;

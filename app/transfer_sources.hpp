@@ -17,7 +17,7 @@ namespace bellows {
 
 /// Where a source came from, for the report.
 struct TransferSourceInfo {
-  std::string name;        // the session's name
+  std::string name;  // the session's name
   std::string directory;
   std::string trajectory;  // its trajectory's name
   int trials = 0;
@@ -35,9 +35,9 @@ void check_transfer_source(const Session& session, const Configuration& target, 
 
 /// Loads and checks every session (`names`: directories or names in `data_dir`). InputError names the
 /// first session that is missing, damaged, empty or does not fit.
-std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names, const std::filesystem::path& data_dir,
-                                            const Configuration& target, const std::string& device,
-                                            const std::string& rig_profile = {});
+std::vector<Session> load_transfer_sessions(const std::vector<std::string>& names,
+                                            const std::filesystem::path& data_dir, const Configuration& target,
+                                            const std::string& device, const std::string& rig_profile = {});
 
 struct TransferReport {
   std::vector<TransferSourceInfo> sources;
@@ -45,8 +45,8 @@ struct TransferReport {
 };
 
 /// Sets up the transfer from `sessions` and solves it for `target`.
-TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config, const Trajectory& target,
-                                TransferMethod method = TransferMethod::kAuto);
+TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config,
+                                const Trajectory& target, TransferMethod method = TransferMethod::kAuto);
 
 /// {"sources": [...], "method", "status", "reason", "prediction": {...}, ...}
 nlohmann::json transfer_json(const TransferReport& report);

@@ -69,7 +69,8 @@ void BM_PaperRun30Iterations(benchmark::State& state) {
     SimulatedArm arm(plant, 1);
     EngineCore core(arm, controller, timing, SafetyParameters{});
     SimulatedClock clock(core, arm);
-    NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{}, paper.learning_samples());
+    NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{},
+                         paper.learning_samples());
     LearningSession session(clock, law, paper, timing, controller);
     for (int i = 0; i <= 30; ++i) {
       benchmark::DoNotOptimize(session.run_trial().rms_deg);

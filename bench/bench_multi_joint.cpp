@@ -37,7 +37,8 @@ constexpr double kSampleTime_s = 0.02;
 /// J paper-type joints, each with the paper's model, coupled through a small off-diagonal input
 /// gain (a full MIMO model: every block of A, B, C is used by the sweeps whatever its values).
 MultiJointModel coupled_model(int joints) {
-  const std::vector<DiscreteArmModel> arms(static_cast<std::size_t>(joints), discretize_arm_model(ModelParameters{}, kSampleTime_s));
+  const std::vector<DiscreteArmModel> arms(static_cast<std::size_t>(joints),
+                                           discretize_arm_model(ModelParameters{}, kSampleTime_s));
   MultiJointModel model = block_diagonal_model(arms);
   for (int i = 0; i + 1 < joints; ++i) model.B(2 * i + 1, i + 1) = 0.2 * model.B(2 * i + 1, i);
   return model;
@@ -58,7 +59,8 @@ struct TrialData {
 void BM_MultiJointUpdate(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
   MultiJointNoilc law;
-  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) != MultiJointNoilcStatus::kOk) {
+  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) !=
+      MultiJointNoilcStatus::kOk) {
     state.SkipWithError("setup failed");
     return;
   }
@@ -70,7 +72,11 @@ void BM_MultiJointUpdate(benchmark::State& state) {
   state.counters["memory_MB"] = static_cast<double>(law.info().memory_bytes) / 1e6;
 }
 BENCHMARK(BM_MultiJointUpdate)
-    ->Args({1, 400})->Args({2, 400})->Args({3, 400})->Args({4, 400})->Args({3, 12000})
+    ->Args({1, 400})
+    ->Args({2, 400})
+    ->Args({3, 400})
+    ->Args({4, 400})
+    ->Args({3, 12000})
     ->Unit(benchmark::kMicrosecond);
 
 // The single-joint law (`noilc`) on the same data, for a comparison under the same machine load.
@@ -103,7 +109,8 @@ BENCHMARK(BM_MultiJointSetup)->Args({3, 400})->Args({3, 12000})->Unit(benchmark:
 void BM_MultiJointConstrainedUpdate(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
   MultiJointNoilcConstrained law;
-  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) != MultiJointNoilcStatus::kOk ||
+  if (law.setup(coupled_model(joints), MultiJointWeights::uniform(IlcParameters{}, joints), n) !=
+          MultiJointNoilcStatus::kOk ||
       law.set_bounds(Eigen::MatrixXd::Constant(n, joints, -0.05), Eigen::MatrixXd::Constant(n, joints, 0.05)) !=
           MultiJointNoilcStatus::kOk) {
     state.SkipWithError("setup failed");
@@ -130,8 +137,9 @@ void BM_MultiJointLearnedUpdateAndRefit(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));
   const Configuration config;
   const MultiJointModel model = coupled_model(joints);
-  LearnedModelNoilc law(closed_loop_prior(model.A, model.B, kSampleTime_s, config.model.volume_gain_per_rad, config.controller),
-                        learned_noilc_settings(config.ilc), n);
+  LearnedModelNoilc law(
+      closed_loop_prior(model.A, model.B, kSampleTime_s, config.model.volume_gain_per_rad, config.controller),
+      learned_noilc_settings(config.ilc), n);
   TrialData a(n, joints), b(n, joints);
   b.u_j = 0.5 * a.u_j.array() + 0.01;
   bool flip = false;
@@ -143,7 +151,12 @@ void BM_MultiJointLearnedUpdateAndRefit(benchmark::State& state) {
   }
   state.counters["refitted"] = law.last_report().refitted ? 1.0 : 0.0;
 }
-BENCHMARK(BM_MultiJointLearnedUpdateAndRefit)->Args({1, 400})->Args({3, 400})->Args({1, 12000})->Args({3, 12000})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MultiJointLearnedUpdateAndRefit)
+    ->Args({1, 400})
+    ->Args({3, 400})
+    ->Args({1, 12000})
+    ->Args({3, 12000})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_MultiJointDenseUpdate(benchmark::State& state) {
   const int joints = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1));

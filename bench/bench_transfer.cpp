@@ -40,12 +40,14 @@ int print_table(int iterations) {
   const Configuration config;
   const double t = config.timing.sample_s();
   const std::vector<TransferSource> sources = trained_sources(config, 30);
-  std::printf("| trajectory | method | status | predicted / measured first-trial RMS (deg) | first-trial ratio | "
-              "RMS at 1 / 3 / 5 / 10 (deg) |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| trajectory | method | status | predicted / measured first-trial RMS (deg) | first-trial ratio | "
+      "RMS at 1 / 3 / 5 / 10 (deg) |\n|---|---|---|---|---|---|\n");
   for (const Trajectory& target : unseen_trajectories(t)) {
     const LearningRun scratch = run_learning(config, target, iterations);
     std::printf("| %s | scratch | feedback only | - / %.2f | 1.00 | %.2f / %.2f / %.2f / %.2f |\n", target.name.c_str(),
-                scratch.rms_deg[0], at(scratch.rms_deg, 1), at(scratch.rms_deg, 3), at(scratch.rms_deg, 5), at(scratch.rms_deg, 10));
+                scratch.rms_deg[0], at(scratch.rms_deg, 1), at(scratch.rms_deg, 3), at(scratch.rms_deg, 5),
+                at(scratch.rms_deg, 10));
     for (const char* name : {"reference-fir", "basis", "inverse-fir", "auto"}) {
       TransferSettings settings;
       settings.method = parse_transfer_method(name);

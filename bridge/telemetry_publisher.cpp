@@ -45,10 +45,14 @@ std::int64_t realtime_us() {
 
 std::int8_t state_code(EngineState state) {
   switch (state) {
-    case EngineState::kSafe: return telemetry_t::STATE_SAFE;
-    case EngineState::kArmed: return telemetry_t::STATE_ARMED;
-    case EngineState::kRunning: return telemetry_t::STATE_RUNNING;
-    case EngineState::kFault: return telemetry_t::STATE_FAULT;
+    case EngineState::kSafe:
+      return telemetry_t::STATE_SAFE;
+    case EngineState::kArmed:
+      return telemetry_t::STATE_ARMED;
+    case EngineState::kRunning:
+      return telemetry_t::STATE_RUNNING;
+    case EngineState::kFault:
+      return telemetry_t::STATE_FAULT;
   }
   return -1;
 }
@@ -121,7 +125,8 @@ void TelemetryPublisher::emit_event(lcm::LCM* bus, const TickRecord& tick, std::
 void TelemetryPublisher::publish_joints(lcm::LCM* bus, const TickRecord& tick, int joints) {
   telemetry_joints_t& t = joints_telemetry_;
   copy_shared_fields(tick, t);
-  t.fault_joint = static_cast<std::int8_t>(tick.fault != FaultCode::kNone && tick.fault_joint >= 0 ? tick.fault_joint + 1 : 0);
+  t.fault_joint =
+      static_cast<std::int8_t>(tick.fault != FaultCode::kNone && tick.fault_joint >= 0 ? tick.fault_joint + 1 : 0);
   t.joint_count = static_cast<std::int8_t>(joints);
   for (int j = 0; j < kMaxJoints; ++j) {
     const bool used = j < joints;  // rows beyond the arm's joints stay zero
@@ -182,7 +187,8 @@ void TelemetryPublisher::on_tick(lcm::LCM* bus, const TickRecord& tick) {
                std::string(to_string(previous_.state)) + " -> " + to_string(tick.state));
   }
   if (tick.fault != FaultCode::kNone && tick.fault != previous_.fault) {
-    emit_event(bus, tick, engine_event_t::KIND_FAULT, std::string(fault_name(tick.fault)) + ": " + fault_message(tick.fault));
+    emit_event(bus, tick, engine_event_t::KIND_FAULT,
+               std::string(fault_name(tick.fault)) + ": " + fault_message(tick.fault));
   }
   if (tick.trial_id != previous_.trial_id) {
     emit_event(bus, tick, engine_event_t::KIND_TRIAL_STARTED, "trial " + std::to_string(tick.trial_id) + " started");

@@ -37,8 +37,8 @@ struct TelemetryPublisherStats {
   std::uint64_t dropped_ticks = 0;  // ticks missing from the ring (it was full)
   std::uint64_t events = 0;
   std::uint64_t trials = 0;
-  std::uint64_t log_events = 0;     // events written into the log
-  std::uint64_t errors = 0;         // failed publishes or log writes
+  std::uint64_t log_events = 0;  // events written into the log
+  std::uint64_t errors = 0;      // failed publishes or log writes
 };
 
 /// LCM's codes for engine states and faults (telemetry_t, engine_event_t).

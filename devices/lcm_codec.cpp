@@ -23,24 +23,36 @@ std::string single_joint_protocol(const char* what, int joints) {
 
 const char* to_string(DecodeStatus status) {
   switch (status) {
-    case DecodeStatus::kOk: return "ok";
-    case DecodeStatus::kTruncated: return "truncated";
-    case DecodeStatus::kWrongType: return "wrong-type";
-    case DecodeStatus::kTooLarge: return "too-large";
-    case DecodeStatus::kMalformed: return "malformed";
-    case DecodeStatus::kOldVersion: return "old-version";
-    case DecodeStatus::kUnauthenticated: return "unauthenticated";
+    case DecodeStatus::kOk:
+      return "ok";
+    case DecodeStatus::kTruncated:
+      return "truncated";
+    case DecodeStatus::kWrongType:
+      return "wrong-type";
+    case DecodeStatus::kTooLarge:
+      return "too-large";
+    case DecodeStatus::kMalformed:
+      return "malformed";
+    case DecodeStatus::kOldVersion:
+      return "old-version";
+    case DecodeStatus::kUnauthenticated:
+      return "unauthenticated";
   }
   return "?";
 }
 
 const char* explain(DecodeStatus status) {
   switch (status) {
-    case DecodeStatus::kOk: return "accepted";
-    case DecodeStatus::kTruncated: return "shorter than its type";
-    case DecodeStatus::kWrongType: return "not of the expected type";
-    case DecodeStatus::kTooLarge: return "longer than any valid message of its type";
-    case DecodeStatus::kMalformed: return "malformed";
+    case DecodeStatus::kOk:
+      return "accepted";
+    case DecodeStatus::kTruncated:
+      return "shorter than its type";
+    case DecodeStatus::kWrongType:
+      return "not of the expected type";
+    case DecodeStatus::kTooLarge:
+      return "longer than any valid message of its type";
+    case DecodeStatus::kMalformed:
+      return "malformed";
     case DecodeStatus::kOldVersion:
       return "of protocol version 1, which this bellows no longer speaks (update the sender: docs/lcm-protocol.md)";
     case DecodeStatus::kUnauthenticated:
@@ -61,13 +73,26 @@ std::int64_t random_nonzero_id() {
 
 void ReceiveCounters::count(DecodeStatus status) {
   switch (status) {
-    case DecodeStatus::kOk: return;  // accepted only once its values and order passed too
-    case DecodeStatus::kTruncated: bump(truncated_); return;
-    case DecodeStatus::kWrongType: bump(wrong_type_); return;
-    case DecodeStatus::kTooLarge: bump(too_large_); return;
-    case DecodeStatus::kMalformed: bump(malformed_); return;
-    case DecodeStatus::kOldVersion: bump(old_version_); return;
-    case DecodeStatus::kUnauthenticated: bump(unauthenticated_); return;
+    case DecodeStatus::kOk:
+      return;  // accepted only once its values and order passed too
+    case DecodeStatus::kTruncated:
+      bump(truncated_);
+      return;
+    case DecodeStatus::kWrongType:
+      bump(wrong_type_);
+      return;
+    case DecodeStatus::kTooLarge:
+      bump(too_large_);
+      return;
+    case DecodeStatus::kMalformed:
+      bump(malformed_);
+      return;
+    case DecodeStatus::kOldVersion:
+      bump(old_version_);
+      return;
+    case DecodeStatus::kUnauthenticated:
+      bump(unauthenticated_);
+      return;
   }
 }
 

@@ -32,35 +32,35 @@ namespace bellows {
 
 enum class DecodeStatus : std::uint8_t {
   kOk,
-  kTruncated,  // shorter than the message it claims to be
-  kWrongType,  // fingerprint of another type (or of another version of this one)
-  kTooLarge,   // longer than any valid message of the type
-  kMalformed,  // lengths or contents that do not parse, or bytes left over
+  kTruncated,        // shorter than the message it claims to be
+  kWrongType,        // fingerprint of another type (or of another version of this one)
+  kTooLarge,         // longer than any valid message of the type
+  kMalformed,        // lengths or contents that do not parse, or bytes left over
   kOldVersion,       // the fingerprint of an earlier protocol version of this type (lcmtypes/v1/)
   kUnauthenticated,  // the right shape, but its MAC does not match the key ([lcm] key_file)
 };
 const char* to_string(DecodeStatus status);
 
 /// Limits on what a decoder accepts.
-inline constexpr std::int32_t kMaxTrialSamples = 1 << 20;   // a trial summary's correction length
-inline constexpr std::size_t kMaxEventBytes = 64 * 1024;    // an engine event, its text included
+inline constexpr std::int32_t kMaxTrialSamples = 1 << 20;  // a trial summary's correction length
+inline constexpr std::size_t kMaxEventBytes = 64 * 1024;   // an engine event, its text included
 
 /// Received messages by outcome: plain numbers, for reports.
 struct ReceiveCounts {
   std::uint64_t accepted = 0;
   std::uint64_t truncated = 0, wrong_type = 0, too_large = 0, malformed = 0;  // did not decode
-  std::uint64_t invalid = 0;       // decoded, but values no valid sender sends
-  std::uint64_t foreign = 0;       // another session (or rig) than the one served
-  std::uint64_t out_of_order = 0;  // sequence number or time not after the last accepted one, or a jump
-  std::uint64_t old_version = 0;   // an earlier protocol version's message
+  std::uint64_t invalid = 0;          // decoded, but values no valid sender sends
+  std::uint64_t foreign = 0;          // another session (or rig) than the one served
+  std::uint64_t out_of_order = 0;     // sequence number or time not after the last accepted one, or a jump
+  std::uint64_t old_version = 0;      // an earlier protocol version's message
   std::uint64_t unauthenticated = 0;  // MAC missing or wrong (only with a key)
-  std::uint64_t other_joints = 0;  // valid, but for an arm of another joint count than this one's
+  std::uint64_t other_joints = 0;     // valid, but for an arm of another joint count than this one's
   // Not an error and not in ignored(): a free rig's offers (session 0), which every engine hears
   // before it binds (the engine's states only; a rig counts none).
   std::uint64_t offers = 0;
   std::uint64_t ignored() const {
-    return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version + unauthenticated +
-           other_joints;
+    return truncated + wrong_type + too_large + malformed + invalid + foreign + out_of_order + old_version +
+           unauthenticated + other_joints;
   }
 };
 
@@ -182,7 +182,7 @@ DecodeStatus decode_checked(const void* data, std::size_t size, Message& out, co
     const int used = out.decode(data, 0, static_cast<int>(size));
     if (used < 0) return DecodeStatus::kMalformed;
     if (static_cast<std::size_t>(used) != size) return DecodeStatus::kMalformed;  // bytes left over
-  } catch (const std::exception&) {  // e.g. a negative string length
+  } catch (const std::exception&) {                                               // e.g. a negative string length
     return DecodeStatus::kMalformed;
   }
   return DecodeStatus::kOk;

@@ -25,13 +25,13 @@ constexpr double kAnswerPoll_s = 0.0001;
 
 void sleep_s(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
 
-
 }  // namespace
 
 LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
     : session_id_(session_id), key_(key), rig_silence_s_(rig_silence_s), joints_(joints) {
   if (!valid_joint_count(joints_)) {
-    throw InputError("an LCM rig of " + std::to_string(joints_) + " joints: the messages carry 1 to " + std::to_string(kMaxJoints));
+    throw InputError("an LCM rig of " + std::to_string(joints_) + " joints: the messages carry 1 to " +
+                     std::to_string(kMaxJoints));
   }
   command_.session_id = session_id_;
   buffer_.resize(max_io_message_bytes());
@@ -57,7 +57,8 @@ void LcmDevice::write_valves(const ValveCommand& command) {
   for (int j = 0; j < joints_; ++j) {
     const JointValves& valves = command.joint[static_cast<std::size_t>(j)];
     JointValves& sent = out.valves.joint[static_cast<std::size_t>(j)];
-    for (int i = 0; i < kActuatorCount; ++i) {  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
+    for (int i = 0; i < kActuatorCount;
+         ++i) {  // the Device contract: clamp to [0, 1]; NaN -> closed inlet, open outlet
       const double inlet = valves.inlet_duty[i], outlet = valves.outlet_duty[i];
       sent.inlet_duty[i] = std::isfinite(inlet) ? std::clamp(inlet, 0.0, 1.0) : 0.0;
       sent.outlet_duty[i] = std::isfinite(outlet) ? std::clamp(outlet, 0.0, 1.0) : 1.0;
@@ -79,7 +80,7 @@ void LcmDevice::advance(double dt_s) {
   const double start_s = monotonic_s();
   while (answered_.load(std::memory_order_acquire) < written_) {
     if (!serving_us_.load(std::memory_order_acquire)) return sleep_s(dt_s);  // no rig steps with us yet: its pace
-    if (monotonic_s() - start_s > answer_timeout_s_) return;                // no answer: a tick without a reading
+    if (monotonic_s() - start_s > answer_timeout_s_) return;                 // no answer: a tick without a reading
     sleep_s(kAnswerPoll_s);
   }
 }
@@ -97,10 +98,12 @@ void LcmDevice::on_limits(const void* data, std::size_t size) {
       l.rig_id != rig_id_) {  // only the rig addressed speaks for this session's rig
     return bump(limits_ignored_);
   }
-  limits_seen_.write({now_s_, l.rig_id, l.joint_count, l.period_s, l.command_timeout_s, l.pressure_ceiling_bar, l.angle_limit_rad});
+  limits_seen_.write(
+      {now_s_, l.rig_id, l.joint_count, l.period_s, l.command_timeout_s, l.pressure_ceiling_bar, l.angle_limit_rad});
 }
 
-void LcmDevice::on_message(const char* channel, const void* data, std::size_t size) {  // io_state_t or io_joints_state_t
+void LcmDevice::on_message(const char* channel, const void* data,
+                           std::size_t size) {  // io_state_t or io_joints_state_t
   if (std::strcmp(channel, kIoLimitsChannel) == 0) return on_limits(data, size);
   const DecodeStatus status = decode_io_state(data, size, received_, key_.present() ? &key_ : nullptr);
   if (status != DecodeStatus::kOk) return counters_.count(status);
@@ -113,7 +116,8 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
   if (s.rig_id == rig_id_ && rig_id_ != 0) {  // for the rig check: what the rig addressed says, whatever its session
     const RigStateSeen seen{now_s_, s.session_id, s.binding, s.command_seq, s.fault_bits, to_reading(s)};
     rig_seen_.write(seen);
-    constexpr std::int32_t kTrip = std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT};
+    constexpr std::int32_t kTrip =
+        std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT};
     if (hold_seen_ && !trip_kept_ && (s.fault_bits & kTrip) != 0) {
       trip_seen_.write(seen);
       trip_kept_ = true;
@@ -135,7 +139,8 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
     if (s.rig_id == rig_id_) bound_ = false;
     // Never switch while the valves are live; while vented, take the offer of any free rig until one
     // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
-    if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) && (s.rig_id != rig_id_ || s.binding != binding_)) {
+    if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) &&
+        (s.rig_id != rig_id_ || s.binding != binding_)) {
       rig_id_ = s.rig_id;
       binding_ = s.binding;
       bound_ = false;
@@ -172,7 +177,8 @@ void LcmDevice::on_message(const char* channel, const void* data, std::size_t si
   last_echoed_seq_ = s.command_seq;
   last_fault_bits_.store(s.fault_bits, std::memory_order_relaxed);
   report_trip(s, false);
-  constexpr std::int32_t kNoReading = std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} |
+  constexpr std::int32_t kNoReading = std::int32_t{io_state_t::FAULT_NO_SESSION} |
+                                      std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT} |
                                       std::int32_t{io_state_t::FAULT_SENSOR} | std::int32_t{io_state_t::FAULT_VALVE};
   if ((s.fault_bits & kNoReading) != 0) return bump(rig_fault_states_);  // not a reading to control with
   counters_.accepted();
@@ -186,7 +192,8 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
                          kTimeout = io_state_t::FAULT_COMMAND_TIMEOUT, kSensor = io_state_t::FAULT_SENSOR,
                          kValve = io_state_t::FAULT_VALVE, kNoSession = io_state_t::FAULT_NO_SESSION;
   // An offer always carries NO_SESSION: only its reasons count there.
-  const std::int32_t trip = s.fault_bits & (kAngle | kPressure | kTimeout | kSensor | kValve | (offered ? 0 : kNoSession));
+  const std::int32_t trip =
+      s.fault_bits & (kAngle | kPressure | kTimeout | kSensor | kValve | (offered ? 0 : kNoSession));
   if ((trip & ~reported_trip_bits_) == 0) return;  // nothing new since this binding's last report
   reported_trip_bits_ |= trip;
   const int joints = std::clamp<int>(s.joint_count, 1, kMaxJoints);
@@ -198,10 +205,11 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
     for (int j = 1; j < joints; ++j) {
       if (!(std::abs(s.angle_rad[at(j)]) <= std::abs(s.angle_rad[at(joint)]))) joint = j;
     }
-    fault.set(FaultCode::kRigLimit, joint,
-              "the rig stopped joint %d at %.1f deg beyond its angle range ([lcm] rig_angle_limit_deg): check the chamber "
-              "wiring (bellows rig check --device lcm pulses each chamber)",
-              joint + 1, s.angle_rad[at(joint)] * 180.0 / std::numbers::pi);
+    fault.set(
+        FaultCode::kRigLimit, joint,
+        "the rig stopped joint %d at %.1f deg beyond its angle range ([lcm] rig_angle_limit_deg): check the chamber "
+        "wiring (bellows rig check --device lcm pulses each chamber)",
+        joint + 1, s.angle_rad[at(joint)] * 180.0 / std::numbers::pi);
   } else if ((trip & kPressure) != 0) {
     int joint = 0, chamber = 0;
     for (int j = 0; j < joints; ++j) {
@@ -209,20 +217,23 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
         if (s.chamber_bar[at(j)][c] > s.chamber_bar[at(joint)][chamber]) joint = j, chamber = c;
       }
     }
-    fault.set(FaultCode::kRigLimit, joint,
-              "the rig vented chamber %c of joint %d at %.3f bar above its pressure ceiling ([controller] p_max_bar + [lcm] "
-              "rig_pressure_margin_bar): check that valve and the rig's ceiling",
-              chamber == 0 ? 'A' : 'B', joint + 1, s.chamber_bar[at(joint)][chamber]);
+    fault.set(
+        FaultCode::kRigLimit, joint,
+        "the rig vented chamber %c of joint %d at %.3f bar above its pressure ceiling ([controller] p_max_bar + [lcm] "
+        "rig_pressure_margin_bar): check that valve and the rig's ceiling",
+        chamber == 0 ? 'A' : 'B', joint + 1, s.chamber_bar[at(joint)][chamber]);
   } else if ((trip & kTimeout) != 0) {
-    fault.set(FaultCode::kRigTimeout, -1,
-              "the LCM rig %llx heard no command of this session for its [lcm] rig_timeout_s and vented itself: check the "
-              "network from this host to the rig",
-              rig);
+    fault.set(
+        FaultCode::kRigTimeout, -1,
+        "the LCM rig %llx heard no command of this session for its [lcm] rig_timeout_s and vented itself: check the "
+        "network from this host to the rig",
+        rig);
   } else if ((trip & (kSensor | kValve)) != 0) {
     fault.set(FaultCode::kRigFault, -1, "the LCM rig %llx reports %s (fault_bits %d): check its driver's log", rig,
               (trip & kSensor) != 0 ? "it cannot read its sensors" : "it cannot drive its valves", s.fault_bits);
   } else {  // NO_SESSION alone, naming this session: the rig ended it without a reason (shut down, restarted)
-    fault.set(FaultCode::kRigFault, -1, "the LCM rig %llx ended this session without a reason (it shut down or restarted?)", rig);
+    fault.set(FaultCode::kRigFault, -1,
+              "the LCM rig %llx ended this session without a reason (it shut down or restarted?)", rig);
   }
   trips_.write(fault);
 }
@@ -241,7 +252,8 @@ void LcmDevice::explain_silence(double silent_s, DeviceFault& fault) const {
   }
   if (const std::uint64_t forged = counters_.snapshot().unauthenticated; forged > 0) {
     fault.set(FaultCode::kForeignSender, -1,
-              "another sender publishes rig states on this bus: %llu failed authentication (or the rig has another [lcm] key_file)",
+              "another sender publishes rig states on this bus: %llu failed authentication (or the rig has another "
+              "[lcm] key_file)",
               static_cast<unsigned long long>(forged));
     return;
   }
@@ -258,17 +270,20 @@ void LcmDevice::explain_silence(double silent_s, DeviceFault& fault) const {
   if (silence_s >= 0.5 * silent_s) {  // nothing at all arrived in the window (give or take the I/O thread's turn)
     if (std::isfinite(silence_s)) {
       fault.set(FaultCode::kLinkLost, -1,
-                "the LCM rig %llx has been silent for %.0f ms (no state on " "BELLOWS_IO_STATE): check that the rig runs and the network to it",
+                "the LCM rig %llx has been silent for %.0f ms (no state on "
+                "BELLOWS_IO_STATE): check that the rig runs and the network to it",
                 rig, silence_s * 1e3);
     } else {
-      fault.set(FaultCode::kLinkLost, -1, "no LCM rig has been heard on BELLOWS_IO_STATE: check that the rig runs and the network to it");
+      fault.set(FaultCode::kLinkLost, -1,
+                "no LCM rig has been heard on BELLOWS_IO_STATE: check that the rig runs and the network to it");
     }
     return;
   }
-  fault.set(FaultCode::kSensorStale, -1,
-            "the LCM rig %llx answers, but none of its states for %.0f ms was a usable reading (frozen time or rejected: "
-            "see lcm.rig.states)",
-            rig, silent_s * 1e3);
+  fault.set(
+      FaultCode::kSensorStale, -1,
+      "the LCM rig %llx answers, but none of its states for %.0f ms was a usable reading (frozen time or rejected: "
+      "see lcm.rig.states)",
+      rig, silent_s * 1e3);
 }
 
 double LcmDevice::service(lcm::LCM* bus, double now_s) {
@@ -329,7 +344,8 @@ DeviceHealth LcmDevice::health() const {
   round_trips_.summarize(h);
   const ReceiveCounts c = counters_.snapshot();
   // The rig's offers before binding are not errors (ReceiveCounts::offers): only what went wrong.
-  h.link_errors = c.ignored() + rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
+  h.link_errors =
+      c.ignored() + rig_fault_states_.load(std::memory_order_relaxed) + publish_errors_.load(std::memory_order_relaxed);
   h.stale_readings = stale_reads_.load(std::memory_order_relaxed);
   return h;
 }
@@ -357,7 +373,8 @@ LcmDeviceStats LcmDevice::stats() const {
 
 std::string LcmDevice::diagnosis() const {
   const LcmDeviceStats s = stats();
-  const std::string advice = s.keyed ? "" : " (set the same [lcm] key_file on the rig and the engine: docs/lcm-protocol.md)";
+  const std::string advice =
+      s.keyed ? "" : " (set the same [lcm] key_file on the rig and the engine: docs/lcm-protocol.md)";
   if (s.commands_not_ours > 0) {
     return "another sender is commanding this rig: it applied commands this session never sent (" +
            std::to_string(s.commands_not_ours) + " states)" + advice;
@@ -377,7 +394,8 @@ std::string LcmDevice::diagnosis() const {
   }
   if (s.rig_foreign_commands > 0 || s.rig_unauthenticated_commands > 0) {
     return "other senders are on this rig's bus: the rig ignored " + std::to_string(s.rig_foreign_commands) +
-           " commands of other sessions and " + std::to_string(s.rig_unauthenticated_commands) + " unauthenticated ones" + advice;
+           " commands of other sessions and " + std::to_string(s.rig_unauthenticated_commands) +
+           " unauthenticated ones" + advice;
   }
   return "";
 }

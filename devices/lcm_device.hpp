@@ -47,20 +47,20 @@ namespace bellows {
 
 struct LcmDeviceStats {
   std::int64_t session_id = 0;
-  std::int64_t rig_id = 0;              // the rig served by, 0: none yet
-  ReceiveCounts states;                  // io_state_t received, by outcome
-  std::uint64_t rig_fault_states = 0;    // states of this session carrying rig fault bits
+  std::int64_t rig_id = 0;             // the rig served by, 0: none yet
+  ReceiveCounts states;                // io_state_t received, by outcome
+  std::uint64_t rig_fault_states = 0;  // states of this session carrying rig fault bits
   std::int32_t last_fault_bits = 0;
-  std::int64_t last_foreign_session = 0; // the session a rig served when it was not this one
-  int joints = 1;                        // this arm's
-  int last_other_joints = 0;             // a rig's joint count when it was not this arm's, 0: none heard
+  std::int64_t last_foreign_session = 0;  // the session a rig served when it was not this one
+  int joints = 1;                         // this arm's
+  int last_other_joints = 0;              // a rig's joint count when it was not this arm's, 0: none heard
   std::uint64_t commands_sent = 0;
   std::uint64_t vent_commands_sent = 0;  // of which armed = false
   std::uint64_t publish_errors = 0;
-  std::uint64_t commands_not_ours = 0;   // states of this session echoing a command it never sent
-  std::int64_t rig_foreign_commands = 0;          // what the rig says it refused (its last state)
+  std::uint64_t commands_not_ours = 0;    // states of this session echoing a command it never sent
+  std::int64_t rig_foreign_commands = 0;  // what the rig says it refused (its last state)
   std::int64_t rig_unauthenticated_commands = 0;
-  bool keyed = false;                     // [lcm] key_file set
+  bool keyed = false;  // [lcm] key_file set
 };
 
 /// What the rig addressed says it enforces by itself (its io_rig_limits_t), for `bellows rig check`.
@@ -77,7 +77,7 @@ struct RigStateSeen {
   double received_s = -1.0;  // the I/O thread's clock; < 0: none
   std::int64_t session_id = 0, binding = 0, command_seq = 0;
   std::int32_t fault_bits = 0;
-  SensorReading reading{};   // its sensor values (time_s the rig's)
+  SensorReading reading{};  // its sensor values (time_s the rig's)
 };
 
 class LcmDevice final : public Device, public LcmEndpoint {
@@ -170,23 +170,23 @@ class LcmDevice final : public Device, public LcmEndpoint {
   const LcmKey key_;
   const double rig_silence_s_;
   const int joints_;
-  LatestValue<Outgoing> outbox_;        // engine -> I/O
-  LatestValue<SensorReading> inbox_;    // I/O -> engine
-  LatestValue<DeviceFault> trips_;      // I/O -> engine: the rig's own trips
-  SensorReading reading_{};             // engine thread's copy
-  std::uint64_t written_ = 0;           // engine thread: valve states written to the outbox
-  bool lockstep_ = false;               // set_lockstep(), before the engine ticks
+  LatestValue<Outgoing> outbox_;      // engine -> I/O
+  LatestValue<SensorReading> inbox_;  // I/O -> engine
+  LatestValue<DeviceFault> trips_;    // I/O -> engine: the rig's own trips
+  SensorReading reading_{};           // engine thread's copy
+  std::uint64_t written_ = 0;         // engine thread: valve states written to the outbox
+  bool lockstep_ = false;             // set_lockstep(), before the engine ticks
   double answer_timeout_s_ = 0.0;
 
   // I/O thread state.
   io_joints_state_t received_{};
   SensorReading pending_{};
   bool pending_fresh_ = false;
-  std::int64_t rig_id_ = 0;        // the rig addressed, 0: none yet
-  std::int64_t binding_ = 0;       // its offer this session answers
-  bool bound_ = false;             // its last state served this session
-  double now_s_ = 0.0;             // of the last service()
-  double last_rig_state_s_ = 0.0;  // when the rig addressed last sent anything valid
+  std::int64_t rig_id_ = 0;              // the rig addressed, 0: none yet
+  std::int64_t binding_ = 0;             // its offer this session answers
+  bool bound_ = false;                   // its last state served this session
+  double now_s_ = 0.0;                   // of the last service()
+  double last_rig_state_s_ = 0.0;        // when the rig addressed last sent anything valid
   std::int32_t reported_trip_bits_ = 0;  // trip bits of this binding already reported
   std::int64_t last_state_seq_ = 0;
   std::int64_t last_echoed_seq_ = 0;
@@ -202,8 +202,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::uint64_t awaited_generation_ = 0, answer_generation_ = 0;
   std::int64_t awaited_seq_ = 0;
   io_rig_limits_t limits_received_{};
-  bool hold_seen_ = false;     // the I/O thread has acted on hold_commands(true)
-  bool trip_kept_ = false;     // the first trip since then is in trip_seen_
+  bool hold_seen_ = false;                       // the I/O thread has acted on hold_commands(true)
+  bool trip_kept_ = false;                       // the first trip since then is in trip_seen_
   LatestValue<RigAnnouncedLimits> limits_seen_;  // I/O -> rig check
   LatestValue<RigStateSeen> trip_seen_, rig_seen_;
   std::atomic<bool> hold_commands_{false}, commands_held_{false};
@@ -213,10 +213,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
 
   ReceiveCounters counters_;
   std::atomic<bool> connected_{false};
-  std::atomic<bool> serving_us_{false};          // the rig addressed serves this session (bound_, shown)
-  std::atomic<std::uint64_t> answered_{0};       // generation whose answer reached the inbox
+  std::atomic<bool> serving_us_{false};     // the rig addressed serves this session (bound_, shown)
+  std::atomic<std::uint64_t> answered_{0};  // generation whose answer reached the inbox
   std::atomic<double> last_state_s_{-1.0};
-  std::atomic<double> io_turn_s_{INFINITY};  // monotonic_s() of the I/O thread's last service() turn
+  std::atomic<double> io_turn_s_{INFINITY};     // monotonic_s() of the I/O thread's last service() turn
   std::atomic<double> rig_silent_s_{INFINITY};  // since the addressed rig's last valid state of any kind (I/O clock)
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};

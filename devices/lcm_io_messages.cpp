@@ -57,13 +57,14 @@ std::size_t encode_io_state(const io_joints_state_t& state, const LcmKey& key, s
   return state.joint_count == 1 ? encode_signed(narrow(state), key, buffer) : encode_signed(state, key, buffer);
 }
 
-std::size_t encode_io_command(const io_joints_command_t& command, const LcmKey& key, std::vector<std::uint8_t>& buffer) {
+std::size_t encode_io_command(const io_joints_command_t& command, const LcmKey& key,
+                              std::vector<std::uint8_t>& buffer) {
   return command.joint_count == 1 ? encode_signed(narrow(command), key, buffer) : encode_signed(command, key, buffer);
 }
 
 std::size_t max_io_message_bytes() {
-  return std::max({detail::fixed_size<io_state_t>(), detail::fixed_size<io_command_t>(), detail::fixed_size<io_joints_state_t>(),
-                   detail::fixed_size<io_joints_command_t>()});
+  return std::max({detail::fixed_size<io_state_t>(), detail::fixed_size<io_command_t>(),
+                   detail::fixed_size<io_joints_state_t>(), detail::fixed_size<io_joints_command_t>()});
 }
 
 namespace {
@@ -159,8 +160,9 @@ bool valid_state(const io_joints_state_t& s) {
 
 bool valid_rig_limits(const io_rig_limits_t& l) {
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
-  return l.rig_id != 0 && l.seq > 0 && valid_joint_count(l.joint_count) && positive(l.period_s) && positive(l.command_timeout_s) &&
-         positive(l.pressure_ceiling_bar) && positive(l.angle_limit_rad) && l.angle_limit_rad <= std::numbers::pi;
+  return l.rig_id != 0 && l.seq > 0 && valid_joint_count(l.joint_count) && positive(l.period_s) &&
+         positive(l.command_timeout_s) && positive(l.pressure_ceiling_bar) && positive(l.angle_limit_rad) &&
+         l.angle_limit_rad <= std::numbers::pi;
 }
 
 ValveCommand to_valves(const io_joints_command_t& c) {

@@ -24,7 +24,8 @@ static_assert(io_joints_state_t::MAX_JOINTS == kMaxJoints && io_joints_command_t
 /// neither is kWrongType, version 1's kOldVersion) and widened to the joints form.
 DecodeStatus decode_io_state(const void* data, std::size_t size, io_joints_state_t& out, const LcmKey* key = nullptr);
 /// The same for io_command_t or io_joints_command_t.
-DecodeStatus decode_io_command(const void* data, std::size_t size, io_joints_command_t& out, const LcmKey* key = nullptr);
+DecodeStatus decode_io_command(const void* data, std::size_t size, io_joints_command_t& out,
+                               const LcmKey* key = nullptr);
 
 /// Encodes and signs (encode_signed) as io_state_t when `state` has one joint, else io_joints_state_t.
 std::size_t encode_io_state(const io_joints_state_t& state, const LcmKey& key, std::vector<std::uint8_t>& buffer);

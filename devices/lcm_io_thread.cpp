@@ -86,7 +86,8 @@ void LcmIoThread::start(RealtimeMode mode, int priority) {
   if (thread_.joinable()) return;
   stop_.store(false);
   ready_.store(false);
-  thread_ = std::thread([this, mode, priority] { serve([this] { return stop_.load(std::memory_order_acquire); }, mode, priority); });
+  thread_ = std::thread(
+      [this, mode, priority] { serve([this] { return stop_.load(std::memory_order_acquire); }, mode, priority); });
   while (!ready_.load(std::memory_order_acquire)) std::this_thread::yield();
   if (!start_error_.empty()) {
     thread_.join();
@@ -112,7 +113,8 @@ void LcmIoThread::serve(const std::function<bool()>& should_stop, RealtimeMode m
     const int error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
     rt_granted_ = error == 0;
     if (error != 0 && mode == RealtimeMode::kEnforce) {
-      start_error_ = "--rt enforce: SCHED_FIFO refused for the LCM I/O thread (" + std::string(std::strerror(error)) + ")";
+      start_error_ =
+          "--rt enforce: SCHED_FIFO refused for the LCM I/O thread (" + std::string(std::strerror(error)) + ")";
       ready_.store(true, std::memory_order_release);
       return;
     }

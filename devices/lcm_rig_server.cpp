@@ -8,17 +8,17 @@
 #include "engine/base/errors.hpp"
 
 namespace bellows {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 RigServer::RigServer(SimulatedArm& arm, RigServerParameters params, std::int64_t rig_id)
     : RigServer(arm, 1, arm.parameters().integration_step_s, std::move(params), rig_id) {}
 
-RigServer::RigServer(Device& arm, int joints, double integration_step_s, RigServerParameters params, std::int64_t rig_id)
+RigServer::RigServer(Device& arm, int joints, double integration_step_s, RigServerParameters params,
+                     std::int64_t rig_id)
     : arm_(arm), joints_(joints), integration_step_s_(integration_step_s), params_(std::move(params)), rig_id_(rig_id) {
   if (!valid_joint_count(joints_)) {
-    throw InputError("a rig of " + std::to_string(joints_) + " joints: the LCM messages carry 1 to " + std::to_string(kMaxJoints));
+    throw InputError("a rig of " + std::to_string(joints_) + " joints: the LCM messages carry 1 to " +
+                     std::to_string(kMaxJoints));
   }
   if (!(integration_step_s_ > 0.0)) throw InputError("the rig's integration step must be positive");
   if (!(params_.period_s > 0.0) || !(params_.command_timeout_s > 0.0)) {
@@ -47,7 +47,9 @@ void RigServer::say(const std::string& line) const {
 
 void RigServer::notice(Notice kind, const std::string& line) {
   bool& reported = reported_[static_cast<int>(kind)];
-  if (!reported) say(line + (kind < Notice::kPressureLimit ? ": counted and ignored (further ones only counted)" : " (further ones only counted)"));
+  if (!reported)
+    say(line + (kind < Notice::kPressureLimit ? ": counted and ignored (further ones only counted)"
+                                              : " (further ones only counted)"));
   reported = true;
 }
 
@@ -56,15 +58,18 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   if (status != DecodeStatus::kOk) {
     counters_.count(status);
     if (status == DecodeStatus::kOldVersion) notice(Notice::kOldVersion, std::string("a command ") + explain(status));
-    if (status == DecodeStatus::kUnauthenticated) notice(Notice::kUnauthenticated, std::string("a command ") + explain(status));
+    if (status == DecodeStatus::kUnauthenticated)
+      notice(Notice::kUnauthenticated, std::string("a command ") + explain(status));
     return;
   }
   const io_joints_command_t& c = received_;
   if (!valid_command(c)) return counters_.invalid();
-  if (c.rig_id != rig_id_) return bump(not_addressed_);  // to another rig, or to none yet: not for us to count as foreign
+  if (c.rig_id != rig_id_)
+    return bump(not_addressed_);   // to another rig, or to none yet: not for us to count as foreign
   if (c.joint_count != joints_) {  // meant for another arm: nothing of it is safe to apply, and it binds nothing
-    notice(Notice::kOtherJoints, "a command for an arm of " + arm_joints_words(c.joint_count) + " but this rig's arm has " +
-                                     arm_joints_words(joints_) + " (the engine's [arm] must be the rig's)");
+    notice(Notice::kOtherJoints, "a command for an arm of " + arm_joints_words(c.joint_count) +
+                                     " but this rig's arm has " + arm_joints_words(joints_) +
+                                     " (the engine's [arm] must be the rig's)");
     counters_.other_joints();
     if (!c.armed) {  // but a vent only makes the rig safer, whatever arm it was meant for
       io_joints_command_t vent = c;
@@ -75,7 +80,8 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   }
   const bool outside_range = (limit_bits_ & io_state_t::FAULT_ANGLE_LIMIT) != 0;
   if (session_ == 0 && c.binding == binding_ && !c.armed && outside_range) {
-    notice(Notice::kForeign, "session " + std::to_string(c.session_id) + " tried to bind while the arm is beyond the rig's angle range");
+    notice(Notice::kForeign,
+           "session " + std::to_string(c.session_id) + " tried to bind while the arm is beyond the rig's angle range");
     return counters_.foreign();
   }
   if (session_ == 0 && c.binding == binding_ && !c.armed) {  // free: a session binds with a vent echoing the offer
@@ -96,14 +102,16 @@ void RigServer::on_message(const char*, const void* data, std::size_t size) {  /
   }
   if (!c.armed) return obey_vent(c);  // whatever its session or sequence number: it only makes the rig safer
   if (!own) {
-    notice(Notice::kForeign, session_ == 0 ? "a command of session " + std::to_string(c.session_id) + " that did not bind first"
-                                            : "a command of session " + std::to_string(c.session_id) +
-                                                  " while serving session " + std::to_string(session_));
+    notice(Notice::kForeign, session_ == 0
+                                 ? "a command of session " + std::to_string(c.session_id) + " that did not bind first"
+                                 : "a command of session " + std::to_string(c.session_id) + " while serving session " +
+                                       std::to_string(session_));
     return counters_.foreign();
   }
   if (c.seq <= last_seq_) return counters_.out_of_order();
-  notice(Notice::kJump, "a command of session " + std::to_string(session_) + " jumping from seq " + std::to_string(last_seq_) +
-                             " to " + std::to_string(c.seq) + " (more than [lcm] seq_window)");
+  notice(Notice::kJump, "a command of session " + std::to_string(session_) + " jumping from seq " +
+                            std::to_string(last_seq_) + " to " + std::to_string(c.seq) +
+                            " (more than [lcm] seq_window)");
   counters_.out_of_order();
 }
 
@@ -118,7 +126,8 @@ void RigServer::obey_vent(const io_joints_command_t& vent) {
   bump(vents_out_of_sequence_);
 }
 
-static_assert(kRigPressureLimitBit == io_state_t::FAULT_PRESSURE_LIMIT && kRigAngleLimitBit == io_state_t::FAULT_ANGLE_LIMIT,
+static_assert(kRigPressureLimitBit == io_state_t::FAULT_PRESSURE_LIMIT &&
+                  kRigAngleLimitBit == io_state_t::FAULT_ANGLE_LIMIT,
               "the rig limits' bits are io_state_t's");
 
 void RigServer::apply_limits(bool write) {
@@ -129,25 +138,29 @@ void RigServer::apply_limits(bool write) {
   const auto rising = [&](std::int32_t bit) { return (limit_bits_ & bit) != 0 && (before & bit) == 0; };
   if (rising(io_state_t::FAULT_PRESSURE_LIMIT)) {
     bump(pressure_trips_);
-    notice(Notice::kPressureLimit, "a chamber above the rig's ceiling of " + std::to_string(params_.limits.pressure_ceiling_bar) +
+    notice(Notice::kPressureLimit, "a chamber above the rig's ceiling of " +
+                                       std::to_string(params_.limits.pressure_ceiling_bar) +
                                        " bar: that chamber vented");
   }
   if (rising(io_state_t::FAULT_ANGLE_LIMIT)) {
     bump(angle_trips_);
     const std::string which = joints_ > 1 ? "joint " + std::to_string(limited.angle_joint + 1) : std::string("the arm");
-    notice(Notice::kAngleLimit, which + " beyond the rig's angle range: vented" +
-                                    (session_ != 0 ? ", session " + std::to_string(session_) + " dropped" : std::string()));
+    notice(Notice::kAngleLimit,
+           which + " beyond the rig's angle range: vented" +
+               (session_ != 0 ? ", session " + std::to_string(session_) + " dropped" : std::string()));
   }
   if (limited.angle_exceeded) {
     commanded_ = ValveCommand::vented(joints_);
-    if (session_ != 0) release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT});
+    if (session_ != 0)
+      release(std::int32_t{io_state_t::FAULT_NO_SESSION} | std::int32_t{io_state_t::FAULT_ANGLE_LIMIT});
   }
   // Written only when something changed: every write starts a new PWM period.
   if (write || limit_bits_ != 0 || before != 0) arm_.write_valves(limited.valves);
 }
 
 void RigServer::release(std::int32_t fault_bits) {
-  constexpr std::int32_t kReasons = std::int32_t{io_state_t::FAULT_ANGLE_LIMIT} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT};
+  constexpr std::int32_t kReasons =
+      std::int32_t{io_state_t::FAULT_ANGLE_LIMIT} | std::int32_t{io_state_t::FAULT_COMMAND_TIMEOUT};
   if (session_ != 0 && (fault_bits & kReasons) != 0) {  // tripped: the states name the session dropped, and why
     tripped_session_ = session_;
     tripped_command_seq_ = applied_seq_;
@@ -187,7 +200,8 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     next_publish_s_ = now_s;
     next_limits_s_ = now_s;
   }
-  if (!params_.stepped) advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
+  if (!params_.stepped)
+    advance_to(now_s);  // the physics catches up with the wall clock under the valves applied so far
   if (pending_fresh_) {
     commanded_ = to_valves(pending_);
     const bool step = params_.stepped && pending_in_sequence_;
@@ -223,7 +237,9 @@ double RigServer::service(lcm::LCM* bus, double now_s) {
     }
   }
   const double next_s = std::min(next_publish_s_, next_limits_s_);
-  return session_ != 0 && params_.command_timeout_enforced ? std::min(next_s, last_command_s_ + params_.command_timeout_s) : next_s;
+  return session_ != 0 && params_.command_timeout_enforced
+             ? std::min(next_s, last_command_s_ + params_.command_timeout_s)
+             : next_s;
 }
 
 void RigServer::finish(lcm::LCM* bus, double now_s) {

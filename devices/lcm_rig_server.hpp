@@ -11,9 +11,9 @@
 // commands stop for `command_timeout_s`, or the arm leaves the rig's angle range, it vents and drops
 // the session: tripped, it goes on naming that session and its last command in its states (with
 // FAULT_NO_SESSION and the reason's bit, and already its new offer) for `command_timeout_s`, so
-// that the engine it served reads why; then its states name no session. A chamber above the rig's ceiling is vented whatever the
-// command. With a key, a command whose MAC does not match is counted and ignored, and every state
-// is signed. Everything refused is counted, in the states and in the log.
+// that the engine it served reads why; then its states name no session. A chamber above the rig's ceiling is vented
+// whatever the command. With a key, a command whose MAC does not match is counted and ignored, and every state is
+// signed. Everything refused is counted, in the states and in the log.
 //
 // Joints: it serves any Device of J joints (the single-joint SimulatedArm, or the J-joint
 // SimulatedArmChain for `[arm] preset`). With one joint it speaks io_command_t / io_state_t exactly
@@ -43,11 +43,11 @@
 namespace bellows {
 
 struct RigServerParameters {
-  double period_s = 1.0 / 200.0;     // state publication period, [timing] tick_s
-  double command_timeout_s = 0.05;   // [lcm] rig_timeout_s
-  std::int64_t seq_window = 100;     // [lcm] seq_window
-  RigLimits limits;                  // RigLimits::from(configuration)
-  LcmKey key;                        // [lcm] key_file; none: nothing checked or signed
+  double period_s = 1.0 / 200.0;    // state publication period, [timing] tick_s
+  double command_timeout_s = 0.05;  // [lcm] rig_timeout_s
+  std::int64_t seq_window = 100;    // [lcm] seq_window
+  RigLimits limits;                 // RigLimits::from(configuration)
+  LcmKey key;                       // [lcm] key_file; none: nothing checked or signed
   /// false: a drill (`io-sim --no-command-timeout`): the rig announces its timeout but never vents
   /// when the commands stop, as a driver that forgot to (`rig check --device lcm` must catch it).
   bool command_timeout_enforced = true;
@@ -64,17 +64,17 @@ struct RigServerParameters {
 
 struct RigServerStats {
   std::int64_t rig_id = 0;
-  ReceiveCounts commands;            // io_command_t received, by outcome
-  std::uint64_t not_addressed = 0;   // valid commands addressed to another rig or to none (not in `commands`)
+  ReceiveCounts commands;           // io_command_t received, by outcome
+  std::uint64_t not_addressed = 0;  // valid commands addressed to another rig or to none (not in `commands`)
   std::uint64_t vents_obeyed_out_of_sequence = 0;  // vents applied whose session or seq did not fit
   std::uint64_t states_published = 0;
-  std::uint64_t sessions_served = 0; // sessions bound, one after another
-  std::uint64_t timeouts = 0;        // times the rig vented because commands stopped
+  std::uint64_t sessions_served = 0;       // sessions bound, one after another
+  std::uint64_t timeouts = 0;              // times the rig vented because commands stopped
   std::uint64_t pressure_limit_trips = 0;  // times a chamber crossed the ceiling and was vented
   std::uint64_t angle_limit_trips = 0;     // times the arm left the range: vented, session dropped
-  std::uint64_t missed_periods = 0;  // periods skipped because the thread woke too late
-  std::int64_t serving = 0;          // the session bound now, 0: none
-  std::int64_t binding = 0;          // offered now (free) or in force (serving): public, in every state
+  std::uint64_t missed_periods = 0;        // periods skipped because the thread woke too late
+  std::int64_t serving = 0;                // the session bound now, 0: none
+  std::int64_t binding = 0;                // offered now (free) or in force (serving): public, in every state
 };
 
 class RigServer final : public LcmEndpoint {
@@ -97,11 +97,20 @@ class RigServer final : public LcmEndpoint {
 
  private:
   // What the log reports once per binding (the refusals first).
-  enum class Notice : std::uint8_t { kOldVersion, kUnauthenticated, kOtherJoints, kForeign, kJump, kPressureLimit, kAngleLimit, kCount };
+  enum class Notice : std::uint8_t {
+    kOldVersion,
+    kUnauthenticated,
+    kOtherJoints,
+    kForeign,
+    kJump,
+    kPressureLimit,
+    kAngleLimit,
+    kCount
+  };
 
   void obey_vent(const io_joints_command_t& vent);  // a vent addressed to this rig, outside its session's sequence
-  void advance_to(double now_s);  // free-running: the physics catches up with the wall clock
-  void advance_by(double dt_s);   // in integration steps, the limits checked after each
+  void advance_to(double now_s);                    // free-running: the physics catches up with the wall clock
+  void advance_by(double dt_s);                     // in integration steps, the limits checked after each
   void apply_limits(bool write);
   void release(std::int32_t fault_bits);  // vent, drop the session, offer a new binding
   void notice(Notice kind, const std::string& line);
@@ -119,12 +128,12 @@ class RigServer final : public LcmEndpoint {
   io_joints_command_t received_{};
   io_joints_command_t pending_{};
   bool pending_fresh_ = false;
-  bool pending_in_sequence_ = false;  // the session's own command (else a vent obeyed out of sequence)
+  bool pending_in_sequence_ = false;                 // the session's own command (else a vent obeyed out of sequence)
   ValveCommand commanded_ = ValveCommand::vented();  // the session's latest, before the limits
-  std::int32_t limit_bits_ = 0;     // the limits acting now
-  std::int32_t limit_bits_since_state_ = 0;  // and those that acted since the last state
-  std::int64_t binding_ = 0;        // offered while free, in force while serving
-  std::int64_t session_ = 0;        // bound now
+  std::int32_t limit_bits_ = 0;                      // the limits acting now
+  std::int32_t limit_bits_since_state_ = 0;          // and those that acted since the last state
+  std::int64_t binding_ = 0;                         // offered while free, in force while serving
+  std::int64_t session_ = 0;                         // bound now
   std::int64_t last_seq_ = 0;
   std::int64_t applied_seq_ = 0;
   std::int32_t fault_bits_ = io_state_t::FAULT_NO_SESSION;

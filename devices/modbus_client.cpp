@@ -29,12 +29,18 @@ constexpr double kStopSlice_s = 0.02;
 
 const char* exception_name(int code) {
   switch (code) {
-    case 1: return "ILLEGAL FUNCTION";
-    case 2: return "ILLEGAL DATA ADDRESS";
-    case 3: return "ILLEGAL DATA VALUE";
-    case 4: return "SLAVE DEVICE FAILURE";
-    case 6: return "SLAVE DEVICE BUSY";
-    default: return "exception";
+    case 1:
+      return "ILLEGAL FUNCTION";
+    case 2:
+      return "ILLEGAL DATA ADDRESS";
+    case 3:
+      return "ILLEGAL DATA VALUE";
+    case 4:
+      return "SLAVE DEVICE FAILURE";
+    case 6:
+      return "SLAVE DEVICE BUSY";
+    default:
+      return "exception";
   }
 }
 
@@ -125,7 +131,9 @@ std::string ModbusClient::connect(double timeout_s) {
     int error = 0;
     socklen_t length = sizeof error;
     if (ready > 0 && getsockopt(fd_, SOL_SOCKET, SO_ERROR, &error, &length) == 0 && error == 0) break;
-    last_error_ = interrupted_ ? "interrupted" : ready == 0 ? "no answer within " + milliseconds(timeout_s) : std::strerror(error != 0 ? error : errno);
+    last_error_ = interrupted_ ? "interrupted"
+                  : ready == 0 ? "no answer within " + milliseconds(timeout_s)
+                               : std::strerror(error != 0 ? error : errno);
     close();
     if (interrupted_ || ready == 0) break;
   }
@@ -220,7 +228,9 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     const int got = receive_frame(deadline);
     if (got == 0) {
       timed_out_ = !interrupted_;
-      return fail(interrupted_ ? "interrupted" : "no answer within " + milliseconds(std::max(0.0, deadline - start)) + " (the exchange's deadline)");
+      return fail(interrupted_ ? "interrupted"
+                               : "no answer within " + milliseconds(std::max(0.0, deadline - start)) +
+                                     " (the exchange's deadline)");
     }
     if (got < 0) return false;
     const std::size_t frame = 6 + get16(&rx_[4]);
@@ -235,8 +245,8 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
       char why[80];
       std::snprintf(why, sizeof why, "%s (Modbus exception %d)", exception_name(last_exception_), last_exception_);
       last_error_ = why;
-    } else if (mine && fc == function && function == kReadHolding && pdu_size == 1 + 2 * static_cast<std::size_t>(count) &&
-               pdu[0] == 2 * count) {
+    } else if (mine && fc == function && function == kReadHolding &&
+               pdu_size == 1 + 2 * static_cast<std::size_t>(count) && pdu[0] == 2 * count) {
       for (int i = 0; i < count; ++i) out[i] = static_cast<std::uint16_t>(get16(pdu + 1 + 2 * i));
       ok = true;
     } else if (mine && fc == function && function == kWriteMultiple && pdu_size == 4 &&
@@ -251,7 +261,9 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     // cannot be trusted (issue 24's words: it is no exception the device sent).
     const auto behind = static_cast<std::uint16_t>(tid - frame_tid);
     if (!mine && (behind == 0 || behind > 0x7fff)) {
-      lose_connection("a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no exception");
+      lose_connection(
+          "a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no "
+          "exception");
       return false;
     }
     if (!mine) {

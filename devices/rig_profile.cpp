@@ -20,9 +20,12 @@ PhysicalBounds physical_bounds(SensorRole role) {
   switch (role) {
     case SensorRole::kChamberA:
     case SensorRole::kChamberB:
-    case SensorRole::kSupply: return {0.0, 50.0};                                        // bar, absolute
-    case SensorRole::kAngle: return {-2.0 * std::numbers::pi, 2.0 * std::numbers::pi};  // rad
-    case SensorRole::kTemperature: return {173.15, 473.15};                              // K: -100..200 C
+    case SensorRole::kSupply:
+      return {0.0, 50.0};  // bar, absolute
+    case SensorRole::kAngle:
+      return {-2.0 * std::numbers::pi, 2.0 * std::numbers::pi};  // rad
+    case SensorRole::kTemperature:
+      return {173.15, 473.15};  // K: -100..200 C
   }
   return {0.0, 0.0};
 }
@@ -38,36 +41,50 @@ bool is_t7_range(double range_V) {
 
 const char* to_string(SensorRole role) {
   switch (role) {
-    case SensorRole::kChamberA: return "chamber_a";
-    case SensorRole::kChamberB: return "chamber_b";
-    case SensorRole::kSupply: return "supply";
-    case SensorRole::kAngle: return "angle";
-    case SensorRole::kTemperature: return "temperature";
+    case SensorRole::kChamberA:
+      return "chamber_a";
+    case SensorRole::kChamberB:
+      return "chamber_b";
+    case SensorRole::kSupply:
+      return "supply";
+    case SensorRole::kAngle:
+      return "angle";
+    case SensorRole::kTemperature:
+      return "temperature";
   }
   return "?";
 }
 
 const char* to_string(ValveRole role) {
   switch (role) {
-    case ValveRole::kInletA: return "inlet_a";
-    case ValveRole::kInletB: return "inlet_b";
-    case ValveRole::kOutletA: return "outlet_a";
-    case ValveRole::kOutletB: return "outlet_b";
+    case ValveRole::kInletA:
+      return "inlet_a";
+    case ValveRole::kInletB:
+      return "inlet_b";
+    case ValveRole::kOutletA:
+      return "outlet_a";
+    case ValveRole::kOutletB:
+      return "outlet_b";
   }
   return "?";
 }
 
 const char* calibrated_unit(SensorRole role) {
   switch (role) {
-    case SensorRole::kAngle: return "rad";
-    case SensorRole::kTemperature: return "K";
-    default: return "bar";
+    case SensorRole::kAngle:
+      return "rad";
+    case SensorRole::kTemperature:
+      return "K";
+    default:
+      return "bar";
   }
 }
 
 void validate_rig_profile(const RigProfile& p) {
   const std::string where = "rig profile " + p.source + ": ";
-  const auto fail = [&](const std::string& key, const std::string& what) { throw InputError(where + key + ": " + what); };
+  const auto fail = [&](const std::string& key, const std::string& what) {
+    throw InputError(where + key + ": " + what);
+  };
   if (p.name.empty()) fail("name", "must not be empty");
   if (!(p.pwm_frequency_hz >= 1.0 && p.pwm_frequency_hz <= 10000.0)) {
     fail("pwm_frequency_hz", "must be between 1 and 10000 Hz, not " + std::to_string(p.pwm_frequency_hz));
@@ -78,7 +95,8 @@ void validate_rig_profile(const RigProfile& p) {
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = p.input(role);
     const std::string section = std::string("[inputs.") + to_string(role) + "] ";
-    if (c.ain < 0) fail(section + "ain", "missing: every input (chamber_a, chamber_b, supply, angle, temperature) needs one");
+    if (c.ain < 0)
+      fail(section + "ain", "missing: every input (chamber_a, chamber_b, supply, angle, temperature) needs one");
     if (c.ain >= t7::kAinCount) fail(section + "ain", "a T7 has AIN0..AIN13, not AIN" + std::to_string(c.ain));
     for (SensorRole other : kSensorRoles) {
       if (other < role && p.input(other).ain == c.ain) {
@@ -90,10 +108,12 @@ void validate_rig_profile(const RigProfile& p) {
     if (!std::isfinite(c.offset)) fail(section + "offset", "must be a number");
     if (!(c.volts_min_V < c.volts_max_V)) fail(section + "volts_min_V", "must be below volts_max_V");
     if (c.volts_min_V < -c.range_V || c.volts_max_V > c.range_V) {
-      fail(section + "volts_max_V", "the valid voltages must lie inside the input range +-" + std::to_string(c.range_V) + " V");
+      fail(section + "volts_max_V",
+           "the valid voltages must lie inside the input range +-" + std::to_string(c.range_V) + " V");
     }
     if (c.resolution_index < 0 || c.resolution_index > t7::kMaxResolutionIndexT7Pro) {
-      fail(section + "resolution_index", "a T7 samples at index 0..8 (0..12 on a T7-Pro), not " + std::to_string(c.resolution_index));
+      fail(section + "resolution_index",
+           "a T7 samples at index 0..8 (0..12 on a T7-Pro), not " + std::to_string(c.resolution_index));
     }
     if (!(c.settling_us >= 0.0 && c.settling_us <= t7::kMaxSettling_us)) {
       fail(section + "settling_us", "must be 0 (automatic) up to 50000 us");
@@ -103,8 +123,9 @@ void validate_rig_profile(const RigProfile& p) {
       const double value = c.value(volts);
       if (!(value >= bounds.low && value <= bounds.high)) {
         char what[200];
-        std::snprintf(what, sizeof what, "maps %.3g V to %.4g %s, outside anything a %s sensor can read (%g..%g %s)", volts,
-                      value, calibrated_unit(role), to_string(role), bounds.low, bounds.high, calibrated_unit(role));
+        std::snprintf(what, sizeof what, "maps %.3g V to %.4g %s, outside anything a %s sensor can read (%g..%g %s)",
+                      volts, value, calibrated_unit(role), to_string(role), bounds.low, bounds.high,
+                      calibrated_unit(role));
         fail(section + "gain_per_V", what);
       }
     }

@@ -54,13 +54,13 @@ struct SensorCalibration {
 };
 
 struct RigProfile {
-  std::string name;                        // e.g. "paper-rig"
-  std::string source;                      // the file it came from (for messages)
+  std::string name;                                          // e.g. "paper-rig"
+  std::string source;                                        // the file it came from (for messages)
   std::array<SensorCalibration, kSensorRoleCount> inputs{};  // by SensorRole
   std::array<int, kValveRoleCount> valve_dio{};              // DIO number by ValveRole
   double pwm_frequency_hz = 200.0;
-  double angle_zero_rad = 0.0;             // subtracted from the calibrated angle
-  std::optional<ModelParameters> model;    // identified on this rig, if it was
+  double angle_zero_rad = 0.0;           // subtracted from the calibrated angle
+  std::optional<ModelParameters> model;  // identified on this rig, if it was
 
   const SensorCalibration& input(SensorRole role) const { return inputs[static_cast<int>(role)]; }
   SensorCalibration& input(SensorRole role) { return inputs[static_cast<int>(role)]; }

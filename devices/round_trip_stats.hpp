@@ -34,7 +34,9 @@ class RoundTripStats {
     std::vector<float> values(kept);
     for (std::size_t i = 0; i < kept; ++i) values[i] = ring_[i].load(std::memory_order_relaxed);
     std::sort(values.begin(), values.end());
-    const auto at = [&](double q) { return static_cast<double>(values[static_cast<std::size_t>(q * static_cast<double>(kept - 1))]); };
+    const auto at = [&](double q) {
+      return static_cast<double>(values[static_cast<std::size_t>(q * static_cast<double>(kept - 1))]);
+    };
     health.round_trip_p50_ms = at(0.5);
     health.round_trip_p99_ms = at(0.99);
     health.round_trip_max_ms = values.back();

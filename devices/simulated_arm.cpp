@@ -10,19 +10,26 @@
 #include "engine/base/units.hpp"
 
 namespace bellows {
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 const char* to_string(SimulatedFault fault) {
   switch (fault) {
-    case SimulatedFault::kNone: return "none";
-    case SimulatedFault::kSensorDropout: return "sensor-dropout";
-    case SimulatedFault::kStuckInlet: return "stuck-inlet";
-    case SimulatedFault::kSupplyLoss: return "supply-loss";
-    case SimulatedFault::kNanAngle: return "nan-angle";
-    case SimulatedFault::kPressureSpike: return "pressure-spike";
-    case SimulatedFault::kSwappedChambers: return "swapped-chambers";
-    case SimulatedFault::kDeadInlet: return "dead-inlet";
+    case SimulatedFault::kNone:
+      return "none";
+    case SimulatedFault::kSensorDropout:
+      return "sensor-dropout";
+    case SimulatedFault::kStuckInlet:
+      return "stuck-inlet";
+    case SimulatedFault::kSupplyLoss:
+      return "supply-loss";
+    case SimulatedFault::kNanAngle:
+      return "nan-angle";
+    case SimulatedFault::kPressureSpike:
+      return "pressure-spike";
+    case SimulatedFault::kSwappedChambers:
+      return "swapped-chambers";
+    case SimulatedFault::kDeadInlet:
+      return "dead-inlet";
   }
   return "?";
 }
@@ -33,12 +40,16 @@ SimulatedFault simulated_fault_from_string(const std::string& name) {
                      SimulatedFault::kSwappedChambers, SimulatedFault::kDeadInlet}) {
     if (name == to_string(fault)) return fault;
   }
-  throw InputError("unknown simulated fault '" + name +
-                   "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet)");
+  throw InputError(
+      "unknown simulated fault '" + name +
+      "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet)");
 }
 
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)
-    : params_(params), bellows_(bellows_of(params), params.gas), supply_Pa_(params.supply_bar * kPaPerBar), noise_(seed) {
+    : params_(params),
+      bellows_(bellows_of(params), params.gas),
+      supply_Pa_(params.supply_bar * kPaPerBar),
+      noise_(seed) {
   state_.chamber_Pa = {params.gas.ambient_bar * kPaPerBar, params.gas.ambient_bar * kPaPerBar};
   state_.command = ValveCommand::vented().joint[0];
   state_.noise = noise_.state();
@@ -71,7 +82,9 @@ void SimulatedArm::set_state(const State& state) {
   noise_.set_state(state.noise);
 }
 
-double SimulatedArm::chamber_volume_m3(int actuator) const { return bellows_.chamber_volume_m3(actuator, state_.angle_rad); }
+double SimulatedArm::chamber_volume_m3(int actuator) const {
+  return bellows_.chamber_volume_m3(actuator, state_.angle_rad);
+}
 
 double SimulatedArm::air_mass_kg() const { return bellows_.air_mass_kg(state_.angle_rad, state_.chamber_Pa); }
 
@@ -82,8 +95,8 @@ SensorReading SimulatedArm::read_sensors() {
   r.time_s = state_.time_s;
   const double resolution_rad = params_.encoder_resolution_deg * kRadPerDeg;
   JointReading& joint = r.joint[0];
-  joint.angle_rad = resolution_rad > 0.0 ? std::round(state_.angle_rad / resolution_rad) * resolution_rad
-                                         : state_.angle_rad;
+  joint.angle_rad =
+      resolution_rad > 0.0 ? std::round(state_.angle_rad / resolution_rad) * resolution_rad : state_.angle_rad;
   for (int i = 0; i < kActuatorCount; ++i) {
     joint.chamber_bar[i] = state_.chamber_Pa[i] / kPaPerBar + params_.pressure_noise_bar * noise_.standard_normal();
   }
@@ -140,7 +153,8 @@ SimulatedArm::Physical SimulatedArm::derivative(const Physical& x, const Bellows
   const double beyond = std::abs(x.angle_rad) - stop_rad;
   if (beyond > 0.0) {
     const double direction = x.angle_rad > 0.0 ? 1.0 : -1.0;
-    acceleration -= direction * p.hard_stop_stiffness_per_s2 * beyond + p.hard_stop_damping_per_s * x.velocity_rad_per_s;
+    acceleration -=
+        direction * p.hard_stop_stiffness_per_s2 * beyond + p.hard_stop_damping_per_s * x.velocity_rad_per_s;
   }
   return {x.velocity_rad_per_s, acceleration, (p.creep_gain * x.angle_rad - x.creep_rad) / p.creep_tau_s,
           pressure_rate[0], pressure_rate[1]};

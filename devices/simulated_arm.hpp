@@ -22,13 +22,13 @@ namespace bellows {
 /// Faults the simulated arm can suffer, so that every guard is tested against one it must catch.
 enum class SimulatedFault : std::uint8_t {
   kNone,
-  kSensorDropout,   // the sensors stop updating: readings frozen, their time too
-  kStuckInlet,      // actuator A's inlet valve stays fully open whatever is commanded
-  kSupplyLoss,      // the supply pressure falls to ambient
-  kNanAngle,        // the encoder reads NaN
-  kPressureSpike,   // chamber A's sensor reads a spike of `spike_bar` for `spike_s`
-  kSwappedChambers, // the tubes are crossed: A's valves feed and vent chamber B, and B's chamber A
-  kDeadInlet,       // actuator A's inlet valve never opens whatever is commanded
+  kSensorDropout,    // the sensors stop updating: readings frozen, their time too
+  kStuckInlet,       // actuator A's inlet valve stays fully open whatever is commanded
+  kSupplyLoss,       // the supply pressure falls to ambient
+  kNanAngle,         // the encoder reads NaN
+  kPressureSpike,    // chamber A's sensor reads a spike of `spike_bar` for `spike_s`
+  kSwappedChambers,  // the tubes are crossed: A's valves feed and vent chamber B, and B's chamber A
+  kDeadInlet,        // actuator A's inlet valve never opens whatever is commanded
 };
 
 /// "none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike",
@@ -44,10 +44,10 @@ class SimulatedArm final : public Device {
     double time_s = 0.0;
     double angle_rad = 0.0;
     double angular_velocity_rad_per_s = 0.0;
-    double creep_rad = 0.0;                        // z of the viscoelastic creep
+    double creep_rad = 0.0;  // z of the viscoelastic creep
     std::array<double, kActuatorCount> chamber_Pa{};
-    double pwm_phase_s = 0.0;                      // time since the current PWM period began
-    JointValves command{};                         // duty cycles of the current period (one joint)
+    double pwm_phase_s = 0.0;  // time since the current PWM period began
+    JointValves command{};     // duty cycles of the current period (one joint)
     GaussianNoise::State noise{};
     SimulatedFault fault = SimulatedFault::kNone;  // active fault
     double fault_since_s = 0.0;

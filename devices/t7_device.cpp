@@ -26,9 +26,7 @@ constexpr double kOutboxPoll_s = 0.0005;
 constexpr std::size_t kRoundTripWindow = 4096;
 constexpr std::size_t kRoundTripRefresh = 64;
 
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 std::string seconds_text(double s) {
   char text[32];
@@ -42,7 +40,6 @@ void sleep_s(double seconds) {
   t.tv_nsec = static_cast<long>((seconds - static_cast<double>(t.tv_sec)) * 1e9);
   nanosleep(&t, nullptr);
 }
-
 
 // The T7's wiring drives one joint: a command for another joint count vents it.
 ValveCommand clamped(const ValveCommand& command) {
@@ -59,10 +56,14 @@ ValveCommand clamped(const ValveCommand& command) {
 double duty_of(const ValveCommand& command, ValveRole role) {
   const JointValves& c = command.joint[0];
   switch (role) {
-    case ValveRole::kInletA: return c.inlet_duty[0];
-    case ValveRole::kInletB: return c.inlet_duty[1];
-    case ValveRole::kOutletA: return c.outlet_duty[0];
-    case ValveRole::kOutletB: return c.outlet_duty[1];
+    case ValveRole::kInletA:
+      return c.inlet_duty[0];
+    case ValveRole::kInletB:
+      return c.inlet_duty[1];
+    case ValveRole::kOutletA:
+      return c.outlet_duty[0];
+    case ValveRole::kOutletB:
+      return c.outlet_duty[1];
   }
   return 0.0;
 }
@@ -102,8 +103,8 @@ T7Device::T7Device(T7DeviceOptions options)
   client_.set_response_timeout(connect_timeout_s);
   if (const std::string why = client_.connect(connect_timeout_s); !why.empty()) {
     if (client_.interrupted()) throw Cancelled("t7 " + address_ + ": connecting interrupted");
-    throw EnvironmentError("t7 " + address_ + ": cannot connect within [t7] connect_timeout_s = " + seconds_text(connect_timeout_s) +
-                           " (" + why + ")");
+    throw EnvironmentError("t7 " + address_ + ": cannot connect within [t7] connect_timeout_s = " +
+                           seconds_text(connect_timeout_s) + " (" + why + ")");
   }
   configure();
   client_.set_stop(nullptr);  // from here on the I/O thread owns the link: its last word is a vent
@@ -125,13 +126,15 @@ void T7Device::stop() {
 // "writing DIO2_EF_CONFIG_A (44304) refused: Modbus exception 4 (SLAVE DEVICE FAILURE), LabJack
 // error 2565 EF_VALUE_GREATER_THAN_PERIOD": a T7 keeps its own error number in LAST_ERR_DETAIL.
 std::string T7Device::refusal(const char* what, int address) {
-  std::string why = std::string(what) + " (" + t7::register_name(address) + ", " + std::to_string(address) + ") refused: " + client_.last_error();
+  std::string why = std::string(what) + " (" + t7::register_name(address) + ", " + std::to_string(address) +
+                    ") refused: " + client_.last_error();
   if (client_.last_exception() != 0) {
     const std::string exception = client_.last_error();
     std::uint16_t detail = 0;
     if (client_.read_u16(t7::kLastErrDetail, detail) && detail != 0) {
       why += ", LabJack error " + std::to_string(detail);
-      if (*t7::error_name(detail) != '\0') why += std::string(" ") + t7::error_name(detail) + ": " + t7::error_description(detail);
+      if (*t7::error_name(detail) != '\0')
+        why += std::string(" ") + t7::error_name(detail) + ": " + t7::error_description(detail);
     }
   }
   return why;
@@ -141,8 +144,9 @@ void T7Device::require(bool ok, const char* what, int address) {
   if (ok) return;
   if (client_.interrupted()) throw Cancelled("t7 " + address_ + ": configuring interrupted");
   if (client_.timed_out()) {
-    throw EnvironmentError("t7 " + address_ + ": no answer within [t7] connect_timeout_s = " + seconds_text(options_.link.connect_timeout_s) +
-                           " while configuring (" + what + " " + t7::register_name(address) + ")");
+    throw EnvironmentError("t7 " + address_ + ": no answer within [t7] connect_timeout_s = " +
+                           seconds_text(options_.link.connect_timeout_s) + " while configuring (" + what + " " +
+                           t7::register_name(address) + ")");
   }
   throw EnvironmentError("t7 " + address_ + ": " + refusal(what, address));
 }
@@ -161,9 +165,9 @@ void T7Device::configure() {
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = options_.profile.input(role);
     if (c.resolution_index > t7::max_resolution_index(product_)) {
-      throw EnvironmentError("t7 " + address_ + ": rig profile " + options_.profile.source + ": [inputs." + to_string(role) +
-                             "] resolution_index = " + std::to_string(c.resolution_index) + " needs a T7-Pro; this is a " +
-                             t7::to_string(product_) + " (indices 1..8)");
+      throw EnvironmentError("t7 " + address_ + ": rig profile " + options_.profile.source + ": [inputs." +
+                             to_string(role) + "] resolution_index = " + std::to_string(c.resolution_index) +
+                             " needs a T7-Pro; this is a " + t7::to_string(product_) + " (indices 1..8)");
     }
   }
   try {
@@ -185,8 +189,8 @@ void T7Device::configure_inputs() {
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = options_.profile.input(role);
     require(client_.write_float(t7::kAinRange(c.ain), c.range_V), "setting", t7::kAinRange(c.ain));
-    require(client_.write_u16(t7::kAinResolutionIndex(c.ain), static_cast<std::uint16_t>(c.resolution_index)), "setting",
-            t7::kAinResolutionIndex(c.ain));
+    require(client_.write_u16(t7::kAinResolutionIndex(c.ain), static_cast<std::uint16_t>(c.resolution_index)),
+            "setting", t7::kAinResolutionIndex(c.ain));
     require(client_.write_float(t7::kAinSettling_us(c.ain), c.settling_us), "setting", t7::kAinSettling_us(c.ain));
   }
 }
@@ -200,7 +204,8 @@ void T7Device::configure_clock() {
     require(client_.read_u16(t7::kClockEnable(clock), enabled), "reading", t7::kClockEnable(clock));
     if (enabled != 0) require(client_.write_u16(t7::kClockEnable(clock), 0), "disabling", t7::kClockEnable(clock));
   }
-  require(client_.write_u16(t7::kClock0Divisor, static_cast<std::uint16_t>(clock_.divisor)), "setting", t7::kClock0Divisor);
+  require(client_.write_u16(t7::kClock0Divisor, static_cast<std::uint16_t>(clock_.divisor)), "setting",
+          t7::kClock0Divisor);
   require(client_.write_u32(t7::kClock0RollValue, clock_.roll), "setting", t7::kClock0RollValue);
   require(client_.write_u16(t7::kClock0Enable, 1), "enabling", t7::kClock0Enable);
 }
@@ -217,7 +222,8 @@ void T7Device::configure_lines() {
     if (enabled != 0) require(client_.write_u32(t7::kDioEfEnable(dio), 0), "disabling", t7::kDioEfEnable(dio));
     require(client_.write_u32(t7::kDioEfIndex(dio), t7::kEfIndexPwmOut), "setting", t7::kDioEfIndex(dio));
     require(client_.write_u32(t7::kDioEfClockSource(dio), 0), "setting", t7::kDioEfClockSource(dio));
-    require(client_.write_u32(t7::kDioEfConfigA(dio), clock_.config_a(duty_of(vented, role))), "setting", t7::kDioEfConfigA(dio));
+    require(client_.write_u32(t7::kDioEfConfigA(dio), clock_.config_a(duty_of(vented, role))), "setting",
+            t7::kDioEfConfigA(dio));
     require(client_.write_u16(t7::kFio(dio), 0), "driving low", t7::kFio(dio));
     require(client_.write_u32(t7::kDioEfEnable(dio), 1), "enabling", t7::kDioEfEnable(dio));
   }
@@ -353,11 +359,21 @@ bool T7Device::exchange(const ValveCommand& valves) {
     const bool valid = c.valid(volts);
     const double value = c.value(volts);
     switch (role) {
-      case SensorRole::kChamberA: r.joint[0].chamber_bar[0] = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kChamberB: r.joint[0].chamber_bar[1] = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kSupply: r.supply_bar = valid ? value : kOutOfRangePressure_bar; break;
-      case SensorRole::kAngle: r.joint[0].angle_rad = valid ? value - angle_zero_rad() : kOutOfRangeAngle_rad; break;
-      case SensorRole::kTemperature: r.temperature_K = valid ? value : NAN; break;  // no guard watches it
+      case SensorRole::kChamberA:
+        r.joint[0].chamber_bar[0] = valid ? value : kOutOfRangePressure_bar;
+        break;
+      case SensorRole::kChamberB:
+        r.joint[0].chamber_bar[1] = valid ? value : kOutOfRangePressure_bar;
+        break;
+      case SensorRole::kSupply:
+        r.supply_bar = valid ? value : kOutOfRangePressure_bar;
+        break;
+      case SensorRole::kAngle:
+        r.joint[0].angle_rad = valid ? value - angle_zero_rad() : kOutOfRangeAngle_rad;
+        break;
+      case SensorRole::kTemperature:
+        r.temperature_K = valid ? value : NAN;
+        break;  // no guard watches it
     }
   }
   // The device's own clock, strictly increasing: the engine's stale guard watches it.
@@ -368,13 +384,15 @@ bool T7Device::exchange(const ValveCommand& valves) {
 }
 
 void T7Device::fail_link(const std::string& why) {
-  if (!link_up_.load(std::memory_order_relaxed)) return;  // reported at the start of the streak (only this thread writes it)
+  if (!link_up_.load(std::memory_order_relaxed))
+    return;  // reported at the start of the streak (only this thread writes it)
   if (!error_published_.load(std::memory_order_acquire)) {
     link_error_ = why;
     error_published_.store(true, std::memory_order_release);
   }
   link_up_.store(false, std::memory_order_release);  // after the error: whoever sees the link down can read why
-  std::fprintf(stderr, "bellows: t7 link %s: %s: no fresh readings while it lasts (the engine holds, then faults and vents)\n",
+  std::fprintf(stderr,
+               "bellows: t7 link %s: %s: no fresh readings while it lasts (the engine holds, then faults and vents)\n",
                address_.c_str(), why.c_str());
 }
 

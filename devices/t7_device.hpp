@@ -132,9 +132,9 @@ class T7Device final : public Device {
   int first_dio_ = 0, dio_span_ = 0;  // the CONFIG_A block written each exchange
   int ain_registers_ = 0;             // AIN0.. up to the highest input used, two registers each
 
-  LatestValue<Outgoing> outbox_;        // engine -> I/O
-  LatestValue<SensorReading> inbox_;    // I/O -> engine
-  SensorReading reading_{};             // engine thread's copy
+  LatestValue<Outgoing> outbox_;      // engine -> I/O
+  LatestValue<SensorReading> inbox_;  // I/O -> engine
+  SensorReading reading_{};           // engine thread's copy
 
   // I/O thread state (preallocated: the thread allocates nothing per exchange).
   std::vector<std::uint16_t> duty_registers_;
@@ -149,7 +149,7 @@ class T7Device final : public Device {
   std::atomic<bool> stop_{false};
   std::atomic<bool> link_up_{true};
   std::atomic<bool> error_published_{false};
-  std::string link_error_;  // written once before error_published_
+  std::string link_error_;                          // written once before error_published_
   std::array<char, kRefusalChars> refusal_text_{};  // written by the I/O thread while !refusal_pending_
   std::atomic<bool> refusal_pending_{false};
   std::array<std::atomic<double>, kSensorRoleCount> volts_{};

@@ -6,14 +6,14 @@
 
 namespace bellows::t7 {
 
-inline constexpr int kErrorIllegalDataAddress = 1202;    // LJME_MBE2_ILLEGAL_DATA_ADDRESS (exception 2)
-inline constexpr int kErrorIllegalDataValue = 1203;      // LJME_MBE3_ILLEGAL_DATA_VALUE (exception 3)
-inline constexpr int kErrorClockNotEnabled = 2554;       // EF_CLOCK_SOURCE_NOT_ENABLED
-inline constexpr int kErrorClock0NeedsClocks12Off = 2558;// EF_32BIT_REQUIRES_BOTH_CLOCK0and1
-inline constexpr int kErrorDivisorInvalid = 2559;        // EF_DIVISOR_VALUE_INVALID
-inline constexpr int kErrorLineMustBeLow = 2563;         // EF_LINE_MUST_BE_LOW_BEFORE_STARTING
-inline constexpr int kErrorValueGreaterThanPeriod = 2565;// EF_VALUE_GREATER_THAN_PERIOD
-inline constexpr int kErrorIndexChangeWhileEnabled = 2566;// EF_CAN_NOT_CHANGE_INDEX_WHILE_ENABLED
+inline constexpr int kErrorIllegalDataAddress = 1202;       // LJME_MBE2_ILLEGAL_DATA_ADDRESS (exception 2)
+inline constexpr int kErrorIllegalDataValue = 1203;         // LJME_MBE3_ILLEGAL_DATA_VALUE (exception 3)
+inline constexpr int kErrorClockNotEnabled = 2554;          // EF_CLOCK_SOURCE_NOT_ENABLED
+inline constexpr int kErrorClock0NeedsClocks12Off = 2558;   // EF_32BIT_REQUIRES_BOTH_CLOCK0and1
+inline constexpr int kErrorDivisorInvalid = 2559;           // EF_DIVISOR_VALUE_INVALID
+inline constexpr int kErrorLineMustBeLow = 2563;            // EF_LINE_MUST_BE_LOW_BEFORE_STARTING
+inline constexpr int kErrorValueGreaterThanPeriod = 2565;   // EF_VALUE_GREATER_THAN_PERIOD
+inline constexpr int kErrorIndexChangeWhileEnabled = 2566;  // EF_CAN_NOT_CHANGE_INDEX_WHILE_ENABLED
 
 /// LabJack's name for an error number ("EF_VALUE_GREATER_THAN_PERIOD"), or "" when bellows does not
 /// know it (static storage).

@@ -13,18 +13,18 @@
 
 namespace bellows::t7 {
 
-inline constexpr int kAinCount = 14;                  // AIN0..AIN13 on the T7's screw terminals and DB37
-inline constexpr int kAin(int n) { return 2 * n; }    // AIN# FLOAT32 volts, read only
+inline constexpr int kAinCount = 14;                             // AIN0..AIN13 on the T7's screw terminals and DB37
+inline constexpr int kAin(int n) { return 2 * n; }               // AIN# FLOAT32 volts, read only
 inline constexpr int kAinRange(int n) { return 40000 + 2 * n; }  // AIN#_RANGE FLOAT32 (+-V)
-inline constexpr int kAinResolutionIndex(int n) { return 41500 + n; }   // UINT16: 0 default, 1..8 (12 on a Pro)
-inline constexpr int kAinSettling_us(int n) { return 42000 + 2 * n; }   // FLOAT32 us: 0 auto, max 50000
-inline constexpr int kAinAllResolutionIndex = 43903;                    // UINT16, every AIN at once
+inline constexpr int kAinResolutionIndex(int n) { return 41500 + n; }  // UINT16: 0 default, 1..8 (12 on a Pro)
+inline constexpr int kAinSettling_us(int n) { return 42000 + 2 * n; }  // FLOAT32 us: 0 auto, max 50000
+inline constexpr int kAinAllResolutionIndex = 43903;                   // UINT16, every AIN at once
 
-inline constexpr int kDioCount = 23;                  // DIO0..DIO22
+inline constexpr int kDioCount = 23;                                         // DIO0..DIO22
 inline constexpr int kDioEfEnable(int dio) { return 44000 + 2 * dio; }       // UINT32
 inline constexpr int kDioEfIndex(int dio) { return 44100 + 2 * dio; }        // UINT32, 0 = PWM out
 inline constexpr int kDioEfClockSource(int dio) { return 44200 + 2 * dio; }  // UINT32, 0 = clock 0
-inline constexpr int kDioEfConfigA(int dio) { return 44300 + 2 * dio; }      // UINT32, PWM: count where the line goes low
+inline constexpr int kDioEfConfigA(int dio) { return 44300 + 2 * dio; }  // UINT32, PWM: count where the line goes low
 inline constexpr std::uint32_t kEfIndexPwmOut = 0;
 /// The T7 lines that can carry PWM out: FIO0 and FIO2..FIO5 (T-Series datasheet 13.2.2).
 inline constexpr std::array<int, 5> kPwmCapableDio = {0, 2, 3, 4, 5};
@@ -49,24 +49,27 @@ inline constexpr int kClock0RollValue = kClockRollValue(0);
 inline constexpr double kCoreClock_Hz = 80e6;
 inline constexpr std::array<int, 8> kClockDivisors = {1, 2, 4, 8, 16, 32, 64, 256};
 
-inline constexpr int kFio(int n) { return 2000 + n; }  // FIO#(0:7) UINT16: a write sets the line an output at that level
+inline constexpr int kFio(int n) {
+  return 2000 + n;
+}  // FIO#(0:7) UINT16: a write sets the line an output at that level
 inline constexpr int kFioCount = 8;
-inline constexpr int kDioState = 2800;         // UINT32 bit mask
-inline constexpr int kDioDirection = 2850;     // UINT32 bit mask, 1 = output
-inline constexpr int kDioInhibit = 2900;       // UINT32 bit mask, 1 = _STATE/_DIRECTION writes ignore the line
+inline constexpr int kDioState = 2800;      // UINT32 bit mask
+inline constexpr int kDioDirection = 2850;  // UINT32 bit mask, 1 = output
+inline constexpr int kDioInhibit = 2900;    // UINT32 bit mask, 1 = _STATE/_DIRECTION writes ignore the line
 
-inline constexpr int kProductId = 60000;       // FLOAT32, 7 for a T7 / T7-Pro
-inline constexpr int kFirmwareVersion = 60004; // FLOAT32
-inline constexpr int kHardwareInstalled = 60010;  // UINT32 bits: 0 high-resolution ADC (a T7-Pro), 1 WiFi, 2 RTC, 3 microSD
+inline constexpr int kProductId = 60000;        // FLOAT32, 7 for a T7 / T7-Pro
+inline constexpr int kFirmwareVersion = 60004;  // FLOAT32
+inline constexpr int kHardwareInstalled =
+    60010;  // UINT32 bits: 0 high-resolution ADC (a T7-Pro), 1 WiFi, 2 RTC, 3 microSD
 inline constexpr std::uint32_t kHardwareHighResolutionAdc = 1u;
-inline constexpr int kSerialNumber = 60028;    // UINT32
-inline constexpr int kLastErrDetail = 55000;          // UINT16: the last LabJack error number the device met
-inline constexpr int kLastErrTransactionId = 55003;   // UINT16: the Modbus TCP transaction that caused it
+inline constexpr int kSerialNumber = 60028;          // UINT32
+inline constexpr int kLastErrDetail = 55000;         // UINT16: the last LabJack error number the device met
+inline constexpr int kLastErrTransactionId = 55003;  // UINT16: the Modbus TCP transaction that caused it
 inline constexpr double kT7ProductId = 7.0;
 
-inline constexpr int kWatchdogEnable = 61600;        // UINT32; disable before writing the others
-inline constexpr int kWatchdogAdvanced = 61602;      // UINT32: 1 IO config to factory, 2 to power-up defaults
-inline constexpr int kWatchdogTimeout_s = 61604;     // UINT32 whole seconds
+inline constexpr int kWatchdogEnable = 61600;     // UINT32; disable before writing the others
+inline constexpr int kWatchdogAdvanced = 61602;   // UINT32: 1 IO config to factory, 2 to power-up defaults
+inline constexpr int kWatchdogTimeout_s = 61604;  // UINT32 whole seconds
 inline constexpr int kWatchdogStartupDelay_s = 61606;
 inline constexpr int kWatchdogStrictEnable = 61610;
 inline constexpr int kWatchdogStrictKey = 61612;
@@ -91,33 +94,51 @@ inline constexpr int kExceptionDeviceFailure = 4;
 /// LabJack's name of a register bellows or t7-sim uses ("DIO2_EF_CONFIG_A"; "register N" otherwise),
 /// for messages.
 inline std::string register_name(int a) {
-  const auto indexed = [](const char* prefix, int n, const char* suffix) { return prefix + std::to_string(n) + suffix; };
+  const auto indexed = [](const char* prefix, int n, const char* suffix) {
+    return prefix + std::to_string(n) + suffix;
+  };
   if (a >= kAin(0) && a < kAin(kAinCount)) return indexed("AIN", a / 2, "");
   if (a >= kFio(0) && a < kFio(kFioCount)) return indexed("FIO", a - kFio(0), "");
   if (a >= kAinRange(0) && a < kAinRange(kAinCount)) return indexed("AIN", (a - kAinRange(0)) / 2, "_RANGE");
-  if (a >= kAinResolutionIndex(0) && a < kAinResolutionIndex(kAinCount)) return indexed("AIN", a - kAinResolutionIndex(0), "_RESOLUTION_INDEX");
-  if (a >= kAinSettling_us(0) && a < kAinSettling_us(kAinCount)) return indexed("AIN", (a - kAinSettling_us(0)) / 2, "_SETTLING_US");
-  const std::pair<int, const char*> ef[] = {{kDioEfEnable(0), "_EF_ENABLE"}, {kDioEfIndex(0), "_EF_INDEX"},
-                                            {kDioEfClockSource(0), "_EF_CLOCK_SOURCE"}, {kDioEfConfigA(0), "_EF_CONFIG_A"}};
+  if (a >= kAinResolutionIndex(0) && a < kAinResolutionIndex(kAinCount))
+    return indexed("AIN", a - kAinResolutionIndex(0), "_RESOLUTION_INDEX");
+  if (a >= kAinSettling_us(0) && a < kAinSettling_us(kAinCount))
+    return indexed("AIN", (a - kAinSettling_us(0)) / 2, "_SETTLING_US");
+  const std::pair<int, const char*> ef[] = {{kDioEfEnable(0), "_EF_ENABLE"},
+                                            {kDioEfIndex(0), "_EF_INDEX"},
+                                            {kDioEfClockSource(0), "_EF_CLOCK_SOURCE"},
+                                            {kDioEfConfigA(0), "_EF_CONFIG_A"}};
   for (const auto& [first, suffix] : ef) {
     if (a >= first && a < first + 2 * kDioCount) return indexed("DIO", (a - first) / 2, suffix);
   }
   if (a >= kClockEnable(0) && a < kClockEnable(3)) {
     const int clock = (a - kClockEnable(0)) / 10;
-    const char* what[] = {"_ENABLE", "_DIVISOR", "_OPTIONS", "_OPTIONS", "_ROLL_VALUE", "_ROLL_VALUE", "", "", "_COUNT", "_COUNT"};
+    const char* what[] = {"_ENABLE",     "_DIVISOR", "_OPTIONS", "_OPTIONS", "_ROLL_VALUE",
+                          "_ROLL_VALUE", "",         "",         "_COUNT",   "_COUNT"};
     return indexed("DIO_EF_CLOCK", clock, what[(a - kClockEnable(0)) % 10]);
   }
-  const std::pair<int, const char*> named[] = {
-      {kAinAllResolutionIndex, "AIN_ALL_RESOLUTION_INDEX"}, {kDioState, "DIO_STATE"}, {kDioDirection, "DIO_DIRECTION"},
-      {kDioInhibit, "DIO_INHIBIT"}, {kProductId, "PRODUCT_ID"}, {kFirmwareVersion, "FIRMWARE_VERSION"},
-      {kHardwareInstalled, "HARDWARE_INSTALLED"}, {kSerialNumber, "SERIAL_NUMBER"}, {kLastErrDetail, "LAST_ERR_DETAIL"},
-      {kLastErrTransactionId, "LAST_ERR_TRANSACTION_ID"}, {kWatchdogEnable, "WATCHDOG_ENABLE_DEFAULT"},
-      {kWatchdogAdvanced, "WATCHDOG_ADVANCED_DEFAULT"}, {kWatchdogTimeout_s, "WATCHDOG_TIMEOUT_S_DEFAULT"},
-      {kWatchdogStartupDelay_s, "WATCHDOG_STARTUP_DELAY_S_DEFAULT"}, {kWatchdogStrictEnable, "WATCHDOG_STRICT_ENABLE_DEFAULT"},
-      {kWatchdogStrictKey, "WATCHDOG_STRICT_KEY_DEFAULT"}, {kWatchdogStrictClear, "WATCHDOG_STRICT_CLEAR"},
-      {kWatchdogResetEnable, "WATCHDOG_RESET_ENABLE_DEFAULT"}, {kWatchdogDioEnable, "WATCHDOG_DIO_ENABLE_DEFAULT"},
-      {kWatchdogDioState, "WATCHDOG_DIO_STATE_DEFAULT"}, {kWatchdogDioDirection, "WATCHDOG_DIO_DIRECTION_DEFAULT"},
-      {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"}};
+  const std::pair<int, const char*> named[] = {{kAinAllResolutionIndex, "AIN_ALL_RESOLUTION_INDEX"},
+                                               {kDioState, "DIO_STATE"},
+                                               {kDioDirection, "DIO_DIRECTION"},
+                                               {kDioInhibit, "DIO_INHIBIT"},
+                                               {kProductId, "PRODUCT_ID"},
+                                               {kFirmwareVersion, "FIRMWARE_VERSION"},
+                                               {kHardwareInstalled, "HARDWARE_INSTALLED"},
+                                               {kSerialNumber, "SERIAL_NUMBER"},
+                                               {kLastErrDetail, "LAST_ERR_DETAIL"},
+                                               {kLastErrTransactionId, "LAST_ERR_TRANSACTION_ID"},
+                                               {kWatchdogEnable, "WATCHDOG_ENABLE_DEFAULT"},
+                                               {kWatchdogAdvanced, "WATCHDOG_ADVANCED_DEFAULT"},
+                                               {kWatchdogTimeout_s, "WATCHDOG_TIMEOUT_S_DEFAULT"},
+                                               {kWatchdogStartupDelay_s, "WATCHDOG_STARTUP_DELAY_S_DEFAULT"},
+                                               {kWatchdogStrictEnable, "WATCHDOG_STRICT_ENABLE_DEFAULT"},
+                                               {kWatchdogStrictKey, "WATCHDOG_STRICT_KEY_DEFAULT"},
+                                               {kWatchdogStrictClear, "WATCHDOG_STRICT_CLEAR"},
+                                               {kWatchdogResetEnable, "WATCHDOG_RESET_ENABLE_DEFAULT"},
+                                               {kWatchdogDioEnable, "WATCHDOG_DIO_ENABLE_DEFAULT"},
+                                               {kWatchdogDioState, "WATCHDOG_DIO_STATE_DEFAULT"},
+                                               {kWatchdogDioDirection, "WATCHDOG_DIO_DIRECTION_DEFAULT"},
+                                               {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"}};
   for (const auto& [address, name] : named) {
     if (a == address || a == address + 1) return name;
   }
@@ -150,7 +171,8 @@ struct PwmClock {
 inline PwmClock pwm_clock_for(double frequency_hz) {
   for (int divisor : kClockDivisors) {
     const double roll = kCoreClock_Hz / (divisor * frequency_hz);
-    if (roll <= 4294967295.0) return {static_cast<std::uint32_t>(divisor), static_cast<std::uint32_t>(std::lround(roll))};
+    if (roll <= 4294967295.0)
+      return {static_cast<std::uint32_t>(divisor), static_cast<std::uint32_t>(std::lround(roll))};
   }
   return {256, 4294967295u};
 }

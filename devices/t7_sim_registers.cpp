@@ -17,7 +17,8 @@ T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0),
   allow(kAinSettling_us(0), 2 * kAinCount, true);
   allow(kAinAllResolutionIndex, 1, true);
   allow(kAinAllResolutionIndex + 1, 2, true);  // AIN_ALL_SETTLING_US
-  for (int first : {kDioEfEnable(0), kDioEfIndex(0), kDioEfClockSource(0), kDioEfConfigA(0)}) allow(first, 2 * kDioCount, true);
+  for (int first : {kDioEfEnable(0), kDioEfIndex(0), kDioEfClockSource(0), kDioEfConfigA(0)})
+    allow(first, 2 * kDioCount, true);
   for (int clock = 0; clock < 3; ++clock) {
     allow(kClockEnable(clock), 6, true);  // ENABLE, DIVISOR, OPTIONS, ROLL_VALUE
     allow(kClockCount(clock), 2, false);
@@ -35,9 +36,10 @@ T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0),
   allow(kProductId, 2, false);
   allow(kFirmwareVersion, 2, false);
   allow(kSerialNumber, 2, false);
-  for (int first : {kWatchdogEnable, kWatchdogAdvanced, kWatchdogTimeout_s, kWatchdogStartupDelay_s, kWatchdogStrictEnable,
-                    kWatchdogStrictKey, kWatchdogStrictClear, kWatchdogResetEnable, kWatchdogDioEnable, kWatchdogDioState,
-                    kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
+  for (int first :
+       {kWatchdogEnable, kWatchdogAdvanced, kWatchdogTimeout_s, kWatchdogStartupDelay_s, kWatchdogStrictEnable,
+        kWatchdogStrictKey, kWatchdogStrictClear, kWatchdogResetEnable, kWatchdogDioEnable, kWatchdogDioState,
+        kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
     allow(first, 2, true);
   }
   put_float(kT7ProductId, &registers_[kProductId]);
@@ -51,10 +53,12 @@ void T7SimRegisters::wrote(int address, int count) {
     if (a >= kFio(0) && a < kFio(kFioCount)) {
       const std::uint32_t bit = 1u << (a - kFio(0));
       set_u32(kDioDirection, u32(kDioDirection) | bit);
-      set_u32(kDioState, registers_[static_cast<std::size_t>(a)] != 0 ? (u32(kDioState) | bit) : (u32(kDioState) & ~bit));
+      set_u32(kDioState,
+              registers_[static_cast<std::size_t>(a)] != 0 ? (u32(kDioState) | bit) : (u32(kDioState) & ~bit));
     }
     if (a == kAinAllResolutionIndex) {
-      for (int n = 0; n < kAinCount; ++n) registers_[static_cast<std::size_t>(kAinResolutionIndex(n))] = registers_[static_cast<std::size_t>(a)];
+      for (int n = 0; n < kAinCount; ++n)
+        registers_[static_cast<std::size_t>(kAinResolutionIndex(n))] = registers_[static_cast<std::size_t>(a)];
     }
   }
 }
@@ -76,8 +80,12 @@ int T7SimRegisters::check(int function, int address, int count) const {
   return 0;
 }
 
-std::uint32_t T7SimRegisters::u32(int address) const { return t7::get_u32(&registers_[static_cast<std::size_t>(address)]); }
-void T7SimRegisters::set_u32(int address, std::uint32_t value) { t7::put_u32(value, &registers_[static_cast<std::size_t>(address)]); }
+std::uint32_t T7SimRegisters::u32(int address) const {
+  return t7::get_u32(&registers_[static_cast<std::size_t>(address)]);
+}
+void T7SimRegisters::set_u32(int address, std::uint32_t value) {
+  t7::put_u32(value, &registers_[static_cast<std::size_t>(address)]);
+}
 
 void T7SimRegisters::set_ain(int ain, double volts) {
   t7::put_float(volts, &registers_[static_cast<std::size_t>(t7::kAin(ain))]);
@@ -111,7 +119,8 @@ bool T7SimRegisters::run_watchdog(double now_s) {
     set_u32(kDioState, 0);
   }
   if (u32(kWatchdogDioEnable) == 1) {
-    const std::uint32_t direction = u32(kWatchdogDioDirection) & ~u32(kWatchdogDioInhibit);  // inhibited lines are left alone
+    const std::uint32_t direction =
+        u32(kWatchdogDioDirection) & ~u32(kWatchdogDioInhibit);  // inhibited lines are left alone
     for (int dio = 0; dio < kDioCount; ++dio) {
       if ((direction & (1u << dio)) != 0) set_u32(kDioEfEnable(dio), 0);  // a line the watchdog sets is a plain output
     }

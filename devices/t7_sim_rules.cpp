@@ -55,9 +55,11 @@ T7Refusal check_written(const T7SimRegisters& now, const Proposed& p, Product pr
   for (int clock = 0; clock < 3; ++clock) {
     if (a == kClockEnable(clock)) {
       const std::uint16_t value = p.u16(a), current = now.u16(a);
-      if (value == 0 && current == 0) return refuse(kExceptionDeviceFailure, kErrorClockNotEnabled, a, "disabling a clock that is not running");
+      if (value == 0 && current == 0)
+        return refuse(kExceptionDeviceFailure, kErrorClockNotEnabled, a, "disabling a clock that is not running");
       if (clock == 0 && value != 0 && (p.u16(kClockEnable(1)) != 0 || p.u16(kClockEnable(2)) != 0)) {
-        return refuse(kExceptionDeviceFailure, kErrorClock0NeedsClocks12Off, a, "enabling clock 0 while clock 1 or 2 runs");
+        return refuse(kExceptionDeviceFailure, kErrorClock0NeedsClocks12Off, a,
+                      "enabling clock 0 while clock 1 or 2 runs");
       }
     }
     if (a == kClockDivisor(clock)) {
@@ -68,12 +70,15 @@ T7Refusal check_written(const T7SimRegisters& now, const Proposed& p, Product pr
     }
   }
   if (in_block(a, kDioEfIndex(0), 2, kDioCount, n) && now.u32(kDioEfEnable(n)) != 0 && p.u32(a) != now.u32(a)) {
-    return refuse(kExceptionDeviceFailure, kErrorIndexChangeWhileEnabled, a, "index %g while the EF is enabled", p.u32(a));
+    return refuse(kExceptionDeviceFailure, kErrorIndexChangeWhileEnabled, a, "index %g while the EF is enabled",
+                  p.u32(a));
   }
-  const auto pwm_on_clock0 = [&](int dio) { return p.u32(kDioEfIndex(dio)) == kEfIndexPwmOut && p.u32(kDioEfClockSource(dio)) == 0; };
+  const auto pwm_on_clock0 = [&](int dio) {
+    return p.u32(kDioEfIndex(dio)) == kEfIndexPwmOut && p.u32(kDioEfClockSource(dio)) == 0;
+  };
   if (in_block(a, kDioEfConfigA(0), 2, kDioCount, n) && pwm_on_clock0(n) && p.u32(a) >= roll_of_clock0(p)) {
-    return refuse(kExceptionDeviceFailure, kErrorValueGreaterThanPeriod, a, "CONFIG_A %.0f, not below the roll value %.0f", p.u32(a),
-                  roll_of_clock0(p));
+    return refuse(kExceptionDeviceFailure, kErrorValueGreaterThanPeriod, a,
+                  "CONFIG_A %.0f, not below the roll value %.0f", p.u32(a), roll_of_clock0(p));
   }
   if (in_block(a, kDioEfEnable(0), 2, kDioCount, n) && p.u32(a) != 0 && now.u32(a) == 0 && pwm_on_clock0(n)) {
     const std::uint32_t bit = 1u << n;
@@ -81,13 +86,14 @@ T7Refusal check_written(const T7SimRegisters& now, const Proposed& p, Product pr
       return refuse(kExceptionDeviceFailure, kErrorLineMustBeLow, a, "PWM on a line that is not an output driven low");
     }
     if (p.u32(kDioEfConfigA(n)) >= roll_of_clock0(p)) {
-      return refuse(kExceptionDeviceFailure, kErrorValueGreaterThanPeriod, a, "CONFIG_A %.0f, not below the roll value %.0f",
-                    p.u32(kDioEfConfigA(n)), roll_of_clock0(p));
+      return refuse(kExceptionDeviceFailure, kErrorValueGreaterThanPeriod, a,
+                    "CONFIG_A %.0f, not below the roll value %.0f", p.u32(kDioEfConfigA(n)), roll_of_clock0(p));
     }
   }
-  if ((in_block(a, kAinResolutionIndex(0), 1, kAinCount, n) || a == kAinAllResolutionIndex) && p.u16(a) > max_resolution_index(product)) {
-    return refuse(kExceptionIllegalDataValue, kErrorIllegalDataValue, a, "resolution index %g (this product: 0..%g)", p.u16(a),
-                  max_resolution_index(product));
+  if ((in_block(a, kAinResolutionIndex(0), 1, kAinCount, n) || a == kAinAllResolutionIndex) &&
+      p.u16(a) > max_resolution_index(product)) {
+    return refuse(kExceptionIllegalDataValue, kErrorIllegalDataValue, a, "resolution index %g (this product: 0..%g)",
+                  p.u16(a), max_resolution_index(product));
   }
   if (in_block(a, kAinSettling_us(0), 2, kAinCount, n) && !(p.f32(a) >= 0.0 && p.f32(a) <= kMaxSettling_us)) {
     return refuse(kExceptionIllegalDataValue, kErrorIllegalDataValue, a, "settling %g us (0..50000)", p.f32(a));
@@ -102,8 +108,9 @@ T7Refusal check_t7_request(const T7SimRegisters& registers, Product product, int
   const int exception = registers.check(function, address, count);
   if (exception != 0) {
     const bool write = function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS;
-    return refuse(exception, exception == kExceptionIllegalDataAddress ? kErrorIllegalDataAddress : 1201, address,
-                  write ? "a write to an address that does not exist or is read only" : "an address that does not exist");
+    return refuse(
+        exception, exception == kExceptionIllegalDataAddress ? kErrorIllegalDataAddress : 1201, address,
+        write ? "a write to an address that does not exist or is read only" : "an address that does not exist");
   }
   if (values == nullptr) return {};
   const Proposed proposed(registers, address, count, values);

@@ -49,12 +49,14 @@ T7SimServer::T7SimServer(T7SimOptions options)
   if (options_.no_supply) arm_.set_supply_bar(options_.plant.gas.ambient_bar);
   arm_.vent();
   context_ = modbus_new_tcp_pi(options_.host.c_str(), std::to_string(options_.port).c_str());
-  if (context_ == nullptr) throw InputError("t7-sim: bad address " + options_.host + ":" + std::to_string(options_.port));
+  if (context_ == nullptr)
+    throw InputError("t7-sim: bad address " + options_.host + ":" + std::to_string(options_.port));
   listen_fd_ = modbus_tcp_pi_listen(context_, 4);
   if (listen_fd_ == -1) {
     const std::string why = modbus_strerror(errno);
     modbus_free(context_);
-    throw EnvironmentError("t7-sim: cannot listen on " + options_.host + ":" + std::to_string(options_.port) + " (" + why + ")");
+    throw EnvironmentError("t7-sim: cannot listen on " + options_.host + ":" + std::to_string(options_.port) + " (" +
+                           why + ")");
   }
   sockaddr_storage bound{};
   socklen_t length = sizeof bound;
@@ -82,7 +84,8 @@ double T7SimServer::now_s() const {
 // answer paced at a T7's speed, a loaded machine): a pressure switch acts continuously.
 void T7SimServer::advance_arm(double now) {
   while (now - arm_time_s_ >= kArmStep_s) {
-    const double step = std::min(now - arm_time_s_, 2.0 * kArmStep_s) >= 2.0 * kArmStep_s ? kArmStep_s : now - arm_time_s_;
+    const double step =
+        std::min(now - arm_time_s_, 2.0 * kArmStep_s) >= 2.0 * kArmStep_s ? kArmStep_s : now - arm_time_s_;
     arm_.advance(step);
     arm_time_s_ += step;
     apply_limits(false);
@@ -102,9 +105,11 @@ void T7SimServer::apply_limits(bool write) {
   if (rising(kRigPressureLimitBit)) ++status_.pressure_limit_trips;
   if (rising(kRigAngleLimitBit)) ++status_.angle_limit_trips;
   if (events_ != nullptr && rising(kRigPressureLimitBit)) {
-    (*events_)("t7-sim: a chamber at the rig's ceiling of " + std::to_string(options_.limits.pressure_ceiling_bar) + " bar: vented");
+    (*events_)("t7-sim: a chamber at the rig's ceiling of " + std::to_string(options_.limits.pressure_ceiling_bar) +
+               " bar: vented");
   }
-  if (events_ != nullptr && rising(kRigAngleLimitBit)) (*events_)("t7-sim: the arm beyond the rig's angle range: every valve vented");
+  if (events_ != nullptr && rising(kRigAngleLimitBit))
+    (*events_)("t7-sim: the arm beyond the rig's angle range: every valve vented");
   if (limited.angle_exceeded) commanded_ = ValveCommand::vented();  // until the client writes its duties again
   // Written only when something changed: every write starts a new PWM period.
   if (write || limit_bits_ != 0 || before != 0) arm_.write_valves(limited.valves);
@@ -119,7 +124,8 @@ void T7SimServer::update_inputs() {
   registers_.set_ain(p.input(SensorRole::kChamberA).ain, p.input(SensorRole::kChamberA).volts(chamber_a));
   registers_.set_ain(p.input(SensorRole::kChamberB).ain, p.input(SensorRole::kChamberB).volts(chamber_b));
   registers_.set_ain(p.input(SensorRole::kSupply).ain, p.input(SensorRole::kSupply).volts(r.supply_bar));
-  registers_.set_ain(p.input(SensorRole::kAngle).ain, p.input(SensorRole::kAngle).volts(r.joint[0].angle_rad + p.angle_zero_rad));
+  registers_.set_ain(p.input(SensorRole::kAngle).ain,
+                     p.input(SensorRole::kAngle).volts(r.joint[0].angle_rad + p.angle_zero_rad));
   registers_.set_ain(p.input(SensorRole::kTemperature).ain, p.input(SensorRole::kTemperature).volts(r.temperature_K));
 }
 
@@ -146,7 +152,8 @@ double T7SimServer::answer_time_s(int function, int address, int count) const {
   if (function != MODBUS_FC_READ_HOLDING_REGISTERS && function != MODBUS_FC_READ_INPUT_REGISTERS) return t;
   for (int ain = 0; ain < t7::kAinCount; ++ain) {
     if (address < t7::kAin(ain) + 2 && t7::kAin(ain) < address + count) {
-      std::uint16_t settling[2] = {registers_.u16(t7::kAinSettling_us(ain)), registers_.u16(t7::kAinSettling_us(ain) + 1)};
+      std::uint16_t settling[2] = {registers_.u16(t7::kAinSettling_us(ain)),
+                                   registers_.u16(t7::kAinSettling_us(ain) + 1)};
       t += t7::sample_time_s(registers_.u16(t7::kAinResolutionIndex(ain)), t7::get_float(settling), options_.product);
     }
   }
@@ -225,7 +232,8 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
   const double answer_s = answer_time_s(function, address, count) + options_.answer_after_s;
   if (answer_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(answer_s));
   now = now_s();
-  const T7Refusal refusal = check_t7_request(registers_, options_.product, function, address, count, writes ? values : nullptr);
+  const T7Refusal refusal =
+      check_t7_request(registers_, options_.product, function, address, count, writes ? values : nullptr);
   if (refusal.exception != 0) {
     modbus_reply_exception(context_, query_.data(), static_cast<unsigned int>(refusal.exception));
     ++status_.exceptions;
@@ -238,12 +246,13 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
     }
     char line[400];
     std::snprintf(line, sizeof line, "t7-sim: refused %s %s (%d): LabJack error %d %s, Modbus exception %d (%s)",
-                  writes ? "writing" : "reading", t7::register_name(refusal.address).c_str(), refusal.address, refusal.error,
-                  t7::error_name(refusal.error), refusal.exception, refusal.why.c_str());
+                  writes ? "writing" : "reading", t7::register_name(refusal.address).c_str(), refusal.address,
+                  refusal.error, t7::error_name(refusal.error), refusal.exception, refusal.why.c_str());
     events(line);
   } else {
-    const bool reads_inputs = (function == MODBUS_FC_READ_HOLDING_REGISTERS || function == MODBUS_FC_READ_INPUT_REGISTERS) &&
-                              address < t7::kAin(t7::kAinCount);
+    const bool reads_inputs =
+        (function == MODBUS_FC_READ_HOLDING_REGISTERS || function == MODBUS_FC_READ_INPUT_REGISTERS) &&
+        address < t7::kAin(t7::kAinCount);
     if (reads_inputs) {
       advance_arm(now);
       update_inputs();
@@ -251,10 +260,12 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
     const bool trickles = options_.trickle_after_s >= 0.0 && now - first_request_s_ >= options_.trickle_after_s;
     if (trickles && !status_.trickling) {
       status_.trickling = true;
-      events("t7-sim: answers trickle from now on, one byte every " + std::to_string(options_.trickle_byte_s) + " s (drill)");
+      events("t7-sim: answers trickle from now on, one byte every " + std::to_string(options_.trickle_byte_s) +
+             " s (drill)");
     }
     if (trickles) {
-      if (writes) for (int i = 0; i < count; ++i) registers_.data()[address + i] = values[i];
+      if (writes)
+        for (int i = 0; i < count; ++i) registers_.data()[address + i] = values[i];
       trickle_reply(fd, function, address, count);
     } else {
       modbus_mapping_t mapping{};
@@ -310,7 +321,8 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
         }
       }
     }
-    if (options_.halve_roll_after_s >= 0.0 && !roll_halved_ && first_request_s_ >= 0.0 && now - first_request_s_ >= options_.halve_roll_after_s) {
+    if (options_.halve_roll_after_s >= 0.0 && !roll_halved_ && first_request_s_ >= 0.0 &&
+        now - first_request_s_ >= options_.halve_roll_after_s) {
       roll_halved_ = true;
       registers_.set_u32(t7::kClock0RollValue, registers_.u32(t7::kClock0RollValue) / 2);
       events("t7-sim: clock 0's roll value halved, as another program might (drill)");
@@ -322,9 +334,10 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
       apply_lines(now);
       char line[200];
       std::snprintf(line, sizeof line,
-                    "t7-sim: watchdog: %u s without a request at %.3f s: lines inlet_a %.3f inlet_b %.3f outlet_a %.3f outlet_b %.3f (%s)",
-                    registers_.watchdog_timeout_s(), now, status_.duty[0], status_.duty[1], status_.duty[2], status_.duty[3],
-                    status_.safe ? "safe" : "NOT SAFE");
+                    "t7-sim: watchdog: %u s without a request at %.3f s: lines inlet_a %.3f inlet_b %.3f outlet_a %.3f "
+                    "outlet_b %.3f (%s)",
+                    registers_.watchdog_timeout_s(), now, status_.duty[0], status_.duty[1], status_.duty[2],
+                    status_.duty[3], status_.safe ? "safe" : "NOT SAFE");
       events(line);
       write_status(now, true);
     }
@@ -348,20 +361,24 @@ void T7SimServer::write_status(double now, bool force) {
   if (options_.status_path.empty()) return;
   const T7SimStatus& s = status_;
   char text[1400];
-  std::snprintf(text, sizeof text,
-                "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
-                "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
-                "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, \"refusals\": %llu, \"last_refused_error\": %d, "
-                "\"max_clients\": %d, \"refused_connections\": %d, "
-                "\"clients\": %d, \"silent\": %s, \"stalls\": %d, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], \"angle_rad\": %.6f, "
-                "\"limits\": {\"pressure_ceiling_bar\": %.6f, \"angle_limit_rad\": %.6f, \"pressure_trips\": %d, \"angle_trips\": %d}}\n",
-                s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
-                s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
-                static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions),
-                static_cast<unsigned long long>(s.refusals), s.last_refused_error, s.max_clients, s.refused_connections, s.clients,
-                s.silent ? "true" : "false", s.stalls, 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1],
-                s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
-                s.angle_limit_trips);
+  std::snprintf(
+      text, sizeof text,
+      "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
+      "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
+      "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, "
+      "\"refusals\": %llu, \"last_refused_error\": %d, "
+      "\"max_clients\": %d, \"refused_connections\": %d, "
+      "\"clients\": %d, \"silent\": %s, \"stalls\": %d, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], "
+      "\"angle_rad\": %.6f, "
+      "\"limits\": {\"pressure_ceiling_bar\": %.6f, \"angle_limit_rad\": %.6f, \"pressure_trips\": %d, "
+      "\"angle_trips\": %d}}\n",
+      s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
+      s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
+      static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions),
+      static_cast<unsigned long long>(s.refusals), s.last_refused_error, s.max_clients, s.refused_connections,
+      s.clients, s.silent ? "true" : "false", s.stalls, 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0],
+      s.chamber_bar[1], s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad,
+      s.pressure_limit_trips, s.angle_limit_trips);
   const std::string temporary = options_.status_path + ".tmp";
   {
     std::ofstream out(temporary, std::ios::trunc);

@@ -38,53 +38,53 @@ namespace bellows {
 
 struct T7SimOptions {
   std::string host = "127.0.0.1";
-  int port = 5020;                     // 0: any free port (port() tells which)
+  int port = 5020;  // 0: any free port (port() tells which)
   RigProfile profile;
   PlantParameters plant;
   std::uint64_t seed = 1;
-  bool swapped_chambers = false;       // chamber A's transmitter wired to chamber B's input and back
-  std::optional<ValveRole> dead_valve; // this valve pair never opens, whatever its line does
-  bool no_supply = false;              // the supply at ambient pressure
-  double silent_after_s = -1.0;        // >= 0: the link goes silent this long after the first request
-  double stall_after_s = -1.0;         // >= 0: this long after the first request, one answer comes late...
-  double stall_s = 0.05;               // ...by this long (the server stalls, as a busy network or T7 would)
-  std::string status_path;             // "": no status file
+  bool swapped_chambers = false;              // chamber A's transmitter wired to chamber B's input and back
+  std::optional<ValveRole> dead_valve;        // this valve pair never opens, whatever its line does
+  bool no_supply = false;                     // the supply at ambient pressure
+  double silent_after_s = -1.0;               // >= 0: the link goes silent this long after the first request
+  double stall_after_s = -1.0;                // >= 0: this long after the first request, one answer comes late...
+  double stall_s = 0.05;                      // ...by this long (the server stalls, as a busy network or T7 would)
+  std::string status_path;                    // "": no status file
   t7::Product product = t7::Product::kT7Pro;  // paces the answers, bounds the resolution index
-  bool nagle = false;                  // drill: keep Nagle's algorithm on the answers (a T7 does not)
-  double answer_after_s = 0.0;         // drill: every answer this much later (a slow device)
-  double trickle_after_s = -1.0;       // drill: this long after the first request, answers trickle...
-  double trickle_byte_s = 0.4;         // ...one byte every this long (the link holds, barely)
-  bool silent_reads = false;           // drill: reads of the analog inputs go unanswered (no reading ever)
-  double halve_roll_after_s = -1.0;    // drill: this long after the first request, clock 0's roll value halves
-                                       // (another program reconfigured it): wide duty cycles are refused, 2565
-  RigLimits limits;                    // the rig's own limits, enforced whatever the client writes
+  bool nagle = false;                         // drill: keep Nagle's algorithm on the answers (a T7 does not)
+  double answer_after_s = 0.0;                // drill: every answer this much later (a slow device)
+  double trickle_after_s = -1.0;              // drill: this long after the first request, answers trickle...
+  double trickle_byte_s = 0.4;                // ...one byte every this long (the link holds, barely)
+  bool silent_reads = false;                  // drill: reads of the analog inputs go unanswered (no reading ever)
+  double halve_roll_after_s = -1.0;           // drill: this long after the first request, clock 0's roll value halves
+                                              // (another program reconfigured it): wide duty cycles are refused, 2565
+  RigLimits limits;                           // the rig's own limits, enforced whatever the client writes
 };
 
 /// What the T7's lines output and what its watchdog did, for tests and scripts.
 struct T7SimStatus {
-  double time_s = 0.0;                          // since the server started
-  std::array<double, kValveRoleCount> duty{};   // by ValveRole: the duty cycle its line outputs
-  bool safe = true;                             // inlets closed, outlets open
-  double safe_since_s = 0.0;                    // when the lines last became safe (-1: not safe)
-  double last_request_s = -1.0;                 // when a request was last answered (-1: never)
+  double time_s = 0.0;                         // since the server started
+  std::array<double, kValveRoleCount> duty{};  // by ValveRole: the duty cycle its line outputs
+  bool safe = true;                            // inlets closed, outlets open
+  double safe_since_s = 0.0;                   // when the lines last became safe (-1: not safe)
+  double last_request_s = -1.0;                // when a request was last answered (-1: never)
   bool watchdog_enabled = false;
   std::uint32_t watchdog_timeout_s = 0;
   int watchdog_actions = 0;
   double last_watchdog_action_s = -1.0;
-  std::uint64_t requests = 0;                   // answered
-  std::uint64_t exceptions = 0;                 // answered with a Modbus exception
-  std::uint64_t refusals = 0;                   // of which for a LabJack rule (t7_sim_rules.hpp), not an address
-  int last_refused_error = 0;                   // LabJack's error number of the latest refusal (0: none)
-  int max_clients = 0;                          // the most connections at once
-  int refused_connections = 0;                  // connections beyond the T7's limit, closed at once
-  int clients = 0;                              // connected now
+  std::uint64_t requests = 0;    // answered
+  std::uint64_t exceptions = 0;  // answered with a Modbus exception
+  std::uint64_t refusals = 0;    // of which for a LabJack rule (t7_sim_rules.hpp), not an address
+  int last_refused_error = 0;    // LabJack's error number of the latest refusal (0: none)
+  int max_clients = 0;           // the most connections at once
+  int refused_connections = 0;   // connections beyond the T7's limit, closed at once
+  int clients = 0;               // connected now
   bool silent = false;
-  int stalls = 0;                               // answers held back by the stall drill
-  bool trickling = false;                       // the trickle drill has begun
+  int stalls = 0;                                    // answers held back by the stall drill
+  bool trickling = false;                            // the trickle drill has begun
   std::array<double, kActuatorCount> chamber_bar{};  // the arm's true chamber pressures, A and B
-  double angle_rad = 0.0;                       // the arm's true angle
-  int pressure_limit_trips = 0;                 // times a chamber reached the ceiling and was vented
-  int angle_limit_trips = 0;                    // times the arm left the angle range and all was vented
+  double angle_rad = 0.0;                            // the arm's true angle
+  int pressure_limit_trips = 0;                      // times a chamber reached the ceiling and was vented
+  int angle_limit_trips = 0;                         // times the arm left the angle range and all was vented
 };
 
 class T7SimServer {
@@ -121,11 +121,11 @@ class T7SimServer {
   T7SimRegisters registers_;
   SimulatedArm arm_;
   double start_s_ = 0.0;
-  double arm_time_s_ = 0.0;   // wall time the arm has been advanced to (since start)
+  double arm_time_s_ = 0.0;  // wall time the arm has been advanced to (since start)
   double first_request_s_ = -1.0;
   bool roll_halved_ = false;
   double last_status_write_s_ = -1.0;
-  T7SimStatus status_;                // the server thread's; published copies under the mutex
+  T7SimStatus status_;  // the server thread's; published copies under the mutex
   mutable std::mutex published_mutex_;
   T7SimStatus published_;
   std::vector<std::uint8_t> query_;

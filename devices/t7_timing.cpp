@@ -53,14 +53,15 @@ void require_exchange_fits(const RigProfile& profile, Product product, double ti
   if (t.exchange_s <= limit_s) return;
   const SensorCalibration& c = profile.input(t.slowest);
   char line[480];
-  std::snprintf(line, sizeof line,
-                "rig profile %s: [inputs.%s] resolution_index = %d: one read of %d inputs takes %.1f ms on a %s "
-                "(%.1f ms link + %.1f ms sampling, LabJack's A-1 and A-3-2-2), the exchange with the valve write %.1f ms: "
-                "more than the %.1f ms tick ([timing] tick_s) and [t7] response_timeout_s (%.1f ms) allow; "
-                "use a smaller resolution_index (1..8 sample in 0.04..1.1 ms)",
-                profile.source.c_str(), bellows::to_string(t.slowest), c.resolution_index, t.inputs, t.read_s * 1e3,
-                to_string(product), kEthernetOverhead_s * 1e3, t.sampling_s * 1e3, t.exchange_s * 1e3, tick_s * 1e3,
-                response_timeout_s * 1e3);
+  std::snprintf(
+      line, sizeof line,
+      "rig profile %s: [inputs.%s] resolution_index = %d: one read of %d inputs takes %.1f ms on a %s "
+      "(%.1f ms link + %.1f ms sampling, LabJack's A-1 and A-3-2-2), the exchange with the valve write %.1f ms: "
+      "more than the %.1f ms tick ([timing] tick_s) and [t7] response_timeout_s (%.1f ms) allow; "
+      "use a smaller resolution_index (1..8 sample in 0.04..1.1 ms)",
+      profile.source.c_str(), bellows::to_string(t.slowest), c.resolution_index, t.inputs, t.read_s * 1e3,
+      to_string(product), kEthernetOverhead_s * 1e3, t.sampling_s * 1e3, t.exchange_s * 1e3, tick_s * 1e3,
+      response_timeout_s * 1e3);
   throw InputError(line);
 }
 

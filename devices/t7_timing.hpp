@@ -23,14 +23,14 @@ inline constexpr int kMaxResolutionIndexT7 = 8;
 inline constexpr int kMaxResolutionIndexT7Pro = 12;
 inline constexpr int kDefaultResolutionIndexT7 = 8;
 inline constexpr int kDefaultResolutionIndexT7Pro = 9;
-inline constexpr double kMaxSettling_us = 50000.0;      // AIN#_SETTLING_US: "0 = Auto. Max is 50000"
+inline constexpr double kMaxSettling_us = 50000.0;  // AIN#_SETTLING_US: "0 = Auto. Max is 50000"
 
 /// Command-response sample time of one input (auto settling) by resolution index 1..12, seconds
 /// (appendix A-3-2-2). Index 0 is not in it: see effective_resolution_index().
 inline constexpr std::array<double, 13> kSampleTime_s = {
-    0.0,       // 0: the product default (never looked up)
+    0.0,                                                               // 0: the product default (never looked up)
     0.00004, 0.00004, 0.0001, 0.0001, 0.0002, 0.0003, 0.0006, 0.0011,  // 1..8: the 16-bit ADC
-    0.0035, 0.0134, 0.0662, 0.159};                                     // 9..12: the Pro's 24-bit ADC
+    0.0035,  0.0134,  0.0662, 0.159};                                  // 9..12: the Pro's 24-bit ADC
 
 int max_resolution_index(Product product);
 /// The index a T7 samples at: `index`, or the product default for 0.
@@ -42,10 +42,10 @@ double sample_time_s(int index, double settling_us, Product product);
 /// One exchange of bellows' T7 link: the write of the duty cycles and the read of AIN0 up to the
 /// highest input in use (inputs in the block that the profile does not use are set to index 1).
 struct ExchangeTime {
-  int inputs = 0;           // AINs in the read block
-  double sampling_s = 0.0;  // their sample times together
-  double read_s = 0.0;      // overhead + sampling
-  double exchange_s = 0.0;  // the write's overhead + the read
+  int inputs = 0;                              // AINs in the read block
+  double sampling_s = 0.0;                     // their sample times together
+  double read_s = 0.0;                         // overhead + sampling
+  double exchange_s = 0.0;                     // the write's overhead + the read
   SensorRole slowest = SensorRole::kChamberA;  // the input whose key a refusal names
 };
 ExchangeTime exchange_time(const RigProfile& profile, Product product);

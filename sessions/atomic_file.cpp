@@ -23,7 +23,8 @@ constexpr std::string_view kTemporaryMarker = ".tmp-";  // unpredictable_tempora
 DirectoryHandle folder_of(const std::filesystem::path& path) {
   const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
   const std::string name = path.filename().string();
-  if (name.empty() || name == "." || name == "..") throw InputError("cannot write " + path.string() + ": not a file name");
+  if (name.empty() || name == "." || name == "..")
+    throw InputError("cannot write " + path.string() + ": not a file name");
   try {
     return DirectoryHandle::open(directory);
   } catch (const InputError& error) {
@@ -46,7 +47,8 @@ AtomicOutputFile::AtomicOutputFile(const std::filesystem::path& path, Replace re
   const cookie_io_functions_t functions{nullptr, &AtomicOutputFile::write_cookie, nullptr, nullptr};
   stream_ = ::fopencookie(this, "w", functions);
   if (stream_ == nullptr) throw InputError("cannot open a stream on " + path.string() + ": " + std::strerror(errno));
-  std::setvbuf(stream_, buffer_.get(), _IOFBF, kStreamBuffer);  // few, large writes (glibc ignores a size without a buffer)
+  std::setvbuf(stream_, buffer_.get(), _IOFBF,
+               kStreamBuffer);  // few, large writes (glibc ignores a size without a buffer)
 }
 
 AtomicOutputFile::~AtomicOutputFile() {

@@ -21,8 +21,8 @@ constexpr int kLastFault = static_cast<int>(kLastFaultCode);
 // Legacy files store these codes (docs/session-format.md): they must keep their meaning.
 static_assert(static_cast<int>(EngineState::kSafe) == 0 && kLastState == 3);
 static_assert(static_cast<int>(FaultCode::kNone) == 0 && static_cast<int>(FaultCode::kSupplyLow) == 4 &&
-              static_cast<int>(FaultCode::kSensorStale) == 7 &&
-              static_cast<int>(FaultCode::kHeartbeatLost) == 9 && kLastFault == 16);
+              static_cast<int>(FaultCode::kSensorStale) == 7 && static_cast<int>(FaultCode::kHeartbeatLost) == 9 &&
+              kLastFault == 16);
 
 std::string state_name(int code) { return to_string(static_cast<EngineState>(code)); }
 std::string fault_name_of(int code) { return fault_name(static_cast<FaultCode>(code)); }
@@ -41,8 +41,8 @@ double whole_at(const Eigen::VectorXd& column, Eigen::Index row, double low, dou
 
 /// `text` with the state and fault fields of every row after the header replaced by `replace`
 /// (column, field, line number). Rows too short to have them are left for parse_csv to refuse.
-std::string with_named_fields_replaced(std::string_view text,
-                                       const std::function<std::string(std::size_t, std::string_view, std::size_t)>& replace) {
+std::string with_named_fields_replaced(
+    std::string_view text, const std::function<std::string(std::size_t, std::string_view, std::size_t)>& replace) {
   std::string out;
   out.reserve(text.size() + text.size() / 8);
   std::size_t line_number = 1;
@@ -58,8 +58,8 @@ std::string with_named_fields_replaced(std::string_view text,
       std::size_t column = 0, field_start = 0;
       while (true) {
         const std::size_t comma = line.find(',', field_start);
-        const std::string_view field = line.substr(field_start, comma == std::string_view::npos ? std::string_view::npos
-                                                                                                 : comma - field_start);
+        const std::string_view field =
+            line.substr(field_start, comma == std::string_view::npos ? std::string_view::npos : comma - field_start);
         if (column > 0) out += ',';
         const bool named = column == kBlackBoxStateColumn || column == kBlackBoxFaultColumn;
         out += named ? replace(column, field, line_number) : std::string(field);
@@ -103,12 +103,25 @@ std::string joined_header(const std::vector<std::string_view>& names) {
 }  // namespace
 
 const std::vector<std::string_view>& legacy_black_box_columns() {
-  static const std::vector<std::string_view> columns = {
-      "tick",          "time_s",        "sensor_time_s", "state",         "fault",
-      "angle_deg",     "desired_deg",   "pressure_a_bar", "pressure_b_bar",
-      "supply_bar",    "u_total_bar",   "pressure_a_setpoint_bar", "pressure_b_setpoint_bar",
-      "inlet_a_duty",  "outlet_a_duty", "inlet_b_duty",  "outlet_b_duty",
-      "sample",        "trial_id"};
+  static const std::vector<std::string_view> columns = {"tick",
+                                                        "time_s",
+                                                        "sensor_time_s",
+                                                        "state",
+                                                        "fault",
+                                                        "angle_deg",
+                                                        "desired_deg",
+                                                        "pressure_a_bar",
+                                                        "pressure_b_bar",
+                                                        "supply_bar",
+                                                        "u_total_bar",
+                                                        "pressure_a_setpoint_bar",
+                                                        "pressure_b_setpoint_bar",
+                                                        "inlet_a_duty",
+                                                        "outlet_a_duty",
+                                                        "inlet_b_duty",
+                                                        "outlet_b_duty",
+                                                        "sample",
+                                                        "trial_id"};
   return columns;
 }
 
@@ -138,7 +151,8 @@ std::string format_black_box_csv(const std::vector<TickRecord>& ticks) {
 
 std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::string& source, int expected_ticks) {
   std::string_view header = text.substr(0, text.find('\n'));
-  while (!header.empty() && (header.back() == '\r' || header.back() == ' ' || header.back() == '\t')) header.remove_suffix(1);
+  while (!header.empty() && (header.back() == '\r' || header.back() == ' ' || header.back() == '\t'))
+    header.remove_suffix(1);
   int joints = 0;  // from the header: the one of 1..kMaxJoints joints it is
   for (int j = 1; j <= kMaxJoints && joints == 0; ++j) {
     if (header == joined_header(header_views(black_box_header(j)))) joints = j;
@@ -161,8 +175,8 @@ std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::st
     c = parse_csv(numeric, header_views(black_box_header(joints)), source, NonFinite::kAccept);
   }
   if (c[0].size() != expected_ticks) {
-    throw InputError(source + ": expected " + std::to_string(expected_ticks) + " rows (the ticks the manifest lists), found " +
-                     std::to_string(c[0].size()));
+    throw InputError(source + ": expected " + std::to_string(expected_ticks) +
+                     " rows (the ticks the manifest lists), found " + std::to_string(c[0].size()));
   }
   // The whole-number columns (joint 1's block: the same positions in every header) before any is cast.
   const std::vector<TickColumn>& table = black_box_record_columns();
@@ -174,8 +188,9 @@ std::vector<TickRecord> parse_black_box_csv(std::string_view text, const std::st
   for (Eigen::Index k = 0; k < c[0].size(); ++k) {
     const double tick = whole_at(column("tick"), k, 0.0, kMostTicks, source, "tick");
     if (k > 0 && tick <= column("tick")(k - 1)) {
-      throw InputError(source + ": line " + std::to_string(k + 2) + ": tick " + std::to_string(static_cast<std::uint64_t>(tick)) +
-                       " does not follow tick " + std::to_string(static_cast<std::uint64_t>(column("tick")(k - 1))) +
+      throw InputError(source + ": line " + std::to_string(k + 2) + ": tick " +
+                       std::to_string(static_cast<std::uint64_t>(tick)) + " does not follow tick " +
+                       std::to_string(static_cast<std::uint64_t>(column("tick")(k - 1))) +
                        " (ticks increase row by row)");
     }
     whole_at(column("state"), k, 0, kLastState, source, "state");

@@ -72,7 +72,8 @@ std::vector<Eigen::VectorXd> parse_csv(std::string_view text, const std::vector<
   const std::size_t header_end = text.find('\n');
   const std::string_view header_line = trim(text.substr(0, header_end));
   if (header_line != joined(header)) {
-    throw InputError(source + ": line 1: the header must be '" + joined(header) + "', found '" + excerpt(header_line) + "'");
+    throw InputError(source + ": line 1: the header must be '" + joined(header) + "', found '" + excerpt(header_line) +
+                     "'");
   }
   std::string_view body = text.substr(header_end + 1);
   const auto rows = static_cast<Eigen::Index>(std::count(body.begin(), body.end(), '\n'));

@@ -37,7 +37,8 @@ std::string shown(const fs::path& path) { return printable(path.string(), kPrint
 
 /// Why opening `name` failed, in words an operator can act on.
 std::string open_failure(int error_number) {
-  if (error_number == ELOOP) return "is a symbolic link; a session's files must be inside it, so links are never followed";
+  if (error_number == ELOOP)
+    return "is a symbolic link; a session's files must be inside it, so links are never followed";
   if (error_number == ENOTDIR) return "is not a directory";
   return std::strerror(error_number);
 }
@@ -88,14 +89,22 @@ int FileDescriptor::release() { return std::exchange(fd_, -1); }
 
 std::string file_type_name(unsigned mode) {
   switch (mode & S_IFMT) {
-    case S_IFREG: return "a regular file";
-    case S_IFDIR: return "a directory";
-    case S_IFLNK: return "a symbolic link";
-    case S_IFIFO: return "a FIFO";
-    case S_IFSOCK: return "a socket";
-    case S_IFCHR: return "a character device";
-    case S_IFBLK: return "a block device";
-    default: return "a special file";
+    case S_IFREG:
+      return "a regular file";
+    case S_IFDIR:
+      return "a directory";
+    case S_IFLNK:
+      return "a symbolic link";
+    case S_IFIFO:
+      return "a FIFO";
+    case S_IFSOCK:
+      return "a socket";
+    case S_IFCHR:
+      return "a character device";
+    case S_IFBLK:
+      return "a block device";
+    default:
+      return "a special file";
   }
 }
 
@@ -115,10 +124,11 @@ std::optional<DirectoryHandle> DirectoryHandle::subdirectory(const std::string& 
     if (error_number == ENOENT) return std::nullopt;
     // ENOTDIR for a file, ELOOP for a link: say which.
     struct stat info {};
-    const std::string what = ::fstatat(fd_.get(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISDIR(info.st_mode)
-                                 ? "is " + file_type_name(info.st_mode) + ", not a directory" +
-                                       (S_ISLNK(info.st_mode) ? " (links are never followed)" : "")
-                                 : open_failure(error_number);
+    const std::string what =
+        ::fstatat(fd_.get(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISDIR(info.st_mode)
+            ? "is " + file_type_name(info.st_mode) + ", not a directory" +
+                  (S_ISLNK(info.st_mode) ? " (links are never followed)" : "")
+            : open_failure(error_number);
     throw InputError(name + " " + what);
   }
   return DirectoryHandle(std::move(fd), path_ / name);
@@ -140,8 +150,9 @@ std::optional<FileDescriptor> open_regular_file_at(const DirectoryHandle& direct
   // Refused before it is opened: opening some devices acts (a tape rewinds, a modem hangs up).
   struct stat before {};
   if (::fstatat(directory.fd(), name.c_str(), &before, AT_SYMLINK_NOFOLLOW) == 0 && !S_ISREG(before.st_mode)) {
-    throw InputError(name + (S_ISLNK(before.st_mode) ? " " + open_failure(ELOOP)
-                                                     : " is " + file_type_name(before.st_mode) + ", not a regular file"));
+    throw InputError(name + (S_ISLNK(before.st_mode)
+                                 ? " " + open_failure(ELOOP)
+                                 : " is " + file_type_name(before.st_mode) + ", not a regular file"));
   }
   // O_NONBLOCK: should a FIFO take its place meanwhile, opening it must not wait for a writer.
   FileDescriptor fd(::openat(directory.fd(), name.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644));
@@ -198,17 +209,19 @@ std::string unpredictable_temporary_name(const std::string& name) {
   // advance (a link to a victim) is never the one used, and O_EXCL refuses it if it were.
   std::uint64_t random = 0;
   if (::getrandom(&random, sizeof random, 0) != static_cast<ssize_t>(sizeof random)) {
-    random = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) * 0x9e3779b97f4a7c15ULL;
+    random =
+        static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) * 0x9e3779b97f4a7c15ULL;
   }
   char suffix[40];
-  std::snprintf(suffix, sizeof suffix, "%ld-%016llx", static_cast<long>(::getpid()), static_cast<unsigned long long>(random));
+  std::snprintf(suffix, sizeof suffix, "%ld-%016llx", static_cast<long>(::getpid()),
+                static_cast<unsigned long long>(random));
   std::string temporary = ".";  // built by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
   temporary.append(name.substr(0, 200)).append(".tmp-").append(suffix);
   return temporary;
 }
 
-int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& to_directory,
-                      const std::string& to) {
+int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from,
+                      const DirectoryHandle& to_directory, const std::string& to) {
   if (::renameat2(from_directory.fd(), from.c_str(), to_directory.fd(), to.c_str(), RENAME_NOREPLACE) == 0) return 0;
   if (errno != EINVAL && errno != ENOSYS) return errno;
   // A file system without RENAME_NOREPLACE: a hard link never replaces (files only).
@@ -221,19 +234,22 @@ int rename_no_replace(const DirectoryHandle& from_directory, const std::string& 
 
 void publish_file_at(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& directory,
                      const std::string& name, Replace replace) {
-  const int error_number = replace == Replace::kAllowed
-                               ? (::renameat(from_directory.fd(), from.c_str(), directory.fd(), name.c_str()) == 0 ? 0 : errno)
-                               : rename_no_replace(from_directory, from, directory, name);
+  const int error_number =
+      replace == Replace::kAllowed
+          ? (::renameat(from_directory.fd(), from.c_str(), directory.fd(), name.c_str()) == 0 ? 0 : errno)
+          : rename_no_replace(from_directory, from, directory, name);
   if (error_number == 0) return;
   ::unlinkat(from_directory.fd(), from.c_str(), 0);
-  if (error_number == EEXIST) throw InputError(shown(directory.path() / name) + " exists already (--force replaces it)");
+  if (error_number == EEXIST)
+    throw InputError(shown(directory.path() / name) + " exists already (--force replaces it)");
   throw InputError("cannot rename a file to " + shown(directory.path() / name) + ": " + std::strerror(error_number));
 }
 
 TemporaryFile::TemporaryFile(const DirectoryHandle& directory, const std::string& name)
     : directory_(directory), name_(name), temporary_(unpredictable_temporary_name(name)) {
   // O_EXCL | O_NOFOLLOW: created here and now, never opened through whatever a name might already be.
-  fd_ = FileDescriptor(::openat(directory.fd(), temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
+  fd_ = FileDescriptor(
+      ::openat(directory.fd(), temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (fd_.get() < 0) {
     const int error_number = errno;
     throw InputError("cannot create " + shown(directory.path() / temporary_) + ": " + std::strerror(error_number));

@@ -136,8 +136,8 @@ void publish_file_at(const DirectoryHandle& from_directory, const std::string& f
                      const std::string& name, Replace replace);
 
 /// renameat2(RENAME_NOREPLACE), or a hard link where the file system lacks it: 0 or the errno.
-int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from, const DirectoryHandle& to_directory,
-                      const std::string& to);
+int rename_no_replace(const DirectoryHandle& from_directory, const std::string& from,
+                      const DirectoryHandle& to_directory, const std::string& to);
 
 /// Flushes a directory's entries (new names, renames) to disk.
 void sync(const DirectoryHandle& directory);

@@ -72,7 +72,8 @@ Eigen::VectorXd rounded_times(const Eigen::VectorXd& time_s) {
 
 namespace {
 
-void append_columns(std::string& out, const std::vector<std::string>& names, const std::vector<Eigen::VectorXd>& values) {
+void append_columns(std::string& out, const std::vector<std::string>& names,
+                    const std::vector<Eigen::VectorXd>& values) {
   std::vector<CsvColumn> columns;
   columns.reserve(names.size());
   for (std::size_t c = 0; c < names.size(); ++c) columns.push_back({names[c], &values[c]});

@@ -47,7 +47,8 @@ std::size_t JsonReader::size() const {
 }
 
 double JsonReader::number() const {
-  if (!value_->is_number()) fail(value_->is_null() ? "expected a number, found null (not a number?)" : "expected a number");
+  if (!value_->is_number())
+    fail(value_->is_null() ? "expected a number, found null (not a number?)" : "expected a number");
   const double value = value_->get<double>();
   if (!std::isfinite(value)) fail("expected a finite number");
   return value;
@@ -58,8 +59,7 @@ int JsonReader::integer(int lowest, int highest) const {
   // Unsigned values beyond int64 would wrap in get<int64_t>(); compare them as unsigned first.
   const bool too_large = value_->is_number_unsigned() &&
                          (highest < 0 || value_->get<std::uint64_t>() > static_cast<std::uint64_t>(highest));
-  const bool in_range =
-      !too_large && value_->get<std::int64_t>() >= lowest && value_->get<std::int64_t>() <= highest;
+  const bool in_range = !too_large && value_->get<std::int64_t>() >= lowest && value_->get<std::int64_t>() <= highest;
   if (!in_range) {
     fail("expected a whole number in [" + std::to_string(lowest) + ", " + std::to_string(highest) + "], found " +
          value_->dump());
@@ -72,7 +72,8 @@ std::uint64_t JsonReader::hex_word() const {
   std::uint64_t word = 0;
   const char* begin = s.data() + 2;
   const char* end = s.data() + s.size();
-  if (s.size() < 3 || s.size() > 18 || s[0] != '0' || (s[1] != 'x' && s[1] != 'X')) fail("expected \"0x\" and hex digits");
+  if (s.size() < 3 || s.size() > 18 || s[0] != '0' || (s[1] != 'x' && s[1] != 'X'))
+    fail("expected \"0x\" and hex digits");
   const auto [stop, error] = std::from_chars(begin, end, word, 16);
   if (error != std::errc() || stop != end) fail("expected \"0x\" and hex digits");
   return word;

@@ -38,7 +38,8 @@ PressureController::State pressure_state_from_json(const JsonReader& r, int filt
   PressureController::State s;
   const JsonReader history = r["history_bar"];
   if (history.size() != s.history_bar.size()) {
-    history.fail("expected " + std::to_string(s.history_bar.size()) + " numbers, found " + std::to_string(history.size()));
+    history.fail("expected " + std::to_string(s.history_bar.size()) + " numbers, found " +
+                 std::to_string(history.size()));
   }
   for (std::size_t i = 0; i < s.history_bar.size(); ++i) s.history_bar[i] = history[i].number();
   s.count = r["count"].integer(0, filter_samples);
@@ -72,7 +73,8 @@ LearnedWith learned_with_from_json(const JsonReader& r) {
   LearnedWith out;
   out.law = r["law"].text();
   const std::vector<std::string> laws = learning_law_names();
-  if (std::find(laws.begin(), laws.end(), out.law) == laws.end()) r["law"].fail("unknown learning law '" + out.law + "'");
+  if (std::find(laws.begin(), laws.end(), out.law) == laws.end())
+    r["law"].fail("unknown learning law '" + out.law + "'");
   const std::vector<std::string> keys = learning_law_weight_keys(out.law);
   for (const auto& item : r.json().items()) {
     if (item.key() != "law" && std::find(keys.begin(), keys.end(), item.key()) == keys.end()) {
@@ -103,7 +105,8 @@ Json summary_to_json(const IterationEntry& entry) {
               {"telemetry_file", session_layout::telemetry_file(s.iteration)}};
   put_digest(out, "samples_sha256", entry.samples_sha256);
   put_digest(out, "telemetry_sha256", entry.telemetry_sha256);
-  if (s.learned_with.known()) out["learned_with"] = learned_with_to_json(s.learned_with);  // absent: not learned or not recorded
+  if (s.learned_with.known())
+    out["learned_with"] = learned_with_to_json(s.learned_with);  // absent: not learned or not recorded
   return out;
 }
 
@@ -230,15 +233,18 @@ constexpr const char* kJointsKey = "joints";
 /// One joint's controllers: joint 1's fields of "controller" (as every session saved them), and
 /// each entry of kJointsKey (or of kVersion1OtherJointsKey).
 Json joint_state_to_json(const ControlCore::JointState& s) {
-  return {{"pid", {{"integral_s", s.pid.integral_s}, {"previous_output", s.pid.previous_output},
-                   {"has_previous", s.pid.has_previous}}},
-          {"pressure_a", pressure_state_to_json(s.pressure_a)},
-          {"pressure_b", pressure_state_to_json(s.pressure_b)},
-          {"setpoints", {{"a_bar", s.setpoints.a_bar}, {"b_bar", s.setpoints.b_bar},
-                         {"saturation_sign", s.setpoints.saturation_sign}}},
-          {"hold_rad", s.hold_rad},
-          {"desired_rad", s.desired_rad},
-          {"u_total_bar", s.u_total_bar}};
+  return {
+      {"pid",
+       {{"integral_s", s.pid.integral_s},
+        {"previous_output", s.pid.previous_output},
+        {"has_previous", s.pid.has_previous}}},
+      {"pressure_a", pressure_state_to_json(s.pressure_a)},
+      {"pressure_b", pressure_state_to_json(s.pressure_b)},
+      {"setpoints",
+       {{"a_bar", s.setpoints.a_bar}, {"b_bar", s.setpoints.b_bar}, {"saturation_sign", s.setpoints.saturation_sign}}},
+      {"hold_rad", s.hold_rad},
+      {"desired_rad", s.desired_rad},
+      {"u_total_bar", s.u_total_bar}};
 }
 
 void joint_state_from_json(const JsonReader& r, const Configuration& config, ControlCore::JointState& s) {
@@ -280,8 +286,8 @@ ControlCore::State controller_state_from_json(const JsonReader& r, const Configu
   if (r.has(kJointsKey) || (joints > 1 && !r.has(kVersion1OtherJointsKey))) {
     const JsonReader all = r[kJointsKey];
     if (all.size() != static_cast<std::size_t>(joints)) {
-      all.fail("expected " + std::to_string(joints) + " entries (one per joint of the session's " + std::to_string(joints) +
-               "), found " + std::to_string(all.size()));
+      all.fail("expected " + std::to_string(joints) + " entries (one per joint of the session's " +
+               std::to_string(joints) + "), found " + std::to_string(all.size()));
     }
     for (int joint = 0; joint < joints; ++joint) {
       joint_state_from_json(all[static_cast<std::size_t>(joint)], config, s.joints[static_cast<std::size_t>(joint)]);
@@ -296,7 +302,8 @@ ControlCore::State controller_state_from_json(const JsonReader& r, const Configu
                   " of the session's " + std::to_string(joints) + "), found " + std::to_string(others.size()));
     }
     for (int joint = 1; joint < joints; ++joint) {
-      joint_state_from_json(others[static_cast<std::size_t>(joint - 1)], config, s.joints[static_cast<std::size_t>(joint)]);
+      joint_state_from_json(others[static_cast<std::size_t>(joint - 1)], config,
+                            s.joints[static_cast<std::size_t>(joint)]);
     }
   }
   return s;
@@ -361,7 +368,8 @@ Json manifest_head_to_json(const SessionManifest& m) {
       {"events", Json::array()},
       {"black_boxes", black_boxes},
   };
-  if (!m.model_source.empty()) out["model"]["source"] = m.model_source;  // absent: not recorded (a rig check learns nothing)
+  if (!m.model_source.empty())
+    out["model"]["source"] = m.model_source;  // absent: not recorded (a rig check learns nothing)
   if (!m.first_correction.is_null()) out["first_correction"] = m.first_correction;
   if (m.resume) {
     Json resume = {{"next_iteration", static_cast<int>(m.iterations.size())}};
@@ -379,7 +387,9 @@ Json manifest_head_to_json(const SessionManifest& m) {
   return out;
 }
 
-std::string dump_manifest_json(const Json& json) { return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace); }
+std::string dump_manifest_json(const Json& json) {
+  return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 /// Appends `element` to `list` as an element of a top-level list in the file: four spaces deeper
 /// than its own dump (no JSON string holds a raw newline, so every newline starts a line).
@@ -407,7 +417,8 @@ void splice_list(std::string& text, const char* key, const std::string& head, co
 
 /// Brings `text` (`count` entries) up to `keep` entries of `entries`.
 template <typename Entry, typename ToJson>
-void extend_cache(const std::vector<Entry>& entries, std::size_t keep, std::size_t& count, std::string& text, ToJson to_json) {
+void extend_cache(const std::vector<Entry>& entries, std::size_t keep, std::size_t& count, std::string& text,
+                  ToJson to_json) {
   if (count > keep) {  // the list shrank (another manifest): start afresh
     count = 0;
     text.clear();
@@ -455,10 +466,12 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   SessionManifest m;
   m.schema_version = r["schema_version"].integer(0, 1000000);
   if (m.schema_version < kOldestSessionSchemaVersion || m.schema_version > kSessionSchemaVersion) {
-    const std::string oldest =
-        kOldestSessionSchemaVersion < kSessionSchemaVersion ? "s " + std::to_string(kOldestSessionSchemaVersion) + " to" : "";
-    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) + " is not supported (this bellows reads version" +
-                             oldest + " " + std::to_string(kSessionSchemaVersion) + ")" +
+    const std::string oldest = kOldestSessionSchemaVersion < kSessionSchemaVersion
+                                   ? "s " + std::to_string(kOldestSessionSchemaVersion) + " to"
+                                   : "";
+    r["schema_version"].fail("schema version " + std::to_string(m.schema_version) +
+                             " is not supported (this bellows reads version" + oldest + " " +
+                             std::to_string(kSessionSchemaVersion) + ")" +
                              (m.schema_version > kSessionSchemaVersion ? ": a newer bellows wrote it" : ""));
   }
   m.program_version = r["program_version"].text();
@@ -469,10 +482,12 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
   m.started_utc = r["started_utc"].text();
   m.updated_utc = r["updated_utc"].text();
   m.configuration = configuration_from_json(r["configuration"]);
-  if (r.has("model") && r["model"].has("source")) m.model_source = r["model"]["source"].text();  // the values: the configuration's
+  if (r.has("model") && r["model"].has("source"))
+    m.model_source = r["model"]["source"].text();  // the values: the configuration's
   const JsonReader trajectory = r["trajectory"];
   m.trajectory_name = trajectory["name"].text();
-  m.trajectory_samples = trajectory["learning_samples"].integer(m.configuration.trajectory.min_learning_samples, kMostSamples);
+  m.trajectory_samples =
+      trajectory["learning_samples"].integer(m.configuration.trajectory.min_learning_samples, kMostSamples);
   try {  // the ticks and the law's matrices such a trial implies, before anything reads or allocates them
     check_trial_cost(m.configuration, m.trajectory_samples);
   } catch (const InputError& error) {
@@ -498,8 +513,8 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
     const JsonReader resume = r["resume"];
     const int next = resume["next_iteration"].integer(0, kMostIterations);
     if (next != static_cast<int>(m.iterations.size())) {
-      resume["next_iteration"].fail("expected " + std::to_string(m.iterations.size()) + " (the iterations listed), found " +
-                                    std::to_string(next));
+      resume["next_iteration"].fail("expected " + std::to_string(m.iterations.size()) +
+                                    " (the iterations listed), found " + std::to_string(next));
     }
     ResumeState state;
     // The first format (1afa6a9, Nov 21) always saved the controllers and the device, without
@@ -508,7 +523,8 @@ SessionManifest parse_manifest(std::string_view text, const std::string& source)
     if (first_format || resume["exact"].boolean()) {
       if (!first_format || resume.has("clock_ticks")) {
         const JsonReader ticks = resume["clock_ticks"];
-        if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0) ticks.fail("expected a whole number >= 0");
+        if (!ticks.json().is_number_integer() || ticks.json().get<long long>() < 0)
+          ticks.fail("expected a whole number >= 0");
         state.clock_ticks = ticks.json().get<long long>();
       }
       state.controller = controller_state_from_json(resume["controller"], m.configuration, m.joints);

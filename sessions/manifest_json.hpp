@@ -23,7 +23,7 @@ std::string format_manifest(const SessionManifest& manifest);
 /// write serializes only what was added (not a document of every iteration, whose thousands of
 /// small blocks, freed again, fragmented a lab day's heap).
 struct ManifestTextCache {
-  std::size_t iterations = 0;   // entries in iterations_text (all but the newest, which may change)
+  std::size_t iterations = 0;  // entries in iterations_text (all but the newest, which may change)
   std::size_t events = 0;
   std::string iterations_text;  // the entries as format_manifest writes them, ",\n"-joined
   std::string events_text;

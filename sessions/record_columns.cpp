@@ -17,9 +17,12 @@ std::size_t at(int joint) { return static_cast<std::size_t>(joint); }
 
 Eigen::VectorXd written(const Eigen::VectorXd& values, ColumnScale scale) {
   switch (scale) {
-    case ColumnScale::kDegrees: return degrees_of(values);
-    case ColumnScale::kTime: return rounded_times(values);
-    case ColumnScale::kAsIs: break;
+    case ColumnScale::kDegrees:
+      return degrees_of(values);
+    case ColumnScale::kTime:
+      return rounded_times(values);
+    case ColumnScale::kAsIs:
+      break;
   }
   return values;
 }
@@ -49,7 +52,8 @@ const std::vector<RecordColumn<TrialSamples>>& samples_record_columns() {
       {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &S::angle_rad, nullptr},
       {"error_deg", "deg", "yD(k) - y(k); 0 at k = 0", kDegrees, kJoint, &S::error_rad, nullptr},
       {"u_pid_bar", "bar", "PID + feed-forward output", kAsIs, kJoint, &S::u_pid_bar, nullptr},
-      {"u_ilc_bar", "bar", "learned correction applied at sample k (0 at k = N)", kAsIs, kJoint, &S::u_ilc_bar, nullptr},
+      {"u_ilc_bar", "bar", "learned correction applied at sample k (0 at k = N)", kAsIs, kJoint, &S::u_ilc_bar,
+       nullptr},
       {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, &S::u_total_bar, nullptr},
       {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &S::pressure_a_bar, nullptr},
       {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &S::pressure_b_bar, nullptr},
@@ -81,43 +85,60 @@ const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns() {
 const std::vector<TickColumn>& black_box_record_columns() {
   using Tick = TickRecord;
   static const std::vector<TickColumn> columns = {
-      {"tick", "", "the engine's tick count", kAsIs, kShared, [](const Tick& t, int) { return static_cast<double>(t.tick); },
+      {"tick", "", "the engine's tick count", kAsIs, kShared,
+       [](const Tick& t, int) { return static_cast<double>(t.tick); },
        [](Tick& t, int, double v) { t.tick = static_cast<std::uint64_t>(v); }},
       {"time_s", "s", "engine time of the tick", kAsIs, kShared, [](const Tick& t, int) { return t.time_s; },
        [](Tick& t, int, double v) { t.time_s = v; }},
-      {"sensor_time_s", "s", "time of the reading the tick used", kAsIs, kShared, [](const Tick& t, int) { return t.reading.time_s; },
-       [](Tick& t, int, double v) { t.reading.time_s = v; }},
+      {"sensor_time_s", "s", "time of the reading the tick used", kAsIs, kShared,
+       [](const Tick& t, int) { return t.reading.time_s; }, [](Tick& t, int, double v) { t.reading.time_s = v; }},
       {"state", "", "engine state (SAFE, ARMED, RUNNING, FAULT)", kAsIs, kShared,
-       [](const Tick& t, int) { return static_cast<double>(t.state); }, [](Tick& t, int, double v) { t.state = static_cast<EngineState>(v); }},
+       [](const Tick& t, int) { return static_cast<double>(t.state); },
+       [](Tick& t, int, double v) { t.state = static_cast<EngineState>(v); }},
       {"fault", "", "the latched fault (none, angle-limit, ...)", kAsIs, kShared,
-       [](const Tick& t, int) { return static_cast<double>(t.fault); }, [](Tick& t, int, double v) { t.fault = static_cast<FaultCode>(v); }},
-      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, [](const Tick& t, int j) { return t.reading.joint[at(j)].angle_rad; },
+       [](const Tick& t, int) { return static_cast<double>(t.fault); },
+       [](Tick& t, int, double v) { t.fault = static_cast<FaultCode>(v); }},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint,
+       [](const Tick& t, int j) { return t.reading.joint[at(j)].angle_rad; },
        [](Tick& t, int j, double v) { t.reading.joint[at(j)].angle_rad = v; }},
-      {"angle_setpoint_deg", "deg", "desired angle", kDegrees, kJoint, [](const Tick& t, int j) { return t.joint(j).desired_rad; },
+      {"angle_setpoint_deg", "deg", "desired angle", kDegrees, kJoint,
+       [](const Tick& t, int j) { return t.joint(j).desired_rad; },
        [](Tick& t, int j, double v) { t.joint(j).desired_rad = v; }},
       {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint,
-       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[0]; }, [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[0] = v; }},
+       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[0]; },
+       [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[0] = v; }},
       {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint,
-       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[1]; }, [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[1] = v; }},
-      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared, [](const Tick& t, int) { return t.reading.supply_bar; },
+       [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[1]; },
+       [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[1] = v; }},
+      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared,
+       [](const Tick& t, int) { return t.reading.supply_bar; },
        [](Tick& t, int, double v) { t.reading.supply_bar = v; }},
-      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint(j).u_total_bar; },
+      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.joint(j).u_total_bar; },
        [](Tick& t, int j, double v) { t.joint(j).u_total_bar = v; }},
-      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint(j).setpoints.a_bar; },
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.joint(j).setpoints.a_bar; },
        [](Tick& t, int j, double v) { t.joint(j).setpoints.a_bar = v; }},
-      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint, [](const Tick& t, int j) { return t.joint(j).setpoints.b_bar; },
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.joint(j).setpoints.b_bar; },
        [](Tick& t, int j, double v) { t.joint(j).setpoints.b_bar = v; }},
-      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[0]; },
+      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[0]; },
        [](Tick& t, int j, double v) { t.valves.joint[at(j)].inlet_duty[0] = v; }},
-      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[0]; },
+      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[0]; },
        [](Tick& t, int j, double v) { t.valves.joint[at(j)].outlet_duty[0] = v; }},
-      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[1]; },
+      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[1]; },
        [](Tick& t, int j, double v) { t.valves.joint[at(j)].inlet_duty[1] = v; }},
-      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint, [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[1]; },
+      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint,
+       [](const Tick& t, int j) { return t.valves.joint[at(j)].outlet_duty[1]; },
        [](Tick& t, int j, double v) { t.valves.joint[at(j)].outlet_duty[1] = v; }},
       {"sample", "", "ILC sample of the running trial, -1 when none runs", kAsIs, kShared,
-       [](const Tick& t, int) { return static_cast<double>(t.sample); }, [](Tick& t, int, double v) { t.sample = static_cast<int>(v); }},
-      {"trial_id", "", "the running trial's id", kAsIs, kShared, [](const Tick& t, int) { return static_cast<double>(t.trial_id); },
+       [](const Tick& t, int) { return static_cast<double>(t.sample); },
+       [](Tick& t, int, double v) { t.sample = static_cast<int>(v); }},
+      {"trial_id", "", "the running trial's id", kAsIs, kShared,
+       [](const Tick& t, int) { return static_cast<double>(t.trial_id); },
        [](Tick& t, int, double v) { t.trial_id = static_cast<std::uint32_t>(v); }},
   };
   return columns;
@@ -125,7 +146,9 @@ const std::vector<TickColumn>& black_box_record_columns() {
 
 std::string joint_column_name(std::string_view name, int joint) {
   std::string out(name);
-  if (joint > 0) out.append("_j").append(std::to_string(joint + 1));  // by appends: GCC 12 warns falsely (-Wrestrict) on "_j" + string
+  if (joint > 0)
+    out.append("_j").append(
+        std::to_string(joint + 1));  // by appends: GCC 12 warns falsely (-Wrestrict) on "_j" + string
   return out;
 }
 
@@ -136,7 +159,8 @@ std::vector<std::string> black_box_header(int joints) { return header_of(black_b
 std::vector<std::string> trajectory_header(int joints) {
   if (joints == 1) return {"time_s", "angle_deg"};
   std::vector<std::string> names = {"time_s"};
-  for (int joint = 1; joint <= joints; ++joint) names.push_back(std::string("q").append(std::to_string(joint)).append("_deg"));
+  for (int joint = 1; joint <= joints; ++joint)
+    names.push_back(std::string("q").append(std::to_string(joint)).append("_deg"));
   return names;
 }
 
@@ -144,7 +168,8 @@ std::vector<std::string_view> header_views(const std::vector<std::string>& names
   return {names.begin(), names.end()};
 }
 
-std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar) {
+std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record,
+                                                 const Eigen::MatrixXd& next_corrections_bar) {
   std::vector<Eigen::VectorXd> values;
   for (int joint = 0; joint < record.joint_count(); ++joint) {
     const TrialSamples& samples = record.joint_samples(joint);

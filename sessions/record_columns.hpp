@@ -38,7 +38,7 @@ struct RecordColumn {
   std::string_view meaning;  // one line for people (docs, exports)
   ColumnScale scale;
   ColumnScope scope;
-  Eigen::VectorXd Joint::*member;         // where each joint keeps it (kPerJoint)
+  Eigen::VectorXd Joint::*member;        // where each joint keeps it (kPerJoint)
   Eigen::VectorXd TrialRecord::*shared;  // where the record keeps it (kShared)
   // Both null: the correction learned (samples).
 };
@@ -78,7 +78,8 @@ std::vector<std::string_view> header_views(const std::vector<std::string>& names
 
 /// Every column's values as written, in the order of samples_header(record.joint_count()).
 /// `next_corrections_bar` is N x J (a missing row or column is 0); the last row's is 0.
-std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar);
+std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record,
+                                                 const Eigen::MatrixXd& next_corrections_bar);
 std::vector<Eigen::VectorXd> telemetry_file_values(const TrialRecord& record);
 /// Every column of black_box_header(joints), one row per tick, angles in degrees as written.
 std::vector<Eigen::VectorXd> black_box_file_values(const std::vector<TickRecord>& ticks, int joints);

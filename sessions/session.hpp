@@ -46,10 +46,10 @@ struct SessionEvent {
 
 /// A fault's black box as the manifest lists it; its ticks are in session_layout::black_box_file().
 struct BlackBoxEntry {
-  std::string time_utc;  // when it was saved
-  int iteration = 0;     // the iteration running or next to run when the fault fired
-  std::string fault;     // fault_name(), e.g. "overpressure"
-  int ticks = 0;         // rows in the file: the ticks before the fault and the fault tick
+  std::string time_utc;     // when it was saved
+  int iteration = 0;        // the iteration running or next to run when the fault fired
+  std::string fault;        // fault_name(), e.g. "overpressure"
+  int ticks = 0;            // rows in the file: the ticks before the fault and the fault tick
   std::string sha256 = {};  // the file's digest as saved; empty in sessions saved before digests
 };
 
@@ -80,7 +80,7 @@ struct SessionManifest {
   int schema_version = session_schema_version_for(1);
   std::string program_version;
   std::string name;
-  std::string device;                                      // Device::name(), e.g. "sim"
+  std::string device;  // Device::name(), e.g. "sim"
   // The arm's joints J: every iteration file holds J joints' columns, the trajectory J columns.
   // Written only when J > 1 (a one-joint manifest is what it always was); absent: one joint.
   int joints = 1;
@@ -93,12 +93,12 @@ struct SessionManifest {
   // saved before it was recorded.
   std::string model_source;
   std::string trajectory_name;
-  int trajectory_samples = 0;  // N learning samples (the file holds N + 1)
+  int trajectory_samples = 0;     // N learning samples (the file holds N + 1)
   std::string trajectory_sha256;  // empty in sessions saved before digests were kept
   std::vector<IterationEntry> iterations;
   std::vector<SessionEvent> events;
   std::vector<BlackBoxEntry> black_boxes;  // numbered 0, 1, ... in the order the faults fired
-  std::optional<ResumeState> resume;  // present once an iteration has completed
+  std::optional<ResumeState> resume;       // present once an iteration has completed
   // Where the first trial's correction came from when it was not zero (a learning transfer: its
   // sources, method and prediction); null for a run that started with feedback only.
   nlohmann::ordered_json first_correction;
@@ -134,7 +134,7 @@ struct Session {
   std::string dropped;
   SessionManifest manifest;
   Trajectory trajectory;
-  std::vector<IterationData> iterations;  // in the order of manifest.iterations
+  std::vector<IterationData> iterations;             // in the order of manifest.iterations
   std::vector<std::vector<TickRecord>> black_boxes;  // in the order of manifest.black_boxes, oldest tick first
 };
 

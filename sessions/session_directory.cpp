@@ -34,8 +34,9 @@ namespace {
 /// A column for people: "angle_deg" -> "angle", "u_pid_bar_j2" -> "joint 2 u_pid".
 std::string column_label(std::string name) {
   std::string joint;
-  if (const std::size_t suffix = name.rfind("_j"); suffix != std::string::npos && suffix + 2 < name.size() &&
-                                                   name.find_first_not_of("0123456789", suffix + 2) == std::string::npos) {
+  if (const std::size_t suffix = name.rfind("_j");
+      suffix != std::string::npos && suffix + 2 < name.size() &&
+      name.find_first_not_of("0123456789", suffix + 2) == std::string::npos) {
     joint = "joint " + name.substr(suffix + 2) + " ";
     name.resize(suffix);
   }
@@ -102,7 +103,8 @@ void write_all_iteration_files(const DirectoryHandle& folder, const std::vector<
 
 std::string write_black_box_file(const DirectoryHandle& session, int index, const std::vector<TickRecord>& ticks) {
   const DirectoryHandle faults = session.make_subdirectory(session_layout::kFaults);
-  return write_layout_file(faults, session_layout::black_box_file(index), format_black_box_csv(ticks), DirectorySync::kNow);
+  return write_layout_file(faults, session_layout::black_box_file(index), format_black_box_csv(ticks),
+                           DirectorySync::kNow);
 }
 
 IterationDigests write_iteration_files(const DirectoryHandle& iterations, int index, const TrialRecord& record,
@@ -123,7 +125,8 @@ IterationDigests write_iteration_files(const DirectoryHandle& iterations, int in
 
 void write_manifest(const DirectoryHandle& session, SessionManifest& manifest, ManifestTextCache* cache) {
   manifest.updated_utc = utc_now();
-  write_file_atomic_at(session, session_layout::kManifest, cache ? format_manifest(manifest, *cache) : format_manifest(manifest));
+  write_file_atomic_at(session, session_layout::kManifest,
+                       cache ? format_manifest(manifest, *cache) : format_manifest(manifest));
 }
 
 CreatedSession create_session_directory(const fs::path& directory, const SessionManifest& manifest,
@@ -143,15 +146,16 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
   const std::string name = directory.filename().string();
   std::error_code error;
   fs::create_directories(parent_path, error);
-  if (error) throw InputError("cannot create the data directory " + printable(parent_path.string()) + ": " + error.message());
+  if (error)
+    throw InputError("cannot create the data directory " + printable(parent_path.string()) + ": " + error.message());
   const DirectoryHandle parent = DirectoryHandle::open(parent_path);
   const auto refuse_existing = [&] {
     if (const auto holder = SessionLock::holder(directory)) {
       throw SessionExistsError(describe_session(directory) + " is in use by " + *holder +
                                "; two processes never write the same session");
     }
-    throw SessionExistsError(describe_session(directory) + " exists already; continue it with --resume " + printable(directory.string()) +
-                     " or choose another --name");
+    throw SessionExistsError(describe_session(directory) + " exists already; continue it with --resume " +
+                             printable(directory.string()) + " or choose another --name");
   };
   struct stat existing {};
   if (::fstatat(parent.fd(), name.c_str(), &existing, AT_SYMLINK_NOFOLLOW) == 0) refuse_existing();
@@ -159,20 +163,25 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
   std::string building_name = ".";  // by appends: GCC 12 warns falsely (-Wrestrict) on "." + string
   // Unique to this process and this creation: threads of one process may create sessions at once.
   static std::atomic<unsigned> creations{0};
-  building_name.append(name).append(".creating-").append(std::to_string(::getpid())).append("-").append(
-      std::to_string(creations.fetch_add(1)));
+  building_name.append(name)
+      .append(".creating-")
+      .append(std::to_string(::getpid()))
+      .append("-")
+      .append(std::to_string(creations.fetch_add(1)));
   fs::remove_all(parent_path / building_name, error);  // a leftover of this pid (a link is removed, not followed)
   if (::mkdirat(parent.fd(), building_name.c_str(), 0755) != 0) {
-    throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": " + std::strerror(errno));
+    throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": " +
+                     std::strerror(errno));
   }
   try {
     std::optional<DirectoryHandle> building = parent.subdirectory(building_name);
-    if (!building) throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": it vanished");
+    if (!building)
+      throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": it vanished");
     SessionLock lock(*building, purpose);
     SessionManifest written = manifest;
     const DirectoryHandle iterations_folder = building->make_subdirectory(session_layout::kIterations);
-    written.trajectory_sha256 =
-        write_layout_file(*building, session_layout::kTrajectory, format_trajectory_csv(trajectory), DirectorySync::kLater);
+    written.trajectory_sha256 = write_layout_file(*building, session_layout::kTrajectory,
+                                                  format_trajectory_csv(trajectory), DirectorySync::kLater);
     write_all_iteration_files(iterations_folder, iterations, written.iterations);
     sync(iterations_folder);
     for (std::size_t i = 0; i < black_boxes.size(); ++i) {

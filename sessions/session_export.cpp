@@ -76,7 +76,7 @@ std::vector<fs::path> export_session_csv(const Session& session, const fs::path&
     telemetry.push_back(format_telemetry_csv(data.record));
   }
   if (samples.empty()) {  // the header alone, of every joint
-    TrialRecord empty;  // no rows: every joint's columns empty
+    TrialRecord empty;    // no rows: every joint's columns empty
     empty.joints.resize(static_cast<std::size_t>(session.manifest.joints));
     samples.push_back(format_samples_csv(empty, Eigen::MatrixXd{}));
     telemetry.push_back(format_telemetry_csv(empty));

@@ -81,7 +81,8 @@ MatVar columns_struct(const std::vector<std::string>& fields, const std::vector<
 }
 
 MatVar samples_struct(const IterationData& data) {
-  return columns_struct(samples_header(data.record.joint_count()), samples_file_values(data.record, data.next_corrections_bar()));
+  return columns_struct(samples_header(data.record.joint_count()),
+                        samples_file_values(data.record, data.next_corrections_bar()));
 }
 
 MatVar telemetry_struct(const TrialRecord& record) {
@@ -100,7 +101,8 @@ MatVar configuration_struct(const Configuration& config) {
     MatVar inner = structure(keys);
     std::size_t k = 0;
     for (const auto& [key, value] : values.items()) {
-      set_field(inner.get(), keys[k++], 0, value.is_string() ? text(value.get<std::string>()) : scalar(value.get<double>()));
+      set_field(inner.get(), keys[k++], 0,
+                value.is_string() ? text(value.get<std::string>()) : scalar(value.get<double>()));
     }
     set_field(out.get(), sections[s++], 0, std::move(inner));
   }
@@ -194,7 +196,8 @@ void write_named(mat_t* file, MatVar var, const char* name, const fs::path& path
   if (Mat_VarWrite(file, var.get(), MAT_COMPRESSION_ZLIB) != 0) {
     // libmatio says only that it failed; the system's reason (a full disk) is in errno, if anywhere.
     const int why = errno;
-    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string() + (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
+    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string() +
+                     (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
   }
 }
 
@@ -202,7 +205,8 @@ void write_named(mat_t* file, MatVar var, const char* name, const fs::path& path
 MatVar names_column(const std::vector<std::string>& names) {
   size_t dims[2] = {names.size(), 1};
   MatVar out(Mat_VarCreate(nullptr, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0));
-  for (std::size_t i = 0; i < names.size(); ++i) Mat_VarSetCell(out.get(), static_cast<int>(i), text(names[i]).release());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    Mat_VarSetCell(out.get(), static_cast<int>(i), text(names[i]).release());
   return out;
 }
 
@@ -249,7 +253,8 @@ void finish_mat_file(mat_t* file, const Session& session, const fs::path& path) 
   errno = 0;
   if (Mat_Close(file) != 0) {
     const int why = errno;
-    throw InputError("cannot write " + path.string() + " (libmatio could not finish it)" + (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
+    throw InputError("cannot write " + path.string() + " (libmatio could not finish it)" +
+                     (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
   }
 }
 
@@ -258,7 +263,8 @@ void finish_mat_file(mat_t* file, const Session& session, const fs::path& path) 
 /// fsync, rename, fsync of the folder): nothing of libmatio's touches the folder.
 void export_mat5(const Session& session, const fs::path& path, Replace replace) {
   const FileDescriptor memory(::memfd_create("bellows-mat-export", MFD_CLOEXEC));
-  if (memory.get() < 0) throw EnvironmentError(std::string("cannot make the MAT file in memory: ") + std::strerror(errno));
+  if (memory.get() < 0)
+    throw EnvironmentError(std::string("cannot make the MAT file in memory: ") + std::strerror(errno));
   const std::string in_memory = "/proc/self/fd/" + std::to_string(memory.get());
   mat_t* file = Mat_CreateVer(in_memory.c_str(), nullptr, MAT_FT_MAT5);
   if (file == nullptr) throw InputError("cannot create " + path.string() + " (libmatio could not open it for writing)");
@@ -268,7 +274,8 @@ void export_mat5(const Session& session, const fs::path& path, Replace replace) 
   for (off_t at = 0;;) {
     const ssize_t got = ::pread(memory.get(), buffer, sizeof buffer, at);
     if (got < 0 && errno == EINTR) continue;
-    if (got < 0) throw EnvironmentError("cannot read the MAT file back from memory: " + std::string(std::strerror(errno)));
+    if (got < 0)
+      throw EnvironmentError("cannot read the MAT file back from memory: " + std::string(std::strerror(errno)));
     if (got == 0) break;
     bytes.append(buffer, static_cast<std::size_t>(got));
     at += got;

@@ -106,9 +106,11 @@ fs::path given_data_dir(const std::string& option_value) {
   const fs::path dir(option_value);
   std::error_code error;
   const fs::file_status status = fs::status(dir, error);
-  if (status.type() == fs::file_type::not_found) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": no such directory");
+  if (status.type() == fs::file_type::not_found)
+    throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": no such directory");
   if (error) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": " + error.message());
-  if (status.type() != fs::file_type::directory) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": not a directory");
+  if (status.type() != fs::file_type::directory)
+    throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": not a directory");
   return dir;
 }
 
@@ -119,7 +121,8 @@ std::string default_session_name(std::time_t start, const std::string& trajector
   std::strftime(stamp, sizeof stamp, "%Y-%m-%d_%H-%M-%S", &local);
   std::string safe;
   for (char c : trajectory_name) {
-    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+    const bool plain =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
     safe += plain ? c : '-';
   }
   return std::string(stamp) + "_" + (safe.empty() ? "trajectory" : safe.substr(0, 64));
@@ -157,7 +160,9 @@ fs::path rename_session(const fs::path& directory, const std::string& new_name) 
   const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
   std::error_code error;
   fs::rename(directory, target, error);
-  if (error) throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " + error.message());
+  if (error)
+    throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " +
+                     error.message());
   manifest.name = new_name;  // the manifest names its session too
   manifest.updated_utc = utc_now();
   // Through the session's own descriptor, by the one safe writer: a link planted at any name in
@@ -176,8 +181,9 @@ fs::path resolve_session_dir(const std::string& path_or_name, const fs::path& da
   if (path.find('/') == std::string::npos && !data_dir.empty() && fs::is_directory(data_dir / path, error)) {
     return data_dir / path;
   }
-  throw InputError("session " + printable(path_or_name) + ": no such directory" +
-                   (data_dir.empty() ? std::string() : " (nor a session of that name in " + printable(data_dir.string()) + ")"));
+  throw InputError(
+      "session " + printable(path_or_name) + ": no such directory" +
+      (data_dir.empty() ? std::string() : " (nor a session of that name in " + printable(data_dir.string()) + ")"));
 }
 
 SessionManifest load_manifest(const fs::path& directory) { return load_manifest(open_session_directory(directory)); }
@@ -217,7 +223,8 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
   session.trajectory = parse_trajectory_csv_file(
       read_session_file(folders, session_layout::kTrajectory, csv_size_limit(header_views(trajectory_names), rows + 1),
                         m.trajectory_sha256, integrity),
-      where + session_layout::kTrajectory, m.trajectory_name, samples, config.timing.sample_s(), config.trajectory, joints);
+      where + session_layout::kTrajectory, m.trajectory_name, samples, config.timing.sample_s(), config.trajectory,
+      joints);
   session.iterations.resize(m.iterations.size());
   for (std::size_t i = 0; i < m.iterations.size(); ++i) {
     const int index = static_cast<int>(i);
@@ -239,16 +246,18 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
     const auto agrees = [&](double rms) { return std::abs(rms - listed) <= 1e-9 * std::max(1.0, listed); };
     const double rms = data.record.rms_error_deg();
     if (!agrees(rms) && !(joints > 1 && agrees(overall_rms_deg(data.record)))) {
-      throw InputError(where + samples_file + ": its RMS error " + std::to_string(joints > 1 ? overall_rms_deg(data.record) : rms) +
+      throw InputError(where + samples_file + ": its RMS error " +
+                       std::to_string(joints > 1 ? overall_rms_deg(data.record) : rms) +
                        " deg differs from the manifest's " + std::to_string(listed) + " deg");
     }
   }
   for (std::size_t i = 0; only == nullptr && i < m.black_boxes.size(); ++i) {
     const BlackBoxEntry& entry = m.black_boxes[i];
     const std::string file = session_layout::black_box_file(static_cast<int>(i));
-    const std::size_t limit = csv_size_limit(header_views(black_box_header(m.joints)), static_cast<std::size_t>(entry.ticks));
-    session.black_boxes.push_back(
-        parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity), where + file, entry.ticks));
+    const std::size_t limit =
+        csv_size_limit(header_views(black_box_header(m.joints)), static_cast<std::size_t>(entry.ticks));
+    session.black_boxes.push_back(parse_black_box_csv(read_session_file(folders, file, limit, entry.sha256, integrity),
+                                                      where + file, entry.ticks));
   }
   session.dropped = describe_dropped(find_uncommitted_files(directory, m));
   return session;
@@ -259,8 +268,9 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
 std::string dropped_line(const Session& session) {
   if (session.dropped.empty()) return "";
   const auto n = static_cast<long long>(session.iterations.size());
-  return describe_session(session.directory) + ": a save was interrupted; dropped what it had not committed: " +
-         session.dropped + "; this is its last committed state (" + std::to_string(n) + (n == 1 ? " iteration)" : " iterations)");
+  return describe_session(session.directory) +
+         ": a save was interrupted; dropped what it had not committed: " + session.dropped +
+         "; this is its last committed state (" + std::to_string(n) + (n == 1 ? " iteration)" : " iterations)");
 }
 
 void save_session(const Session& session, const fs::path& directory) {

@@ -74,12 +74,14 @@ void SessionWriter::check_fits(const TrialRecord& record, const Eigen::MatrixXd&
                                const char* what) const {
   if (!record.complete || record.learning_samples != manifest_.trajectory_samples ||
       next_corrections_bar.rows() != manifest_.trajectory_samples) {
-    throw std::invalid_argument(std::string("SessionWriter::") + what + ": the record does not match the session's trajectory");
+    throw std::invalid_argument(std::string("SessionWriter::") + what +
+                                ": the record does not match the session's trajectory");
   }
   if (record.joint_count() != manifest_.joints || next_corrections_bar.cols() != manifest_.joints) {
     throw std::invalid_argument(std::string("SessionWriter::") + what + ": the session has " +
-                                std::to_string(manifest_.joints) + " joints, the record " + std::to_string(record.joint_count()) +
-                                " and the correction " + std::to_string(next_corrections_bar.cols()));
+                                std::to_string(manifest_.joints) + " joints, the record " +
+                                std::to_string(record.joint_count()) + " and the correction " +
+                                std::to_string(next_corrections_bar.cols()));
   }
 }
 
@@ -91,8 +93,8 @@ void SessionWriter::save_iteration(const TrialRecord& record, const IterationSum
 void SessionWriter::save_iteration(const TrialRecord& record, const IterationSummary& summary,
                                    const Eigen::MatrixXd& next_corrections_bar, ResumeState resume) {
   if (summary.iteration != next_iteration()) {
-    throw std::invalid_argument("SessionWriter::save_iteration: expected iteration " + std::to_string(next_iteration()) +
-                                ", got " + std::to_string(summary.iteration));
+    throw std::invalid_argument("SessionWriter::save_iteration: expected iteration " +
+                                std::to_string(next_iteration()) + ", got " + std::to_string(summary.iteration));
   }
   check_fits(record, next_corrections_bar, "save_iteration");
   const IterationDigests digests = write_iteration_files(iterations_, summary.iteration, record, next_corrections_bar);
@@ -174,7 +176,9 @@ void SessionWriter::update_next_correction(const TrialRecord& record, const Eige
   IterationEntry& entry = manifest_.iterations.back();
   const std::string contents = format_samples_csv(record, next_correction_bar);
   const int revision = entry.samples_revision + 1;
-  const auto name_of = [&](int r) { return session_layout::folder_and_name(session_layout::samples_file(iteration, r)).second; };
+  const auto name_of = [&](int r) {
+    return session_layout::folder_and_name(session_layout::samples_file(iteration, r)).second;
+  };
   write_file_atomic_at(iterations_, name_of(revision), contents);
   std::string previous_digest = std::exchange(entry.samples_sha256, sha256_hex(contents));
   entry.samples_revision = revision;

@@ -2,7 +2,8 @@
 // after every completed iteration and records events (faults, operator actions) as they occur.
 // Every save writes new files under new names first and then the manifest that names them: the
 // manifest's rename is the single commit point, so a crash at any moment leaves a session that
-// loads with every iteration whose save returned, and a file already committed is never rewritten. The writer holds the session's lock for its lifetime: one writer per session.
+// loads with every iteration whose save returned, and a file already committed is never rewritten. The writer holds the
+// session's lock for its lifetime: one writer per session.
 #pragma once
 
 #include <filesystem>

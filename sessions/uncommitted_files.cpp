@@ -42,7 +42,8 @@ std::string name_in_folder(const std::string& relative) { return session_layout:
 std::vector<UncommittedFile> find_uncommitted_files(const DirectoryHandle& session, const SessionManifest& manifest) {
   std::vector<UncommittedFile> found;
   for (const std::string& name : entry_names(session)) {
-    if (is_temporary_file_name(name)) found.push_back({"", name, "an unfinished write of " + name.substr(1, name.find(".tmp-") - 1)});
+    if (is_temporary_file_name(name))
+      found.push_back({"", name, "an unfinished write of " + name.substr(1, name.find(".tmp-") - 1)});
   }
   const auto folder_of = [&](const char* name) -> std::optional<DirectoryHandle> {
     try {
@@ -60,7 +61,8 @@ std::vector<UncommittedFile> find_uncommitted_files(const DirectoryHandle& sessi
         if (name != name_in_folder(session_layout::samples_file(samples->number, samples->revision))) continue;
         if (samples->number >= listed) {
           found.push_back({session_layout::kIterations, name, "iteration " + std::to_string(samples->number)});
-        } else if (const int committed = manifest.iterations[static_cast<std::size_t>(samples->number)].samples_revision;
+        } else if (const int committed =
+                       manifest.iterations[static_cast<std::size_t>(samples->number)].samples_revision;
                    samples->revision > committed) {
           found.push_back({session_layout::kIterations, name,
                            "the correction learned from iteration " + std::to_string(samples->number)});
@@ -93,8 +95,8 @@ std::string describe_dropped(const std::vector<UncommittedFile>& files) {
   std::vector<std::string> parts;
   for (const UncommittedFile& file : files) {
     // A hidden temporary is the partial copy of a file a crash cut short: named by what it was for.
-    const std::string what = file.description == "an unfinished write" ? "an unfinished write in " + file.folder + "/"
-                                                                        : file.description;
+    const std::string what =
+        file.description == "an unfinished write" ? "an unfinished write in " + file.folder + "/" : file.description;
     if (!what.empty() && std::find(parts.begin(), parts.end(), what) == parts.end()) parts.push_back(what);
   }
   std::sort(parts.begin(), parts.end());

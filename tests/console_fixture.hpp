@@ -28,8 +28,8 @@ class MemorySessions final : public ui::SessionGateway {
   /// Like the store: a new session, or what was added to the session named by the snapshot.
   std::string save(const ui::SessionSnapshot& snapshot) override {
     const std::lock_guard<std::mutex> guard(mutex);
-    const std::string location =
-        snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size()) : snapshot.experiment.session_location;
+    const std::string location = snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size())
+                                                                              : snapshot.experiment.session_location;
     ui::SessionSnapshot merged = snapshot;
     if (const auto old = saved.find(location); old != saved.end()) {
       const auto& before = old->second.experiment.trials;
@@ -41,7 +41,8 @@ class MemorySessions final : public ui::SessionGateway {
       }
       merged.events = old->second.events;
       const std::size_t first_new = snapshot.events_total - snapshot.events.size();
-      for (std::size_t i = snapshot.experiment.saved_events > first_new ? snapshot.experiment.saved_events - first_new : 0;
+      for (std::size_t i = snapshot.experiment.saved_events > first_new ? snapshot.experiment.saved_events - first_new
+                                                                        : 0;
            i < snapshot.events.size(); ++i) {
         merged.events.push_back(snapshot.events[i]);
       }
@@ -101,7 +102,8 @@ struct ConsoleFixture {
     env.stop_after_rises = stop_after_rises;
     env.write_figures = std::move(write_figures);
     env.clock_text = [] { return std::string("12:00:00"); };
-    console = std::make_unique<ui::ConsoleController>(env, library_trajectory(start_trajectory, c.timing.sample_s()), false);
+    console =
+        std::make_unique<ui::ConsoleController>(env, library_trajectory(start_trajectory, c.timing.sample_s()), false);
     console->resize(120, 40);
     console->start(clock.now_s());
   }
@@ -124,8 +126,8 @@ struct ConsoleFixture {
       // Engine time stands still while the learner works or a save runs, so that runs are
       // deterministic: a batch's next trial waits for the autosave, and on a loaded machine a save
       // to disk can take longer than the engine time this loop would otherwise race through.
-      const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning || console->state().learner_busy ||
-                           !console->state().law_ready || !console->saves_settled();
+      const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning ||
+                           console->state().learner_busy || !console->state().law_ready || !console->saves_settled();
       if (waiting) std::this_thread::sleep_for(std::chrono::microseconds(200));
       else clock.step(5);
       console->update(clock.now_s());
@@ -136,7 +138,9 @@ struct ConsoleFixture {
     const double until = clock.now_s() + engine_s;
     pump_until([&] { return clock.now_s() >= until; });
   }
-  bool idle() const { return state().run.mode == ui::RunProgress::Mode::kIdle && state().engine_state != EngineState::kRunning; }
+  bool idle() const {
+    return state().run.mode == ui::RunProgress::Mode::kIdle && state().engine_state != EngineState::kRunning;
+  }
   void arm_valves() {
     ASSERT_TRUE(pump_until([&] { return state().law_ready; }));
     key('a');

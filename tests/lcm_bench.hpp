@@ -36,7 +36,8 @@ void publish(lcm::LCM& bus, const char* channel, const Message& message, const L
 template <typename Message>
 Message decode(const Recorded& recorded, const LcmKey* key = nullptr) {
   Message message{};
-  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message, key), DecodeStatus::kOk) << recorded.channel;
+  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message, key), DecodeStatus::kOk)
+      << recorded.channel;
   return message;
 }
 

@@ -107,7 +107,8 @@ inline std::string enter_private_network_namespace() {
            " (needs root or CAP_SYS_ADMIN)";
   }
   struct stat after {};
-  if (stat("/proc/self/ns/net", &after) != 0 || after.st_ino == before.st_ino) return "the network namespace did not change";
+  if (stat("/proc/self/ns/net", &after) != 0 || after.st_ino == before.st_ino)
+    return "the network namespace did not change";
   // Only now, inside the new namespace.
   if (std::system("ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo") != 0) {
     return "cannot set up loopback multicast in the namespace (is iproute2 installed?)";
@@ -116,8 +117,8 @@ inline std::string enter_private_network_namespace() {
 }
 
 /// In a test body (namespace bellows): enters a private network namespace, or skips the test saying why not.
-#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                       \
-  do {                                                                                  \
+#define ENTER_PRIVATE_NETWORK_NAMESPACE_OR_SKIP()                                      \
+  do {                                                                                 \
     const std::string why_not = testing::enter_private_network_namespace();            \
     if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not; \
   } while (false)

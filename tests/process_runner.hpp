@@ -38,7 +38,8 @@ inline std::filesystem::path make_temp_dir(const std::string& prefix) {
 inline ProcessResult run_process(const std::string& command) {
   static const std::filesystem::path scratch = make_temp_dir("bellows-test");
   const std::filesystem::path err_path = scratch / "stderr.txt";
-  const std::string full = "XDG_DATA_HOME='" + (scratch / "xdg").string() + "' " + command + " 2>'" + err_path.string() + "'";
+  const std::string full =
+      "XDG_DATA_HOME='" + (scratch / "xdg").string() + "' " + command + " 2>'" + err_path.string() + "'";
   ProcessResult result;
   FILE* pipe = popen(full.c_str(), "r");
   if (pipe == nullptr) return result;
@@ -54,7 +55,8 @@ inline ProcessResult run_process(const std::string& command) {
   return result;
 }
 
-inline std::filesystem::path write_file(const std::filesystem::path& dir, const std::string& name, const std::string& text) {
+inline std::filesystem::path write_file(const std::filesystem::path& dir, const std::string& name,
+                                        const std::string& text) {
   const std::filesystem::path path = dir / name;
   std::ofstream(path) << text;
   return path;

@@ -105,7 +105,8 @@ inline ProcessResult run_bellows(const std::vector<std::string>& args, const std
   char buffer[4096];
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(guard_ms);
   while (open_pipes > 0) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0 && !result.hung) {
       result.hung = true;
       ::kill(pid, SIGKILL);  // its pipes close: the loop ends

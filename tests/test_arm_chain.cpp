@@ -86,9 +86,13 @@ TEST(ArmChain, PresetsCarryTheSpecsTables) {
                                  {0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31}};
   for (int i = 0; i < 3; ++i) {
     const ChainLink& l = arm3.links[static_cast<std::size_t>(i)];
-    const double actual[9] = {l.mass_kg, l.length_m, l.center_of_mass_m, l.inertia_kg_m2, l.tip_mass_kg,
-                              l.stiffness_Nm_per_rad, l.kappa_rad_per_bar, l.omega0_straight_rad_per_s, l.damping_ratio};
-    for (int column = 0; column < 9; ++column) EXPECT_EQ(actual[column], expected[i][column]) << "joint " << i + 1 << " column " << column;
+    const double actual[9] = {l.mass_kg,           l.length_m,
+                              l.center_of_mass_m,  l.inertia_kg_m2,
+                              l.tip_mass_kg,       l.stiffness_Nm_per_rad,
+                              l.kappa_rad_per_bar, l.omega0_straight_rad_per_s,
+                              l.damping_ratio};
+    for (int column = 0; column < 9; ++column)
+      EXPECT_EQ(actual[column], expected[i][column]) << "joint " << i + 1 << " column " << column;
   }
   try {
     chain_preset("arm7");
@@ -119,7 +123,8 @@ TEST(ArmChain, PresetsGiveTheSpecsDerivedNumbers) {
     for (int i = 0; i < arm->joints(); ++i) {
       const ChainLink& l = arm->parameters().links[static_cast<std::size_t>(i)];
       const double w0 = l.omega0_straight_rad_per_s;
-      EXPECT_NEAR(l.stiffness_Nm_per_rad / (w0 * w0 * arm->straight_inertia_kg_m2()(i)), 1.0, 0.01) << "joint " << i + 1;
+      EXPECT_NEAR(l.stiffness_Nm_per_rad / (w0 * w0 * arm->straight_inertia_kg_m2()(i)), 1.0, 0.01)
+          << "joint " << i + 1;
       EXPECT_DOUBLE_EQ(arm->damping_Nms_per_rad()(i), 2.0 * 0.31 * w0 * arm->straight_inertia_kg_m2()(i));
     }
   }
@@ -140,7 +145,8 @@ TEST(ArmChain, TwoLinksMatchTheTextbookFormulas) {
     const double h = b.mass_kg * a.length_m * b.center_of_mass_m;
     const double m22 = b.inertia_kg_m2 + b.mass_kg * b.center_of_mass_m * b.center_of_mass_m;
     const double m11 = a.inertia_kg_m2 + a.mass_kg * a.center_of_mass_m * a.center_of_mass_m +
-                       a.tip_mass_kg * a.length_m * a.length_m + m22 + b.mass_kg * a.length_m * a.length_m + 2.0 * h * c2;
+                       a.tip_mass_kg * a.length_m * a.length_m + m22 + b.mass_kg * a.length_m * a.length_m +
+                       2.0 * h * c2;
     const double m12 = m22 + h * c2;
     const JointMatrix M = arm.mass_matrix(q);
     EXPECT_NEAR(M(0, 0), m11, 1e-14);
@@ -188,7 +194,8 @@ TEST(ArmChain, EnergyIsConservedWithoutInputDampingAndCreep) {
     for (int ms = 0; ms < 1000; ms += 5) {
       arm.advance(0.005, no_input);
       const ArmChain::State& s = arm.state();
-      kinetic_swing = std::max(kinetic_swing, 0.5 * s.velocity_rad_per_s.dot(arm.mass_matrix(s.angle_rad) * s.velocity_rad_per_s));
+      kinetic_swing =
+          std::max(kinetic_swing, 0.5 * s.velocity_rad_per_s.dot(arm.mass_matrix(s.angle_rad) * s.velocity_rad_per_s));
       largest_drift = std::max(largest_drift, std::abs(arm.mechanical_energy_J(s) - initial));
     }
     EXPECT_GT(kinetic_swing, 0.05) << preset << ": the arm must actually swing";
@@ -263,10 +270,11 @@ TEST(ArmChain, OneJointWithoutGravityIsTheSingleJointArm) {
     double expected = w0 * w0 * (plant.kappa_rad_per_bar * dp_bar - alpha - z) - 2.0 * plant.damping * w0 * alpha_dot;
     const double beyond = std::abs(alpha) - plant.hard_stop_deg * std::numbers::pi / 180.0;
     if (beyond > 0.0) {
-      expected -= (alpha > 0 ? 1.0 : -1.0) * plant.hard_stop_stiffness_per_s2 * beyond + plant.hard_stop_damping_per_s * alpha_dot;
+      expected -= (alpha > 0 ? 1.0 : -1.0) * plant.hard_stop_stiffness_per_s2 * beyond +
+                  plant.hard_stop_damping_per_s * alpha_dot;
     }
-    const double actual =
-        arm.acceleration(joints_vector({alpha}), joints_vector({alpha_dot}), joints_vector({z}), joints_vector({dp_bar}))(0);
+    const double actual = arm.acceleration(joints_vector({alpha}), joints_vector({alpha_dot}), joints_vector({z}),
+                                           joints_vector({dp_bar}))(0);
     EXPECT_NEAR(actual, expected, 1e-11 * (1.0 + std::abs(expected))) << "alpha " << alpha;
   }
 }

@@ -60,7 +60,8 @@ double step_response_mismatch(const char* preset, const JointVector& pose, const
     largest_difference = std::max(largest_difference, (simulated - predicted).cwiseAbs().maxCoeff());
   }
   EXPECT_GT(largest_response, 1e-4);  // it moved
-  testing::Test::RecordProperty(std::string(preset) + "_mismatch", std::to_string(largest_difference / largest_response));
+  testing::Test::RecordProperty(std::string(preset) + "_mismatch",
+                                std::to_string(largest_difference / largest_response));
   return largest_difference / largest_response;
 }
 

@@ -38,7 +38,8 @@ Session stopped_arm_session(const char* preset, const char* trajectory_name) {
   clock.step(200);
   TrialRecord record;
   record.prepare(trajectory.learning_samples(), config.timing.ticks_per_sample, trajectory.joints());
-  const Eigen::MatrixXd correction = Eigen::MatrixXd::Constant(trajectory.learning_samples(), trajectory.joints(), 0.01);
+  const Eigen::MatrixXd correction =
+      Eigen::MatrixXd::Constant(trajectory.learning_samples(), trajectory.joints(), 0.01);
   EXPECT_TRUE(core.send(EngineCommand::start_trial(trajectory, correction, record, 0, 1)));
   clock.step(std::lround(1.0 / config.timing.tick_s));  // the arm's moves start at 0.6 s
   core.request_emergency_stop();
@@ -104,14 +105,16 @@ std::string joined(const std::vector<std::string>& names) {
 }
 
 TEST(BlackBoxJoints, OneJointKeepsTheColumnsOfEverySessionSavedSoFar) {
-  EXPECT_EQ(joined(black_box_header(1)),
-            "tick,time_s,sensor_time_s,state,fault,angle_deg,angle_setpoint_deg,pressure_a_bar,pressure_b_bar,supply_bar,"
-            "u_tot_bar,pressure_a_setpoint_bar,pressure_b_setpoint_bar,inlet_a_duty,outlet_a_duty,inlet_b_duty,"
-            "outlet_b_duty,sample,trial_id");
-  EXPECT_EQ(joined(black_box_header(2)), joined(black_box_header(1)) +
-                                             ",angle_deg_j2,angle_setpoint_deg_j2,pressure_a_bar_j2,pressure_b_bar_j2,u_tot_bar_j2,"
-                                             "pressure_a_setpoint_bar_j2,pressure_b_setpoint_bar_j2,inlet_a_duty_j2,"
-                                             "outlet_a_duty_j2,inlet_b_duty_j2,outlet_b_duty_j2");
+  EXPECT_EQ(
+      joined(black_box_header(1)),
+      "tick,time_s,sensor_time_s,state,fault,angle_deg,angle_setpoint_deg,pressure_a_bar,pressure_b_bar,supply_bar,"
+      "u_tot_bar,pressure_a_setpoint_bar,pressure_b_setpoint_bar,inlet_a_duty,outlet_a_duty,inlet_b_duty,"
+      "outlet_b_duty,sample,trial_id");
+  EXPECT_EQ(joined(black_box_header(2)),
+            joined(black_box_header(1)) +
+                ",angle_deg_j2,angle_setpoint_deg_j2,pressure_a_bar_j2,pressure_b_bar_j2,u_tot_bar_j2,"
+                "pressure_a_setpoint_bar_j2,pressure_b_setpoint_bar_j2,inlet_a_duty_j2,"
+                "outlet_a_duty_j2,inlet_b_duty_j2,outlet_b_duty_j2");
   const std::string docs = testing::read_text(fs::path(BELLOWS_SOURCE_DIR) / "docs" / "session-format.md");
   for (const TickColumn& column : black_box_record_columns()) {
     EXPECT_NE(docs.find("`" + std::string(column.name) + "`"), std::string::npos) << column.name;
@@ -162,7 +165,9 @@ j = sys.argv[2]
 print(t.__dict__["u_tot_bar_j" + j][-2], t.__dict__["pressure_b_setpoint_bar_j" + j][-2], t.__dict__["outlet_b_duty_j" + j][-1])
 )");
   FILE* pipe = ::popen(("/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "out.mat").string() + " " +
-                        std::to_string(joints) + " 2>&1").c_str(), "r");
+                        std::to_string(joints) + " 2>&1")
+                           .c_str(),
+                       "r");
   ASSERT_NE(pipe, nullptr);
   char buffer[512] = {};
   const std::size_t got = std::fread(buffer, 1, sizeof buffer - 1, pipe);

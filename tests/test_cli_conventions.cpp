@@ -14,7 +14,9 @@ using testing::expect_refused_in_one_line;
 
 using testing::run_process;
 
-testing::ProcessResult bellows(const std::string& args) { return run_process(std::string(BELLOWS_BINARY) + " " + args + " < /dev/null"); }
+testing::ProcessResult bellows(const std::string& args) {
+  return run_process(std::string(BELLOWS_BINARY) + " " + args + " < /dev/null");
+}
 
 TEST(CliConventions, VersionIsTheOneSessionsRecord) {
   const auto result = bellows("--version");
@@ -23,10 +25,23 @@ TEST(CliConventions, VersionIsTheOneSessionsRecord) {
   EXPECT_FALSE(program_version().empty());
 }
 
-const char* const kCommands[] = {"",           "run",          "sessions",     "sessions list", "sessions show",
-                                 "sessions export", "sessions rm", "sessions rename", "sessions plot", "io-sim",
-                                 "t7-sim",     "console",      "config",       "identify",      "rig",
-                                 "rig check",  "trajectories"};
+const char* const kCommands[] = {"",
+                                 "run",
+                                 "sessions",
+                                 "sessions list",
+                                 "sessions show",
+                                 "sessions export",
+                                 "sessions rm",
+                                 "sessions rename",
+                                 "sessions plot",
+                                 "io-sim",
+                                 "t7-sim",
+                                 "console",
+                                 "config",
+                                 "identify",
+                                 "rig",
+                                 "rig check",
+                                 "trajectories"};
 
 TEST(CliConventions, HelpShowsWordsNotCodesOrBuildPaths) {
   for (const std::string command : kCommands) {
@@ -74,7 +89,8 @@ TEST(CliConventions, ConfigErrorsNameTheFileAndSayWhyItCannotBeRead) {
     const auto file = testing::write_file(dir, "ilc.toml", text);
     expect_refused_in_one_line("run --no-save --config " + file.string(), "config " + file.string() + ": [ilc]");
   }
-  expect_refused_in_one_line("config --config " + (dir / "missing.toml").string(), "missing.toml: cannot be read: No such file");
+  expect_refused_in_one_line("config --config " + (dir / "missing.toml").string(),
+                             "missing.toml: cannot be read: No such file");
   expect_refused_in_one_line("config --config " + dir.string(), "is a directory");
 }
 

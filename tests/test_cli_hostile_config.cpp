@@ -82,7 +82,8 @@ TEST(HostileConfig, ADeeplyNestedFileIsRefusedNotACrash) {
 
 TEST(HostileConfig, ADirectoryOrAFifoAsConfigIsRefused) {
   TempDir dir;
-  expect_one_line_refusal(run({"config", "--config", dir.path().string()}), {dir.path().string(), "not a regular file"});
+  expect_one_line_refusal(run({"config", "--config", dir.path().string()}),
+                          {dir.path().string(), "not a regular file"});
   const fs::path fifo = dir / "fifo.toml";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   expect_one_line_refusal(run({"config", "--config", fifo.string()}), {"not a regular file"});  // no hang
@@ -143,9 +144,12 @@ TEST(HostileManifest, BadValuesInASavedSessionAreRefusedByShowAndResumeWithoutHa
   const fs::path manifest = fs::path(data) / "s" / "manifest.json";
   const std::string original = testing::read_text(manifest);
   const std::vector<std::tuple<std::string, std::string, nlohmann::json>> cases = {
-      {"timing", "tick_s", 1e-9},          {"safety", "black_box_s", 1e9},
-      {"plant", "integration_step_s", 1e-12}, {"ilc", "prediction_grid_points", 100000},
-      {"safety", "stale_ticks", 4294967299LL}, {"timing", "ticks_per_sample", 4294967297LL},
+      {"timing", "tick_s", 1e-9},
+      {"safety", "black_box_s", 1e9},
+      {"plant", "integration_step_s", 1e-12},
+      {"ilc", "prediction_grid_points", 100000},
+      {"safety", "stale_ticks", 4294967299LL},
+      {"timing", "ticks_per_sample", 4294967297LL},
       {"timing", "settle_s", 1e9},
   };
   for (const auto& [section, key, value] : cases) {
@@ -159,7 +163,8 @@ TEST(HostileManifest, BadValuesInASavedSessionAreRefusedByShowAndResumeWithoutHa
   nlohmann::ordered_json json = nlohmann::ordered_json::parse(original);
   json["trajectory"]["learning_samples"] = 50'000'000;
   testing::write_text(manifest, json.dump(2));
-  expect_one_line_refusal(run({"sessions", "show", data + "/s"}), {"manifest.json", "learning_samples", "ticks per trial"});
+  expect_one_line_refusal(run({"sessions", "show", data + "/s"}),
+                          {"manifest.json", "learning_samples", "ticks per trial"});
   expect_one_line_refusal(run({"run", "--resume", data + "/s", "--iterations", "1"}), {"learning_samples"});
   // The refusals held no lock: the repaired session resumes.
   testing::write_text(manifest, original);

@@ -41,7 +41,8 @@ TEST(CliIdentifyJoints, Arm2FitsEveryJointAndTheCoupledModelAndComparesItWithThe
     // Each joint's own fit beats its row of the arm's table on the held-out trial (the table ignores
     // the joints' coupling, creep and the bellows).
     EXPECT_GT(joint.at("validation_fit_percent").get<double>(), 75.0) << joint.dump();
-    EXPECT_GT(joint.at("validation_fit_percent").get<double>(), joint.at("arm_model_validation_fit_percent").get<double>() + 2.0);
+    EXPECT_GT(joint.at("validation_fit_percent").get<double>(),
+              joint.at("arm_model_validation_fit_percent").get<double>() + 2.0);
   }
   const nlohmann::json& coupled = report.at("coupled_model");
   EXPECT_EQ(coupled.at("states"), 4);
@@ -52,7 +53,8 @@ TEST(CliIdentifyJoints, Arm2FitsEveryJointAndTheCoupledModelAndComparesItWithThe
   ASSERT_EQ(held_out.size(), 2u);
   for (std::size_t j = 0; j < 2; ++j) {
     EXPECT_GT(held_out[j], 80.0) << "joint " << j + 1;
-    EXPECT_GT(held_out[j], linearized[j] + 5.0) << "joint " << j + 1 << ": the linearization leaves out creep and the bellows";
+    EXPECT_GT(held_out[j], linearized[j] + 5.0)
+        << "joint " << j + 1 << ": the linearization leaves out creep and the bellows";
     EXPECT_GT(held_out[j], independent[j]) << "joint " << j + 1 << ": the coupling is worth fitting";
   }
   // The identified model is near the linearization, not equal to it.
@@ -75,16 +77,21 @@ TEST(CliIdentifyJoints, Arm2FitsEveryJointAndTheCoupledModelAndComparesItWithThe
 
 TEST(CliIdentifyJoints, TheIdentifiedCoupledModelIsWhatARunLearnsWith) {
   const std::string arm2 = identify_arm_config("arm2w", "# my arm\n[arm]\npreset = \"arm2\"\n");
-  const auto identified = testing::run_process(testing::kBellows + " identify --no-save --config " + arm2 + " --write-model " + arm2);
+  const auto identified =
+      testing::run_process(testing::kBellows + " identify --no-save --config " + arm2 + " --write-model " + arm2);
   ASSERT_EQ(identified.exit_code, 0) << identified.err;
   // Without --json the progress lines go to stdout with the results.
-  EXPECT_NE(identified.out.find("wrote [identified_joint1..2] and [ilc] joint_model = \"identified\""), std::string::npos) << identified.out;
+  EXPECT_NE(identified.out.find("wrote [identified_joint1..2] and [ilc] joint_model = \"identified\""),
+            std::string::npos)
+      << identified.out;
   std::stringstream text;
   text << std::ifstream(arm2).rdbuf();
-  for (const char* expected : {"# my arm", "[identified_joint1]", "[identified_joint2]", "per_bar_j2_rad_per_s2", "joint_model = \"identified\""}) {
+  for (const char* expected : {"# my arm", "[identified_joint1]", "[identified_joint2]", "per_bar_j2_rad_per_s2",
+                               "joint_model = \"identified\""}) {
     EXPECT_NE(text.str().find(expected), std::string::npos) << expected << "\n" << text.str();
   }
-  const auto run = testing::run_process(testing::kBellows + " run --json --quiet --no-save --iterations 5 --config " + arm2);
+  const auto run =
+      testing::run_process(testing::kBellows + " run --json --quiet --no-save --iterations 5 --config " + arm2);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(run.out);
   EXPECT_EQ(report.at("arm").at("joint_model"), "identified");
@@ -95,13 +102,16 @@ TEST(CliIdentifyJoints, TheIdentifiedCoupledModelIsWhatARunLearnsWith) {
 
 TEST(CliIdentifyJoints, WhatCannotWorkIsRefusedInOneLine) {
   const std::string arm2 = identify_arm_config("arm2r", "[arm]\npreset = \"arm2\"\n");
-  testing::expect_refused_in_one_line("identify --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
-                                      "an arm of several joints runs on --device sim or lcm; --device t7 drives one joint");
-  const std::string one_joint = identify_arm_config("one", "[model]\nkappa = 7.0\n");
-  testing::expect_refused_in_one_line("identify --no-save --config " + arm2 + " --write-model " + one_joint,
-                                      "its arm is one joint, not arm2; write the coupled model into the arm's configuration");
   testing::expect_refused_in_one_line(
-      "run --no-save --config " + identify_arm_config("none", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"identified\"\n"),
+      "identify --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
+      "an arm of several joints runs on --device sim or lcm; --device t7 drives one joint");
+  const std::string one_joint = identify_arm_config("one", "[model]\nkappa = 7.0\n");
+  testing::expect_refused_in_one_line(
+      "identify --no-save --config " + arm2 + " --write-model " + one_joint,
+      "its arm is one joint, not arm2; write the coupled model into the arm's configuration");
+  testing::expect_refused_in_one_line(
+      "run --no-save --config " +
+          identify_arm_config("none", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"identified\"\n"),
       "[ilc] joint_model = 'identified': [identified_joint1] holds no identified model");
 }
 

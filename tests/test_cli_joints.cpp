@@ -57,18 +57,21 @@ TEST(CliJoints, Arm3RunsPaper3WithIndependentJointsToo) {
   const nlohmann::json report = joints_run_json("--config " + arm3 + " --trajectory paper3 --iterations 1");
   EXPECT_EQ(report.at("arm").at("joint_model"), "independent");
   for (const nlohmann::json& it : report.at("iterations")) EXPECT_EQ(it.at("joint_rms_deg").size(), 3u);
-  const auto rms = [&](int iteration, int joint) { return report["iterations"][iteration]["joint_rms_deg"][joint].get<double>(); };
+  const auto rms = [&](int iteration, int joint) {
+    return report["iterations"][iteration]["joint_rms_deg"][joint].get<double>();
+  };
   for (int j = 0; j < 3; ++j) EXPECT_LT(rms(1, j), rms(0, j)) << "joint " << j + 1;
 }
 
 TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   // arm2 written out key by key (multi-joint.md section 2; the shoulder's bellows twice the paper's):
   // the same arm, so the same run to the last bit.
-  const std::string own = arm_config("own2",
-                                     "[arm]\njoints = 2\n"
-                                     "[arm_joint1]\nmass_kg = 0.40\nlength_m = 0.25\ncenter_of_mass_m = 0.125\ninertia_kg_m2 = 2.08e-3\n"
-                                     "tip_mass_kg = 0.30\nstiffness_Nm_per_rad = 2.81\nkappa_rad_per_bar = 5.0\n"
-                                     "omega0_straight_rad_per_s = 8.0\nbellows_scale = 2.0\n");
+  const std::string own =
+      arm_config("own2",
+                 "[arm]\njoints = 2\n"
+                 "[arm_joint1]\nmass_kg = 0.40\nlength_m = 0.25\ncenter_of_mass_m = 0.125\ninertia_kg_m2 = 2.08e-3\n"
+                 "tip_mass_kg = 0.30\nstiffness_Nm_per_rad = 2.81\nkappa_rad_per_bar = 5.0\n"
+                 "omega0_straight_rad_per_s = 8.0\nbellows_scale = 2.0\n");
   const std::string arm2 = arm_config("arm2same", "[arm]\npreset = \"arm2\"\n");
   const nlohmann::json by_keys = joints_run_json("--config " + own + " --iterations 2");
   const nlohmann::json by_preset = joints_run_json("--config " + arm2 + " --iterations 2");
@@ -76,7 +79,8 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   EXPECT_EQ(by_keys.at("trajectory"), "paper2");
   ASSERT_EQ(by_keys.at("iterations").size(), 3u);
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(by_keys["iterations"][i]["joint_rms_deg"], by_preset["iterations"][i]["joint_rms_deg"]) << "iteration " << i;
+    EXPECT_EQ(by_keys["iterations"][i]["joint_rms_deg"], by_preset["iterations"][i]["joint_rms_deg"])
+        << "iteration " << i;
   }
   // Another shoulder is another arm.
   const std::string light = arm_config("light2", "[arm]\njoints = 2\n[arm_joint1]\nbellows_scale = 2.0\n");
@@ -90,8 +94,9 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
       "run --no-save --config " + arm_config("faulty", "[arm]\npreset = \"arm2\"\n[plant]\nfault = \"supply-loss\"\n"),
       "[plant] fault = 'supply-loss': the simulated arm of several joints ([arm]) injects no faults");
   expect_refused_in_one_line("run --no-save --config " + arm_config("five", "[arm]\njoints = 5\n"), "[arm] joints = 5");
-  expect_refused_in_one_line("run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
-                             "[arm_joint2] mass_kg = 0");
+  expect_refused_in_one_line(
+      "run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
+      "[arm_joint2] mass_kg = 0");
   expect_refused_in_one_line("run --no-save --config " + own + " --device t7 --t7 127.0.0.1:1",
                              "[arm] joints = 2: an arm of several joints runs on --device sim or lcm");
 }
@@ -115,8 +120,9 @@ TEST(CliJoints, WhatCannotDriveTheArmIsRefusedInOneLine) {
                              "trajectory 'paper3' has 3 joints; the arm has 2 (arm2)");
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --device t7 --t7 127.0.0.1:1",
                              "an arm of several joints runs on --device sim or lcm; --device t7 drives one joint");
-  expect_refused_in_one_line("run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
-                             "[ilc] joint_model = 'rigid': unknown (known: coupled, independent, identified)");
+  expect_refused_in_one_line(
+      "run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
+      "[ilc] joint_model = 'rigid': unknown (known: coupled, independent, identified)");
   expect_refused_in_one_line("rig check --config " + arm2, "`bellows rig check` tests the valves of one joint's rig");
   expect_refused_in_one_line("run --no-save --config " + arm2 + " --transfer-from nowhere",
                              "--transfer-from learns one joint's correction; trajectory 'paper2' has 2");

@@ -40,9 +40,9 @@ TEST(CliRun, ReproducesThePapersLearningCurve) {
 TEST(CliRun, ConvergesWithAModelTwentyPercentOff) {
   const auto dir = testing::make_temp_dir("bellows-mismatch");
   for (double factor : {1.2, 0.8}) {
-    const auto config = write_file(dir, "mismatch.toml",
-                                   "[plant]\nkappa = " + std::to_string(7.91 * factor) +
-                                       "\nomega0 = " + std::to_string(14.14 * factor) + "\n");
+    const auto config = write_file(
+        dir, "mismatch.toml",
+        "[plant]\nkappa = " + std::to_string(7.91 * factor) + "\nomega0 = " + std::to_string(14.14 * factor) + "\n");
     const std::vector<double> rms = rms_sequence(run_json("--iterations 30 --config " + config.string()));
     ASSERT_EQ(rms.size(), 31u);
     EXPECT_LE(rms[30], rms[0] / 3.0) << "plant factor " << factor;
@@ -129,7 +129,8 @@ TEST(CliRun, BadInputGetsOneLineAndExitStatusTwo) {
   expect_bad_input("--config " + write_file(dir, "key.toml", "[plant]\nkapa = 1.0\n").string(), "unknown key");
   expect_bad_input("--config " + write_file(dir, "type.toml", "[ilc]\ns = \"big\"\n").string(), "expected a number");
   expect_bad_input("--config " + write_file(dir, "tau.toml", "[plant]\ncreep_tau_s = 0\n").string(), "must be in (0, ");
-  expect_bad_input("--config " + write_file(dir, "taup.toml", "[controller]\ntau_p_s = -1\n").string(), "must be in (0, ");
+  expect_bad_input("--config " + write_file(dir, "taup.toml", "[controller]\ntau_p_s = -1\n").string(),
+                   "must be in (0, ");
   expect_bad_input("--config " + (dir / "none.toml").string(), "cannot be read");
   expect_bad_input("--iterations -3", "iterations");
   expect_bad_input("--iterations many", "iterations");
@@ -150,7 +151,8 @@ TEST(CliRun, ProgressIsOneRedrawnLineOnATerminalAndALinePerIterationElsewhere) {
   // Into a pipe: a line per iteration 0..3, nothing a terminal would interpret.
   const auto piped = run_process(std::string(BELLOWS_BINARY) + " run --no-save --iterations 3");
   ASSERT_EQ(piped.exit_code, 0) << piped.err;
-  for (int i = 0; i <= 3; ++i) EXPECT_EQ(count(piped.out, "iteration   " + std::to_string(i) + "  rms"), 1u) << piped.out;
+  for (int i = 0; i <= 3; ++i)
+    EXPECT_EQ(count(piped.out, "iteration   " + std::to_string(i) + "  rms"), 1u) << piped.out;
   EXPECT_EQ(count(piped.out, "\n"), 4u) << piped.out;
   EXPECT_EQ(piped.out.find_first_of("\r\x1b"), std::string::npos) << piped.out;
 
@@ -158,7 +160,8 @@ TEST(CliRun, ProgressIsOneRedrawnLineOnATerminalAndALinePerIterationElsewhere) {
   // names the iteration, its RMS and the time left, and ends with one newline when the run is done.
   const auto shown = run_on_terminal("run --no-save --iterations 3");
   ASSERT_EQ(shown.exit_code, 0) << shown.out << shown.err;
-  for (int i = 0; i <= 3; ++i) EXPECT_EQ(count(shown.out, "\riteration " + std::to_string(i) + " of 0..3  rms "), 1u) << shown.out;
+  for (int i = 0; i <= 3; ++i)
+    EXPECT_EQ(count(shown.out, "\riteration " + std::to_string(i) + " of 0..3  rms "), 1u) << shown.out;
   EXPECT_EQ(count(shown.out, "ETA "), 3u) << shown.out;
   EXPECT_EQ(count(shown.out, "done in "), 1u) << shown.out;
   EXPECT_EQ(count(shown.out, "\x1b[K"), 4u) << shown.out;

@@ -27,7 +27,8 @@ TEST(CliTrajectories, SingleJointRunAndConsoleRefuseSeveralJoints) {
                              "trajectory 'paper2' has 2 joints; the arm has 1 ([arm] preset)");
   expect_refused_in_one_line("run --no-save --iterations 1 --trajectory paper3", "trajectory 'paper3' has 3 joints");
   const auto file = testing::write_file(dir, "two.csv", "time_s,q1_deg,q2_deg\n0,0,0\n0.02,1,2\n0.04,2,4\n");
-  expect_refused_in_one_line("run --no-save --iterations 1 --trajectory " + file.string(), "trajectory 'two' has 2 joints");
+  expect_refused_in_one_line("run --no-save --iterations 1 --trajectory " + file.string(),
+                             "trajectory 'two' has 2 joints");
   expect_refused_in_one_line("console --trajectory paper2", "trajectory 'paper2' has 2 joints");
   // A bad multi-joint file is refused for what is wrong with it, in one line too.
   const auto five = testing::write_file(dir, "five.csv", "time_s,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg\n0,0,0,0,0,0\n");
@@ -51,12 +52,13 @@ TEST(CliTrajectories, ATrajectoryExportedAsCsvRunsAsTheLibrarysOwn) {
 
   const auto dir = testing::make_temp_dir("bellows-cli-export");
   const std::string file = (dir / "exported.csv").string();
-  const testing::ProcessResult written = testing::run_process(testing::kBellows + " trajectories paper --output " + file);
+  const testing::ProcessResult written =
+      testing::run_process(testing::kBellows + " trajectories paper --output " + file);
   ASSERT_EQ(written.exit_code, 0) << written.err;
   EXPECT_TRUE(written.out.empty()) << written.out;
   auto first_rms = [](const std::string& trajectory) {
-    const testing::ProcessResult run =
-        testing::run_process(testing::kBellows + " run --no-save --json --quiet --iterations 0 --trajectory " + trajectory);
+    const testing::ProcessResult run = testing::run_process(
+        testing::kBellows + " run --no-save --json --quiet --iterations 0 --trajectory " + trajectory);
     EXPECT_EQ(run.exit_code, 0) << run.err;
     return testing::rms_sequence(nlohmann::json::parse(run.out)).at(0);
   };

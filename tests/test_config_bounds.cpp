@@ -81,7 +81,8 @@ TEST(ConfigBounds, EveryNumberKeyHasARangeHoldingItsDefault) {
 TEST(ConfigBounds, TheLoaderRefusesEveryBadValueOfEveryKeyNamingFileAndKey) {
   int checked = 0;
   for (const ParameterBinding& b : parameter_bindings()) {
-    std::vector<BadValue> bad = b.text ? std::vector<BadValue>{{"3", 3, "a number"}, {"nan", NAN, "NaN"}} : bad_values(b);
+    std::vector<BadValue> bad =
+        b.text ? std::vector<BadValue>{{"3", 3, "a number"}, {"nan", NAN, "NaN"}} : bad_values(b);
     for (const BadValue& v : bad) {
       const std::string toml = "[" + b.section + "]\n" + b.key + " = " + v.toml + "\n";
       Configuration config;
@@ -155,10 +156,12 @@ TEST(ConfigBounds, TheIssuesHugeValuesAreRefused) {
 TEST(ConfigBounds, CombinationsOverACostBudgetAreRefusedNamingTheKeys) {
   // Each value is in its own range; together they would allocate or compute far too much.
   expect_config_refused("[timing]\ntick_s = 1e-4\n[safety]\nblack_box_s = 60.0\n", "black_box_s");
-  expect_config_refused("[timing]\ntick_s = 1.0\n[plant]\npwm_period_s = 1.0\nintegration_step_s = 1e-6\n", "integration_step_s");
+  expect_config_refused("[timing]\ntick_s = 1.0\n[plant]\npwm_period_s = 1.0\nintegration_step_s = 1e-6\n",
+                        "integration_step_s");
   expect_config_refused("[timing]\ntick_s = 1e-4\n[identify]\nduration_s = 600.0\n", "[identify] duration_s");
-  expect_config_refused("[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n[identify]\nduration_s = 50.0\n",
-                 "[identify] duration_s");
+  expect_config_refused(
+      "[timing]\ntick_s = 1e-4\nsettle_s = 60.0\n[safety]\nblack_box_s = 1.0\n[identify]\nduration_s = 50.0\n",
+      "[identify] duration_s");
   // A law whose Q-filter is at or above the Nyquist frequency is refused at load, naming the file.
   expect_config_refused("[ilc]\nlaw = \"pd\"\npd_q_cutoff_hz = 30.0\n", "[ilc] pd_q_cutoff_hz");
   expect_config_refused("[ilc]\nlaw = \"p-type\"\n", "[ilc] law");
@@ -193,18 +196,19 @@ TEST(ConfigBounds, DeeplyNestedOrHugeFilesAreRefusedBeforeParsing) {
   std::string header = "[a";
   while (header.size() < 100000) header += ".a";
   expect_config_refused(header + ".b]\nx = 1\n", "nested deeper");
-  expect_config_refused("[plant]\nkappa = " + std::string(50000, '[') + std::string(50000, ']') + "\n", "nested deeper");
+  expect_config_refused("[plant]\nkappa = " + std::string(50000, '[') + std::string(50000, ']') + "\n",
+                        "nested deeper");
   std::string inline_tables = "x = ";
   for (int i = 0; i < 50000; ++i) inline_tables += "{a=";
   expect_config_refused(inline_tables + "1" + std::string(50000, '}') + "\n", "nested deeper");
   expect_config_refused("[plant]\n" + std::string(300000, '#') + "\n", "larger than");
   // Brackets and dots inside strings and comments are not nesting.
   Configuration config;
-  EXPECT_NO_THROW(apply_config_toml(
-      "# [a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t]\n[plant]\n"
-      "fault = \"[[[[[[[[[[[[[[[[[[[[.......\\\"{{{{{{{{{{{{{{{{{\"  # {{{{{{{{{{{{{{{{{{{{\n"
-      "[ilc]\nlaw = 'noilc'\n",
-      "lab.toml", config));
+  EXPECT_NO_THROW(
+      apply_config_toml("# [a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t]\n[plant]\n"
+                        "fault = \"[[[[[[[[[[[[[[[[[[[[.......\\\"{{{{{{{{{{{{{{{{{\"  # {{{{{{{{{{{{{{{{{{{{\n"
+                        "[ilc]\nlaw = 'noilc'\n",
+                        "lab.toml", config));
   EXPECT_EQ(config.plant.fault, "[[[[[[[[[[[[[[[[[[[[.......\"{{{{{{{{{{{{{{{{{");
 }
 

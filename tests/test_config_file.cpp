@@ -57,7 +57,8 @@ p_max_bar = 1.5
 m = 2.0
 s = 0.2
 w = 1e-5
-)", "test.toml", c);
+)",
+                    "test.toml", c);
   EXPECT_DOUBLE_EQ(c.plant.kappa_rad_per_bar, 7.0);
   EXPECT_DOUBLE_EQ(c.plant.valve_critical_ratio, 0.38);
   EXPECT_DOUBLE_EQ(c.model.kappa_rad_per_bar, 7.5);
@@ -82,7 +83,8 @@ TEST(ConfigFile, RejectsBadConfigurations) {
   expect_config_refused("plant = 3\n", "must be a table");
   // The TOML parser's own refusals name the key too, not only the line (issue 24).
   expect_config_refused("[controller]\nfilter_samples = 18446744073709551617\n", "[controller] filter_samples: ");
-  expect_config_refused("[controller]\n  # a note\nfilter_samples = 18446744073709551617\n", "[controller] filter_samples: ");
+  expect_config_refused("[controller]\n  # a note\nfilter_samples = 18446744073709551617\n",
+                        "[controller] filter_samples: ");
 }
 
 TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
@@ -92,12 +94,14 @@ TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
   EXPECT_EQ(c.arm.preset, "arm3");
   apply_config_toml("[arm]\npreset = \"arm2\"\n", "arm2.toml", c);
   EXPECT_EQ(c.arm.preset, "arm2");
-  expect_config_refused("[arm]\npreset = \"arm7\"\n", "[arm] preset = 'arm7': unknown arm (known: arm2, arm3; empty: one joint)");
+  expect_config_refused("[arm]\npreset = \"arm7\"\n",
+                        "[arm] preset = 'arm7': unknown arm (known: arm2, arm3; empty: one joint)");
   expect_config_refused("[arm]\npreset = 2\n", "[arm] preset");
   expect_config_refused("[arm]\nlinks = 2\n", "unknown key");
   // A chain of its own keys: the joints, each link's keys in its own section.
   Configuration own;
-  apply_config_toml("[arm]\njoints = 3\ngravity = 0\n[arm_joint3]\nmass_kg = 0.06\nbellows_scale = 1.5\n", "own.toml", own);
+  apply_config_toml("[arm]\njoints = 3\ngravity = 0\n[arm_joint3]\nmass_kg = 0.06\nbellows_scale = 1.5\n", "own.toml",
+                    own);
   EXPECT_EQ(own.arm.joints, 3);
   EXPECT_EQ(own.arm.gravity, 0);
   EXPECT_EQ(own.arm.joint[2].mass_kg, 0.06);
@@ -112,9 +116,10 @@ TEST(ConfigFile, ArmPresetChoosesTheChainAndIsOneJointWhenAbsent) {
 TEST(ConfigFile, EachJointHasItsOwnAngleLimitDefaultingToTheSafetyLimit) {
   Configuration c;
   // A joint guarded more tightly than the others: every trajectory's range below it.
-  apply_config_toml("[arm]\npreset = \"arm2\"\n[safety]\nangle_limit_deg = 92\n[trajectory]\nmax_abs_angle_deg = 60\n"
-                    "[arm_joint2]\nangle_limit_deg = 70\n",
-                    "arm2.toml", c);
+  apply_config_toml(
+      "[arm]\npreset = \"arm2\"\n[safety]\nangle_limit_deg = 92\n[trajectory]\nmax_abs_angle_deg = 60\n"
+      "[arm_joint2]\nangle_limit_deg = 70\n",
+      "arm2.toml", c);
   EXPECT_EQ(c.safety.angle_limit_deg_of(0), 92.0) << "no key of its own: [safety] angle_limit_deg";
   EXPECT_EQ(c.safety.angle_limit_deg_of(1), 70.0);
   // One joint ([plant]'s) is joint 1: its own limit too.
@@ -126,7 +131,8 @@ TEST(ConfigFile, EachJointHasItsOwnAngleLimitDefaultingToTheSafetyLimit) {
                         "[arm_joint2] angle_limit_deg = 90: must be above [trajectory] max_abs_angle_deg = 90");
   expect_config_refused("[arm_joint3]\nangle_limit_deg = 120\n",
                         "[arm_joint3] angle_limit_deg = 120: must not be above [lcm] rig_angle_limit_deg = 100");
-  expect_config_refused("[arm_joint1]\nangle_limit_deg = -5\n", "[arm_joint1] angle_limit_deg = -5: must be in [0, 180]");
+  expect_config_refused("[arm_joint1]\nangle_limit_deg = -5\n",
+                        "[arm_joint1] angle_limit_deg = -5: must be in [0, 180]");
   apply_config_toml("[lcm]\nrig_angle_limit_deg = 130\n[arm_joint4]\nangle_limit_deg = 120\n", "wide.toml", c);
   EXPECT_EQ(c.safety.angle_limit_deg_of(3), 120.0);
 }
@@ -160,7 +166,8 @@ TEST(ConfigFile, EveryKeyIsDocumented) {
     ASSERT_NE(section, std::string::npos) << "section [" << b.section << "] is not documented";
     const auto next_section = doc.find("\n## ", section + 1);
     const auto key = doc.find("| `" + b.key + "` |", section);
-    EXPECT_TRUE(key != std::string::npos && key < next_section) << "[" << b.section << "] " << b.key << " is not documented";
+    EXPECT_TRUE(key != std::string::npos && key < next_section)
+        << "[" << b.section << "] " << b.key << " is not documented";
   }
 }
 

@@ -78,8 +78,10 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
     ASSERT_EQ(c.joint_count, 2);
     for (int j = 0; j < 2; ++j) {
       const JointValves& single = (j == 0 ? c1 : c2).joint[0];
-      ASSERT_EQ(c.joint[static_cast<std::size_t>(j)].inlet_duty, single.inlet_duty) << "joint " << j + 1 << " tick " << tick;
-      ASSERT_EQ(c.joint[static_cast<std::size_t>(j)].outlet_duty, single.outlet_duty) << "joint " << j + 1 << " tick " << tick;
+      ASSERT_EQ(c.joint[static_cast<std::size_t>(j)].inlet_duty, single.inlet_duty)
+          << "joint " << j + 1 << " tick " << tick;
+      ASSERT_EQ(c.joint[static_cast<std::size_t>(j)].outlet_duty, single.outlet_duty)
+          << "joint " << j + 1 << " tick " << tick;
       if (single.inlet_duty[0] > 0.0) ++saw_inlet;
     }
     ASSERT_EQ(both.setpoints(1).a_bar, alone_2.setpoints().a_bar);
@@ -92,9 +94,12 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
   for (int j = 0; j < 2; ++j) {
     const TrialRecord& single = j == 0 ? record_1 : record_2;
     const TrialSamples &s = record.joint_samples(j), &t = single.joint_samples(0);
-    for (const auto& [a, b, what] : {std::tuple{&s.setpoint_rad, &t.setpoint_rad, "setpoint"}, {&s.angle_rad, &t.angle_rad, "angle"},
-                                     {&s.error_rad, &t.error_rad, "error"}, {&s.u_ilc_bar, &t.u_ilc_bar, "u_ilc"},
-                                     {&s.u_total_bar, &t.u_total_bar, "u_total"}, {&s.setpoint_b_bar, &t.setpoint_b_bar, "p_B set"}}) {
+    for (const auto& [a, b, what] : {std::tuple{&s.setpoint_rad, &t.setpoint_rad, "setpoint"},
+                                     {&s.angle_rad, &t.angle_rad, "angle"},
+                                     {&s.error_rad, &t.error_rad, "error"},
+                                     {&s.u_ilc_bar, &t.u_ilc_bar, "u_ilc"},
+                                     {&s.u_total_bar, &t.u_total_bar, "u_total"},
+                                     {&s.setpoint_b_bar, &t.setpoint_b_bar, "p_B set"}}) {
       expect_same_columns(*a, *b, what, j);
     }
     const TrialTicks &u = record.joint_ticks(j), &v = single.joint_ticks(0);
@@ -154,8 +159,10 @@ TEST(ControlJoints, EveryJointsStateResumesExactlyAndJointOneKeepsItsFields) {
     const SensorReading r = moving_reading(3, tick, timing.tick_s);
     const ValveCommand a = first.tick(r), b = resumed.tick(r);
     for (int j = 0; j < 3; ++j) {
-      ASSERT_EQ(a.joint[static_cast<std::size_t>(j)].inlet_duty, b.joint[static_cast<std::size_t>(j)].inlet_duty) << tick;
-      ASSERT_EQ(a.joint[static_cast<std::size_t>(j)].outlet_duty, b.joint[static_cast<std::size_t>(j)].outlet_duty) << tick;
+      ASSERT_EQ(a.joint[static_cast<std::size_t>(j)].inlet_duty, b.joint[static_cast<std::size_t>(j)].inlet_duty)
+          << tick;
+      ASSERT_EQ(a.joint[static_cast<std::size_t>(j)].outlet_duty, b.joint[static_cast<std::size_t>(j)].outlet_duty)
+          << tick;
     }
   }
   // A single-joint state (what every session saved so far holds) drives one joint.

@@ -25,8 +25,8 @@ constexpr double kIlcSample_s = 0.02;
 /// J trials of `seconds`: in trial k joint k's pressure difference sweeps a chirp (0.1 bar), every
 /// other joint's wanders by a few hundredths of a bar (as a holding PID's does); the angles are
 /// `truth`'s response plus measurement noise of `noise_deg`.
-std::vector<JointIdentificationData> simulated_trials(const CoupledJointDynamics& truth, double seconds, double noise_deg,
-                                                      unsigned seed) {
+std::vector<JointIdentificationData> simulated_trials(const CoupledJointDynamics& truth, double seconds,
+                                                      double noise_deg, unsigned seed) {
   const int J = truth.joints();
   const auto n = static_cast<Eigen::Index>(std::lround(seconds / kTick_s));
   std::mt19937_64 random(seed);
@@ -72,7 +72,8 @@ CoupledJointDynamics table_dynamics(const ChainParameters& chain) {
 double largest_relative_entry_error(const CoupledJointDynamics& fitted, const CoupledJointDynamics& truth) {
   double worst = 0.0;
   const auto compare = [&](const JointMatrix& a, const JointMatrix& b) {
-    worst = std::max(worst, (Eigen::MatrixXd(a) - Eigen::MatrixXd(b)).cwiseAbs().maxCoeff() / Eigen::MatrixXd(b).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (Eigen::MatrixXd(a) - Eigen::MatrixXd(b)).cwiseAbs().maxCoeff() /
+                                Eigen::MatrixXd(b).cwiseAbs().maxCoeff());
   };
   compare(fitted.per_angle, truth.per_angle);
   compare(fitted.per_velocity, truth.per_velocity);
@@ -111,7 +112,8 @@ INSTANTIATE_TEST_SUITE_P(Presets, CoupledIdentification, ::testing::Values("arm2
 
 TEST(CoupledJointDynamics, TheLinearizationDiscretizesAsTheSingleJointModelOnItsDiagonal) {
   const ModelParameters paper{7.91, 14.14, 0.31};
-  const MultiJointModel one = discretize_joint_dynamics(independent_dynamics(std::vector<ModelParameters>{paper}), kIlcSample_s);
+  const MultiJointModel one =
+      discretize_joint_dynamics(independent_dynamics(std::vector<ModelParameters>{paper}), kIlcSample_s);
   const DiscreteArmModel expected = discretize_arm_model(paper, kIlcSample_s);
   EXPECT_LT((Eigen::MatrixXd(one.A) - Eigen::MatrixXd(expected.A)).norm(), 1e-12);
   EXPECT_LT((Eigen::MatrixXd(one.B) - Eigen::MatrixXd(expected.B)).norm(), 1e-12);
@@ -136,8 +138,10 @@ TEST(CoupledJointDynamics, IdentifiedKeysCarryTheModelToTheLearning) {
     joint_learning_model(arm3, "identified", kIlcSample_s, IdentifiedArmParameters{});
     ADD_FAILURE() << "no identified model, yet learned";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("[ilc] joint_model = 'identified': [identified_joint1] holds no identified model"),
-              std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what())
+                  .find("[ilc] joint_model = 'identified': [identified_joint1] holds no identified model"),
+              std::string::npos)
+        << error.what();
   }
   IdentifiedArmParameters singular = keys;
   for (double& entry : singular.joint[2].per_angle_per_s2) entry = 0.0;

@@ -83,8 +83,9 @@ TEST(DeviceFactory, ARigRefusesAnArmOfSeveralJointsInOneLine) {
     open_device(resolve_device({"t7", "", "127.0.0.1:1", ""}, c.device), c, 1, RealtimeMode::kOff, 0);
     FAIL() << "a T7 link must not silently drive one joint of arm2";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "[arm] preset = 'arm2': an arm of several joints runs on --device sim or lcm; --device t7 drives one "
-                           "joint (leave [arm] out)");
+    EXPECT_STREQ(e.what(),
+                 "[arm] preset = 'arm2': an arm of several joints runs on --device sim or lcm; --device t7 drives one "
+                 "joint (leave [arm] out)");
   }
 }
 
@@ -118,10 +119,11 @@ TEST(DeviceFactory, EveryCommandTakesTheSameDeviceOptions) {
     const auto r = testing::run_process(std::string(BELLOWS_BINARY) + " " + command + " --device usb < /dev/null");
     EXPECT_EQ(r.exit_code, 2) << command;
     EXPECT_NE(r.err.find("--device"), std::string::npos) << command << ": " << r.err;
-    const auto misplaced =
-        testing::run_process(std::string(BELLOWS_BINARY) + " " + command + " --device sim --rig-profile x.toml < /dev/null");
+    const auto misplaced = testing::run_process(std::string(BELLOWS_BINARY) + " " + command +
+                                                " --device sim --rig-profile x.toml < /dev/null");
     EXPECT_EQ(misplaced.exit_code, 2) << command;
-    EXPECT_NE(misplaced.err.find("--rig-profile are for --device t7"), std::string::npos) << command << ": " << misplaced.err;
+    EXPECT_NE(misplaced.err.find("--rig-profile are for --device t7"), std::string::npos)
+        << command << ": " << misplaced.err;
   }
 }
 

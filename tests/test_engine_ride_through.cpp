@@ -20,7 +20,11 @@ namespace {
 
 struct GappyEngine {
   explicit GappyEngine(const Configuration& c = Configuration{}, bool own_time = false)
-      : config(c), arm(c.plant, 1), device(arm, own_time), core(device, c.controller, c.timing, c.safety), clock(core, device) {}
+      : config(c),
+        arm(c.plant, 1),
+        device(arm, own_time),
+        core(device, c.controller, c.timing, c.safety),
+        clock(core, device) {}
   /// One tick of a loop that woke `missed` periods late: the rig's time went on meanwhile.
   void step_late(int missed) {
     const double tick_s = config.timing.tick_s;
@@ -160,7 +164,8 @@ TEST(EngineRideThrough, ADevicesOwnFaultIsLatchedWithItsWordsAndJoint) {
   EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
   e.clock.step(10);
   DeviceFault trip;
-  trip.set(FaultCode::kRigLimit, 0, "the rig stopped joint %d at %.0f deg beyond its range %d deg: check the chamber wiring", 1, -100.0, 100);
+  trip.set(FaultCode::kRigLimit, 0,
+           "the rig stopped joint %d at %.0f deg beyond its range %d deg: check the chamber wiring", 1, -100.0, 100);
   e.device.report(trip);
   e.drain();
   e.clock.step();
@@ -171,7 +176,8 @@ TEST(EngineRideThrough, ADevicesOwnFaultIsLatchedWithItsWordsAndJoint) {
     if (event.kind != EventKind::kFault) continue;
     fault_seen = true;
     EXPECT_EQ(event.fault_joint, 0);
-    EXPECT_STREQ(event.detail.data(), "the rig stopped joint 1 at -100 deg beyond its range 100 deg: check the chamber wiring");
+    EXPECT_STREQ(event.detail.data(),
+                 "the rig stopped joint 1 at -100 deg beyond its range 100 deg: check the chamber wiring");
   }
   EXPECT_TRUE(fault_seen);
   // Reset clears the words: the next fault has its own.
@@ -241,7 +247,8 @@ TEST(EngineLateLoop, ALateWakeUpAsLongAsTheStaleLimitVentsAndFaultsInTheTickItWa
   for (const EngineEvent& event : e.drain()) {
     if (event.kind != EventKind::kFault) continue;
     fault_seen = true;
-    EXPECT_NE(std::strstr(event.detail.data(), "the rig went 40 ms without the loop's commands, 40 ms of it because the loop was late"),
+    EXPECT_NE(std::strstr(event.detail.data(),
+                          "the rig went 40 ms without the loop's commands, 40 ms of it because the loop was late"),
               nullptr)
         << event.detail.data();
   }
@@ -260,7 +267,8 @@ TEST(EngineLateLoop, MissedPeriodsAndMissingReadingsAddUpToTheStaleLimitNamedByT
     FaultCode named;
   };
   // Mostly the loop's lateness: missed-deadlines; mostly the link's silence: the device's word.
-  for (const Case c : {Case{limit / 2, limit - limit / 2, FaultCode::kMissedDeadlines}, Case{limit - 2, 2, FaultCode::kSensorStale}}) {
+  for (const Case c :
+       {Case{limit / 2, limit - limit / 2, FaultCode::kMissedDeadlines}, Case{limit - 2, 2, FaultCode::kSensorStale}}) {
     GappyEngine e(Configuration{}, true);
     EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
     e.clock.step(20);

@@ -75,9 +75,7 @@ TEST(EngineStateMachine, EveryTransitionAllowedAndRefused) {
   }
 }
 
-TEST(EngineStateMachine, TableCoversEveryPair) {
-  EXPECT_EQ(std::size(kTable), 4u * 10u);
-}
+TEST(EngineStateMachine, TableCoversEveryPair) { EXPECT_EQ(std::size(kTable), 4u * 10u); }
 
 TEST(EngineStateMachine, ValvesAreLiveOnlyWhenArmedOrRunning) {
   EXPECT_FALSE(valves_live(S::kSafe));

@@ -111,8 +111,8 @@ TEST(Identification, TrialIsAbortedAndTheArmVentedBeyondTheAngleBound) {
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
   TrialRecord record;
-  EXPECT_THROW(run_identification_trial(clock, identification_trajectory("chirp", config.identify, 0.02),
-                                        config.timing, config.identify.max_abs_angle_deg, record),
+  EXPECT_THROW(run_identification_trial(clock, identification_trajectory("chirp", config.identify, 0.02), config.timing,
+                                        config.identify.max_abs_angle_deg, record),
                InputError);
   EXPECT_EQ(arm.state().command.inlet_duty[0], 0.0);
   EXPECT_EQ(arm.state().command.outlet_duty[0], 1.0);
@@ -141,7 +141,8 @@ TEST(ModelSection, ReplacesKeysInPlaceKeepingEverythingElse) {
   m.omega0_rad_per_s = 13.5;
   m.damping = 0.28;
   const std::string text =
-      "# lab rig 2\n[ilc]\nlaw = \"noilc\"  # default\n\n[model]\n# from the paper\nkappa = 7.91\n\n[plant]\ncreep_gain = 0.2\n";
+      "# lab rig 2\n[ilc]\nlaw = \"noilc\"  # default\n\n[model]\n# from the paper\nkappa = "
+      "7.91\n\n[plant]\ncreep_gain = 0.2\n";
   const std::string updated = with_model_section(text, "lab.toml", m);
   EXPECT_NE(updated.find("# lab rig 2"), std::string::npos);
   EXPECT_NE(updated.find("# from the paper"), std::string::npos);

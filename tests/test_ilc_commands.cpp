@@ -34,7 +34,8 @@ class IlcCommands : public ::testing::Test {
 
   Result bellows(const std::string& arguments) {
     const auto out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string(BELLOWS_BINARY) + " " + arguments + " >" + out.string() + " 2>" + err.string();
+    const std::string command =
+        std::string(BELLOWS_BINARY) + " " + arguments + " >" + out.string() + " 2>" + err.string();
     Result r;
     const int raw = std::system(command.c_str());
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -155,8 +156,8 @@ TEST_F(IlcCommands, IdentifyFitsThePlantOfTheFileItWritesAndSaysWhich) {
 TEST_F(IlcCommands, IdentifyIsRecordedInASession) {
   const auto lab = write("lab.toml", "[identify]\nduration_s = 8.0\n");
   const auto data = dir_ / "data";
-  const Result r = bellows("identify --json --config " + lab.string() + " --write-model " + lab.string() + " --data-dir " +
-                           data.string() + " --name ident");
+  const Result r = bellows("identify --json --config " + lab.string() + " --write-model " + lab.string() +
+                           " --data-dir " + data.string() + " --name ident");
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   ASSERT_EQ(report["session"], (data / "ident").string());
@@ -167,7 +168,8 @@ TEST_F(IlcCommands, IdentifyIsRecordedInASession) {
   const nlohmann::json session = nlohmann::json::parse(shown.out);
   EXPECT_EQ(session["device"], "sim");
   EXPECT_EQ(session["device_info"]["seed"], 1);
-  EXPECT_EQ(session["trajectory"]["name"].get<std::string>().find("chirp") != std::string::npos, true) << session["trajectory"];
+  EXPECT_EQ(session["trajectory"]["name"].get<std::string>().find("chirp") != std::string::npos, true)
+      << session["trajectory"];
   ASSERT_EQ(session["iterations"].size(), 1u);  // the identification trial
   EXPECT_TRUE(session["model"]["source"].is_null()) << "identify learns nothing: no model source";
   std::vector<std::string> kinds;
@@ -177,7 +179,8 @@ TEST_F(IlcCommands, IdentifyIsRecordedInASession) {
     if (e["kind"] == "identify-fit") fit = e["message"];
     if (e["kind"] == "model-written") written = e["message"];
   }
-  EXPECT_EQ(kinds, (std::vector<std::string>{"start", "identify-trial", "identify-trial", "identify-fit", "model-written", "finish"}));
+  EXPECT_EQ(kinds, (std::vector<std::string>{"start", "identify-trial", "identify-trial", "identify-fit",
+                                             "model-written", "finish"}));
   char kappa[32];
   std::snprintf(kappa, sizeof kappa, "kappa %.6g rad/bar", report["model"]["kappa"].get<double>());
   EXPECT_NE(fit.find(kappa), std::string::npos) << fit;

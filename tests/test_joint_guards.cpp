@@ -46,9 +46,7 @@ struct GuardedArm2 {
   }
 
   /// The largest |angle| joint `joint` reached in the trial's samples (deg).
-  double peak_deg(int joint) const {
-    return record.joint_samples(joint).angle_rad.cwiseAbs().maxCoeff() * kDegPerRad;
-  }
+  double peak_deg(int joint) const { return record.joint_samples(joint).angle_rad.cwiseAbs().maxCoeff() * kDegPerRad; }
 
   Configuration config;
   SimulatedArmChain arm;
@@ -84,7 +82,8 @@ TEST(JointGuards, AJointsOwnLimitTripsOnThatJointOnlyAndTheGuardNamesIt) {
         EXPECT_EQ(fired.code, FaultCode::kAngleLimit) << "joint " << limited + 1;
         EXPECT_EQ(fired.joint, limited);
       } else {
-        EXPECT_EQ(fired.code, FaultCode::kNone) << "joint " << moved + 1 << " at 40 deg tripped joint " << limited + 1 << "'s limit";
+        EXPECT_EQ(fired.code, FaultCode::kNone)
+            << "joint " << moved + 1 << " at 40 deg tripped joint " << limited + 1 << "'s limit";
       }
       r.joint[static_cast<std::size_t>(moved)].angle_rad = 96.0 / kDegPerRad;  // beyond [safety] angle_limit_deg
       EXPECT_EQ(find_guard_fault(r, in, limits).joint, moved);

@@ -65,8 +65,8 @@ TEST(JointLearning, NoilcOfSeveralJointsIsTheJointNormOptimalUpdateWithTheChosen
     EXPECT_EQ(learning->joints(), 2);
     EXPECT_EQ(learning->single_joint_law(), nullptr);
     MultiJointNoilc oracle;
-    ASSERT_EQ(oracle.setup(joint_learning_model(chain_preset("arm2"), joint_model, sample_s), MultiJointWeights::uniform(c.ilc, 2),
-                           kLearningSamples),
+    ASSERT_EQ(oracle.setup(joint_learning_model(chain_preset("arm2"), joint_model, sample_s),
+                           MultiJointWeights::uniform(c.ilc, 2), kLearningSamples),
               MultiJointNoilcStatus::kOk);
     const Eigen::MatrixXd u = random_columns(2, random, 0.05), e = random_columns(2, random, 0.01);
     Eigen::MatrixXd next(kLearningSamples, 2), expected(kLearningSamples, 2);

@@ -95,7 +95,8 @@ TEST(LcmRigLimits, VentTheChamberAboveTheCeilingAndEverythingBeyondTheAngleRange
   EXPECT_EQ(out.valves.joint[0].outlet_duty[0], 1.0);
   EXPECT_EQ(out.valves.joint[0].inlet_duty[1], 0.5) << "only the chamber above the ceiling";
   r.joint[0].chamber_bar = {1.2, std::nan("")};
-  EXPECT_EQ(enforce_rig_limits(open, r, limits).valves.joint[0].inlet_duty[1], 0.0) << "a NaN pressure counts as too high";
+  EXPECT_EQ(enforce_rig_limits(open, r, limits).valves.joint[0].inlet_duty[1], 0.0)
+      << "a NaN pressure counts as too high";
   r.joint[0].chamber_bar = {1.2, 1.2};
   r.joint[0].angle_rad = -1.8;
   out = enforce_rig_limits(open, r, limits);
@@ -138,14 +139,15 @@ TEST(LcmAttacks, ForgedCommandsOnAnIdleRigCannotPassItsPressureCeilingNorItsAngl
   unlimited.lcm.rig_angle_limit_deg = 180.0;
   RigBench before(unlimited);
   const Extremes reached = forge_for(before, 1.5);
-  std::cerr << "forged commands, no rig limit: chamber A " << reached.chamber_a_bar << " bar, angle " << reached.angle_deg << " deg\n";
+  std::cerr << "forged commands, no rig limit: chamber A " << reached.chamber_a_bar << " bar, angle "
+            << reached.angle_deg << " deg\n";
   ASSERT_GT(reached.chamber_a_bar, 2.5) << "the attack must be able to do harm for this test to mean anything";
 
   RigBench b;  // the defaults
   const double ceiling = RigLimits::from(b.config).pressure_ceiling_bar;
   const Extremes held = forge_for(b, 1.5);
-  std::cerr << "forged commands, rig limits: chamber A " << held.chamber_a_bar << " bar (ceiling " << ceiling << "), angle "
-            << held.angle_deg << " deg (range " << b.config.lcm.rig_angle_limit_deg << ")\n";
+  std::cerr << "forged commands, rig limits: chamber A " << held.chamber_a_bar << " bar (ceiling " << ceiling
+            << "), angle " << held.angle_deg << " deg (range " << b.config.lcm.rig_angle_limit_deg << ")\n";
   // Checked at every 0.1 ms integration step: the chamber rises by far less than 10 mbar in one.
   EXPECT_LE(held.chamber_a_bar, ceiling + 0.01);
   EXPECT_LE(held.angle_deg, b.config.lcm.rig_angle_limit_deg);
@@ -238,7 +240,8 @@ TEST(LcmAttacks, AForgedSequenceNumberCannotTakeOverASessionAndTheEnginesVentIsA
   // and the engine says what happened instead of calling it a stale sensor.
   s.step();
   EXPECT_GT(s.device.stats().commands_not_ours, 0u);
-  EXPECT_NE(s.device.diagnosis().find("another sender is commanding this rig"), std::string::npos) << s.device.diagnosis();
+  EXPECT_NE(s.device.diagnosis().find("another sender is commanding this rig"), std::string::npos)
+      << s.device.diagnosis();
 }
 
 TEST(LcmAttacks, WithAKeyForgedCommandsAreCountedAndIgnored) {
@@ -277,15 +280,16 @@ TEST(LcmAttacks, WithAKeyForgedStatesAreIgnoredAndDiagnosed) {
   forged.seq = real.seq + 1000;
   forged.time_s = real.time_s + 10.0;
   forged.angle_rad = 60.0 * kPi / 180.0;
-  publish(s.b.bus, kIoStateChannel, forged);                // unsigned
-  publish(s.b.bus, kIoStateChannel, forged, test_key(9));   // signed with another key
+  publish(s.b.bus, kIoStateChannel, forged);               // unsigned
+  publish(s.b.bus, kIoStateChannel, forged, test_key(9));  // signed with another key
   s.step();
   s.step();
   EXPECT_LT(std::abs(s.device.read_sensors().joint[0].angle_rad), 0.1) << "the forged 60 deg never reached the engine";
   const LcmDeviceStats d = s.device.stats();
   EXPECT_EQ(d.states.unauthenticated, 2u);
   EXPECT_GT(d.states.accepted, 0u);
-  EXPECT_NE(s.device.diagnosis().find("another sender publishes rig states"), std::string::npos) << s.device.diagnosis();
+  EXPECT_NE(s.device.diagnosis().find("another sender publishes rig states"), std::string::npos)
+      << s.device.diagnosis();
 }
 
 TEST(LcmAttacks, WithAKeyNoOneLocksTheOperatorOut) {
@@ -329,13 +333,15 @@ TEST(LcmAttacks, OldFormatMessagesAreRefusedWithAClearLine) {
 
 // ---- the key ----
 
-std::filesystem::path key_file(const std::filesystem::path& dir, const std::string& name, std::size_t bytes, mode_t mode) {
+std::filesystem::path key_file(const std::filesystem::path& dir, const std::string& name, std::size_t bytes,
+                               mode_t mode) {
   const auto path = testing::write_file(dir, name, std::string(bytes, 'k'));
   chmod(path.c_str(), mode);
   return path;
 }
 
-void expect_refused(const std::string& path, const std::string& fragment, const std::filesystem::path& relative_to = {}) {
+void expect_refused(const std::string& path, const std::string& fragment,
+                    const std::filesystem::path& relative_to = {}) {
   try {
     load_lcm_key(path, relative_to);
     ADD_FAILURE() << path << " was accepted";

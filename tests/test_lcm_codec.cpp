@@ -274,7 +274,8 @@ TEST(LcmCodec, TheIoMessagesCarryOneJointAndRefuseMore) {
   ValveCommand two_joints;
   two_joints.joint_count = 2;
   two_joints.joint[0].inlet_duty = {0.5, 0.0};
-  EXPECT_NE(testing::error_of([&] { fill_command(two_joints, true, command); }).find("carry one joint"), std::string::npos);
+  EXPECT_NE(testing::error_of([&] { fill_command(two_joints, true, command); }).find("carry one joint"),
+            std::string::npos);
   EXPECT_EQ(command.inlet_duty[0], 0.0) << "nothing of it filled in";
   fill_command(ValveCommand::vented(), true, command);
   EXPECT_EQ(command.outlet_duty[1], 1.0);
@@ -294,8 +295,8 @@ TEST(LcmCodec, TheProtocolDocListsEveryFaultCode) {
     // Rows of the fault table: "| 7 | `sensor-stale` |".
     std::istringstream row(line);
     std::string bar, number, name;
-    if (!(row >> bar >> number >> bar >> name) || number.empty() || !std::isdigit(static_cast<unsigned char>(number[0])) ||
-        name.size() < 3 || name.front() != '`') {
+    if (!(row >> bar >> number >> bar >> name) || number.empty() ||
+        !std::isdigit(static_cast<unsigned char>(number[0])) || name.size() < 3 || name.front() != '`') {
       continue;
     }
     const int code = std::stoi(number);

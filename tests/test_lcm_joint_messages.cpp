@@ -30,8 +30,8 @@ std::int64_t fingerprint_of(const testing::Recorded& r) {
   return hash;
 }
 
-io_joints_command_t joints_command(std::int64_t session, std::int64_t seq, bool armed, std::int64_t rig, std::int64_t binding,
-                                   int joints = 2) {
+io_joints_command_t joints_command(std::int64_t session, std::int64_t seq, bool armed, std::int64_t rig,
+                                   std::int64_t binding, int joints = 2) {
   io_joints_command_t c{};
   c.session_id = session;
   c.seq = seq;
@@ -120,7 +120,8 @@ TEST(LcmJointMessages, SeveralJointsTravelInTheJointMessagesRoundTrip) {
   EXPECT_EQ(back.joint_count, 3);
   for (int j = 0; j < 3; ++j) {
     EXPECT_EQ(back.joint[static_cast<std::size_t>(j)].angle_rad, reading.joint[static_cast<std::size_t>(j)].angle_rad);
-    EXPECT_EQ(back.joint[static_cast<std::size_t>(j)].chamber_bar, reading.joint[static_cast<std::size_t>(j)].chamber_bar);
+    EXPECT_EQ(back.joint[static_cast<std::size_t>(j)].chamber_bar,
+              reading.joint[static_cast<std::size_t>(j)].chamber_bar);
   }
   EXPECT_EQ(out.angle_rad[3], 0.0);
   // Signed like the one-joint messages: the MAC covers every byte before it.
@@ -270,7 +271,10 @@ TEST(LcmJointRig, ServesArm2InTheJointMessagesAndAppliesEachJointsValves) {
   EXPECT_EQ(duties[0].inlet[0], 0.8);
   EXPECT_EQ(duties[1].inlet[1], 0.7);
   for (int i = 0; i < 40; ++i) {
-    publish(b.bus, kIoCommandChannel, [&] { drive.seq += 1; return drive; }());
+    publish(b.bus, kIoCommandChannel, [&] {
+      drive.seq += 1;
+      return drive;
+    }());
     b.step();
   }
   const io_joints_state_t s = b.last_state();
@@ -312,7 +316,8 @@ TEST(LcmJointRig, ForgedJointCountsAreInvalidAndTodaysSingleJointCommandsAreRefu
   int lines = 0;
   for (const std::string& line : b.log) lines += line.find("for an arm of") != std::string::npos ? 1 : 0;
   EXPECT_EQ(lines, 1) << "one line, the rest counted";
-  EXPECT_TRUE(b.logged("a command for an arm of one joint (io_state_t / io_command_t) but this rig's arm has 2 joints"));
+  EXPECT_TRUE(
+      b.logged("a command for an arm of one joint (io_state_t / io_command_t) but this rig's arm has 2 joints"));
   b.step();
   EXPECT_EQ(b.last_state().foreign_commands, 3) << "the states tell the engine what was refused";
 }
@@ -324,7 +329,8 @@ TEST(LcmJointRig, OneJointThroughTheDeviceConstructorIsTheSingleJointRig) {
     SimulatedArm arm(c.plant, 1);
     std::vector<std::string> log;
     lcm::LCM bus("memq://");
-    RigServer rig = as_device ? RigServer(static_cast<Device&>(arm), 1, c.plant.integration_step_s, RigBench::parameters(c, {}, log), 5)
+    RigServer rig = as_device ? RigServer(static_cast<Device&>(arm), 1, c.plant.integration_step_s,
+                                          RigBench::parameters(c, {}, log), 5)
                               : RigServer(arm, RigBench::parameters(c, {}, log), 5);
     testing::BusRecorder states(kIoStateChannel);
     rig.attach(bus);
@@ -403,7 +409,8 @@ TEST(LcmJointDevice, ArmOfTwoRefusesARigOfTodaysSingleJointMessagesInOneLineAndN
   EXPECT_EQ(c.joint_count, 2);
   EXPECT_EQ(c.rig_id, 0) << "addressed to no rig";
   EXPECT_EQ(device.diagnosis(),
-            "a rig on this bus serves an arm of one joint (io_state_t / io_command_t) but this arm has 2 joints: 5 states ignored "
+            "a rig on this bus serves an arm of one joint (io_state_t / io_command_t) but this arm has 2 joints: 5 "
+            "states ignored "
             "(the engine's [arm] must be the rig's: docs/lcm-protocol.md)");
 }
 
@@ -422,7 +429,8 @@ TEST(LcmJointDevice, ArmOfOneRefusesARigOfTwoAndSendsTodaysMessages) {
   EXPECT_GE(device.stats().states.other_joints, 5u);
   EXPECT_EQ(device.stats().rig_id, 0);
   EXPECT_EQ(rig.rig.stats().serving, 0);
-  EXPECT_NE(device.diagnosis().find("serves an arm of 2 joints but this arm has one joint"), std::string::npos) << device.diagnosis();
+  EXPECT_NE(device.diagnosis().find("serves an arm of 2 joints but this arm has one joint"), std::string::npos)
+      << device.diagnosis();
   const testing::Recorded last = commands.messages().back();
   EXPECT_EQ(fingerprint_of(last), io_command_t::getHash());
   EXPECT_EQ(last.bytes.size(), detail::fixed_size<io_command_t>());
@@ -442,8 +450,8 @@ TEST(LcmJointDevice, ArmOfTwoWritesBothJointsAndReadsBoth) {
   ASSERT_TRUE(device.connected());
   EXPECT_EQ(rig.rig.stats().serving, 1234);
   ValveCommand valves = ValveCommand::vented(2);
-  valves.joint[0].inlet_duty = {0.9, NAN};   // NaN inlet: closed
-  valves.joint[1].inlet_duty = {0.0, 1.7};   // clamped
+  valves.joint[0].inlet_duty = {0.9, NAN};  // NaN inlet: closed
+  valves.joint[1].inlet_duty = {0.0, 1.7};  // clamped
   valves.joint[1].outlet_duty = {1.0, 0.0};
   device.write_valves(valves);
   device.service(&rig.bus, rig.t);

@@ -24,7 +24,8 @@ namespace {
 
 /// Iteration 0 (no correction) of `trajectory` on `driver`'s engine, already armed: the record, or a
 /// failed test when the engine faults, refuses or does not finish within `timeout_s` of wall time.
-TrialRecord feedback_trial(EngineDriver& driver, const Configuration& c, const Trajectory& trajectory, double timeout_s) {
+TrialRecord feedback_trial(EngineDriver& driver, const Configuration& c, const Trajectory& trajectory,
+                           double timeout_s) {
   TrialRecord record;
   record.prepare(trajectory.learning_samples(), c.timing.ticks_per_sample, trajectory.joints());
   const int settle_ticks = static_cast<int>(std::lround(c.timing.settle_s / c.timing.tick_s));
@@ -82,7 +83,8 @@ TEST(LcmJointClosedLoop, TheEngineDrivesArm2OverMemqAndEveryJointTracksAsInProce
   const PneumaticChainParameters arm2 = pneumatic_chain_of(c.plant, ArmParameters{"arm2"});
   SimulatedArmChain arm(arm2, 1);
   std::vector<std::string> rig_log;
-  RigServer rig(arm, arm.joints(), arm2.chain.integration_step_s, testing::RigBench::parameters(c, LcmKey{}, rig_log), 77);
+  RigServer rig(arm, arm.joints(), arm2.chain.integration_step_s, testing::RigBench::parameters(c, LcmKey{}, rig_log),
+                77);
   LcmDevice device(LcmDevice::random_session_id(), LcmKey{}, c.lcm.rig_timeout_s, 2);
   testing::BusRecorder commands(kIoCommandChannel);
   LcmIoThread io("memq://", {&device, &rig, &commands});  // memq: one handle, so one thread for both ends
@@ -161,8 +163,8 @@ TEST(LcmJointClosedLoop, InLockstepTheSameTrialGivesTheSameNumbersTwiceAndTracks
   ASSERT_EQ(first.rms_deg.size(), 2u);
   EXPECT_EQ(first.rms_deg, second.rms_deg);  // bit for bit: no wall clock in the numbers
   for (std::size_t j = 0; j < 2; ++j) {
-    std::cout << "lockstep arm2/paper2 iteration 0, joint " << j + 1 << ": RMS " << first.rms_deg[j] << " deg over LCM, "
-              << in_process[j] << " deg in process\n";
+    std::cout << "lockstep arm2/paper2 iteration 0, joint " << j + 1 << ": RMS " << first.rms_deg[j]
+              << " deg over LCM, " << in_process[j] << " deg in process\n";
     // Not bit-identical to the arm in process: the rig reads its sensors (drawing their noise) at
     // every integration step, the engine in process once per tick.
     EXPECT_NEAR(first.rms_deg[j], in_process[j], 0.01 * in_process[j]) << "joint " << j + 1;

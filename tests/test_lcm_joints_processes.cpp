@@ -37,7 +37,8 @@ TEST(LcmJointProcesses, IoSimServesArm2InTheJointMessagesAndAnEngineOfOneJointRe
   if (!why_not.empty()) GTEST_SKIP() << "no private network namespace: " << why_not;
   const auto dir = testing::make_temp_dir("bellows-lcm-joints");
   const std::string config = testing::write_file(dir, "arm2.toml", "[arm]\npreset = \"arm2\"\n").string();
-  Child rig({testing::kBellows, "io-sim", "--json", "--rt", "off", "--config", config}, dir / "rig.out", dir / "rig.err");
+  Child rig({testing::kBellows, "io-sim", "--json", "--rt", "off", "--config", config}, dir / "rig.out",
+            dir / "rig.err");
   ASSERT_TRUE(rig.started());
 
   LcmDevice one_joint(LcmDevice::random_session_id());  // an engine of today's single-joint arm
@@ -45,18 +46,23 @@ TEST(LcmJointProcesses, IoSimServesArm2InTheJointMessagesAndAnEngineOfOneJointRe
   {
     LcmIoThread bus(kDefaultLcmUrl, {&one_joint, &states});
     bus.start(RealtimeMode::kOff, 0);
-    EXPECT_TRUE(vent_until(one_joint, [&] { return one_joint.stats().states.other_joints >= 20; }, 20.0)) << rig.err();
+    EXPECT_TRUE(vent_until(
+        one_joint, [&] { return one_joint.stats().states.other_joints >= 20; }, 20.0))
+        << rig.err();
     bus.stop();
   }
   EXPECT_FALSE(one_joint.connected());
   EXPECT_EQ(one_joint.stats().states.accepted, 0u);
-  EXPECT_EQ(one_joint.diagnosis().rfind("a rig on this bus serves an arm of 2 joints but this arm has one joint (io_state_t / io_command_t)", 0),
-            0u)
+  EXPECT_EQ(
+      one_joint.diagnosis().rfind(
+          "a rig on this bus serves an arm of 2 joints but this arm has one joint (io_state_t / io_command_t)", 0),
+      0u)
       << one_joint.diagnosis();
   ASSERT_FALSE(states.messages().empty());
   for (const testing::Recorded& r : states.messages()) {
     io_joints_state_t s{};
-    ASSERT_EQ(decode_checked(r.bytes.data(), r.bytes.size(), s), DecodeStatus::kOk) << "io-sim speaks the joint messages";
+    ASSERT_EQ(decode_checked(r.bytes.data(), r.bytes.size(), s), DecodeStatus::kOk)
+        << "io-sim speaks the joint messages";
     EXPECT_EQ(s.joint_count, 2);
   }
 
@@ -64,11 +70,14 @@ TEST(LcmJointProcesses, IoSimServesArm2InTheJointMessagesAndAnEngineOfOneJointRe
   {
     LcmIoThread bus(kDefaultLcmUrl, {&two_joints});
     bus.start(RealtimeMode::kOff, 0);
-    EXPECT_TRUE(vent_until(two_joints, [&] { return two_joints.connected(); }, 20.0)) << rig.err();
+    EXPECT_TRUE(vent_until(
+        two_joints, [&] { return two_joints.connected(); }, 20.0))
+        << rig.err();
     const SensorReading reading = two_joints.read_sensors();
     EXPECT_EQ(reading.joint_count, 2);
     EXPECT_NEAR(reading.supply_bar, 3.0, 0.05);
-    for (int j = 0; j < 2; ++j) EXPECT_NEAR(reading.joint[static_cast<std::size_t>(j)].chamber_bar[0], 1.013, 0.05) << "vented";
+    for (int j = 0; j < 2; ++j)
+      EXPECT_NEAR(reading.joint[static_cast<std::size_t>(j)].chamber_bar[0], 1.013, 0.05) << "vented";
     bus.stop();
   }
   EXPECT_EQ(two_joints.stats().states.other_joints, 0u);
@@ -76,13 +85,15 @@ TEST(LcmJointProcesses, IoSimServesArm2InTheJointMessagesAndAnEngineOfOneJointRe
 
   // `bellows run --device lcm` of one joint against it: refused in one line, exit 4 (rig unavailable).
   const std::string quick = testing::write_file(dir, "one.toml", "[lcm]\nconnect_timeout_s = 1\n").string();
-  Child run({testing::kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "1", "--json", "--config", quick},
+  Child run({testing::kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "1", "--json",
+             "--config", quick},
             dir / "run.out", dir / "run.err");
   const auto run_status = run.wait(60.0);
   ASSERT_TRUE(run_status.has_value()) << "bellows run did not give up";
   EXPECT_EQ(*run_status, 4) << run.err();
   EXPECT_EQ(nlohmann::json::parse(run.out())["fault"]["name"], "rig-unavailable");
-  EXPECT_NE(run.err().find("a rig on this bus serves an arm of 2 joints but this arm has one joint"), std::string::npos) << run.err();
+  EXPECT_NE(run.err().find("a rig on this bus serves an arm of 2 joints but this arm has one joint"), std::string::npos)
+      << run.err();
 
   rig.signal(SIGTERM);
   ASSERT_TRUE(rig.wait(30.0).has_value()) << "io-sim did not stop on SIGTERM";
@@ -103,17 +114,19 @@ TEST(LcmJointProcesses, RunDrivesArm2OverLcmAndEveryJointTracksAsTheInProcessArm
   // a loaded machine stalling either process changes none of the numbers; the free-running rig on the
   // wall clock has tests of its own.
   const std::string config = testing::write_file(dir, "arm2.toml", "[arm]\npreset = \"arm2\"\n").string();
-  Child rig({testing::kBellows, "io-sim", "--stepped", "--seed", "5", "--config", config}, dir / "rig.out", dir / "rig.err");
+  Child rig({testing::kBellows, "io-sim", "--stepped", "--seed", "5", "--config", config}, dir / "rig.out",
+            dir / "rig.err");
   ASSERT_TRUE(rig.started());
-  Child run({testing::kBellows, "run", "--no-save", "--device", "lcm", "--clock", "lockstep", "--iterations", "2", "--json", "--seed",
-             "5", "--trajectory", "paper2", "--config", config},
+  Child run({testing::kBellows, "run", "--no-save", "--device", "lcm", "--clock", "lockstep", "--iterations", "2",
+             "--json", "--seed", "5", "--trajectory", "paper2", "--config", config},
             dir / "run.out", dir / "run.err");
   const auto run_status = run.wait(300.0);
   ASSERT_TRUE(run_status.has_value()) << "bellows run did not finish in 5 minutes";
   EXPECT_EQ(*run_status, 0) << run.err();
   rig.signal(SIGTERM);
   ASSERT_TRUE(rig.wait(30.0).has_value());
-  const testing::ProcessResult local = testing::run_process(testing::kBellows + " run --no-save --iterations 2 --json --seed 5 --trajectory paper2 --config " + config);
+  const testing::ProcessResult local = testing::run_process(
+      testing::kBellows + " run --no-save --iterations 2 --json --seed 5 --trajectory paper2 --config " + config);
   ASSERT_EQ(local.exit_code, 0) << local.err;
   const nlohmann::json remote = nlohmann::json::parse(run.out())["iterations"];
   const nlohmann::json in_process = nlohmann::json::parse(local.out)["iterations"];
@@ -122,9 +135,10 @@ TEST(LcmJointProcesses, RunDrivesArm2OverLcmAndEveryJointTracksAsTheInProcessArm
   for (std::size_t i = 0; i < remote.size(); ++i) {
     ASSERT_EQ(remote[i]["joint_rms_deg"].size(), 2u);
     for (std::size_t j = 0; j < 2; ++j) {
-      const double over_lcm = remote[i]["joint_rms_deg"][j].get<double>(), local_rms = in_process[i]["joint_rms_deg"][j].get<double>();
-      std::cout << "arm2/paper2 iteration " << i << ", joint " << j + 1 << ": " << over_lcm << " deg over LCM, " << local_rms
-                << " deg in process\n";
+      const double over_lcm = remote[i]["joint_rms_deg"][j].get<double>(),
+                   local_rms = in_process[i]["joint_rms_deg"][j].get<double>();
+      std::cout << "arm2/paper2 iteration " << i << ", joint " << j + 1 << ": " << over_lcm << " deg over LCM, "
+                << local_rms << " deg in process\n";
       EXPECT_NEAR(over_lcm, local_rms, 0.01 * local_rms) << "iteration " << i << ", joint " << j + 1;
     }
   }

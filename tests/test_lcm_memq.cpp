@@ -34,7 +34,8 @@ using testing::vented;
 
 constexpr std::int64_t kBinding = 4242;  // the hand-made rig's offer in the device tests
 
-io_state_t state(std::int64_t rig, std::int64_t session, std::int64_t seq, double time_s, std::int64_t command_seq = 0) {
+io_state_t state(std::int64_t rig, std::int64_t session, std::int64_t seq, double time_s,
+                 std::int64_t command_seq = 0) {
   io_state_t s{};
   s.rig_id = rig;
   s.binding = kBinding;
@@ -66,10 +67,10 @@ TEST(LcmRigServer, HoldsTheSafeStateBindsOneSessionAndVentsWhenCommandsStop) {
   const std::int64_t offer = s.binding;
 
   // Nothing invalid, malformed, foreign-typed, addressed elsewhere or armed before binding opens a valve.
-  b.send(command(5, 1, 1.5, false, offer));                        // a duty beyond 1
-  b.send(testing::command(5, 1, 0.5, false, rig + 1, offer));      // another rig
-  b.send(command(5, 1, 0.5, true, offer));                         // armed before binding
-  b.send(command(5, 1, 0.5, false, offer + 1));                    // a stale offer: a vent, obeyed, binds nothing
+  b.send(command(5, 1, 1.5, false, offer));                    // a duty beyond 1
+  b.send(testing::command(5, 1, 0.5, false, rig + 1, offer));  // another rig
+  b.send(command(5, 1, 0.5, true, offer));                     // armed before binding
+  b.send(command(5, 1, 0.5, false, offer + 1));                // a stale offer: a vent, obeyed, binds nothing
   publish_garbage(b.bus, kIoCommandChannel);
   b.step(0.001);
   EXPECT_TRUE(vented(b.arm.state().command));
@@ -92,7 +93,7 @@ TEST(LcmRigServer, HoldsTheSafeStateBindsOneSessionAndVentsWhenCommandsStop) {
   EXPECT_TRUE(b.logged("a command of session 6 while serving session 5"));
   EXPECT_TRUE(b.logged("jumping from seq 2 to 103"));
   b.send(command(5, 2 + b.config.lcm.seq_window, 0.4, true, offer));  // the largest step allowed
-  b.step(0.003);  // the next state is due
+  b.step(0.003);                                                      // the next state is due
   EXPECT_EQ(b.arm.state().command.inlet_duty[0], 0.4);
   s = b.last_state();
   EXPECT_EQ(s.session_id, 5);
@@ -237,15 +238,16 @@ TEST(LcmDevice, TrustsOnlyItsSessionsStatesInOrder) {
   publish(b.bus, kIoStateChannel, state(55, 1234, 4, 0.3, 2));   // rig time not advancing
   publish(b.bus, kIoStateChannel, state(55, 1234, 5, 0.5, 99));  // echoes a command never sent
   io_state_t faulty = state(55, 1234, 6, 0.6, 2);
-  faulty.fault_bits = io_state_t::FAULT_SENSOR;                 // the rig says its sensors are bad
+  faulty.fault_bits = io_state_t::FAULT_SENSOR;  // the rig says its sensors are bad
   publish(b.bus, kIoStateChannel, faulty);
   publish(b.bus, kIoStateChannel, state(66, 1234, 1, 0.1, 0));  // another rig while the valves are live
   io_state_t other_binding = state(55, 1234, 7, 0.65, 2);
-  other_binding.binding = kBinding + 1;                         // not the binding this session made
+  other_binding.binding = kBinding + 1;  // not the binding this session made
   publish(b.bus, kIoStateChannel, other_binding);
   b.step();
   EXPECT_EQ(b.device.read_sensors().time_s, first_time) << "none of these is a fresh reading";
-  EXPECT_NE(b.device.diagnosis().find("another sender is commanding this rig"), std::string::npos) << b.device.diagnosis();
+  EXPECT_NE(b.device.diagnosis().find("another sender is commanding this rig"), std::string::npos)
+      << b.device.diagnosis();
 
   io_state_t limited = state(55, 1234, 8, 0.7, 2);
   limited.fault_bits = io_state_t::FAULT_PRESSURE_LIMIT;  // a rig limit acting: the reading is still one
@@ -337,7 +339,7 @@ void expect_stale_fault_after(int stale_ticks) {
 
 TEST(LcmDevice, NoStateForStaleTicksIsALostLinkFaultThatVents) {
   expect_stale_fault_after(SafetyParameters{}.stale_ticks);  // the default
-  expect_stale_fault_after(6);  // [safety] stale_ticks
+  expect_stale_fault_after(6);                               // [safety] stale_ticks
 }
 
 Trajectory short_rig_move() {

@@ -100,9 +100,11 @@ TEST(LcmProcessAttacks, ForgedCommandsOnAnIdleRigMeetItsPressureCeiling) {
   rig.signal(SIGTERM);
   ASSERT_TRUE(rig.wait(30.0).has_value());
   const double ceiling = RigLimits::from(Configuration{}).pressure_ceiling_bar;
-  std::cerr << "1.5 s of forged commands: chamber A at most " << forger.max_chamber_a_bar() << " bar (ceiling " << ceiling << ")\n";
+  std::cerr << "1.5 s of forged commands: chamber A at most " << forger.max_chamber_a_bar() << " bar (ceiling "
+            << ceiling << ")\n";
   EXPECT_GT(forger.max_chamber_a_bar(), 1.5) << "the forger did drive the rig";
-  EXPECT_LE(forger.max_chamber_a_bar(), ceiling + 0.01 + 4 * Configuration{}.plant.pressure_noise_bar);  // as read, with noise
+  EXPECT_LE(forger.max_chamber_a_bar(),
+            ceiling + 0.01 + 4 * Configuration{}.plant.pressure_noise_bar);  // as read, with noise
   const nlohmann::json report = nlohmann::json::parse(rig.out());
   EXPECT_GT(report["pressure_limit_trips"].get<std::uint64_t>(), 0u);
   EXPECT_EQ(report["authenticated"], false);
@@ -117,8 +119,8 @@ TEST(LcmProcessAttacks, WithoutAKeyATakeoverIsDiagnosedNotCalledAStaleSensor) {
   Forger forger(Forger::Mode::kFollow);
   LcmIoThread bus(kDefaultLcmUrl, {&forger});
   bus.start(RealtimeMode::kOff, 0);
-  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "2", "--json"}, dir / "run.out",
-            dir / "run.err");
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "wall", "--iterations", "2", "--json"},
+            dir / "run.out", dir / "run.err");
   ASSERT_TRUE(rig.started() && run.started());
   const auto status = run.wait(120.0);
   ASSERT_TRUE(status.has_value()) << "the engine did not stop";
@@ -129,7 +131,8 @@ TEST(LcmProcessAttacks, WithoutAKeyATakeoverIsDiagnosedNotCalledAStaleSensor) {
   ASSERT_GT(forger.sent(), 0u);
   const nlohmann::json report = nlohmann::json::parse(run.out());
   EXPECT_EQ(report["fault"]["name"], "foreign-sender") << report.dump();
-  EXPECT_NE(report["fault"]["message"].get<std::string>().find("another sender is commanding this rig"), std::string::npos);
+  EXPECT_NE(report["fault"]["message"].get<std::string>().find("another sender is commanding this rig"),
+            std::string::npos);
   EXPECT_NE(run.err().find("bellows: another sender is commanding this rig"), std::string::npos) << run.err();
   EXPECT_GT(report["lcm"]["rig"]["commands_not_ours"].get<std::uint64_t>(), 0u);
 }
@@ -145,8 +148,9 @@ TEST(LcmKeyCli, AWorldReadableOrWrongSizedKeyIsRefusedWithOneLine) {
   expect_refused_in_one_line("io-sim --config " + world_config.string(), "readable or writable by everyone");
   expect_refused_in_one_line("io-sim --config " + small_config.string(), "16 bytes; a key is exactly 32 bytes");
   expect_refused_in_one_line("run --no-save --device lcm --clock wall --lcm memq:// --config " + world_config.string(),
-                 "readable or writable by everyone");
-  expect_refused_in_one_line("run --no-save --device lcm --clock wall --lcm memq:// --config " + small_config.string(), "exactly 32 bytes");
+                             "readable or writable by everyone");
+  expect_refused_in_one_line("run --no-save --device lcm --clock wall --lcm memq:// --config " + small_config.string(),
+                             "exactly 32 bytes");
 }
 
 }  // namespace

@@ -38,7 +38,8 @@ void isolate_sessions() { setenv("XDG_DATA_HOME", testing::make_temp_dir("bellow
 template <typename Message>
 Message decode(const Recorded& recorded) {
   Message message{};
-  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message), DecodeStatus::kOk) << recorded.channel;
+  EXPECT_EQ(decode_checked(recorded.bytes.data(), recorded.bytes.size(), message), DecodeStatus::kOk)
+      << recorded.channel;
   return message;
 }
 
@@ -59,7 +60,8 @@ class Heckler final : public LcmEndpoint {
   void attach(lcm::LCM& bus) override { subscribe(bus, kIoStateChannel); }
   void on_message(const char*, const void* data, std::size_t size) override {
     io_state_t state{};
-    if (decode_checked(data, size, state) == DecodeStatus::kOk && state.session_id != 0 && state.session_id != kSession) {
+    if (decode_checked(data, size, state) == DecodeStatus::kOk && state.session_id != 0 &&
+        state.session_id != kSession) {
       served_ = state;
       rig_taken_ = true;
     }
@@ -127,10 +129,11 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   const auto key = testing::write_file(dir, "rig.key", std::string(32, 'q'));
   chmod(key.c_str(), 0600);
   const std::string config = testing::write_file(dir, "keyed.toml", "[lcm]\nkey_file = \"rig.key\"\n").string();
-  Child rig({kBellows, "io-sim", "--stepped", "--seed", "5", "--json", "--config", config}, dir / "rig.out", dir / "rig.err");
+  Child rig({kBellows, "io-sim", "--stepped", "--seed", "5", "--json", "--config", config}, dir / "rig.out",
+            dir / "rig.err");
   ASSERT_TRUE(rig.started());
-  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "lockstep", "--iterations", "3", "--json", "--seed", "5",
-             "--config", config},
+  Child run({kBellows, "run", "--no-save", "--device", "lcm", "--clock", "lockstep", "--iterations", "3", "--json",
+             "--seed", "5", "--config", config},
             dir / "run.out", dir / "run.err");
   ASSERT_TRUE(run.started());
   const auto run_status = run.wait(300.0);
@@ -141,7 +144,8 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   bus.stop();
 
   // The same seed in-process, on the simulated clock.
-  Child local({kBellows, "run", "--no-save", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out", dir / "local.err");
+  Child local({kBellows, "run", "--no-save", "--iterations", "3", "--json", "--seed", "5"}, dir / "local.out",
+              dir / "local.err");
   const auto local_status = local.wait(300.0);
   ASSERT_TRUE(local_status.has_value());
   ASSERT_EQ(*local_status, 0) << local.err();
@@ -180,7 +184,8 @@ TEST(LcmProcesses, ARemoteRigLearnsLikeTheInProcessArmAndIgnoresWhatItMustNotTru
   EXPECT_NE(rig.err().find("not signed with this [lcm] key_file"), std::string::npos) << rig.err();
   EXPECT_EQ(rig_report["sessions_served"], 1);
   // In lockstep the rig applied a command for every tick of the four trials, and never timed out.
-  const std::uint64_t trial_ticks = 4 * remote_report["samples"].get<std::uint64_t>() * Configuration{}.timing.ticks_per_sample;
+  const std::uint64_t trial_ticks =
+      4 * remote_report["samples"].get<std::uint64_t>() * Configuration{}.timing.ticks_per_sample;
   EXPECT_GE(rig_report["commands"]["accepted"].get<std::uint64_t>(), trial_ticks) << rig_report.dump();
   EXPECT_EQ(rig_report["timeouts"], 0);
   EXPECT_EQ(remote_report["clock"], "lockstep");
@@ -198,8 +203,10 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   // this test's subject, and a loaded machine's stalls of 20-80 ms before it must not end the trial
   // first (the default's exact tick count has in-process tests: EngineRideThrough).
   const int stale_ticks = 24;
-  const std::string config = testing::write_file(dir, "loaded.toml", "[safety]\nstale_ticks = " + std::to_string(stale_ticks) +
-                                                                          "\nmissed_deadline_streak = 1000\n").string();
+  const std::string config = testing::write_file(dir, "loaded.toml",
+                                                 "[safety]\nstale_ticks = " + std::to_string(stale_ticks) +
+                                                     "\nmissed_deadline_streak = 1000\n")
+                                 .string();
   Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
   Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
              kDefaultLcmUrl, "--lcm-log", "--name", "killed", "--config", config},
@@ -255,7 +262,8 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   EXPECT_EQ(std::lround((ticks[fault].time_s - ticks[fresh].time_s) / Configuration{}.timing.tick_s), stale_ticks);
   EXPECT_EQ(ticks[fresh].state, static_cast<std::int8_t>(telemetry_t::STATE_RUNNING));
   for (std::size_t i = fresh + 1; i < fault; ++i) {  // held: nothing inflates, nothing drains
-    EXPECT_EQ(ticks[i].inlet_duty[0] + ticks[i].inlet_duty[1] + ticks[i].outlet_duty[0] + ticks[i].outlet_duty[1], 0.0) << i;
+    EXPECT_EQ(ticks[i].inlet_duty[0] + ticks[i].inlet_duty[1] + ticks[i].outlet_duty[0] + ticks[i].outlet_duty[1], 0.0)
+        << i;
   }
   EXPECT_EQ(ticks[fault].inlet_duty[0], 0.0);
   EXPECT_EQ(ticks[fault].inlet_duty[1], 0.0);
@@ -284,7 +292,8 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
   }
   double first_vent_s = 0.0;
   for (std::size_t i = last_state + 1; i < messages.size() && first_vent_s == 0.0; ++i) {
-    if (messages[i].channel == kIoCommandChannel && !decode<io_command_t>(messages[i]).armed) first_vent_s = messages[i].received_s;
+    if (messages[i].channel == kIoCommandChannel && !decode<io_command_t>(messages[i]).armed)
+      first_vent_s = messages[i].received_s;
   }
   std::cerr << "after the rig's last state: " << live_after << " live commands, first vent after "
             << (first_vent_s - messages[last_state].received_s) * 1e3 << " ms\n";
@@ -300,8 +309,9 @@ TEST(LcmProcesses, LcmLogplayerReplaysASavedLogThatASubscriberDecodesEntirely) {
   for (int k = 0; k <= 50; ++k) csv += std::to_string(k * 0.02) + "," + std::to_string(k < 10 ? 0.0 : 15.0) + "\n";
   const auto trajectory = testing::write_file(dir, "step.csv", csv);
   const auto config = testing::write_file(dir, "short.toml", "[timing]\nsettle_s = 0.2\n");
-  const auto made = testing::run_process(kBellows + " run --no-save --clock wall --speed 2 --iterations 1 --json --trajectory " +
-                                         trajectory.string() + " --config " + config.string() + " --lcm-log " + log);
+  const auto made =
+      testing::run_process(kBellows + " run --no-save --clock wall --speed 2 --iterations 1 --json --trajectory " +
+                           trajectory.string() + " --config " + config.string() + " --lcm-log " + log);
   ASSERT_EQ(made.exit_code, 0) << made.err;
   EXPECT_EQ(nlohmann::json::parse(made.out)["lcm"]["telemetry"]["dropped_ticks"], 0);
 
@@ -396,12 +406,14 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
   expect_refused_in_one_line("run --device lcm --clock wall --lcm nowhere://at-all", "unknown provider 'nowhere'");
   expect_refused_in_one_line("io-sim --lcm nowhere://at-all", "unknown provider 'nowhere'");
   const std::string unopenable = "file://" + (dir / "no-such-folder" / "bus.lcmlog").string() + "?mode=r";
-  expect_refused_in_one_line("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
+  expect_refused_in_one_line("run --device lcm --clock wall --lcm " + unopenable, "cannot open the LCM bus",
+                             kExitEnvironment);
   expect_refused_in_one_line("io-sim --lcm " + unopenable, "cannot open the LCM bus", kExitEnvironment);
   // A multicast bus on a host without a multicast route (a fresh network namespace has none):
   // LCM's reason is quoted in bellows' one line.
   if (testing::run_process("unshare -n true").exit_code == 0) {
-    const auto result = testing::run_process("unshare -n " + kBellows + " io-sim --lcm udpm://239.255.76.67:7667?ttl=0");
+    const auto result =
+        testing::run_process("unshare -n " + kBellows + " io-sim --lcm udpm://239.255.76.67:7667?ttl=0");
     EXPECT_EQ(result.exit_code, kExitEnvironment) << result.err;
     EXPECT_NE(result.err.find("(LCM: "), std::string::npos) << result.err;
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
@@ -412,8 +424,8 @@ TEST(LcmCli, RefusesWhatMakesNoSenseAndSaysWhenNoRigAnswers) {
 
   // memq:// is private to a process: nobody answers there. No --clock: a rig runs on the wall clock.
   const auto config = testing::write_file(dir, "quick.toml", "[lcm]\nconnect_timeout_s = 0.5\n");
-  const auto result = testing::run_process(kBellows + " run --device lcm --lcm memq:// --json --config " +
-                                           config.string());
+  const auto result =
+      testing::run_process(kBellows + " run --device lcm --lcm memq:// --json --config " + config.string());
   EXPECT_EQ(result.exit_code, kExitEnvironment) << result.err;  // no rig: the environment, not a fault
   const nlohmann::json report = nlohmann::json::parse(result.out);
   EXPECT_EQ(report["clock"], "wall");

@@ -41,8 +41,8 @@ struct RigRun {
 };
 
 /// io-sim (with `rig_args`, its own `rig_config`) and one `bellows run --device lcm` trial against it.
-RigRun run_against_rig(const std::filesystem::path& dir, const std::vector<std::string>& rig_args, const std::string& rig_config,
-                       std::vector<std::string> run_args) {
+RigRun run_against_rig(const std::filesystem::path& dir, const std::vector<std::string>& rig_args,
+                       const std::string& rig_config, std::vector<std::string> run_args) {
   std::vector<std::string> rig_argv = {kBellows, "io-sim"};
   rig_argv.insert(rig_argv.end(), rig_args.begin(), rig_args.end());
   if (!rig_config.empty()) {
@@ -71,7 +71,10 @@ TEST(LcmRigFaults, SwappedChambersInsideTheGuardEndWithTheRigsTripNamed) {
   // The lab's rig stops at 90 deg (its hardware's stops), inside the engine's guard of 95 deg. A
   // build beside the suite may stall threads: not this test's subject (nor a rig timeout).
   const std::string rig_config =
-      testing::write_file(dir, "rig.toml", "[trajectory]\nmax_abs_angle_deg = 80\n[safety]\nangle_limit_deg = 85\nmissed_deadline_streak = 1000\n[lcm]\nrig_angle_limit_deg = 90\nrig_timeout_s = 2.0\n").string();
+      testing::write_file(dir, "rig.toml",
+                          "[trajectory]\nmax_abs_angle_deg = 80\n[safety]\nangle_limit_deg = "
+                          "85\nmissed_deadline_streak = 1000\n[lcm]\nrig_angle_limit_deg = 90\nrig_timeout_s = 2.0\n")
+          .string();
   const RigRun r = run_against_rig(dir, {"--swapped-chambers"}, rig_config, {"--iterations", "0", "--name", "swapped"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_EQ(r.report["fault"]["name"], "rig-limit") << r.report.dump();
@@ -105,7 +108,10 @@ TEST(LcmRigFaults, ACleanRunReportsNoLinkErrorsAndCountsTheOffersApart) {
   const auto dir = testing::make_temp_dir("bellows-lcm-clean");
   // The machine's stalls are not this test's subject: ride-through, the stale limit and the rig's
   // command timeout have theirs.
-  const std::string config = testing::write_file(dir, "tolerant.toml", "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n").string();
+  const std::string config =
+      testing::write_file(dir, "tolerant.toml",
+                          "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n")
+          .string();
   const RigRun r = run_against_rig(dir, {}, config, {"--iterations", "0", "--no-save", "--config", config});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json& rig = r.report["lcm"]["rig"];
@@ -124,9 +130,10 @@ TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambe
   // good valve read as dead) nor vents the check before the last valve (missed-deadlines, seen
   // under the suite's load beside helpers' builds).
   const std::string config =
-      testing::write_file(dir, "tolerant.toml",
-                          "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n[rig_check]\n"
-                          "timeout_tolerance_s = 0.5\nvalve_pulse_s = 0.1\n")
+      testing::write_file(
+          dir, "tolerant.toml",
+          "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 2.0\n[rig_check]\n"
+          "timeout_tolerance_s = 0.5\nvalve_pulse_s = 0.1\n")
           .string();
   for (const bool swapped : {false, true}) {
     std::vector<std::string> rig_argv = {kBellows, "io-sim", "--config", config};
@@ -151,7 +158,8 @@ TEST(LcmRigFaults, RigCheckPassesAgainstIoSimAndNamesTheSwapAgainstSwappedChambe
     if (!swapped) {
       EXPECT_EQ(*status, 0) << check.err();
       EXPECT_EQ(report["all_pass"], true) << report.dump();
-      EXPECT_NE(check.err().find("rig check: every valve passed, every limit passed"), std::string::npos) << check.err();
+      EXPECT_NE(check.err().find("rig check: every valve passed, every limit passed"), std::string::npos)
+          << check.err();
     } else {
       EXPECT_NE(*status, 0) << check.err();
       EXPECT_EQ(report["all_pass"], false);
@@ -168,17 +176,19 @@ TEST(LcmRigFaults, RigCheckNamesEachLimitOfARigThatBreaksThem) {
   const auto dir = testing::make_temp_dir("bellows-lcm-rig-limits");
   // Loaded-machine settings (as below): pulses of 0.1 s and a stale limit of 200 ms, so that a stalled
   // tick neither eats most of a 30 ms pulse nor vents the check (missed-deadlines) before a valve.
-  const std::string tolerant = "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 0.5\n"
-                               "[rig_check]\ntimeout_tolerance_s = 0.3\nvalve_pulse_s = 0.1\n";
+  const std::string tolerant =
+      "[safety]\nmissed_deadline_streak = 1000\nstale_ticks = 40\n[lcm]\nrig_timeout_s = 0.5\n"
+      "[rig_check]\ntimeout_tolerance_s = 0.3\nvalve_pulse_s = 0.1\n";
   const std::string config = testing::write_file(dir, "engine.toml", tolerant).string();
   const std::string rig_config =
-      testing::write_file(dir, "rig.toml",
-                          "[controller]\np_max_bar = 1.2\n[safety]\nangle_limit_deg = 85\nmissed_deadline_streak = 1000\n[lcm]\n"
-                          "rig_timeout_s = 0.5\nrig_angle_limit_deg = 90\n[trajectory]\nmax_abs_angle_deg = 80\n")
+      testing::write_file(
+          dir, "rig.toml",
+          "[controller]\np_max_bar = 1.2\n[safety]\nangle_limit_deg = 85\nmissed_deadline_streak = 1000\n[lcm]\n"
+          "rig_timeout_s = 0.5\nrig_angle_limit_deg = 90\n[trajectory]\nmax_abs_angle_deg = 80\n")
           .string();
   Child rig({kBellows, "io-sim", "--config", rig_config, "--no-command-timeout"}, dir / "rig.out", dir / "rig.err");
-  Child check({kBellows, "rig", "check", "--device", "lcm", "--yes", "--json", "--no-save", "--config", config}, dir / "check.out",
-              dir / "check.err");
+  Child check({kBellows, "rig", "check", "--device", "lcm", "--yes", "--json", "--no-save", "--config", config},
+              dir / "check.out", dir / "check.err");
   const auto status = check.wait(120.0);
   rig.signal(SIGTERM);
   ASSERT_TRUE(rig.wait(30.0).has_value());
@@ -186,7 +196,8 @@ TEST(LcmRigFaults, RigCheckNamesEachLimitOfARigThatBreaksThem) {
   EXPECT_EQ(*status, 5) << check.err();
   EXPECT_NE(rig.err().find("drill: no command timeout"), std::string::npos) << rig.err();
   const std::string err = check.err();
-  EXPECT_NE(err.find("FAIL pressure ceiling: the rig vents chambers above 1.550 bar absolute, this configuration expects 1.750 bar"),
+  EXPECT_NE(err.find("FAIL pressure ceiling: the rig vents chambers above 1.550 bar absolute, this configuration "
+                     "expects 1.750 bar"),
             std::string::npos)
       << err;
   EXPECT_NE(err.find("at or below the engine's own guard 1.650 bar"), std::string::npos) << err;

@@ -61,7 +61,8 @@ TEST(RigCheckLimits, EachAnnouncedLimitThatDiffersIsNamedWithTheKeysToSet) {
   const Configuration c;
   RigAnnouncedLimits a = as_configured(c);
   a.pressure_ceiling_bar = 1.4;  // the rig's ceiling set to p_max, the margin forgotten (issue 25, question 4)
-  expect_only_failure(judge_announced_limits(&a, c, 1), "pressure ceiling", "at or below the engine's own guard 1.650 bar");
+  expect_only_failure(judge_announced_limits(&a, c, 1), "pressure ceiling",
+                      "at or below the engine's own guard 1.650 bar");
   a = as_configured(c);
   a.pressure_ceiling_bar = 2.2;  // above: not below the guard, but not what was planned
   expect_only_failure(judge_announced_limits(&a, c, 1), "pressure ceiling", "expects 1.750 bar");
@@ -146,7 +147,11 @@ TEST(RigCheckLimits, TheProvokedTimeoutPassesOnlyWhenTheRigTripsInTimeNamesTheSe
 /// Loaded-machine settings: a build beside the suite stalls threads past 50 ms; the timeout and its
 /// tolerance are wide so that the check judges the rig, not the machine's load.
 struct MemqRig {
-  explicit MemqRig(bool timeout_enforced) : arm(config().plant, 3), rig(arm, parameters(timeout_enforced), 77), core(device, c.controller, c.timing, c.safety), loop(core, device, 1.0) {
+  explicit MemqRig(bool timeout_enforced)
+      : arm(config().plant, 3),
+        rig(arm, parameters(timeout_enforced), 77),
+        core(device, c.controller, c.timing, c.safety),
+        loop(core, device, 1.0) {
     io.start(RealtimeMode::kTry, 70);
     loop.start(RealtimeMode::kTry);
   }
@@ -182,7 +187,8 @@ TEST(RigCheckLimitsMemq, TheRigServerAnnouncesItsLimitsAndItsTimeoutProvokedPass
   MemqRig m(true);
   ASSERT_TRUE(testing::eventually([&] { return m.device.connected(); }, 10.0)) << "the rig never answered";
   RigAnnouncedLimits announced;
-  ASSERT_TRUE(testing::eventually([&] { return m.device.read_announced_limits(announced); }, 5.0)) << "no limits announced";
+  ASSERT_TRUE(testing::eventually([&] { return m.device.read_announced_limits(announced); }, 5.0))
+      << "no limits announced";
   EXPECT_EQ(announced.rig_id, 77);
   EXPECT_DOUBLE_EQ(announced.pressure_ceiling_bar, 1.75);
   EXPECT_DOUBLE_EQ(announced.command_timeout_s, 0.4);
@@ -200,7 +206,8 @@ TEST(RigCheckLimitsMemq, TheRigServerAnnouncesItsLimitsAndItsTimeoutProvokedPass
   EXPECT_EQ(t.trip.session_id, m.device.session_id());
   EXPECT_EQ(t.trip.command_seq, t.last_command_seq);
   EXPECT_NE(t.trip.fault_bits & io_state_t::FAULT_COMMAND_TIMEOUT, 0);
-  EXPECT_GT(t.before.joint[0].chamber_bar[0], m.c.controller.gas.ambient_bar + m.c.rig_check.min_change_bar) << "the fill held air";
+  EXPECT_GT(t.before.joint[0].chamber_bar[0], m.c.controller.gas.ambient_bar + m.c.rig_check.min_change_bar)
+      << "the fill held air";
   // Silent only once every valve was closed: the chambers kept their air until the rig vented them.
   EXPECT_LT(t.trip.reading.joint[0].chamber_bar[0], t.before.joint[0].chamber_bar[0] + 0.02) << "filled while silent";
   EXPECT_LT(t.after.joint[0].chamber_bar[0], t.before.joint[0].chamber_bar[0]) << "vented";

@@ -19,9 +19,9 @@ namespace bellows {
 namespace {
 
 using testing::BusRecorder;
-using testing::Recorded;
 using testing::decode;
 using testing::pump;
+using testing::Recorded;
 
 /// An engine on `device` running `trajectory` for a second with a small correction, then faulted by
 /// a guard or the operator; every tick goes through `tap`.
@@ -124,7 +124,8 @@ TEST_P(JointTelemetry, EveryTickCarriesEveryJoint) {
   EXPECT_EQ(last.fault_joint, 0) << "an operator's stop is no joint's";
 }
 
-INSTANTIATE_TEST_SUITE_P(Arms, JointTelemetry, ::testing::Values(std::pair{"arm2", "paper2"}, std::pair{"arm3", "paper3"}),
+INSTANTIATE_TEST_SUITE_P(Arms, JointTelemetry,
+                         ::testing::Values(std::pair{"arm2", "paper2"}, std::pair{"arm3", "paper3"}),
                          [](const auto& arm) { return std::string(arm.param.first); });
 
 TEST(JointTelemetryFault, NamesTheJointTheGuardFiredOn) {

@@ -27,8 +27,8 @@ constexpr double kHoldTolerance_rad = 3.0 * std::numbers::pi / 180.0;  // after 
 /// configured settling hold. Fails the test unless the engine hands the record back complete and
 /// stays armed.
 template <typename Correction>
-TrialRecord run_trial(EngineCore& core, SimulatedClock& clock, const Configuration& config, const Trajectory& trajectory,
-                      const Correction& correction, std::uint32_t id) {
+TrialRecord run_trial(EngineCore& core, SimulatedClock& clock, const Configuration& config,
+                      const Trajectory& trajectory, const Correction& correction, std::uint32_t id) {
   TrialRecord record;
   record.prepare(trajectory.learning_samples(), config.timing.ticks_per_sample, trajectory.joints());
   const int settle_ticks = static_cast<int>(std::lround(config.timing.settle_s / config.timing.tick_s));
@@ -143,8 +143,8 @@ TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEvery
     ASSERT_EQ(record.joint_count(), joints);
     rms.push_back(joint_rms_deg(record));
     const Eigen::MatrixXd errors = record.normalized_joint_errors();
-    std::cout << "arm2/paper2 iteration " << iteration << ": RMS per joint (deg) " << rms.back()
-              << ", overall " << std::sqrt(errors.squaredNorm() / static_cast<double>(errors.size())) * 180.0 << "\n";
+    std::cout << "arm2/paper2 iteration " << iteration << ": RMS per joint (deg) " << rms.back() << ", overall "
+              << std::sqrt(errors.squaredNorm() / static_cast<double>(errors.size())) * 180.0 << "\n";
     for (int j = 0; j < joints; ++j) {
       EXPECT_EQ(record.joint_samples(j).u_ilc_bar.head(n), u.col(j)) << "joint " << j + 1 << " got its own correction";
     }
@@ -165,7 +165,8 @@ TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEvery
   // at every iteration; after 5, each joint's error is below 0.3 of its feedback-only error
   // (measured 0.16 shoulder, 0.21 elbow).
   for (int j = 0; j < joints; ++j) {
-    for (int i = 1; i <= kIterations; ++i) EXPECT_LT(rms[i](j), rms[i - 1](j)) << "joint " << j + 1 << ", iteration " << i;
+    for (int i = 1; i <= kIterations; ++i)
+      EXPECT_LT(rms[i](j), rms[i - 1](j)) << "joint " << j + 1 << ", iteration " << i;
     EXPECT_LT(rms[kIterations](j), 0.3 * rms[0](j)) << "joint " << j + 1 << " learned";
   }
 }

@@ -36,7 +36,8 @@ Eigen::MatrixXd paper_rad(int joints) {
   reference.col(1) = elbow.joint(0);
   if (joints == 3) {
     std::vector<TrapezoidalMove> wrist_moves;
-    const double paper_moves[6][3] = {{0.6, 0, 30}, {1.6, 30, -30}, {2.6, -30, 30}, {3.6, 30, -30}, {4.6, -30, 30}, {5.6, 30, 0}};
+    const double paper_moves[6][3] = {{0.6, 0, 30},   {1.6, 30, -30}, {2.6, -30, 30},
+                                      {3.6, 30, -30}, {4.6, -30, 30}, {5.6, 30, 0}};
     for (const auto& m : paper_moves) wrist_moves.push_back({m[0] + 0.3, m[1], m[2]});
     reference.col(2) = trajectory_from_moves("wrist", 0.0, wrist_moves, 8.0, kSampleTime_s).joint(0);
   }
@@ -67,8 +68,11 @@ class ArmTrials {
     JointVector dp(J);
     for (int t = 0; t < samples(); ++t) {
       for (int i = 0; i < J; ++i) {
-        const double desired = reference_(t, i) / std::numbers::pi, measured = arm.state().angle_rad(i) / std::numbers::pi;
-        const double total = pids[static_cast<std::size_t>(i)].step(desired, measured, saturation[static_cast<std::size_t>(i)]) + u_ilc(t, i);
+        const double desired = reference_(t, i) / std::numbers::pi,
+                     measured = arm.state().angle_rad(i) / std::numbers::pi;
+        const double total =
+            pids[static_cast<std::size_t>(i)].step(desired, measured, saturation[static_cast<std::size_t>(i)]) +
+            u_ilc(t, i);
         dp(i) = std::clamp(total, -limit_bar, limit_bar);
         saturation[static_cast<std::size_t>(i)] = total > limit_bar ? 1 : (total < -limit_bar ? -1 : 0);
       }
@@ -89,7 +93,8 @@ using JointRms = Eigen::RowVectorXd;
 std::vector<JointRms> learn(const ArmTrials& trials, const MultiJointModel& model, int iterations) {
   const int J = trials.joints();
   MultiJointNoilc law;
-  EXPECT_EQ(law.setup(model, MultiJointWeights::uniform(IlcParameters{}, J), trials.samples()), MultiJointNoilcStatus::kOk);
+  EXPECT_EQ(law.setup(model, MultiJointWeights::uniform(IlcParameters{}, J), trials.samples()),
+            MultiJointNoilcStatus::kOk);
   Eigen::MatrixXd u = Eigen::MatrixXd::Zero(trials.samples(), J), next(trials.samples(), J);
   std::vector<JointRms> rms;
   for (int j = 0; j <= iterations; ++j) {

@@ -29,8 +29,8 @@ std::vector<IterationSummary> learn_on_the_arm(const char* preset, const char* j
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
   const Trajectory trajectory = library_trajectory("paper" + std::to_string(arm.joints()), config.timing.sample_s());
-  const auto learning = make_joint_learning(config, discretize_arm_model(config.model, config.timing.sample_s()), trajectory.joints(),
-                                            trajectory.learning_samples());
+  const auto learning = make_joint_learning(config, discretize_arm_model(config.model, config.timing.sample_s()),
+                                            trajectory.joints(), trajectory.learning_samples());
   LearningSession session(clock, *learning, trajectory, config.timing, config.controller);
   std::vector<IterationSummary> history;
   for (int i = 0; i <= iterations; ++i) {
@@ -76,7 +76,8 @@ TEST(MultiJointRun, EveryJointLearnsToAnEighthIn30IterationsAndStaysThereTo60) {
   print("arm2/paper2 independent", independent);
   EXPECT_EQ(independent[0].rms_deg, arm2[0].rms_deg) << "iteration 0 is feedback only, whatever the model";
   for (int i : {5, 10, 30}) {
-    EXPECT_LT(arm2[static_cast<std::size_t>(i)].rms_deg, independent[static_cast<std::size_t>(i)].rms_deg) << "iteration " << i;
+    EXPECT_LT(arm2[static_cast<std::size_t>(i)].rms_deg, independent[static_cast<std::size_t>(i)].rms_deg)
+        << "iteration " << i;
   }
 }
 

@@ -71,7 +71,8 @@ TEST(NoilcConstrained, UpdateIsTheBoundedOptimum) {
     dense.update(p.u_j, p.e_j, free);
     const double reach = 0.5 * free.cwiseAbs().maxCoeff();
     const Eigen::VectorXd lower = Eigen::VectorXd::Constant(samples, -reach);
-    const Eigen::VectorXd upper = Eigen::VectorXd::Constant(samples, reach).array() - 0.1 * reach * (Eigen::ArrayXd::LinSpaced(samples, 0.0, 1.0));
+    const Eigen::VectorXd upper = Eigen::VectorXd::Constant(samples, reach).array() -
+                                  0.1 * reach * (Eigen::ArrayXd::LinSpaced(samples, 0.0, 1.0));
     constrained.set_bounds(lower, upper);
     Eigen::VectorXd u(samples);
     constrained.update(p.u_j, p.e_j, u);
@@ -130,9 +131,9 @@ TEST(NoilcConstrained, LeavesOutTheErrorsAfterInputsOnTheLimit) {
   const double limit = 0.3;
   const Eigen::VectorXd feedback = Eigen::VectorXd::Zero(samples);
   Eigen::VectorXd u_j = p.u_j;
-  u_j(30) = limit;                     // the set point reached the limit at inputs 30 and 31
-  u_j(31) = -limit - 0.01;             // (beyond it: clamped in the trial)
-  u_j(100) = limit;                    // and at 100
+  u_j(30) = limit;          // the set point reached the limit at inputs 30 and 31
+  u_j(31) = -limit - 0.01;  // (beyond it: clamped in the trial)
+  u_j(100) = limit;         // and at 100
   NormOptimalConstrained constrained(paper_model(), parameters, samples);
   constrained.set_input_context(feedback, limit);
   Eigen::VectorXd actual(samples);
@@ -197,7 +198,8 @@ TEST(NoilcConstrained, LimitShapedErrorsAreZeroedNotUnweighted) {
   D.row(n - 1) = D.row(n - 2);
   const Eigen::MatrixXd H = P.transpose() * mask.asDiagonal() * P + parameters.s * Eigen::MatrixXd::Identity(n, n) +
                             parameters.w * D.transpose() * D;
-  const Eigen::VectorXd v = H.ldlt().solve(P.transpose() * mask.asDiagonal() * p.e_j - parameters.w * D.transpose() * D * u_j);
+  const Eigen::VectorXd v =
+      H.ldlt().solve(P.transpose() * mask.asDiagonal() * p.e_j - parameters.w * D.transpose() * D * u_j);
   const Eigen::VectorXd unweighted = u_j + v;
   EXPECT_GT((unweighted - actual).norm(), 0.05 * (actual - u_j).norm());
   // And the zero-weight optimum is what the dense form gives on the error with M zeroed there: a sanity
@@ -279,9 +281,11 @@ TEST(NoilcConstrainedOnThePaperScenario, NoWindupWhereTheUnconstrainedLawWindsUp
   // The correction has settled: its largest value over the last 50 trials is no larger than over the
   // 50 before (the unconstrained one grows by ~0.1 bar per 50 trials there).
   const auto largest_in = [](const std::vector<double>& v, std::size_t from, std::size_t to) {
-    return *std::max_element(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
+    return *std::max_element(v.begin() + static_cast<std::ptrdiff_t>(from),
+                             v.begin() + static_cast<std::ptrdiff_t>(to));
   };
-  EXPECT_LT(largest_in(constrained.max_correction_bar, 151, 201), largest_in(constrained.max_correction_bar, 101, 151) + 0.005);
+  EXPECT_LT(largest_in(constrained.max_correction_bar, 151, 201),
+            largest_in(constrained.max_correction_bar, 101, 151) + 0.005);
 
   // The paper's unconstrained update winds up, and the run says so.
   EXPECT_TRUE(free.windup.detected);

@@ -24,7 +24,8 @@ TEST(NormOptimalDense, UpdateZeroesTheCostGradientForRandomData) {
   const DiscreteArmModel model = discretize_arm_model(ModelParameters{}, 0.02);
   for (int trial = 0; trial < 12; ++trial) {
     const int n = 5 + trial * 17;
-    const IlcParameters weights = trial == 0 ? IlcParameters{} : IlcParameters{"noilc-dense", weight(rng), weight(rng), weight(rng) * 1e-4};
+    const IlcParameters weights =
+        trial == 0 ? IlcParameters{} : IlcParameters{"noilc-dense", weight(rng), weight(rng), weight(rng) * 1e-4};
     NormOptimalDense law(model, weights, n);
     Eigen::VectorXd u(n), e(n), next(n);
     for (int i = 0; i < n; ++i) {

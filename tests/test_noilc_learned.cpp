@@ -34,8 +34,10 @@ Eigen::VectorXd random_vector(int n, double sigma, unsigned seed) {
 
 std::complex<double> symbol(const StateSpaceModel& m, double theta) {
   const std::complex<double> z = std::polar(1.0, theta);
-  const Eigen::MatrixXcd resolvent = z * Eigen::MatrixXcd::Identity(m.states(), m.states()) - m.A.cast<std::complex<double>>();
-  const Eigen::MatrixXcd G = m.C.cast<std::complex<double>>() * resolvent.partialPivLu().solve(m.B.cast<std::complex<double>>());
+  const Eigen::MatrixXcd resolvent =
+      z * Eigen::MatrixXcd::Identity(m.states(), m.states()) - m.A.cast<std::complex<double>>();
+  const Eigen::MatrixXcd G =
+      m.C.cast<std::complex<double>>() * resolvent.partialPivLu().solve(m.B.cast<std::complex<double>>());
   return G(0, 0);
 }
 
@@ -85,7 +87,8 @@ TEST(ClosedLoopModel, IsTheArmBehindThePressureLagInsideThePid) {
   for (const double theta : {0.01, 0.1, 0.5, 1.0, 2.0, 3.1}) {
     const std::complex<double> z = std::polar(1.0, theta), zi = 1.0 / z;
     const std::complex<double> G = symbol(plant, theta);  // u(t) -> y(t), one step of delay
-    const std::complex<double> pid = prior.pid.k_p + prior.pid.k_i_per_s * T / (1.0 - zi) + prior.pid.k_d_s * (1.0 - zi) / T;
+    const std::complex<double> pid =
+        prior.pid.k_p + prior.pid.k_i_per_s * T / (1.0 - zi) + prior.pid.k_d_s * (1.0 - zi) / T;
     const std::complex<double> expected = G / (1.0 + G * pid);
     EXPECT_LT(std::abs(symbol(closed, theta) - expected), 1e-9 * std::abs(expected)) << "theta " << theta;
   }
@@ -230,7 +233,8 @@ TEST(NoilcLearned, DoesNotLearnFromHeldOrLimitShapedOutputs) {
   limited.update(Eigen::MatrixXd::Zero(n, 1), reference, u_next);
   limited.set_input_context(Eigen::MatrixXd::Zero(n, 1), 1.0);
   limited.update(u_next, reference - plant.simulate(u_next), u);
-  EXPECT_EQ(limited.last_report().left_out, static_cast<int>(std::lround(LearnedNoilcSettings{}.limit_recovery_s / prior.sample_time_s)));
+  EXPECT_EQ(limited.last_report().left_out,
+            static_cast<int>(std::lround(LearnedNoilcSettings{}.limit_recovery_s / prior.sample_time_s)));
 }
 
 // The law on the simulated arm across the faults bellows ships and the [plant] parameters a user sets,
@@ -244,7 +248,8 @@ struct SweepCase {
 
 TEST(NoilcLearnedScenario, NeverDivergesOnTheShippedFaultsAndThePlantRanges) {
   std::vector<SweepCase> cases;
-  for (const char* fault : {"none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike", "swapped-chambers", "dead-inlet"}) {
+  for (const char* fault : {"none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike",
+                            "swapped-chambers", "dead-inlet"}) {
     cases.push_back({std::string("fault ") + fault, [fault](Configuration& c) {
                        c.plant.fault = fault;
                        c.plant.fault_at_s = 0.0;  // from the start: every trial, the first one (feedback alone) too
@@ -252,7 +257,8 @@ TEST(NoilcLearnedScenario, NeverDivergesOnTheShippedFaultsAndThePlantRanges) {
   }
   const auto scale = [&](const char* key, double PlantParameters::*field) {
     for (const double factor : {0.5, 2.0}) {
-      cases.push_back({std::string(key) + " x" + std::to_string(factor), [field, factor](Configuration& c) { c.plant.*field *= factor; }});
+      cases.push_back({std::string(key) + " x" + std::to_string(factor),
+                       [field, factor](Configuration& c) { c.plant.*field *= factor; }});
     }
   };
   scale("kappa", &PlantParameters::kappa_rad_per_bar);
@@ -272,7 +278,8 @@ TEST(NoilcLearnedScenario, NeverDivergesOnTheShippedFaultsAndThePlantRanges) {
     config.ilc.law = "noilc-learned";
     sweep.apply(config);
     const Trajectory trajectory = library_trajectory("sine", config.timing.sample_s());
-    const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()), trajectory.learning_samples());
+    const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()),
+                                       trajectory.learning_samples());
     SimulatedArm arm(config.plant, 1);
     EngineCore core(arm, config.controller, config.timing, config.safety);
     SimulatedClock clock(core, arm);
@@ -297,12 +304,13 @@ TEST(NoilcLearnedScenario, NeverDivergesOnTheShippedFaultsAndThePlantRanges) {
   }
 }
 
-
 // RMS (deg) of iterations 0..updates of `law` on `trajectory` with the simulated arm of `config`, seed 1.
-std::vector<double> learning_curve(Configuration config, const std::string& law_name, const std::string& trajectory_name, int updates) {
+std::vector<double> learning_curve(Configuration config, const std::string& law_name,
+                                   const std::string& trajectory_name, int updates) {
   config.ilc.law = law_name;
   const Trajectory trajectory = library_trajectory(trajectory_name, config.timing.sample_s());
-  const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()), trajectory.learning_samples());
+  const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()),
+                                     trajectory.learning_samples());
   SimulatedArm arm(config.plant, 1);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
@@ -330,7 +338,11 @@ TEST(NoilcLearnedScenario, HeldBackArmsLearnFasterThanThePapersLawAndNeverDiverg
   };
   const std::vector<HeldBack> arms{
       {"heavier", [](PlantParameters& p) { p.omega0_rad_per_s /= std::sqrt(2.0); }},
-      {"stiffer", [](PlantParameters& p) { p.kappa_rad_per_bar /= 2.0; p.omega0_rad_per_s *= std::sqrt(2.0); }},
+      {"stiffer",
+       [](PlantParameters& p) {
+         p.kappa_rad_per_bar /= 2.0;
+         p.omega0_rad_per_s *= std::sqrt(2.0);
+       }},
       {"slower valves", [](PlantParameters& p) { p.valve_conductance_m3_per_sPa /= 2.0; }},
   };
   constexpr int kUpdates = 30;

@@ -33,8 +33,8 @@ struct TrialData {
 
 /// Solves with both forms on three random trials and compares; also checks that the dense answer is
 /// the optimum (its cost gradient vanishes), so the comparison is against the true minimizer.
-void expect_riccati_equals_dense(const MultiJointModel& model, const MultiJointWeights& weights, int samples, double rho,
-                                 Random& random) {
+void expect_riccati_equals_dense(const MultiJointModel& model, const MultiJointWeights& weights, int samples,
+                                 double rho, Random& random) {
   const int J = model.joints();
   MultiJointNoilc riccati;
   ASSERT_EQ(riccati.setup(model, weights, samples, rho), MultiJointNoilcStatus::kOk);
@@ -69,7 +69,8 @@ TEST(NoilcMimo, OneJointEqualsTheSingleJointLaws) {
     single.update(data.u_j.col(0), data.e_j.col(0), expected);
     single_dense.update(data.u_j.col(0), data.e_j.col(0), expected_dense);
     EXPECT_LT(relative_difference(actual.col(0), expected), 1e-12) << "N = " << samples;
-    EXPECT_LT(relative_difference(mimo_dense.update(data.u_j, data.e_j).col(0), expected_dense), 1e-12) << "N = " << samples;
+    EXPECT_LT(relative_difference(mimo_dense.update(data.u_j, data.e_j).col(0), expected_dense), 1e-12)
+        << "N = " << samples;
   }
 }
 
@@ -193,7 +194,8 @@ TEST(NoilcMimo, SetupReportsEveryBadInput) {
   nothing.w.setZero();
   EXPECT_EQ(law.setup(good, nothing, 100), MultiJointNoilcStatus::kNotPositiveDefinite);
   EXPECT_EQ(law.info().status, MultiJointNoilcStatus::kNotPositiveDefinite);
-  EXPECT_STREQ(to_string(MultiJointNoilcStatus::kNotPositiveDefinite), "the weights do not give a positive definite cost");
+  EXPECT_STREQ(to_string(MultiJointNoilcStatus::kNotPositiveDefinite),
+               "the weights do not give a positive definite cost");
 
   Eigen::MatrixXd u(100, 2), out(100, 2);
   u.setZero();
@@ -205,8 +207,9 @@ TEST(NoilcMimo, SolveRefusesBadDataAndLeavesTheOutputAlone) {
   Random random(47);
   constexpr int kSamples = 80;
   MultiJointNoilc law;
-  ASSERT_EQ(law.setup(random_coupled_model(3, 0.9, random), MultiJointWeights::uniform(IlcParameters{}, 3), kSamples, 0.5),
-            MultiJointNoilcStatus::kOk);
+  ASSERT_EQ(
+      law.setup(random_coupled_model(3, 0.9, random), MultiJointWeights::uniform(IlcParameters{}, 3), kSamples, 0.5),
+      MultiJointNoilcStatus::kOk);
   const TrialData data(kSamples, 3, random);
   Eigen::MatrixXd out = Eigen::MatrixXd::Constant(kSamples, 3, 7.0);
   const Eigen::MatrixXd untouched = out;
@@ -214,7 +217,8 @@ TEST(NoilcMimo, SolveRefusesBadDataAndLeavesTheOutputAlone) {
   Eigen::MatrixXd two_joints = data.u_j.leftCols(2);
   EXPECT_EQ(law.solve(short_trial, data.e_j, data.target, out), MultiJointNoilcStatus::kShapeMismatch);
   EXPECT_EQ(law.solve(data.u_j, two_joints, data.target, out), MultiJointNoilcStatus::kShapeMismatch);
-  EXPECT_EQ(law.solve(data.u_j, data.e_j, short_trial, out), MultiJointNoilcStatus::kShapeMismatch);  // rho > 0 reads it
+  EXPECT_EQ(law.solve(data.u_j, data.e_j, short_trial, out),
+            MultiJointNoilcStatus::kShapeMismatch);  // rho > 0 reads it
   Eigen::MatrixXd with_nan = data.e_j;
   with_nan(40, 2) = std::nan("");
   EXPECT_EQ(law.solve(data.u_j, with_nan, data.target, out), MultiJointNoilcStatus::kNonFiniteData);

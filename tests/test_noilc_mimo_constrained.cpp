@@ -84,8 +84,9 @@ TEST(NoilcMimoConstrained, OneJointIsTheSingleJointBoundedLaw) {
   NormOptimalConstrained single(arm, parameters, kSamples);
   MultiJointNoilcConstrained law;
   MultiJointAdmmSettings admm{parameters.admm_rho, parameters.admm_max_iterations, parameters.admm_tolerance};
-  ASSERT_EQ(law.setup(block_diagonal_model(std::span(&arm, 1)), MultiJointWeights::uniform(parameters, 1), kSamples, admm),
-            MultiJointNoilcStatus::kOk);
+  ASSERT_EQ(
+      law.setup(block_diagonal_model(std::span(&arm, 1)), MultiJointWeights::uniform(parameters, 1), kSamples, admm),
+      MultiJointNoilcStatus::kOk);
   Random random(73);
   const Eigen::MatrixXd u_j = random.matrix(kSamples, 1, 0.05), e_j = random.matrix(kSamples, 1, 0.5);
   const Eigen::MatrixXd lower = Eigen::MatrixXd::Constant(kSamples, 1, -0.05) - random.matrix(kSamples, 1, 0.01);
@@ -115,7 +116,8 @@ TEST(NoilcMimoConstrained, LooseBoundsGiveTheUnconstrainedOptimum) {
   ASSERT_EQ(free.update(u_j, e_j, expected), MultiJointNoilcStatus::kOk);
   ASSERT_EQ(bounded.solve(u_j, e_j, actual), MultiJointNoilcStatus::kOk);  // no bounds set: infinite
   EXPECT_EQ(actual, expected);
-  ASSERT_EQ(bounded.set_bounds(Eigen::MatrixXd::Constant(kSamples, kJoints, -10.0), Eigen::MatrixXd::Constant(kSamples, kJoints, 10.0)),
+  ASSERT_EQ(bounded.set_bounds(Eigen::MatrixXd::Constant(kSamples, kJoints, -10.0),
+                               Eigen::MatrixXd::Constant(kSamples, kJoints, 10.0)),
             MultiJointNoilcStatus::kOk);
   ASSERT_EQ(bounded.solve(u_j, e_j, actual), MultiJointNoilcStatus::kOk);
   EXPECT_EQ(actual, expected);

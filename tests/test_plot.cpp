@@ -44,13 +44,16 @@ TEST_F(Plot, TheFiguresHaveTheExpectedSeriesAndData) {
   request.paper_rms = std::vector<std::pair<double, double>>{{0, 12.6}, {1, 9.5}};
   const std::vector<Figure> figures = session_figures(session_, request);
   ASSERT_EQ(figures.size(), 5u);
-  EXPECT_EQ(named(figures, "rms").series, (std::vector<std::string>{"bellows: s", "paper", "iterations shown in time"}));
+  EXPECT_EQ(named(figures, "rms").series,
+            (std::vector<std::string>{"bellows: s", "paper", "iterations shown in time"}));
   EXPECT_EQ(named(figures, "angle").series, (std::vector<std::string>{"set point", "iteration 0", "iteration 3"}));
   EXPECT_EQ(named(figures, "error").series, (std::vector<std::string>{"iteration 0", "iteration 3"}));
   EXPECT_EQ(named(figures, "u_ilc").series, (std::vector<std::string>{"iteration 0", "iteration 3"}));
-  EXPECT_EQ(named(figures, "pressures").series, (std::vector<std::string>{"A measured", "A set point", "B measured", "B set point"}));
+  EXPECT_EQ(named(figures, "pressures").series,
+            (std::vector<std::string>{"A measured", "A set point", "B measured", "B set point"}));
   // The supply, far above the chambers' pressures, is named in the legend's title, not drawn.
-  EXPECT_NE(named(figures, "pressures").plot.find("title 'chambers (supply "), std::string::npos) << named(figures, "pressures").plot;
+  EXPECT_NE(named(figures, "pressures").plot.find("title 'chambers (supply "), std::string::npos)
+      << named(figures, "pressures").plot;
   EXPECT_NE(named(figures, "rms").plot.find("set logscale y"), std::string::npos);
   EXPECT_NE(named(figures, "pressures").plot.find("Pressures, iteration 2"), std::string::npos);
   // The RMS data block holds the manifest's values, one row per iteration.
@@ -76,8 +79,10 @@ TEST_F(Plot, DefaultsToFirstSecondMiddleAndLastIteration) {
   EXPECT_EQ(default_plot_iterations(2), (std::vector<int>{0, 1}));
   EXPECT_EQ(default_plot_iterations(31), (std::vector<int>{0, 1, 15, 30}));
   const std::vector<Figure> figures = session_figures(session_, FigureRequest{});
-  EXPECT_EQ(named(figures, "u_ilc").series, (std::vector<std::string>{"iteration 0", "iteration 1", "iteration 2", "iteration 3"}));
-  EXPECT_EQ(named(figures, "rms").series, (std::vector<std::string>{"bellows: s", "iterations shown in time"}));  // no overlay unless asked
+  EXPECT_EQ(named(figures, "u_ilc").series,
+            (std::vector<std::string>{"iteration 0", "iteration 1", "iteration 2", "iteration 3"}));
+  EXPECT_EQ(named(figures, "rms").series,
+            (std::vector<std::string>{"bellows: s", "iterations shown in time"}));  // no overlay unless asked
 }
 
 TEST_F(Plot, RefusesIterationsAndFormatsTheSessionCannotGive) {
@@ -94,9 +99,9 @@ TEST_F(Plot, RefusesIterationsAndFormatsTheSessionCannotGive) {
 
 TEST_F(Plot, GnuplotDrawsEveryFigureInEveryFormat) {
   testing::write_text(dir_ / "paper.csv", "iteration,rms_deg\n0,12.6\n1,9.5\n2,7.4\n");
-  const ProcessResult result = run_bellows({"sessions", "plot", (dir_ / "s").string(), "--output", (dir_ / "figs").string(),
-                                            "--formats", "png,svg,pdf", "--paper", (dir_ / "paper.csv").string(),
-                                            "--iterations", "0,3", "--json"});
+  const ProcessResult result =
+      run_bellows({"sessions", "plot", (dir_ / "s").string(), "--output", (dir_ / "figs").string(), "--formats",
+                   "png,svg,pdf", "--paper", (dir_ / "paper.csv").string(), "--iterations", "0,3", "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json report = nlohmann::json::parse(result.out);
   EXPECT_EQ(report["files"].size(), 1u + 5u * 3u);  // the script, then 5 figures x 3 formats
@@ -125,19 +130,25 @@ TEST_F(Plot, GnuplotDrawsEveryFigureInEveryFormat) {
   EXPECT_NE(error.find(">iteration 3<"), std::string::npos);
 
   // Again: the figures exist, so nothing is replaced without --force.
-  const ProcessResult again = run_bellows({"sessions", "plot", (dir_ / "s").string(), "--output", (dir_ / "figs").string()});
+  const ProcessResult again =
+      run_bellows({"sessions", "plot", (dir_ / "s").string(), "--output", (dir_ / "figs").string()});
   EXPECT_EQ(again.exit_code, 2);
-  EXPECT_EQ(again.err, "bellows: " + (dir_ / "figs" / "figures.gp").string() + " exists already (--force replaces it)\n");
+  EXPECT_EQ(again.err,
+            "bellows: " + (dir_ / "figs" / "figures.gp").string() + " exists already (--force replaces it)\n");
   const ProcessResult forced =
       run_bellows({"sessions", "plot", (dir_ / "s").string(), "--output", (dir_ / "figs").string(), "--force"});
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
 }
 
 TEST_F(Plot, OneLineForABadRequest) {
-  for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"--iterations", "0,12"}, {"--trial", "7"}, {"--output", (dir_ / "s" / "figs").string()},
-        {"--output", (dir_ / "no" / "figs").string()}, {"--paper", (dir_ / "missing.csv").string()},
-        {"--formats", "gif"}, {"--style", "poster"}, {"--paper", (dir_ / "s" / "manifest.json").string()}}) {
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--iterations", "0,12"},
+                                               {"--trial", "7"},
+                                               {"--output", (dir_ / "s" / "figs").string()},
+                                               {"--output", (dir_ / "no" / "figs").string()},
+                                               {"--paper", (dir_ / "missing.csv").string()},
+                                               {"--formats", "gif"},
+                                               {"--style", "poster"},
+                                               {"--paper", (dir_ / "s" / "manifest.json").string()}}) {
     std::vector<std::string> command = {"sessions", "plot", (dir_ / "s").string()};
     command.insert(command.end(), args.begin(), args.end());
     const ProcessResult result = run_bellows(command);
@@ -177,9 +188,11 @@ TEST_F(Plot, OneColourPerIterationInEveryFigureAndTheSetPointOnTop) {
   other.iterations = {0, 1};
   EXPECT_EQ(colour_of(named(session_figures(session_, other), "angle"), "$iteration_0 using "), iteration_colour(0));
   EXPECT_EQ(colour_of(named(figures, "angle"), "$iteration_0 using "), iteration_colour(0));
-  EXPECT_NE(named(figures, "rms").data.find("\n0 " ), std::string::npos);
+  EXPECT_NE(named(figures, "rms").data.find("\n0 "), std::string::npos);
   const std::string marks = named(figures, "rms").data.substr(named(figures, "rms").data.find("$rms_drawn"));
-  EXPECT_NE(marks.find(" " + std::to_string(std::stoi(iteration_colour(0).substr(1), nullptr, 16)) + "\n"), std::string::npos) << marks;
+  EXPECT_NE(marks.find(" " + std::to_string(std::stoi(iteration_colour(0).substr(1), nullptr, 16)) + "\n"),
+            std::string::npos)
+      << marks;
   // Enough contrast on white: no palette colour is lighter than 3:1 (WCAG's floor for graphics).
   for (int i = 0; i < iteration_colours(); ++i) {
     const int rgb = std::stoi(iteration_colour(i).substr(1), nullptr, 16);
@@ -209,7 +222,8 @@ std::pair<double, double> range_of(const std::string& plot, const std::string& a
 TEST_F(Plot, RangesFitTheDataAndLegendsSitInsideTheAxes) {
   const std::vector<Figure> figures = session_figures(session_, FigureRequest{});
   double low = 1e9, high = 0.0;
-  for (const IterationEntry& e : session_.manifest.iterations) low = std::min(low, e.summary.rms_deg), high = std::max(high, e.summary.rms_deg);
+  for (const IterationEntry& e : session_.manifest.iterations)
+    low = std::min(low, e.summary.rms_deg), high = std::max(high, e.summary.rms_deg);
   const auto [rms_low, rms_high] = range_of(named(figures, "rms").plot, "y");
   EXPECT_LE(rms_low, low);
   EXPECT_GT(rms_low, low * 0.8) << "not a decade below the data";
@@ -219,7 +233,8 @@ TEST_F(Plot, RangesFitTheDataAndLegendsSitInsideTheAxes) {
   // Pressures: the axis spans the chambers, not the supply far above them.
   const TrialTicks& t = session_.iterations.back().record.joint_ticks(0);
   const double p_low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
-  const double p_high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(), t.setpoint_b_bar.maxCoeff()});
+  const double p_high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(),
+                                  t.setpoint_b_bar.maxCoeff()});
   const auto [y_low, y_high] = range_of(named(figures, "pressures").plot, "y");
   EXPECT_LE(y_low, p_low);
   EXPECT_GE(y_high, p_high);
@@ -235,14 +250,17 @@ TEST_F(Plot, RangesFitTheDataAndLegendsSitInsideTheAxes) {
 TEST_F(Plot, PaperStylesHaveThePapersSizesAndNoTitles) {
   EXPECT_THROW(figure_style("poster"), InputError);
   const FigureStyle column = figure_style("paper-column");
-  EXPECT_EQ(figure_terminal(column, "pdf").find("set terminal pdfcairo size 3.5in,2.45in"), 0u) << figure_terminal(column, "pdf");
-  EXPECT_EQ(figure_terminal(column, "png").find("set terminal pngcairo size 1050,735"), 0u) << figure_terminal(column, "png");
+  EXPECT_EQ(figure_terminal(column, "pdf").find("set terminal pdfcairo size 3.5in,2.45in"), 0u)
+      << figure_terminal(column, "pdf");
+  EXPECT_EQ(figure_terminal(column, "png").find("set terminal pngcairo size 1050,735"), 0u)
+      << figure_terminal(column, "png");
   EXPECT_EQ(figure_terminal(figure_style("paper-wide"), "pdf").find("set terminal pdfcairo size 7.16in,"), 0u);
   EXPECT_NE(figure_terminal(figure_style("screen"), "svg").find("set terminal svg size 720,450"), std::string::npos);
   FigureRequest request;
   request.style = "paper-column";
   const std::vector<Figure> figures = session_figures(session_, request);
-  for (const Figure& f : figures) EXPECT_EQ(f.plot.find("set title"), std::string::npos) << f.name;  // the caption's job
+  for (const Figure& f : figures)
+    EXPECT_EQ(f.plot.find("set title"), std::string::npos) << f.name;  // the caption's job
   EXPECT_NE(gnuplot_script(figures, {"pdf"}, "paper-column").find("pdfcairo size 3.5in"), std::string::npos);
   EXPECT_NE(session_figures(session_, FigureRequest{})[1].plot.find("set title"), std::string::npos);  // screen: titled
 }
@@ -263,7 +281,8 @@ TEST_F(Plot, ThePapersCurveIsNamedOrItsAbsenceSaid) {
   if (fs::is_regular_file(default_paper_rms_path())) {
     EXPECT_EQ(found.note, "paper's RMS curve from " + default_paper_rms_path().string());
   } else {
-    EXPECT_EQ(found.note, "paper's RMS curve: not overlaid, " + default_paper_rms_path().string() + " is not there (--paper FILE gives one)");
+    EXPECT_EQ(found.note, "paper's RMS curve: not overlaid, " + default_paper_rms_path().string() +
+                              " is not there (--paper FILE gives one)");
     EXPECT_FALSE(none.paper_rms);
   }
 }
@@ -280,7 +299,8 @@ TEST_F(Plot, AFewIterationsOfALongSessionAreRead) {
   EXPECT_EQ(session_figures(part, request).size(), 5u);
   const Session first_two = read_figure_session(dir_ / "s", FigureRequest{}, 2);
   EXPECT_EQ(first_two.manifest.iterations.size(), 2u);
-  EXPECT_NE(named(session_figures(first_two, FigureRequest{}), "pressures").plot.find("Pressures, iteration 1:"), std::string::npos);
+  EXPECT_NE(named(session_figures(first_two, FigureRequest{}), "pressures").plot.find("Pressures, iteration 1:"),
+            std::string::npos);
 }
 
 TEST(PlotPaper, TheSharedCurveIsReadWhenPresent) {

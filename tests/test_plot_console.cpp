@@ -36,7 +36,8 @@ class PlotConsole : public ::testing::Test {
   std::function<std::string(const std::string&, int)> writer(StoreSessionGateway& gateway) {
     return [this, &gateway](const std::string& location, int iterations) {
       ++calls_;
-      return write_console_figures(location, iterations, root_, [&gateway](const std::function<void()>& read) { gateway.read_quietly(read); });
+      return write_console_figures(location, iterations, root_,
+                                   [&gateway](const std::function<void()>& read) { gateway.read_quietly(read); });
     };
   }
   std::vector<fs::path> folders() const {
@@ -93,7 +94,8 @@ TEST_F(PlotConsole, TheFigureKeyWritesFiguresWhileTheBatchGoesOn) {
   ASSERT_EQ(written.size(), 1u);
   // Named after the saved session and the iterations it had when the key was pressed (the first).
   EXPECT_EQ(written[0].filename().string(), session + "_iteration_0000") << written[0];
-  for (const std::string name : {"rms.png", "rms.svg", "angle.svg", "error.png", "u_ilc.png", "pressures.svg", "figures.gp"}) {
+  for (const std::string name :
+       {"rms.png", "rms.svg", "angle.svg", "error.png", "u_ilc.png", "pressures.svg", "figures.gp"}) {
     EXPECT_GT(fs::file_size(written[0] / name), 0u) << name;
   }
   EXPECT_EQ(block_rows(testing::read_text(written[0] / "figures.gp"), "rms"), 1);
@@ -159,7 +161,9 @@ TEST_F(PlotConsole, AReopenedSessionsFiguresHoldEveryIteration) {
 
 TEST_F(PlotConsole, WithoutASavedSessionThereAreNoFigures) {
   EXPECT_THROW(write_console_figures("", 0, "/tmp", [](const std::function<void()>& read) { read(); }), InputError);
-  EXPECT_THROW(write_console_figures((dir_ / "none").string(), 3, root_, [](const std::function<void()>& read) { read(); }), InputError);
+  EXPECT_THROW(
+      write_console_figures((dir_ / "none").string(), 3, root_, [](const std::function<void()>& read) { read(); }),
+      InputError);
 }
 
 }  // namespace

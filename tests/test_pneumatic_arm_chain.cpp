@@ -66,7 +66,8 @@ TEST(PneumaticArmChain, OneJointWithoutGravityIsTheSingleJointSimulatedArm) {
     ASSERT_EQ(a.time_s, b.time_s);
     ASSERT_EQ(a.supply_bar, b.supply_bar);  // the same noise, drawn in the same order
     for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.joint[0].chamber_bar[c], b.chamber_bar[0][c], 1e-9) << "tick " << tick;
-    if (a.joint[0].angle_rad != b.angle_rad(0)) ++readings_differing;  // at most where the angle sits on a quantization edge
+    if (a.joint[0].angle_rad != b.angle_rad(0))
+      ++readings_differing;  // at most where the angle sits on a quantization edge
     EXPECT_NEAR(a.joint[0].angle_rad, b.angle_rad(0), 0.1 * std::numbers::pi / 180.0 + 1e-12);
     const SimulatedArm::State s = single.state();
     const PneumaticArmChain::State t = chain.state();
@@ -75,7 +76,8 @@ TEST(PneumaticArmChain, OneJointWithoutGravityIsTheSingleJointSimulatedArm) {
     ASSERT_NEAR(s.creep_rad, t.creep_rad(0), 1e-10);
     for (int c = 0; c < 2; ++c) ASSERT_NEAR(s.chamber_Pa[c], t.chamber_Pa[0][c], 1e-4) << "tick " << tick;
     largest_angle = std::max(largest_angle, std::abs(s.angle_rad));
-    largest_pressure_difference_bar = std::max(largest_pressure_difference_bar, std::abs(s.chamber_Pa[0] - s.chamber_Pa[1]) / 1e5);
+    largest_pressure_difference_bar =
+        std::max(largest_pressure_difference_bar, std::abs(s.chamber_Pa[0] - s.chamber_Pa[1]) / 1e5);
     const BellowsDuties d = drive(0, a.time_s);
     ValveCommand command;
     command.joint[0].inlet_duty = d.inlet;
@@ -152,7 +154,8 @@ TEST(PneumaticArmChain, ClosedValvesKeepEachJointsAirWhileTheChainSwingsAndItsVo
   for (int tick = 0; tick < 200; ++tick) {  // 1 s: the arm falls and swings, coupled
     arm.advance(kTick_s);
     largest_swing = std::max(largest_swing, arm.state().angle_rad.cwiseAbs().maxCoeff());
-    for (int i = 0; i < 3; ++i) ASSERT_NEAR(arm.air_mass_kg(i) / mass[static_cast<std::size_t>(i)], 1.0, 1e-9) << "joint " << i + 1;
+    for (int i = 0; i < 3; ++i)
+      ASSERT_NEAR(arm.air_mass_kg(i) / mass[static_cast<std::size_t>(i)], 1.0, 1e-9) << "joint " << i + 1;
     arm.write_valves(closed);
   }
   EXPECT_GT(largest_swing, 0.1);
@@ -164,7 +167,8 @@ TEST(PneumaticArmChain, ClosedValvesKeepEachJointsAirWhileTheChainSwingsAndItsVo
     EXPECT_NEAR(arm.chamber_volume_m3(i, 1), v0 * (1.0 - 0.35 * q), 1e-15);
     // the gas law with the joint's own volumes: p V constant for closed chambers
     EXPECT_NEAR(end.chamber_Pa[static_cast<std::size_t>(i)][0] * arm.chamber_volume_m3(i, 0),
-                s.chamber_Pa[static_cast<std::size_t>(i)][0] * v0, 1e-9 * s.chamber_Pa[static_cast<std::size_t>(i)][0] * v0);
+                s.chamber_Pa[static_cast<std::size_t>(i)][0] * v0,
+                1e-9 * s.chamber_Pa[static_cast<std::size_t>(i)][0] * v0);
   }
 }
 
@@ -176,7 +180,8 @@ TEST(PneumaticArmChain, GravityPullsTheVentedArmDownAndHoldingPressuresHoldIt) {
   PneumaticArmChain held(pneumatic_chain_preset("arm2"), 1);
   PneumaticArmChain::State s = held.state();
   const JointVector hold = held.mechanics().holding_pressure_bar(JointVector::Zero(2));
-  for (int i = 0; i < 2; ++i) s.chamber_Pa[static_cast<std::size_t>(i)] = {1.2e5 + 0.5e5 * hold(i), 1.2e5 - 0.5e5 * hold(i)};
+  for (int i = 0; i < 2; ++i)
+    s.chamber_Pa[static_cast<std::size_t>(i)] = {1.2e5 + 0.5e5 * hold(i), 1.2e5 - 0.5e5 * hold(i)};
   held.set_state(s);
   std::vector<BellowsDuties> closed(2);
   held.write_valves(closed);
@@ -209,7 +214,7 @@ TEST(PneumaticArmChain, CommandsAreClampedAndMisSizedOnesRefused) {
   const PneumaticArmChain::State state = arm.state();  // by value: a reference into the temporary would dangle
   const BellowsDuties& applied = state.duties[0];
   EXPECT_EQ(applied.inlet[0], 1.0);
-  EXPECT_EQ(applied.inlet[1], 0.0);   // a non-finite inlet duty closes it
+  EXPECT_EQ(applied.inlet[1], 0.0);  // a non-finite inlet duty closes it
   EXPECT_EQ(applied.outlet[0], 0.0);
   EXPECT_EQ(applied.outlet[1], 1.0);  // a non-finite outlet duty opens it
   std::vector<BellowsDuties> three(3);

@@ -17,17 +17,23 @@ TEST(PrintableText, EscapesEveryControl) {
   EXPECT_EQ(printable("a\x1b]0;title\x07z"), "a\\e]0;title\\x07z");
   EXPECT_EQ(printable("line\nnext\r\ttab\x7f"), "line\\nnext\\r\\ttab\\x7f");
   EXPECT_EQ(printable(std::string("nul\0x", 5)), "nul\\x00x");
-  EXPECT_EQ(printable("\xc2\x9b" "31m"), "\\u{009b}31m");           // C1 CSI as UTF-8
-  EXPECT_EQ(printable("abc\xe2\x80\xae" "cba"), "abc\\u{202e}cba");  // right-to-left override
-  EXPECT_EQ(printable("\xef\xbb\xbf" "time_s"), "\\u{feff}time_s");  // a byte order mark, made visible
+  EXPECT_EQ(printable("\xc2\x9b"
+                      "31m"),
+            "\\u{009b}31m");  // C1 CSI as UTF-8
+  EXPECT_EQ(printable("abc\xe2\x80\xae"
+                      "cba"),
+            "abc\\u{202e}cba");  // right-to-left override
+  EXPECT_EQ(printable("\xef\xbb\xbf"
+                      "time_s"),
+            "\\u{feff}time_s");  // a byte order mark, made visible
 }
 
 TEST(PrintableText, EscapesInvalidUtf8ByteByByte) {
   EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");
-  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");              // overlong '/'
-  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");     // a surrogate
-  EXPECT_EQ(printable("cut \xe2\x82"), "cut \\xe2\\x82");      // a sequence cut short
-  EXPECT_EQ(printable("\x9b[2J"), "\\x9b[2J");                 // a raw 8-bit CSI
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");           // overlong '/'
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");  // a surrogate
+  EXPECT_EQ(printable("cut \xe2\x82"), "cut \\xe2\\x82");   // a sequence cut short
+  EXPECT_EQ(printable("\x9b[2J"), "\\x9b[2J");              // a raw 8-bit CSI
 }
 
 TEST(PrintableText, ShortensLongTextAtACharacter) {

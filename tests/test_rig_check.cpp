@@ -32,7 +32,8 @@ Configuration with_fault(const std::string& fault) {
 
 ValveTestReport check(const Configuration& c) {
   EngineFixture f(c);
-  ValveTestReport report = run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+  ValveTestReport report =
+      run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
   EXPECT_EQ(f.core.state(), EngineState::kSafe) << "the test ends disarmed (vented)";
   return report;
 }
@@ -82,7 +83,8 @@ TEST(ValveTest, ADeadInletIsNamedAndTheOthersPass) {
 
 TEST(ValveTest, NoSupplyIsNamedAndNothingIsArmed) {
   EngineFixture f(with_fault("supply-loss"));
-  const ValveTestReport r = run_valve_test(f.clock, f.config.rig_check, f.config.safety, f.config.controller.gas.ambient_bar, f.config.model.volume_gain_per_rad);
+  const ValveTestReport r = run_valve_test(f.clock, f.config.rig_check, f.config.safety,
+                                           f.config.controller.gas.ambient_bar, f.config.model.volume_gain_per_rad);
   ASSERT_TRUE(r.finished);
   for (const ValveVerdict& v : r.valves) EXPECT_FALSE(v.pass);
   EXPECT_NE(verdict(r, ValveId::kInletA).problem.find("no supply"), std::string::npos);
@@ -98,7 +100,8 @@ TEST(ValveTest, AGuardStillVentsDuringAPulse) {
   Configuration c;
   c.rig_check.valve_pulse_s = 3.0;
   EngineFixture f(c);
-  const ValveTestReport r = run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+  const ValveTestReport r =
+      run_valve_test(f.clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
   ASSERT_TRUE(r.finished);
   EXPECT_NE(r.aborted.find("the engine vented"), std::string::npos) << r.aborted;
   EXPECT_EQ(f.core.state(), EngineState::kFault);
@@ -109,7 +112,9 @@ TEST(ValveTest, AGuardStillVentsDuringAPulse) {
 TEST(ValveTest, TheEmergencyStopEndsTheTest) {
   EngineFixture f;
   std::atomic<bool> stop{true};
-  const ValveTestReport r = run_valve_test(f.clock, f.config.rig_check, f.config.safety, f.config.controller.gas.ambient_bar, f.config.model.volume_gain_per_rad, &stop);
+  const ValveTestReport r =
+      run_valve_test(f.clock, f.config.rig_check, f.config.safety, f.config.controller.gas.ambient_bar,
+                     f.config.model.volume_gain_per_rad, &stop);
   EXPECT_NE(r.aborted.find("emergency stop"), std::string::npos) << r.aborted;
   EXPECT_EQ(f.core.state(), EngineState::kFault);
 }
@@ -170,8 +175,8 @@ ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
   LaggingDevice device(arm, lag_ticks, c.timing.tick_s);
   EngineCore core(device, c.controller, c.timing, c.safety);
   SimulatedClock clock(core, device);
-  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad, nullptr,
-                        link_lag_s);
+  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad,
+                        nullptr, link_lag_s);
 }
 
 // The default 30 ms pulses on a rig whose readings lag by 4 ticks (20 ms): judged on readings that
@@ -227,7 +232,8 @@ TEST(ValveTest, ThePulseCommandNeedsArmedValves) {
   ASSERT_TRUE(f.core.send(EngineCommand::valve_pulse({ValveCommand{}, ValveCommand{}, 10, 1})));
   f.clock.step(2);
   bool refused = false;
-  for (const EngineEvent& e : f.drain_events()) refused |= e.kind == EventKind::kCommandRefused && e.command == CommandKind::kValvePulse;
+  for (const EngineEvent& e : f.drain_events())
+    refused |= e.kind == EventKind::kCommandRefused && e.command == CommandKind::kValvePulse;
   EXPECT_TRUE(refused);
 }
 
@@ -250,12 +256,14 @@ CheckRun rig_check(const std::string& args, const std::string& fault = "", const
   const auto dir = testing::make_temp_dir("bellows-rig-check");
   std::string config_arg;
   if (!fault.empty()) {
-    config_arg = " --config '" + write_file(dir, "rig.toml", "[plant]\nfault = \"" + fault + "\"\nfault_at_s = 0.0\n").string() + "'";
+    config_arg = " --config '" +
+                 write_file(dir, "rig.toml", "[plant]\nfault = \"" + fault + "\"\nfault_at_s = 0.0\n").string() + "'";
   }
   const std::string input = answer.empty() ? "/dev/null" : write_file(dir, "answer", answer + "\n").string();
   const std::filesystem::path sessions = dir / "sessions";
   const std::string save = args.find("--no-save") == std::string::npos ? " --data-dir '" + sessions.string() + "'" : "";
-  const auto r = run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + save + " " + args + " < '" + input + "'");
+  const auto r =
+      run_process(std::string(BELLOWS_BINARY) + " rig check" + config_arg + save + " " + args + " < '" + input + "'");
   return {r.exit_code, r.out, r.err, sessions};
 }
 
@@ -324,7 +332,8 @@ TEST(RigCheckCli, TheCheckIsRecordedInASession) {
   const auto manifest = nlohmann::json::parse(in);
   EXPECT_EQ(manifest.at("device"), "sim");
   std::map<std::string, std::vector<std::string>> events;
-  for (const auto& e : manifest.at("events")) events[e.at("kind").get<std::string>()].push_back(e.at("message").get<std::string>());
+  for (const auto& e : manifest.at("events"))
+    events[e.at("kind").get<std::string>()].push_back(e.at("message").get<std::string>());
   ASSERT_EQ(events["start"].size(), 1u);
   EXPECT_NE(events["start"][0].find("bellows rig check"), std::string::npos) << events["start"][0];
   ASSERT_EQ(events["rig-input"].size(), 1u);  // the simulated arm: one line of values, no volts

@@ -101,7 +101,9 @@ TEST(RigScreen, TheHeaderShowsTheDevicesLink) {
   env.config = c;
   env.device_name = "lcm";
   env.device_health = [&link] { return link; };
-  env.load_trajectory = [c](const std::string& name) { return resolve_trajectory(name, c.timing.sample_s(), c.trajectory); };
+  env.load_trajectory = [c](const std::string& name) {
+    return resolve_trajectory(name, c.timing.sample_s(), c.trajectory);
+  };
   env.clock_text = [] { return std::string("12:00:00"); };
   ui::ConsoleController console(env, library_trajectory("paper", c.timing.sample_s()), false);
   console.resize(160, 40);

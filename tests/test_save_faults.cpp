@@ -122,12 +122,15 @@ TEST_F(SaveFaults, TheConsolesSaveKilledAtEveryCallLeavesTheLastCommittedState) 
   // The uninterrupted references, each resumed by the real binary: the session as the save under
   // test left it (the clean run), and as it was before that save (the driver quits instead).
   fs::create_directory(scratch / "before");
-  const testing::ProcessResult before_run =
-      testing::run_process("BELLOWS_DRIVER_SKIP_ARMED_TRIAL=1 " + quoted(kDriver) + " " + quoted((scratch / "before").string()));
+  const testing::ProcessResult before_run = testing::run_process(
+      "BELLOWS_DRIVER_SKIP_ARMED_TRIAL=1 " + quoted(kDriver) + " " + quoted((scratch / "before").string()));
   ASSERT_EQ(before_run.exit_code, 0) << before_run.out << before_run.err;
   const Session before = load_session(session_in(scratch / "before"));
   ASSERT_EQ(before.iterations.size(), 2u);
-  ASSERT_EQ(testing::run_process("cp -r " + quoted(clean.directory.string()) + " " + quoted((scratch / "after").string())).exit_code, 0);
+  ASSERT_EQ(
+      testing::run_process("cp -r " + quoted(clean.directory.string()) + " " + quoted((scratch / "after").string()))
+          .exit_code,
+      0);
   const double rms_after = resumed_rms(scratch / "after");
   const double rms_before = resumed_rms(session_in(scratch / "before"));
   int dropped_reported = 0, at_before = 0, at_learned = 0, at_after = 0;
@@ -152,20 +155,27 @@ TEST_F(SaveFaults, TheConsolesSaveKilledAtEveryCallLeavesTheLastCommittedState) 
     }
     // Every trial completed before that save, exactly as the clean run saved them.
     for (std::size_t i = 0; i < n; ++i) {
-      EXPECT_EQ(loaded.iterations[i].record.joint_samples(0).angle_rad, clean.iterations[i].record.joint_samples(0).angle_rad) << i;
-      EXPECT_EQ(loaded.iterations[i].record.joint_samples(0).u_ilc_bar, clean.iterations[i].record.joint_samples(0).u_ilc_bar) << i;
+      EXPECT_EQ(loaded.iterations[i].record.joint_samples(0).angle_rad,
+                clean.iterations[i].record.joint_samples(0).angle_rad)
+          << i;
+      EXPECT_EQ(loaded.iterations[i].record.joint_samples(0).u_ilc_bar,
+                clean.iterations[i].record.joint_samples(0).u_ilc_bar)
+          << i;
     }
     // Iteration 1's correction is the one learned from it (committed) or the one before (not yet):
     // never anything else; with iteration 2 listed, it is what iteration 2 ran with.
     const Eigen::MatrixXd next = loaded.iterations[n - 1].next_corrections_bar();
     const Eigen::MatrixXd next1 = loaded.iterations[1].next_corrections_bar();
-    const Eigen::MatrixXd ran2 = clean.iterations[2].record.joint_samples(0).u_ilc_bar.head(clean.trajectory.learning_samples());
+    const Eigen::MatrixXd ran2 =
+        clean.iterations[2].record.joint_samples(0).u_ilc_bar.head(clean.trajectory.learning_samples());
     const bool learned1 = next1.col(0) == ran2.col(0);
     if (n == 3) {
       EXPECT_TRUE(learned1) << "iteration 2 listed with another correction than it ran";
-      EXPECT_TRUE(next == clean.iterations[2].next_corrections_bar()) << "iteration 2's correction is not the clean run's";
+      EXPECT_TRUE(next == clean.iterations[2].next_corrections_bar())
+          << "iteration 2's correction is not the clean run's";
     } else if (!learned1) {
-      EXPECT_TRUE(next == before.iterations[1].next_corrections_bar()) << "iteration 1's correction is neither learned nor the one before";
+      EXPECT_TRUE(next == before.iterations[1].next_corrections_bar())
+          << "iteration 1's correction is neither learned nor the one before";
     }
     // `bellows run --resume` continues it: it takes the session as committed (what was dropped is
     // removed), runs iteration n with the committed correction on a freshly armed arm (the console
@@ -190,10 +200,11 @@ TEST_F(SaveFaults, TheConsolesSaveKilledAtEveryCallLeavesTheLastCommittedState) 
   EXPECT_GT(at_before + at_learned, 0);
   EXPECT_GT(at_after, 0);
   EXPECT_GT(dropped_reported, 0);
-  std::printf("console save: %d calls swept (kill, then sessions show and run --resume): %d left the state before the save "
-              "(resumed RMS %.17g, as uninterrupted), %d iteration 1's learned correction without iteration 2 and %d the state "
-              "after (resumed RMS %.17g, as uninterrupted); %d reported a drop\n",
-              calls, at_before, rms_before, at_learned, at_after, rms_after, dropped_reported);
+  std::printf(
+      "console save: %d calls swept (kill, then sessions show and run --resume): %d left the state before the save "
+      "(resumed RMS %.17g, as uninterrupted), %d iteration 1's learned correction without iteration 2 and %d the state "
+      "after (resumed RMS %.17g, as uninterrupted); %d reported a drop\n",
+      calls, at_before, rms_before, at_learned, at_after, rms_after, dropped_reported);
 }
 
 TEST_F(SaveFaults, TheConsolesSaveFailingAtEveryCallIsReportedAndExitsNonZero) {
@@ -212,7 +223,8 @@ TEST_F(SaveFaults, TheConsolesSaveFailingAtEveryCallIsReportedAndExitsNonZero) {
     const std::string unsaved = line_of(failed.out, "unsaved");
     EXPECT_NE(unsaved.find("iteration"), std::string::npos) << failed.out;
     EXPECT_NE(unsaved.find("not saved"), std::string::npos) << failed.out;
-    const std::string failure = line_of(failed.out, "failure");  // the log line, also the status until a stop replaces it
+    const std::string failure =
+        line_of(failed.out, "failure");  // the log line, also the status until a stop replaces it
     EXPECT_NE(failure.find("No space left on device"), std::string::npos) << failed.out;
     EXPECT_NE(failure.find(unsaved), std::string::npos) << failed.out;
     EXPECT_NE(line_of(failed.out, "confirmation").find(unsaved), std::string::npos) << failed.out;
@@ -269,7 +281,9 @@ struct Writer {
   int stride = 1;
 };
 
-bool same_bytes(const fs::path& file, const fs::path& clean_file) { return testing::read_text(file) == testing::read_text(clean_file); }
+bool same_bytes(const fs::path& file, const fs::path& clean_file) {
+  return testing::read_text(file) == testing::read_text(clean_file);
+}
 
 /// A MAT file libmatio reads whole: as many bytes as the clean one (the header's date differs) and
 /// its three variables there.
@@ -344,7 +358,8 @@ void sweep_writer(const Writer& writer) {
         // there and whole.
         ++harmless;
         if (writer.name.rfind("sessions rename", 0) != 0) {
-          for (const std::string& name : writer.outputs) EXPECT_TRUE(fs::exists(out / writer.folder / name)) << "reported done without " << name;
+          for (const std::string& name : writer.outputs)
+            EXPECT_TRUE(fs::exists(out / writer.folder / name)) << "reported done without " << name;
         }
       } else {
         const std::string said = result.out + result.err;  // run says it beside its progress, on stdout
@@ -365,14 +380,17 @@ void sweep_writer(const Writer& writer) {
         continue;
       }
       if (!writer.folder.empty()) {  // nothing beside the writer's folder
-        for (const fs::path& p : entries(out)) EXPECT_EQ(p.filename().string(), writer.folder) << "written outside: " << p;
+        for (const fs::path& p : entries(out))
+          EXPECT_EQ(p.filename().string(), writer.folder) << "written outside: " << p;
       }
       expect_whole_outputs(out / writer.folder, scratch / "clean" / writer.folder, writer, mode == std::string("kill"));
     }
   }
-  std::printf("%s: %d calls, %d runs swept (kill and ENOSPC at %s; %d ENOSPC lost nothing and exited 0)\n", writer.name.c_str(),
-              calls, swept, writer.stride == 1 ? "every call" : ("every " + std::to_string(writer.stride) + "th call and the last 4").c_str(),
-              harmless);
+  std::printf(
+      "%s: %d calls, %d runs swept (kill and ENOSPC at %s; %d ENOSPC lost nothing and exited 0)\n", writer.name.c_str(),
+      calls, swept,
+      writer.stride == 1 ? "every call" : ("every " + std::to_string(writer.stride) + "th call and the last 4").c_str(),
+      harmless);
 }
 
 std::string bellows_command(const std::string& arguments) { return quoted(testing::kBellows) + " " + arguments; }
@@ -381,20 +399,26 @@ TEST_F(SaveFaults, EveryWriterKilledOrFailedAtEveryCallLeavesWholeFilesOrNone) {
   const fs::path session = small_session();
   ASSERT_TRUE(fs::is_directory(session));
   sweep_writer({.name = "sessions export",
-                .command = [&](const fs::path& out) {
-                  return bellows_command("sessions export " + quoted(session.string()) + " --output " + quoted((out / "e.csv").string()));
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      return bellows_command("sessions export " + quoted(session.string()) + " --output " +
+                                             quoted((out / "e.csv").string()));
+                    },
                 .outputs = {"e.csv", "e_telemetry.csv", "e_summary.csv"}});
   sweep_writer({.name = "trajectories --output",
-                .command = [](const fs::path& out) { return bellows_command("trajectories paper --output " + quoted((out / "t.csv").string())); },
+                .command =
+                    [](const fs::path& out) {
+                      return bellows_command("trajectories paper --output " + quoted((out / "t.csv").string()));
+                    },
                 .outputs = {"t.csv"}});
   sweep_writer({.name = "sessions rename (the manifest)",
-                .command = [&](const fs::path& out) {
-                  const testing::ProcessResult copy =
-                      testing::run_process("cp -r " + quoted(session.string()) + " " + quoted((out / "a").string()));
-                  EXPECT_EQ(copy.exit_code, 0);
-                  return bellows_command("sessions rename " + quoted((out / "a").string()) + " b");
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      const testing::ProcessResult copy = testing::run_process("cp -r " + quoted(session.string()) +
+                                                                               " " + quoted((out / "a").string()));
+                      EXPECT_EQ(copy.exit_code, 0);
+                      return bellows_command("sessions rename " + quoted((out / "a").string()) + " b");
+                    },
                 .outputs = {"a", "b"}});
 }
 
@@ -402,18 +426,21 @@ TEST_F(SaveFaults, TheMatExportKilledOrFailedAtEveryCallLeavesAWholeFileOrNone) 
   const fs::path session = small_session();
   // MAT v5: libmatio writes into memory, the safe writer writes it out.
   sweep_writer({.name = "sessions export --format mat",
-                .command = [&](const fs::path& out) {
-                  return bellows_command("sessions export " + quoted(session.string()) + " --format mat --output " +
-                                         quoted((out / "e.mat").string()));
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      return bellows_command("sessions export " + quoted(session.string()) + " --format mat --output " +
+                                             quoted((out / "e.mat").string()));
+                    },
                 .outputs = {"e.mat"},
                 .whole = whole_mat_file});
   // MAT v7.3: HDF5 writes in its private folder (hundreds of pwrites), then fsync, rename, fsync.
   sweep_writer({.name = "sessions export --format mat --mat-version 7.3",
-                .command = [&](const fs::path& out) {
-                  return bellows_command("sessions export " + quoted(session.string()) + " --format mat --mat-version 7.3 --output " +
-                                         quoted((out / "e.mat").string()));
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      return bellows_command("sessions export " + quoted(session.string()) +
+                                             " --format mat --mat-version 7.3 --output " +
+                                             quoted((out / "e.mat").string()));
+                    },
                 .outputs = {"e.mat"},
                 .whole = whole_mat_file,
                 .stride = 150});
@@ -423,11 +450,13 @@ TEST_F(SaveFaults, TheLcmLogKilledOrFailedAtEveryCallIsWholeOrAbsent) {
   const fs::path session = small_session();
   const fs::path files = session.parent_path();  // short.csv, short.toml
   sweep_writer({.name = "run --lcm-log",
-                .command = [&](const fs::path& out) {
-                  return bellows_command("run --iterations 0 --no-save --seed 3 --trajectory " + quoted((files / "short.csv").string()) +
-                                         " --config " + quoted((files / "short.toml").string()) + " --lcm-log " +
-                                         quoted((out / "t.lcmlog").string()));
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      return bellows_command("run --iterations 0 --no-save --seed 3 --trajectory " +
+                                             quoted((files / "short.csv").string()) + " --config " +
+                                             quoted((files / "short.toml").string()) + " --lcm-log " +
+                                             quoted((out / "t.lcmlog").string()));
+                    },
                 .outputs = {"t.lcmlog"},
                 .whole = whole_lcm_log});
 }
@@ -436,23 +465,27 @@ TEST_F(SaveFaults, PlotAndIdentifyKilledOrFailedAtEveryCallLeaveWholeFilesOrNone
   const fs::path session = small_session();
   // sessions plot: the script, then each figure gnuplot drew in its private folder, published.
   sweep_writer({.name = "sessions plot",
-                .command = [&](const fs::path& out) {
-                  return bellows_command("sessions plot " + quoted(session.string()) + " --formats svg --no-paper --output " +
-                                         quoted((out / "fig").string()));
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      return bellows_command("sessions plot " + quoted(session.string()) +
+                                             " --formats svg --no-paper --output " + quoted((out / "fig").string()));
+                    },
                 .outputs = {"figures.gp", "rms.svg", "angle.svg", "error.svg", "u_ilc.svg", "pressures.svg"},
                 .folder = "fig"});
   // identify --write-model: a new configuration, and one whose model --force replaces.
-  const std::string identify = "identify --no-save --config " + quoted(short_identification_config().string()) + " --write-model ";
-  sweep_writer({.name = "identify --write-model (new file)",
-                .command = [&](const fs::path& out) { return bellows_command(identify + quoted((out / "m.toml").string())); },
-                .outputs = {"m.toml"}});
+  const std::string identify =
+      "identify --no-save --config " + quoted(short_identification_config().string()) + " --write-model ";
+  sweep_writer(
+      {.name = "identify --write-model (new file)",
+       .command = [&](const fs::path& out) { return bellows_command(identify + quoted((out / "m.toml").string())); },
+       .outputs = {"m.toml"}});
   const std::string previous = "# the lab's configuration\n[model]\nkappa = 7.0\nomega0 = 14.0\ndamping = 0.3\n";
   sweep_writer({.name = "identify --write-model --force (replacing a model)",
-                .command = [&](const fs::path& out) {
-                  testing::write_text(out / "m.toml", previous);
-                  return bellows_command(identify + quoted((out / "m.toml").string()) + " --force");
-                },
+                .command =
+                    [&](const fs::path& out) {
+                      testing::write_text(out / "m.toml", previous);
+                      return bellows_command(identify + quoted((out / "m.toml").string()) + " --force");
+                    },
                 .outputs = {"m.toml"},
                 .previous_text = previous});
 }
@@ -464,7 +497,8 @@ TEST_F(SaveFaults, LinksPlantedAtTheOldTemporaryNamesWriteNothingOutside) {
   TempDir dir;
   const fs::path victim = dir / "victim";
   testing::write_text(victim, "precious\n");
-  const testing::ProcessResult copy = testing::run_process("cp -r " + quoted(session.string()) + " " + quoted((dir / "S").string()));
+  const testing::ProcessResult copy =
+      testing::run_process("cp -r " + quoted(session.string()) + " " + quoted((dir / "S").string()));
   ASSERT_EQ(copy.exit_code, 0);
   // sessions rename: the old temporary name was .manifest.json.tmp-<pid>; $$ is the pid bellows gets.
   const std::string b = quoted(testing::kBellows);
@@ -484,8 +518,9 @@ TEST_F(SaveFaults, LinksPlantedAtTheOldTemporaryNamesWriteNothingOutside) {
            {".t.csv.tmp-$$", "trajectories paper --output " + (out / "t.csv").string()},
        }) {
     SCOPED_TRACE(command);
-    const testing::ProcessResult result = testing::run_process(
-        "bash -c " + quoted("ln -sf " + victim.string() + " " + out.string() + "/" + planted + "; exec " + testing::kBellows + " " + command));
+    const testing::ProcessResult result =
+        testing::run_process("bash -c " + quoted("ln -sf " + victim.string() + " " + out.string() + "/" + planted +
+                                                 "; exec " + testing::kBellows + " " + command));
     EXPECT_EQ(result.exit_code, 0) << result.err;
     EXPECT_EQ(testing::read_text(victim), "precious\n");
   }
@@ -503,18 +538,21 @@ TEST_F(SaveFaults, AnOutputThatIsALinkOrExistsIsRefusedWithoutForceAndReplacedWi
   EXPECT_EQ(refused.exit_code, 2) << refused.err;
   EXPECT_NE(refused.err.find("exists already (--force replaces it)"), std::string::npos) << refused.err;
   EXPECT_EQ(testing::read_text(existing), "mine\n");
-  const testing::ProcessResult forced = testing::run_bellows({"trajectories", "steps", "--output", existing.string(), "--force"});
+  const testing::ProcessResult forced =
+      testing::run_bellows({"trajectories", "steps", "--output", existing.string(), "--force"});
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_NE(testing::read_text(existing), "mine\n");
   // A link at the output: refused without --force; with it, the link is replaced, never followed.
   fs::create_symlink(victim, dir / "link.csv");
   EXPECT_EQ(testing::run_bellows({"trajectories", "steps", "--output", (dir / "link.csv").string()}).exit_code, 2);
-  EXPECT_EQ(testing::run_bellows({"trajectories", "steps", "--output", (dir / "link.csv").string(), "--force"}).exit_code, 0);
+  EXPECT_EQ(
+      testing::run_bellows({"trajectories", "steps", "--output", (dir / "link.csv").string(), "--force"}).exit_code, 0);
   EXPECT_FALSE(fs::is_symlink(dir / "link.csv"));
   EXPECT_EQ(testing::read_text(victim), "precious\n");
   // The LCM log: a dangling link at its name is refused, and nothing is created through it.
   fs::create_symlink(dir / "created-through-link", dir / "log.lcmlog");
-  const testing::ProcessResult log = testing::run_bellows({"run", "--iterations", "1", "--no-save", "--lcm-log", (dir / "log.lcmlog").string()});
+  const testing::ProcessResult log =
+      testing::run_bellows({"run", "--iterations", "1", "--no-save", "--lcm-log", (dir / "log.lcmlog").string()});
   EXPECT_EQ(log.exit_code, 2) << log.err;
   EXPECT_FALSE(fs::exists(dir / "created-through-link"));
 }
@@ -523,7 +561,8 @@ TEST_F(SaveFaults, AnOutputThatIsALinkOrExistsIsRefusedWithoutForceAndReplacedWi
 
 TEST_F(SaveFaults, IdentifyWriteModelAddsAModelButReplacesOneOnlyWithForce) {
   TempDir dir;
-  const std::vector<std::string> identify = {"identify", "--no-save", "--config", short_identification_config().string(), "--write-model"};
+  const std::vector<std::string> identify = {"identify", "--no-save", "--config",
+                                             short_identification_config().string(), "--write-model"};
   const auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = identify;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -540,13 +579,15 @@ TEST_F(SaveFaults, IdentifyWriteModelAddsAModelButReplacesOneOnlyWithForce) {
   EXPECT_NE(again.err.find("holds a model already ([model] kappa = "), std::string::npos) << again.err;
   EXPECT_NE(again.err.find("--force replaces it"), std::string::npos) << again.err;
   EXPECT_EQ(std::count(again.err.begin(), again.err.end(), '\n'), 1) << again.err;
-  EXPECT_EQ(again.out.find("identification trial"), std::string::npos) << "a trial ran before the refusal: " << again.out;
+  EXPECT_EQ(again.out.find("identification trial"), std::string::npos)
+      << "a trial ran before the refusal: " << again.out;
   EXPECT_EQ(testing::read_text(fresh), fitted);
   // A configuration without a model: the model is added, the rest kept, no --force needed.
   const fs::path lab = dir / "lab.toml";
   testing::write_text(lab, "# the lab's settings\n[timing]\nsettle_s = 0\n");
   ASSERT_EQ(with({lab.string()}).exit_code, 0);
-  EXPECT_EQ(testing::read_text(lab).rfind("# the lab's settings\n[timing]\nsettle_s = 0\n", 0), 0u) << testing::read_text(lab);
+  EXPECT_EQ(testing::read_text(lab).rfind("# the lab's settings\n[timing]\nsettle_s = 0\n", 0), 0u)
+      << testing::read_text(lab);
   EXPECT_NE(testing::read_text(lab).find("[model]"), std::string::npos);
   // A rig profile with a model: refused; with --force, replaced (its other tables kept).
   const fs::path profile = dir / "rig.toml";
@@ -576,7 +617,8 @@ TEST_F(SaveFaults, SessionsRmRemovesOnlyABellowsSession) {
   EXPECT_TRUE(fs::exists(dir / "w" / "src" / "main.c"));
   EXPECT_FALSE(fs::exists(dir / "w" / "lock"));
   // A session holding a file of its owner's: refused, nothing removed.
-  const testing::ProcessResult copy = testing::run_process("cp -r " + quoted(small_session().string()) + " " + quoted((dir / "S").string()));
+  const testing::ProcessResult copy =
+      testing::run_process("cp -r " + quoted(small_session().string()) + " " + quoted((dir / "S").string()));
   ASSERT_EQ(copy.exit_code, 0);
   testing::write_text(dir / "S" / "notes.txt", "mine\n");
   const testing::ProcessResult foreign = testing::run_bellows({"sessions", "rm", (dir / "S").string(), "--yes"});
@@ -590,7 +632,8 @@ TEST_F(SaveFaults, SessionsRmRemovesOnlyABellowsSession) {
   EXPECT_TRUE(fs::exists(dir / "S" / "manifest.json"));
   // Answering no creates nothing (no lock file either).
   fs::remove(dir / "S" / "lock");
-  const testing::ProcessResult no = testing::run_process("echo n | " + quoted(testing::kBellows) + " sessions rm " + quoted((dir / "S").string()));
+  const testing::ProcessResult no =
+      testing::run_process("echo n | " + quoted(testing::kBellows) + " sessions rm " + quoted((dir / "S").string()));
   EXPECT_EQ(no.exit_code, 1) << no.err;
   EXPECT_FALSE(fs::exists(dir / "S" / "lock"));
   // A session: removed, every file of it, and the folder.

@@ -44,7 +44,8 @@ void expect_same_ticks(const std::vector<TickRecord>& loaded, const std::vector<
     EXPECT_EQ(a.reading.time_s, b.reading.time_s);
     EXPECT_EQ(a.state, b.state);
     EXPECT_EQ(a.fault, b.fault);
-    EXPECT_TRUE(same_number(a.reading.joint[0].angle_rad, b.reading.joint[0].angle_rad)) << a.reading.joint[0].angle_rad << " " << b.reading.joint[0].angle_rad;
+    EXPECT_TRUE(same_number(a.reading.joint[0].angle_rad, b.reading.joint[0].angle_rad))
+        << a.reading.joint[0].angle_rad << " " << b.reading.joint[0].angle_rad;
     EXPECT_EQ(a.joint(0).desired_rad, b.joint(0).desired_rad);
     EXPECT_EQ(a.reading.joint[0].chamber_bar, b.reading.joint[0].chamber_bar);
     EXPECT_EQ(a.reading.supply_bar, b.reading.supply_bar);
@@ -153,8 +154,9 @@ TEST(SessionBlackBox, DamageIsReportedWithTheFileAndLine) {
   EXPECT_NE(damaged(bad_state).find("line 2: state '7' is not one of SAFE, ARMED, RUNNING, FAULT"), std::string::npos)
       << damaged(bad_state);
   // Ticks out of order.
-  const std::string swapped = good.substr(0, second_line) + good.substr(third_line, good.find('\n', third_line) + 1 - third_line) +
-                              good.substr(second_line, third_line - second_line) + good.substr(good.find('\n', third_line) + 1);
+  const std::string swapped =
+      good.substr(0, second_line) + good.substr(third_line, good.find('\n', third_line) + 1 - third_line) +
+      good.substr(second_line, third_line - second_line) + good.substr(good.find('\n', third_line) + 1);
   EXPECT_NE(damaged(swapped).find("line 3: tick"), std::string::npos) << damaged(swapped);
   fs::remove(file);
   EXPECT_NE(load_error(dir / "s").find(session_layout::black_box_file(0)), std::string::npos);

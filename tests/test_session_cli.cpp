@@ -62,8 +62,11 @@ TEST(SessionResume, TenIterationsEqualFivePlusAResumeOfFive) {
   ASSERT_EQ(a.iterations.size(), 11u);
   ASSERT_EQ(b.iterations.size(), 11u);
   for (std::size_t i = 0; i < 11; ++i) {
-    EXPECT_EQ(a.iterations[i].record.joint_samples(0).angle_rad, b.iterations[i].record.joint_samples(0).angle_rad) << i;
-    EXPECT_EQ(a.iterations[i].record.joint_ticks(0).pressure_a_bar, b.iterations[i].record.joint_ticks(0).pressure_a_bar) << i;
+    EXPECT_EQ(a.iterations[i].record.joint_samples(0).angle_rad, b.iterations[i].record.joint_samples(0).angle_rad)
+        << i;
+    EXPECT_EQ(a.iterations[i].record.joint_ticks(0).pressure_a_bar,
+              b.iterations[i].record.joint_ticks(0).pressure_a_bar)
+        << i;
     EXPECT_EQ(a.iterations[i].next_corrections_bar(), b.iterations[i].next_corrections_bar()) << i;
   }
   EXPECT_LT(split.back()["rms_deg"].get<double>(), 0.5 * split.front()["rms_deg"].get<double>());
@@ -88,9 +91,11 @@ TEST(SessionResume, FindsASessionByNameInTheDataDirectory) {
 }
 
 TEST(SessionResume, RefusesOptionsThatWouldChangeTheSession) {
-  for (const std::vector<std::string>& extra :
-       {std::vector<std::string>{"--trajectory", "sine"}, {"--config", "x.toml"}, {"--seed", "3"}, {"--no-save"},
-        {"--name", "other"}}) {
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--trajectory", "sine"},
+                                                {"--config", "x.toml"},
+                                                {"--seed", "3"},
+                                                {"--no-save"},
+                                                {"--name", "other"}}) {
     std::vector<std::string> args = {"run", "--resume", "/tmp/somewhere", "--iterations", "1"};
     args.insert(args.end(), extra.begin(), extra.end());
     const ProcessResult result = run_bellows(args);
@@ -117,8 +122,8 @@ TEST(SessionSaving, DefaultsToTheXdgDataDirectory) {
 TEST(SessionSaving, FallsBackToTheHomeDirectory) {
   TempDir dir;
   testing::write_short_run_files(dir.path());
-  const ProcessResult result =
-      run_bellows(short_run(dir, {"--iterations", "0", "--name", "h"}), {"XDG_DATA_HOME", "HOME=" + dir.path().string()});
+  const ProcessResult result = run_bellows(short_run(dir, {"--iterations", "0", "--name", "h"}),
+                                           {"XDG_DATA_HOME", "HOME=" + dir.path().string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(load_session(dir / ".local/share/bellows/sessions/h").iterations.size(), 1u);
 }
@@ -126,8 +131,9 @@ TEST(SessionSaving, FallsBackToTheHomeDirectory) {
 TEST(SessionSaving, NoSaveWritesNothing) {
   TempDir dir;
   testing::write_short_run_files(dir.path());
-  const ProcessResult result = run_bellows(short_run(dir, {"--iterations", "1", "--no-save"}),
-                                           {"XDG_DATA_HOME=" + (dir / "xdg").string(), "HOME=" + (dir / "home").string()});
+  const ProcessResult result =
+      run_bellows(short_run(dir, {"--iterations", "1", "--no-save"}),
+                  {"XDG_DATA_HOME=" + (dir / "xdg").string(), "HOME=" + (dir / "home").string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(result.out.find("session"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "xdg"));
@@ -138,7 +144,8 @@ TEST(SessionSaving, AnUnusableDataDirectoryIsAClearError) {
   TempDir dir;
   testing::write_short_run_files(dir.path());
   testing::write_text(dir / "file", "not a directory");
-  const ProcessResult result = run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", (dir / "file").string()}));
+  const ProcessResult result =
+      run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", (dir / "file").string()}));
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.err.find("bellows: cannot create the data directory " + (dir / "file").string()), std::string::npos)
       << result.err;
@@ -153,7 +160,8 @@ TEST(SessionSaving, ANameInUseIsRefused) {
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_NE(again.err.find("session " + data + "/n exists already; continue it with --resume"), std::string::npos)
       << again.err;
-  const ProcessResult bad_name = run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", data, "--name", "a/b"}));
+  const ProcessResult bad_name =
+      run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", data, "--name", "a/b"}));
   EXPECT_EQ(bad_name.exit_code, 2);
   EXPECT_NE(bad_name.err.find("must be a plain directory name"), std::string::npos) << bad_name.err;
 }
@@ -173,7 +181,8 @@ TEST(SessionLocking, ASecondProcessIsRefusedAndTheFirstNamed) {
   const ProcessResult resume = run_bellows({"run", "--resume", data + "/busy", "--iterations", "1"});
   EXPECT_EQ(resume.exit_code, 2);
   EXPECT_NE(resume.err.find("bellows: session " + data + "/busy " + holder), std::string::npos) << resume.err;
-  const ProcessResult same_name = run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", data, "--name", "busy"}));
+  const ProcessResult same_name =
+      run_bellows(short_run(dir, {"--iterations", "0", "--data-dir", data, "--name", "busy"}));
   EXPECT_EQ(same_name.exit_code, 2);
   EXPECT_NE(same_name.err.find(holder), std::string::npos) << same_name.err;
   ::kill(first.pid, SIGKILL);
@@ -211,7 +220,8 @@ TEST(SessionSaving, AGuardsFaultKeepsItsBlackBoxWhichShowPrints) {
   TempDir dir;
   testing::write_short_run_files(dir.path());
   // Supply lost 0.9 s in: during iteration 1 (each trial is 0.05 s of settle and 0.5 s of moves).
-  testing::write_text(dir / "short.toml", "[timing]\nsettle_s = 0.05\n[plant]\nfault = \"supply-loss\"\nfault_at_s = 0.9\n");
+  testing::write_text(dir / "short.toml",
+                      "[timing]\nsettle_s = 0.05\n[plant]\nfault = \"supply-loss\"\nfault_at_s = 0.9\n");
   const std::string data = (dir / "data").string();
   const ProcessResult run = run_bellows(short_run(dir, {"--iterations", "5", "--data-dir", data, "--name", "f"}));
   EXPECT_EQ(run.exit_code, 3) << run.err;
@@ -242,8 +252,8 @@ TEST(SessionSaving, AWallClockRunSavesAndResumesWithItsCorrection) {
   TempDir dir;
   testing::write_short_run_files(dir.path());
   const std::string data = (dir / "data").string();
-  const ProcessResult wall =
-      run_bellows(short_run(dir, {"--clock", "wall", "--speed", "max", "--iterations", "1", "--data-dir", data, "--name", "w"}));
+  const ProcessResult wall = run_bellows(
+      short_run(dir, {"--clock", "wall", "--speed", "max", "--iterations", "1", "--data-dir", data, "--name", "w"}));
   ASSERT_EQ(wall.exit_code, 0) << wall.err;
   const Session saved = load_session(dir / "data" / "w");
   ASSERT_EQ(saved.iterations.size(), 2u);
@@ -253,7 +263,8 @@ TEST(SessionSaving, AWallClockRunSavesAndResumesWithItsCorrection) {
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   const Session continued = load_session(dir / "data" / "w");
   ASSERT_EQ(continued.iterations.size(), 3u);
-  EXPECT_EQ(continued.iterations[2].record.joint_samples(0).u_ilc_bar.head(25), saved.iterations[1].next_corrections_bar());
+  EXPECT_EQ(continued.iterations[2].record.joint_samples(0).u_ilc_bar.head(25),
+            saved.iterations[1].next_corrections_bar());
 }
 
 class SessionsCommand : public ::testing::Test {
@@ -284,7 +295,8 @@ TEST_F(SessionsCommand, ListIsATableAndJson) {
 
   EXPECT_LT(table.out.find("\nsecond "), first_line);  // newest first, as the console's browser
 
-  const nlohmann::json list = nlohmann::json::parse(run_bellows({"sessions", "list", "--data-dir", data_, "--json"}).out);
+  const nlohmann::json list =
+      nlohmann::json::parse(run_bellows({"sessions", "list", "--data-dir", data_, "--json"}).out);
   ASSERT_EQ(list.size(), 2u);
   EXPECT_EQ(list[0]["name"], "second");
   EXPECT_EQ(list[1]["name"], "first");
@@ -322,13 +334,15 @@ TEST_F(SessionsCommand, ShowGivesTheSummaryAndRmsPerIteration) {
   const ProcessResult shown = run_bellows({"sessions", "show", data_ + "/first"});
   ASSERT_EQ(shown.exit_code, 0) << shown.err;
   EXPECT_NE(shown.out.find("trajectory   short: 25 samples"), std::string::npos) << shown.out;
-  EXPECT_NE(shown.out.find("learning     " + Configuration{}.ilc.law + ", m = 1, s = 0.1"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("learning     " + Configuration{}.ilc.law + ", m = 1, s = 0.1"), std::string::npos)
+      << shown.out;
   for (const auto& iteration : first_["iterations"]) {
     char row[64];
     std::snprintf(row, sizeof row, "%9d  %9.3f", iteration["iteration"].get<int>(), iteration["rms_deg"].get<double>());
     EXPECT_NE(shown.out.find(row), std::string::npos) << row;
   }
-  const nlohmann::json json = nlohmann::json::parse(run_bellows({"sessions", "show", "first", "--data-dir", data_, "--json"}).out);
+  const nlohmann::json json =
+      nlohmann::json::parse(run_bellows({"sessions", "show", "first", "--data-dir", data_, "--json"}).out);
   EXPECT_EQ(json["name"], "first");
   EXPECT_EQ(json["device_info"]["seed"], 1);
   ASSERT_EQ(json["iterations"].size(), 4u);
@@ -354,16 +368,17 @@ TEST_F(SessionsCommand, ExportsCsvThatReadsBack) {
   for (int i = 0; i < 4; ++i) {
     for (int k = 0; k < 26; ++k) {
       EXPECT_EQ(samples[0](i * 26 + k), i);
-      EXPECT_EQ(radians_from_degrees(samples[3](i * 26 + k)), session.iterations[i].record.joint_samples(0).angle_rad(k));
+      EXPECT_EQ(radians_from_degrees(samples[3](i * 26 + k)),
+                session.iterations[i].record.joint_samples(0).angle_rad(k));
     }
   }
   std::vector<std::string_view> telemetry_header = {"iteration"};
   for (std::string_view column : telemetry_columns()) telemetry_header.push_back(column);
   const auto telemetry = parse_csv(testing::read_text(dir_ / "export" / "first_telemetry.csv"), telemetry_header, "t");
   EXPECT_EQ(telemetry[0].size(), 4 * 100);
-  const auto summary = parse_csv(testing::read_text(dir_ / "export" / "first_summary.csv"),
-                                 {"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples"},
-                                 "s");
+  const auto summary =
+      parse_csv(testing::read_text(dir_ / "export" / "first_summary.csv"),
+                {"iteration", "rms_deg", "max_abs_error_deg", "max_abs_correction_bar", "saturated_samples"}, "s");
   for (int i = 0; i < 4; ++i) EXPECT_EQ(summary[1](i), first_["iterations"][i]["rms_deg"].get<double>());
 }
 
@@ -390,7 +405,8 @@ TEST_F(SessionsCommand, ExportsMatlabV73WithOneStructPerIteration) {
   EXPECT_EQ(iterations->dims[0] * iterations->dims[1], 4u);
   const Session session = load_session(dir_ / "data" / "first");
   for (std::size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(mat_column(iterations, "rms_deg", i), std::vector<double>{session.manifest.iterations[i].summary.rms_deg});
+    EXPECT_EQ(mat_column(iterations, "rms_deg", i),
+              std::vector<double>{session.manifest.iterations[i].summary.rms_deg});
     matvar_t* samples = Mat_VarGetStructFieldByName(iterations, "samples", i);
     ASSERT_NE(samples, nullptr);
     const std::vector<double> angle = mat_column(samples, "angle_deg", 0);

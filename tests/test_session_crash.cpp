@@ -100,8 +100,17 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
     if (resume) {
       args = {"run", "--resume", session.string(), "--iterations", "100000"};
     } else {
-      args = {"run", "--trajectory", (dir / "short.csv").string(), "--config", (dir / "short.toml").string(),
-              "--iterations", "100000", "--data-dir", data.string(), "--name", name};
+      args = {"run",
+              "--trajectory",
+              (dir / "short.csv").string(),
+              "--config",
+              (dir / "short.toml").string(),
+              "--iterations",
+              "100000",
+              "--data-dir",
+              data.string(),
+              "--name",
+              name};
     }
     const testing::Spawned run = testing::spawn_bellows(args);
     std::string out;
@@ -137,7 +146,8 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
     try {
       loaded = load_session(session);
     } catch (const InputError& load_error) {
-      ADD_FAILURE() << "round " << round << " (" << (at_a_write ? "at a write" : "random") << "): " << load_error.what();
+      ADD_FAILURE() << "round " << round << " (" << (at_a_write ? "at a write" : "random")
+                    << "): " << load_error.what();
       continue;
     }
     ++loaded_sessions;
@@ -151,7 +161,8 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
     if (!resume) loadable.push_back(name);
     if (round % 4 == 0) {
       // A killed session resumes: its lock died with its writer.
-      const testing::ProcessResult resumed = testing::run_bellows({"run", "--resume", session.string(), "--iterations", "1"});
+      const testing::ProcessResult resumed =
+          testing::run_bellows({"run", "--resume", session.string(), "--iterations", "1"});
       EXPECT_EQ(resumed.exit_code, 0) << "round " << round << ": " << resumed.err;
       const std::size_t expected = loaded.iterations.size() + (loaded.iterations.empty() ? 2 : 1);
       EXPECT_EQ(load_session(session).iterations.size(), expected) << "round " << round;

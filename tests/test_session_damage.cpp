@@ -89,7 +89,8 @@ std::vector<Damage> damages() {
        "not a bellows session manifest"},
       {"schema version too new", [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["schema_version"] = 3; }); },
        "schema version 3 is not supported (this bellows reads versions 1 to 2)"},
-      {"schema version missing", [](const fs::path& d) { edit_manifest(d, [](auto& j) { j.erase("schema_version"); }); },
+      {"schema version missing",
+       [](const fs::path& d) { edit_manifest(d, [](auto& j) { j.erase("schema_version"); }); },
        "missing \"schema_version\""},
       {"NaN in the manifest",
        [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["iterations"][1]["rms_deg"] = NAN; }); },
@@ -98,7 +99,9 @@ std::vector<Damage> damages() {
        [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["configuration"]["ilc"]["m"] = "one"; }); },
        "/configuration/ilc/m: expected a number"},
       {"invalid configuration",
-       [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["configuration"]["controller"]["p_max_bar"] = 0.9; }); },
+       [](const fs::path& d) {
+         edit_manifest(d, [](auto& j) { j["configuration"]["controller"]["p_max_bar"] = 0.9; });
+       },
        "[controller] p_max_bar = 0.9: must be above ambient pressure"},
       {"unknown configuration key",
        [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["configuration"]["ilc"]["horizon"] = 3; }); },
@@ -117,9 +120,12 @@ std::vector<Damage> damages() {
       {"resume missing", [](const fs::path& d) { edit_manifest(d, [](auto& j) { j.erase("resume"); }); },
        "missing \"resume\""},
       {"controller state out of range",
-       [](const fs::path& d) { edit_manifest(d, [](auto& j) { j["resume"]["controller"]["pressure_a"]["next"] = 40; }); },
+       [](const fs::path& d) {
+         edit_manifest(d, [](auto& j) { j["resume"]["controller"]["pressure_a"]["next"] = 40; });
+       },
        "/resume/controller/pressure_a/next: expected a whole number in [0, 3]"},
-      {"samples file missing", [=](const fs::path& d) { fs::remove(samples(d)); }, "iterations/iteration_0001.csv is missing"},
+      {"samples file missing", [=](const fs::path& d) { fs::remove(samples(d)); },
+       "iterations/iteration_0001.csv is missing"},
       {"samples truncated mid-line",
        [=](const fs::path& d) {
          const std::string text = testing::read_text(samples(d));
@@ -174,9 +180,10 @@ TEST_P(BadSession, IsRefusedWithAClearError) {
   EXPECT_EQ(shown.out, "");
   EXPECT_EQ(shown.err, "bellows: " + error + "\n");
   // And a resume refuses it the same way, writing nothing.
-  const std::string manifest_before = fs::is_regular_file(dir / "s" / "manifest.json")
-                                          ? testing::read_text(dir / "s" / "manifest.json") : "";
-  const testing::ProcessResult resumed = testing::run_bellows({"run", "--resume", (dir / "s").string(), "--iterations", "1"});
+  const std::string manifest_before =
+      fs::is_regular_file(dir / "s" / "manifest.json") ? testing::read_text(dir / "s" / "manifest.json") : "";
+  const testing::ProcessResult resumed =
+      testing::run_bellows({"run", "--resume", (dir / "s").string(), "--iterations", "1"});
   EXPECT_EQ(resumed.exit_code, 2);
   EXPECT_EQ(resumed.err, "bellows: " + error + "\n");
   if (!manifest_before.empty()) {

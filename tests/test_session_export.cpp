@@ -89,7 +89,8 @@ void expect_mat_contents(const fs::path& path, const Session& session, mat_ft ve
   ASSERT_EQ(faults->class_type, MAT_C_CELL);
   EXPECT_EQ(chars(Mat_VarGetCell(faults, static_cast<int>(box.size()) - 1)), "sensor-nan");
   EXPECT_EQ(chars(Mat_VarGetCell(faults, 0)), "none");
-  EXPECT_EQ(chars(Mat_VarGetCell(Mat_VarGetStructFieldByName(ticks, "state", 0), static_cast<int>(box.size()) - 1)), "FAULT");
+  EXPECT_EQ(chars(Mat_VarGetCell(Mat_VarGetStructFieldByName(ticks, "state", 0), static_cast<int>(box.size()) - 1)),
+            "FAULT");
   Mat_VarFree(boxes);
   Mat_Close(file);
 }
@@ -105,7 +106,8 @@ TEST_F(SessionExport, CsvHasTheBlackBoxWithTheIterationFilesNamesAndNamedCodes) 
   EXPECT_EQ(files[3], dir_ / "out_blackbox.csv");
   const std::string text = testing::read_text(files[3]);
   const std::string header = text.substr(0, text.find('\n'));
-  EXPECT_EQ(header.rfind("black_box,tick,time_s,sensor_time_s,state,fault,angle_deg,angle_setpoint_deg,", 0), 0u) << header;
+  EXPECT_EQ(header.rfind("black_box,tick,time_s,sensor_time_s,state,fault,angle_deg,angle_setpoint_deg,", 0), 0u)
+      << header;
   EXPECT_NE(header.find(",u_tot_bar,"), std::string::npos) << header;
   const std::string last_row = text.substr(text.rfind('\n', text.size() - 2) + 1);
   EXPECT_NE(last_row.find(",FAULT,sensor-nan,nan,"), std::string::npos) << last_row;
@@ -120,9 +122,10 @@ TEST_F(SessionExport, CsvHasTheBlackBoxWithTheIterationFilesNamesAndNamedCodes) 
 
 TEST_F(SessionExport, ReadsLegacyBlackBoxesWithNumericCodes) {
   const std::vector<TickRecord>& box = session_.black_boxes[0];
-  std::string legacy = "tick,time_s,sensor_time_s,state,fault,angle_deg,desired_deg,pressure_a_bar,pressure_b_bar,"
-                       "supply_bar,u_total_bar,pressure_a_setpoint_bar,pressure_b_setpoint_bar,inlet_a_duty,"
-                       "outlet_a_duty,inlet_b_duty,outlet_b_duty,sample,trial_id\n";
+  std::string legacy =
+      "tick,time_s,sensor_time_s,state,fault,angle_deg,desired_deg,pressure_a_bar,pressure_b_bar,"
+      "supply_bar,u_total_bar,pressure_a_setpoint_bar,pressure_b_setpoint_bar,inlet_a_duty,"
+      "outlet_a_duty,inlet_b_duty,outlet_b_duty,sample,trial_id\n";
   const std::vector<Eigen::VectorXd> values = black_box_values(box);
   const std::vector<std::string> header = black_box_header(1);
   std::vector<CsvColumn> columns;
@@ -163,10 +166,12 @@ TEST_F(SessionExport, NeverReplacesAFileUnlessForced) {
 TEST_F(SessionExport, NeverWritesIntoTheSessionItExportsEvenWhenForced) {
   const std::string manifest = testing::read_text(dir_ / "s" / session_layout::kManifest);
   const std::string trajectory = testing::read_text(dir_ / "s" / session_layout::kTrajectory);
-  EXPECT_NE(message_of([&] { export_session_csv(session_, dir_ / "s" / "trajectory.csv", true); }).find("inside the session"),
-            std::string::npos);
-  EXPECT_NE(message_of([&] { export_session_mat(session_, dir_ / "s" / "iterations" / "x.mat", MatVersion::kV5, true); })
-                .find("inside the session"),
+  EXPECT_NE(
+      message_of([&] { export_session_csv(session_, dir_ / "s" / "trajectory.csv", true); }).find("inside the session"),
+      std::string::npos);
+  EXPECT_NE(message_of([&] {
+              export_session_mat(session_, dir_ / "s" / "iterations" / "x.mat", MatVersion::kV5, true);
+            }).find("inside the session"),
             std::string::npos);
   EXPECT_EQ(testing::read_text(dir_ / "s" / session_layout::kTrajectory), trajectory);
   EXPECT_EQ(testing::read_text(dir_ / "s" / session_layout::kManifest), manifest);
@@ -177,7 +182,7 @@ TEST_F(SessionExport, RefusesAnotherExtensionAndAMissingFolder) {
   EXPECT_EQ(message_of([&] { export_session_mat(session_, dir_ / "x.csv"); }),
             "the output " + (dir_ / "x.csv").string() + " must end in .mat for this format (not .csv)");
   EXPECT_FALSE(fs::exists(dir_ / "x.csv"));
-  EXPECT_EQ(message_of([&] { export_session_csv(session_, dir_ / "x.mat"); }).find("must end in .csv"), 
+  EXPECT_EQ(message_of([&] { export_session_csv(session_, dir_ / "x.mat"); }).find("must end in .csv"),
             ("the output " + (dir_ / "x.mat").string() + " ").size());
   for (const MatVersion version : {MatVersion::kV5, MatVersion::kV73}) {
     EXPECT_EQ(message_of([&] { export_session_mat(session_, dir_ / "nowhere" / "x.mat", version); }),
@@ -189,7 +194,8 @@ TEST_F(SessionExport, RefusesAnotherExtensionAndAMissingFolder) {
 TEST_F(SessionExport, TheCommandLineSaysItInOneLineWithExitStatus2) {
   const std::string session = (dir_ / "s").string();
   for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"--format", "mat", "--mat-version", "7.3", "--output", (dir_ / "no" / "x.mat").string()},
+       {std::vector<std::string>{"--format", "mat", "--mat-version", "7.3", "--output",
+                                 (dir_ / "no" / "x.mat").string()},
         {"--format", "mat", "--output", (dir_ / "x.csv").string()},
         {"--format", "csv", "--mat-version", "5", "--output", (dir_ / "x.csv").string()},
         {"--format", "csv", "--output", (dir_ / "s" / "manifest.json").string(), "--force"}}) {
@@ -201,13 +207,15 @@ TEST_F(SessionExport, TheCommandLineSaysItInOneLineWithExitStatus2) {
     EXPECT_EQ(result.err.rfind("bellows: ", 0), 0u) << result.err;
   }
   EXPECT_NO_THROW(load_session(dir_ / "s"));
-  const ProcessResult first = run_bellows({"sessions", "export", session, "--format", "mat", "--output", (dir_ / "a.mat").string()});
+  const ProcessResult first =
+      run_bellows({"sessions", "export", session, "--format", "mat", "--output", (dir_ / "a.mat").string()});
   EXPECT_EQ(first.exit_code, 0) << first.err;
-  const ProcessResult again = run_bellows({"sessions", "export", session, "--format", "mat", "--output", (dir_ / "a.mat").string()});
+  const ProcessResult again =
+      run_bellows({"sessions", "export", session, "--format", "mat", "--output", (dir_ / "a.mat").string()});
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_EQ(again.err, "bellows: " + (dir_ / "a.mat").string() + " exists already (--force replaces it)\n");
-  const ProcessResult forced = run_bellows(
-      {"sessions", "export", session, "--format", "mat", "--mat-version", "7.3", "--force", "--output", (dir_ / "a.mat").string()});
+  const ProcessResult forced = run_bellows({"sessions", "export", session, "--format", "mat", "--mat-version", "7.3",
+                                            "--force", "--output", (dir_ / "a.mat").string()});
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   mat_t* file = Mat_Open((dir_ / "a.mat").c_str(), MAT_ACC_RDONLY);
   ASSERT_NE(file, nullptr);

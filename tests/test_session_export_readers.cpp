@@ -82,8 +82,11 @@ Json columns_of(const fs::path& file) {
 std::string expected_mat_json(const Session& session) {
   const SessionManifest& m = session.manifest;
   const fs::path& dir = session.directory;
-  Json summary = {{"iteration", Json::array()}, {"rms_deg", Json::array()}, {"max_abs_error_deg", Json::array()},
-                  {"max_abs_correction_bar", Json::array()}, {"saturated_samples", Json::array()}};
+  Json summary = {{"iteration", Json::array()},
+                  {"rms_deg", Json::array()},
+                  {"max_abs_error_deg", Json::array()},
+                  {"max_abs_correction_bar", Json::array()},
+                  {"saturated_samples", Json::array()}};
   Json iterations = Json::array();
   for (std::size_t i = 0; i < m.iterations.size(); ++i) {
     const IterationSummary& s = m.iterations[i].summary;
@@ -92,8 +95,11 @@ std::string expected_mat_json(const Session& session) {
     summary["max_abs_error_deg"].push_back(s.max_abs_error_deg);
     summary["max_abs_correction_bar"].push_back(s.max_abs_correction_bar);
     summary["saturated_samples"].push_back(s.saturated_samples);
-    iterations.push_back({{"iteration", s.iteration}, {"rms_deg", s.rms_deg}, {"max_abs_error_deg", s.max_abs_error_deg},
-                          {"max_abs_correction_bar", s.max_abs_correction_bar}, {"saturated_samples", s.saturated_samples},
+    iterations.push_back({{"iteration", s.iteration},
+                          {"rms_deg", s.rms_deg},
+                          {"max_abs_error_deg", s.max_abs_error_deg},
+                          {"max_abs_correction_bar", s.max_abs_correction_bar},
+                          {"saturated_samples", s.saturated_samples},
                           {"completed_utc", m.iterations[i].completed_utc},
                           {"samples", columns_of(dir / session_layout::samples_file(static_cast<int>(i)))},
                           {"telemetry", columns_of(dir / session_layout::telemetry_file(static_cast<int>(i)))}});
@@ -106,15 +112,23 @@ std::string expected_mat_json(const Session& session) {
   Json boxes = Json::array();
   for (std::size_t b = 0; b < m.black_boxes.size(); ++b) {
     const BlackBoxEntry& e = m.black_boxes[b];
-    boxes.push_back({{"fault", e.fault}, {"iteration", e.iteration}, {"time_utc", e.time_utc},
+    boxes.push_back({{"fault", e.fault},
+                     {"iteration", e.iteration},
+                     {"time_utc", e.time_utc},
                      {"ticks", columns_of(dir / session_layout::black_box_file(static_cast<int>(b)))}});
   }
   const Json expected = {
       {"session",
-       {{"name", m.name}, {"program_version", m.program_version}, {"device", m.device}, {"started_utc", m.started_utc},
-        {"updated_utc", m.updated_utc}, {"configuration", configuration_to_json(m.configuration)},
-        {"trajectory", {{"name", m.trajectory_name}, {"time_s", trajectory["time_s"]}, {"angle_deg", trajectory["angle_deg"]}}},
-        {"summary", summary}, {"events", events}}},
+       {{"name", m.name},
+        {"program_version", m.program_version},
+        {"device", m.device},
+        {"started_utc", m.started_utc},
+        {"updated_utc", m.updated_utc},
+        {"configuration", configuration_to_json(m.configuration)},
+        {"trajectory",
+         {{"name", m.trajectory_name}, {"time_s", trajectory["time_s"]}, {"angle_deg", trajectory["angle_deg"]}}},
+        {"summary", summary},
+        {"events", events}}},
       {"iterations", iterations},
       {"black_boxes", boxes}};
   std::string text = expected.dump(1);
@@ -142,8 +156,10 @@ TEST_F(SessionReaders, ScipyReadsEveryFieldOfMatV5) {
   std::string wrong = testing::read_text(dir_ / "expected.json");
   wrong.replace(wrong.find("\"sensor-nan\""), 12, "\"overpressure\"");
   testing::write_text(dir_ / "wrong.json", wrong);
-  EXPECT_EQ(run_in(dir_.path(), std::string(kPython) + " " + (recipes() / "check_mat_scipy.py").string() +
-                                    " session.mat wrong.json").status, 1);
+  EXPECT_EQ(run_in(dir_.path(),
+                   std::string(kPython) + " " + (recipes() / "check_mat_scipy.py").string() + " session.mat wrong.json")
+                .status,
+            1);
 }
 
 TEST_F(SessionReaders, OctaveReadsEveryFieldOfMatV5) {
@@ -179,7 +195,8 @@ TEST_F(SessionReaders, TheRecipesRunAsDocumented) {
   expect_documented("<!-- recipe: pandas -->", recipes() / "pandas_recipe.py");
   Output out = run_in(dir_.path(), std::string(kPython) + " " + (recipes() / "pandas_recipe.py").string());
   EXPECT_EQ(out.status, 0) << out.text;
-  EXPECT_EQ(out.text, expected + "black box: sensor-nan at tick " + std::to_string(session_.black_boxes[0].back().tick) + "\n");
+  EXPECT_EQ(out.text,
+            expected + "black box: sensor-nan at tick " + std::to_string(session_.black_boxes[0].back().tick) + "\n");
 
   expect_documented("<!-- recipe: scipy -->", recipes() / "scipy_recipe.py");
   out = run_in(dir_.path(), std::string(kPython) + " " + (recipes() / "scipy_recipe.py").string());

@@ -78,7 +78,7 @@ TEST(ExactDegrees, ReadBackToTheSameRadiansAndPreferShortDecimals) {
     ++total;
     exact += radians_from_degrees(degrees_for_exact_radians(rad)) == rad;
   }
-  EXPECT_EQ(exact, total);  // every angle that came from degrees reads back bit for bit
+  EXPECT_EQ(exact, total);                                // every angle that came from degrees reads back bit for bit
   for (double rad = -1.6; rad <= 1.6; rad += 0.000731) {  // arbitrary radians: within an ulp
     EXPECT_NEAR(radians_from_degrees(degrees_for_exact_radians(rad)), rad, 2e-16 * std::abs(rad) + 1e-300);
   }
@@ -88,8 +88,8 @@ TEST(IterationFiles, TrajectoryRoundTripsExactly) {
   const Trajectory trajectory = testing::short_trajectory(0.02);
   const std::string text = format_trajectory_csv(trajectory);
   EXPECT_EQ(text.substr(0, 17), "time_s,angle_deg\n");
-  const Trajectory loaded =
-      parse_trajectory_csv_file(text, "t.csv", trajectory.name, trajectory.learning_samples(), 0.02, TrajectoryLimits{});
+  const Trajectory loaded = parse_trajectory_csv_file(text, "t.csv", trajectory.name, trajectory.learning_samples(),
+                                                      0.02, TrajectoryLimits{});
   EXPECT_EQ(loaded.name, trajectory.name);
   EXPECT_EQ(loaded.sample_time_s, trajectory.sample_time_s);
   ASSERT_EQ(loaded.joint(0).size(), trajectory.joint(0).size());
@@ -114,7 +114,8 @@ TEST(JsonReader, NamesThePathOfEveryFault) {
   const JsonReader r(json, "m.json");
   EXPECT_EQ(r["a"]["b"][0].number(), 1.0);
   EXPECT_EQ(error_of([&] { r["a"]["b"][1].number(); }), "m.json: /a/b/1: expected a number");
-  EXPECT_EQ(error_of([&] { r["a"]["b"][2].number(); }), "m.json: /a/b/2: expected a number, found null (not a number?)");
+  EXPECT_EQ(error_of([&] { r["a"]["b"][2].number(); }),
+            "m.json: /a/b/2: expected a number, found null (not a number?)");
   EXPECT_EQ(error_of([&] { r["a"]["c"]; }), "m.json: /a: missing \"c\"");
   EXPECT_EQ(error_of([&] { r["a"]["b"][9]; }), "m.json: /a/b: expected at least 10 elements");
   EXPECT_EQ(error_of([&] { r["n"].integer(0, 3); }), "m.json: /n: expected a whole number in [0, 3], found 5");
@@ -126,7 +127,8 @@ TEST(JsonReader, NamesThePathOfEveryFault) {
 TEST(JsonReader, RejectsIntegersOutsideTheRangeWithoutWrapping) {
   const auto json = parse_json(R"({"big": 18446744073709551615, "neg": -3, "real": 1.5})", "m.json");
   const JsonReader r(json, "m.json");
-  EXPECT_NE(error_of([&] { r["big"].integer(-10, 10); }).find("expected a whole number in [-10, 10]"), std::string::npos);
+  EXPECT_NE(error_of([&] { r["big"].integer(-10, 10); }).find("expected a whole number in [-10, 10]"),
+            std::string::npos);
   EXPECT_EQ(r["neg"].integer(-10, 10), -3);
   EXPECT_NE(error_of([&] { r["neg"].integer(0, 10); }).find("in [0, 10]"), std::string::npos);
   EXPECT_EQ(error_of([&] { r["real"].integer(0, 10); }), "m.json: /real: expected a whole number");
@@ -156,7 +158,8 @@ TEST(AtomicFile, RemovesLeftoversOfACrashedWriter) {
 }
 
 TEST(AtomicFile, ReportsWhyItCannotWrite) {
-  EXPECT_NE(error_of([] { write_file_atomic("/nonexistent-dir/f.txt", "x"); }).find("cannot create"), std::string::npos);
+  EXPECT_NE(error_of([] { write_file_atomic("/nonexistent-dir/f.txt", "x"); }).find("cannot create"),
+            std::string::npos);
   EXPECT_NE(error_of([] { read_file("/nonexistent-dir/f.txt"); }).find("No such file"), std::string::npos);
 }
 

@@ -140,7 +140,8 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
       }
     }
     for (int j = 0; j < joints; ++j) {
-      const std::vector<double> angle_deg = fixture_csv_column(fixture / "trajectory.csv", trajectory_column(j, joints));
+      const std::vector<double> angle_deg =
+          fixture_csv_column(fixture / "trajectory.csv", trajectory_column(j, joints));
       const Eigen::VectorXd& angle_rad = session.trajectory.joint(j);
       ASSERT_EQ(static_cast<std::size_t>(angle_rad.size()), angle_deg.size());
       EXPECT_NEAR(angle_rad(angle_rad.size() - 1) * 180.0 / M_PI, angle_deg.back(), 1e-12) << "joint " << j + 1;
@@ -150,13 +151,14 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
     const nlohmann::json& resume = raw["resume"];
     if (resume.contains("clock_ticks") && resume["device"].contains("time_s")) {
       const double tick_s = session.manifest.configuration.timing.tick_s;
-      EXPECT_EQ(std::llround(resume["device"]["time_s"].get<double>() / tick_s), resume["clock_ticks"].get<long long>());
+      EXPECT_EQ(std::llround(resume["device"]["time_s"].get<double>() / tick_s),
+                resume["clock_ticks"].get<long long>());
     }
     const int boxes = files_starting_with(fixture / "faults", "blackbox_");
     ASSERT_EQ(session.black_boxes.size(), static_cast<std::size_t>(boxes));
     for (std::size_t b = 0; b < session.black_boxes.size(); ++b) {
-      EXPECT_EQ(session.black_boxes[b].size(), fixture_csv_column(fixture / raw["black_boxes"][b]["file"].get<std::string>(),
-                                                                  "time_s").size());
+      EXPECT_EQ(session.black_boxes[b].size(),
+                fixture_csv_column(fixture / raw["black_boxes"][b]["file"].get<std::string>(), "time_s").size());
       // The fault tick last, whether the file names the fault or gives its code (before 59907e0).
       EXPECT_EQ(fault_name(session.black_boxes[b].back().fault), raw["black_boxes"][b]["fault"].get<std::string>());
     }
@@ -184,7 +186,8 @@ TEST(SessionFixtures, EveryJointsControllersAreReadFromEveryFormat) {
     ASSERT_EQ(state.joint_count, joints);
     std::vector<const nlohmann::json*> saved = {&controller};
     for (const auto& item : controller.items()) {
-      if (item.value().is_array()) for (const nlohmann::json& joint : item.value()) saved.push_back(&joint);
+      if (item.value().is_array())
+        for (const nlohmann::json& joint : item.value()) saved.push_back(&joint);
     }
     ASSERT_EQ(saved.size(), static_cast<std::size_t>(joints));
     for (int j = 0; j < joints; ++j) {
@@ -216,7 +219,8 @@ TEST(SessionFixtures, EveryFixtureIsShownAndExported) {
     EXPECT_EQ(report["integrity"][digests ? "unverified_files" : "verified_files"], 0) << report["integrity"];
     EXPECT_GT(report["integrity"][digests ? "verified_files" : "unverified_files"], 0) << report["integrity"];
     const fs::path csv = dir / "export.csv";
-    const ProcessResult exported = run_bellows({"sessions", "export", copy.string(), "--format", "csv", "--output", csv.string()});
+    const ProcessResult exported =
+        run_bellows({"sessions", "export", copy.string(), "--format", "csv", "--output", csv.string()});
     ASSERT_EQ(exported.exit_code, 0) << exported.err;
     const std::size_t rows_per_iteration = fixture_csv_column(fixture / "trajectory.csv", "time_s").size();
     EXPECT_EQ(fixture_csv_column(csv, "iteration").size(), raw["iterations"].size() * rows_per_iteration);
@@ -232,7 +236,8 @@ TEST(SessionFixtures, EveryFixtureResumesWithOneMoreIterationAndTheEarlierOnesUn
     // A fixture whose configuration injects a fault on the simulated arm ([plant] fault, at a device
     // time) meets it again: the resume continues the arm's clock exactly, so the next trial faults
     // as the saved run did, and keeps the new black box beside the saved ones.
-    const nlohmann::json* plant = before["configuration"].contains("plant") ? &before["configuration"]["plant"] : nullptr;
+    const nlohmann::json* plant =
+        before["configuration"].contains("plant") ? &before["configuration"]["plant"] : nullptr;
     const bool faults_again = plant != nullptr && plant->contains("fault") && (*plant)["fault"] != "none";
     const ProcessResult resumed = run_bellows({"run", "--resume", copy.string(), "--iterations", "1"});
     ASSERT_EQ(resumed.exit_code, faults_again ? 3 : 0) << resumed.err;
@@ -270,13 +275,15 @@ TEST(SessionFixtures, EveryFixtureResumesWithOneMoreIterationAndTheEarlierOnesUn
     EXPECT_EQ(after["started_utc"], before["started_utc"]);
     // Every key the fixture saved keeps its value; keys added since hold their defaults (as in a TOML file).
     for (const auto& [section, keys] : before["configuration"].items()) {
-      for (const auto& [key, value] : keys.items()) EXPECT_EQ(after["configuration"][section][key], value) << section << "." << key;
+      for (const auto& [key, value] : keys.items())
+        EXPECT_EQ(after["configuration"][section][key], value) << section << "." << key;
     }
     if (faults_again) continue;
     // The new iteration ran, on every joint, with the correction the fixture's last iteration learned.
     for (int j = 0; j < before["trajectory"].value("joints", 1); ++j) {
-      const std::vector<double> saved_next = fixture_csv_column(
-          fixture / before["iterations"][earlier - 1]["samples_file"].get<std::string>(), joint_column("u_ilc_next_bar", j));
+      const std::vector<double> saved_next =
+          fixture_csv_column(fixture / before["iterations"][earlier - 1]["samples_file"].get<std::string>(),
+                             joint_column("u_ilc_next_bar", j));
       const std::vector<double> applied = fixture_csv_column(
           copy / after["iterations"][earlier]["samples_file"].get<std::string>(), joint_column("u_ilc_bar", j));
       EXPECT_EQ(applied, saved_next) << "joint " << j + 1;
@@ -313,7 +320,8 @@ TEST(SessionVersions, AFirstFormatArmTimeThatCannotBeTheClocksIsRefusedInOneLine
 }
 
 TEST(SessionVersions, OnlyVersionsFromTheOldestToTheCurrentAreRead) {
-  nlohmann::json manifest = nlohmann::json::parse(read_text(kFixtureRoot / "2026-11-30-3060f58-plain" / "manifest.json"));
+  nlohmann::json manifest =
+      nlohmann::json::parse(read_text(kFixtureRoot / "2026-11-30-3060f58-plain" / "manifest.json"));
   for (int version = kOldestSessionSchemaVersion; version <= kSessionSchemaVersion; ++version) {
     manifest["schema_version"] = version;
     EXPECT_EQ(parse_manifest(manifest.dump(), "m").schema_version, version);

@@ -28,7 +28,9 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 Json read_manifest(const fs::path& session) { return Json::parse(testing::read_text(session / "manifest.json")); }
-void write_manifest(const fs::path& session, const Json& json) { testing::write_text(session / "manifest.json", json.dump(2)); }
+void write_manifest(const fs::path& session, const Json& json) {
+  testing::write_text(session / "manifest.json", json.dump(2));
+}
 
 /// One line on stderr, starting "bellows: ", containing `expected`, with exit status 2.
 void expect_refused(const ProcessResult& result, const std::string& expected) {
@@ -43,10 +45,12 @@ void expect_refused(const ProcessResult& result, const std::string& expected) {
 void expect_every_command_refuses(const fs::path& session, const std::string& expected) {
   expect_refused(run_bellows({"sessions", "show", session.string()}), expected);
   expect_refused(run_bellows({"sessions", "show", "--json", session.string()}), expected);
-  expect_refused(run_bellows({"sessions", "export", session.string(), "--output", (session.parent_path() / "x.csv").string()}),
-                 expected);
+  expect_refused(
+      run_bellows({"sessions", "export", session.string(), "--output", (session.parent_path() / "x.csv").string()}),
+      expected);
   const std::string manifest = fs::is_regular_file(fs::symlink_status(session / "manifest.json"))
-                                   ? testing::read_text(session / "manifest.json") : "";
+                                   ? testing::read_text(session / "manifest.json")
+                                   : "";
   expect_refused(run_bellows({"run", "--resume", session.string(), "--iterations", "1"}), expected);
   if (!manifest.empty()) {
     EXPECT_EQ(testing::read_text(session / "manifest.json"), manifest);
@@ -139,7 +143,8 @@ TEST_F(HostileSession, FifosAreRefusedWithoutHanging) {
 TEST_F(HostileSession, AManifestLargerThanItsFormatAllowsIsRefusedUnread) {
   fs::resize_file(session_ / "manifest.json", session_layout::kMostManifestBytes + 1);  // sparse: no disk used
   expect_every_command_refuses(session_, "manifest.json is " + std::to_string(session_layout::kMostManifestBytes + 1) +
-                                             " bytes, more than the " + std::to_string(session_layout::kMostManifestBytes));
+                                             " bytes, more than the " +
+                                             std::to_string(session_layout::kMostManifestBytes));
 }
 
 TEST_F(HostileSession, AnOversizedCsvIsRefusedUnread) {
@@ -186,8 +191,8 @@ TEST_F(HostileSession, AnEditedTrajectoryIsRefusedByItsDigest) {
   const std::size_t comma = text.find(',', line);
   text.replace(comma + 1, text.find('\n', comma) - comma - 1, "80");
   testing::write_text(session_ / "trajectory.csv", text);
-  expect_every_command_refuses(session_, "session " + session_.string() +
-                                             ": trajectory.csv was changed after it was saved: its SHA-256 digest");
+  expect_every_command_refuses(
+      session_, "session " + session_.string() + ": trajectory.csv was changed after it was saved: its SHA-256 digest");
 }
 
 TEST_F(HostileSession, EveryListedFileHasADigestThatShowVerifies) {
@@ -205,9 +210,9 @@ TEST_F(HostileSession, ASessionSavedBeforeDigestsOpensAsUnverified) {
   // A session as `bellows run` saves it, with its digests then taken out, as an older bellows wrote it.
   testing::write_short_run_files(dir_.path());
   const fs::path session = dir_ / "data" / "old";
-  const ProcessResult first = run_bellows({"run", "--trajectory", (dir_ / "short.csv").string(), "--config",
-                                           (dir_ / "short.toml").string(), "--iterations", "1", "--data-dir",
-                                           (dir_ / "data").string(), "--name", "old"});
+  const ProcessResult first =
+      run_bellows({"run", "--trajectory", (dir_ / "short.csv").string(), "--config", (dir_ / "short.toml").string(),
+                   "--iterations", "1", "--data-dir", (dir_ / "data").string(), "--name", "old"});
   ASSERT_EQ(first.exit_code, 0) << first.err;
   Json manifest = read_manifest(session);
   manifest["trajectory"].erase("sha256");
@@ -250,7 +255,9 @@ bool has_control_bytes(const std::string& text) {
 
 TEST_F(HostileSession, TextFromASessionReachesTheTerminalEscapedAndShortened) {
   const fs::path data = dir_ / "data";
-  const std::string attack = "\x1b]0;owned\x07\x1b[2J\xc2\x9b" "31m\xe2\x80\xae";
+  const std::string attack =
+      "\x1b]0;owned\x07\x1b[2J\xc2\x9b"
+      "31m\xe2\x80\xae";
   const fs::path session = data / ("evil" + attack);
   fs::create_directories(data);
   save_session(testing::simulate_session(1), session);
@@ -261,8 +268,8 @@ TEST_F(HostileSession, TextFromASessionReachesTheTerminalEscapedAndShortened) {
   manifest["events"][0]["kind"] = "kind" + attack;
   std::string many_lines;  // a console-log event is shown a line per row: a million rows is too many
   for (int i = 0; i < 1000000; ++i) many_lines += "12:00:00 operator: line\n";
-  manifest["events"].push_back({{"time_utc", "2024-05-01T12:00:00.000Z"}, {"iteration", 0}, {"kind", "console-log"},
-                                {"message", many_lines}});
+  manifest["events"].push_back(
+      {{"time_utc", "2024-05-01T12:00:00.000Z"}, {"iteration", 0}, {"kind", "console-log"}, {"message", many_lines}});
   write_manifest(session, manifest);
 
   const ProcessResult shown = run_bellows({"sessions", "show", session.string()});
@@ -324,7 +331,8 @@ TEST_F(HostileSession, CrLfCsvsAndAByteOrderMarkAreAccepted) {
 /// Runs bellows with its standard output on /dev/full; returns the exit status and stderr.
 ProcessResult run_into_full_disk(const TempDir& dir, const std::string& args) {
   const fs::path err = dir / "stderr.txt";
-  const int status = std::system(("'" + std::string(BELLOWS_BINARY) + "' " + args + " >/dev/full 2>'" + err.string() + "'").c_str());
+  const int status =
+      std::system(("'" + std::string(BELLOWS_BINARY) + "' " + args + " >/dev/full 2>'" + err.string() + "'").c_str());
   ProcessResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   result.err = testing::read_text(err);
@@ -333,9 +341,9 @@ ProcessResult run_into_full_disk(const TempDir& dir, const std::string& args) {
 
 TEST_F(HostileSession, AReportThatCannotBeWrittenIsAnErrorNotASilentSuccess) {
   ASSERT_TRUE(fs::exists("/dev/full"));
-  for (const std::string& args : {"sessions show --json '" + session_.string() + "'",
-                                 "sessions show '" + session_.string() + "'",
-                                 std::string("run --json --no-save --iterations 0")}) {
+  for (const std::string& args :
+       {"sessions show --json '" + session_.string() + "'", "sessions show '" + session_.string() + "'",
+        std::string("run --json --no-save --iterations 0")}) {
     SCOPED_TRACE(args);
     const ProcessResult result = run_into_full_disk(dir_, args);
     EXPECT_EQ(result.exit_code, 4);
@@ -348,11 +356,13 @@ TEST_F(HostileSession, AReportThatCannotBeWrittenIsAnErrorNotASilentSuccess) {
 
 TEST(HostileInput, AnEmptySessionNameIsRefusedNotIgnored) {
   TempDir dir;
-  const ProcessResult result = run_bellows({"run", "--iterations", "0", "--data-dir", (dir / "data").string(), "--name", ""});
+  const ProcessResult result =
+      run_bellows({"run", "--iterations", "0", "--data-dir", (dir / "data").string(), "--name", ""});
   expect_refused(result, "the session name must not be empty");
   EXPECT_FALSE(fs::exists(dir / "data"));
-  expect_refused(run_bellows({"run", "--iterations", "0", "--data-dir", (dir / "data").string(), "--name", "a\x1b[2Jb"}),
-                 "session name 'a\\e[2Jb' must be a plain directory name");
+  expect_refused(
+      run_bellows({"run", "--iterations", "0", "--data-dir", (dir / "data").string(), "--name", "a\x1b[2Jb"}),
+      "session name 'a\\e[2Jb' must be a plain directory name");
 }
 
 TEST(HostileInput, AConfigOrTrajectoryThatIsNotARegularFileIsRefusedWithoutHanging) {

@@ -184,8 +184,9 @@ TEST_P(JointSessions, RoundTripEveryJointAndExportIt) {
   const std::string samples_header_line = header_of_file(dir / "s" / session_layout::samples_file(0));
   EXPECT_EQ(samples_header_line.rfind("time_s,angle_setpoint_deg,angle_deg,", 0), 0u) << samples_header_line;
   EXPECT_NE(samples_header_line.find(",angle_deg_j" + std::to_string(joints) + ","), std::string::npos);
-  EXPECT_NE(header_of_file(dir / "s" / session_layout::telemetry_file(0)).find("inlet_a_duty_j" + std::to_string(joints)),
-            std::string::npos);
+  EXPECT_NE(
+      header_of_file(dir / "s" / session_layout::telemetry_file(0)).find("inlet_a_duty_j" + std::to_string(joints)),
+      std::string::npos);
   ASSERT_EQ(loaded.iterations.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     ASSERT_EQ(loaded.iterations[i].record.joint_count(), joints);
@@ -217,7 +218,8 @@ TEST_P(JointSessions, RoundTripEveryJointAndExportIt) {
   EXPECT_EQ(header_of_file(csv[1]), "iteration," + header_of_file(dir / "s" / session_layout::telemetry_file(0)));
   const std::string exported = testing::read_text(csv[0]);
   const std::string file = testing::read_text(dir / "s" / session_layout::samples_file(1));
-  const std::string first_row_of_iteration_1 = file.substr(file.find('\n') + 1, file.find('\n', file.find('\n') + 1) - file.find('\n'));
+  const std::string first_row_of_iteration_1 =
+      file.substr(file.find('\n') + 1, file.find('\n', file.find('\n') + 1) - file.find('\n'));
   EXPECT_NE(exported.find("\n1," + first_row_of_iteration_1), std::string::npos);
 
   // The MAT export, read by scipy: every joint's samples and telemetry, the trajectory's columns.
@@ -236,7 +238,9 @@ print(len(m["iterations"]), it.samples.__dict__["angle_deg_j%d" % j][5], it.tele
   Eigen::Index moved = 0;  // the sample where the last joint is farthest from 0
   loaded.trajectory.joint(last).cwiseAbs().maxCoeff(&moved);
   FILE* pipe = ::popen(("/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "out.mat").string() + " " +
-                        std::to_string(joints) + " " + std::to_string(moved) + " 2>&1").c_str(), "r");
+                        std::to_string(joints) + " " + std::to_string(moved) + " 2>&1")
+                           .c_str(),
+                       "r");
   ASSERT_NE(pipe, nullptr);
   char buffer[512] = {};
   const std::size_t got = std::fread(buffer, 1, sizeof buffer - 1, pipe);
@@ -262,14 +266,14 @@ INSTANTIATE_TEST_SUITE_P(Arms, JointSessions,
 TEST(JointSessionFiles, OneJointIsWrittenAsAlways) {
   // The headers of every session saved so far (the fixtures hold them too), and no joint count in
   // a one-joint manifest or resume state.
-  EXPECT_EQ(samples_header(1), (std::vector<std::string>{"time_s", "angle_setpoint_deg", "angle_deg", "error_deg",
-                                                          "u_pid_bar", "u_ilc_bar", "u_tot_bar", "pressure_a_bar",
-                                                          "pressure_b_bar", "pressure_a_setpoint_bar",
-                                                          "pressure_b_setpoint_bar", "u_ilc_next_bar"}));
-  EXPECT_EQ(telemetry_header(1), (std::vector<std::string>{"time_s", "angle_deg", "pressure_a_bar", "pressure_b_bar",
-                                                            "supply_bar", "pressure_a_setpoint_bar",
-                                                            "pressure_b_setpoint_bar", "inlet_a_duty", "outlet_a_duty",
-                                                            "inlet_b_duty", "outlet_b_duty"}));
+  EXPECT_EQ(samples_header(1),
+            (std::vector<std::string>{"time_s", "angle_setpoint_deg", "angle_deg", "error_deg", "u_pid_bar",
+                                      "u_ilc_bar", "u_tot_bar", "pressure_a_bar", "pressure_b_bar",
+                                      "pressure_a_setpoint_bar", "pressure_b_setpoint_bar", "u_ilc_next_bar"}));
+  EXPECT_EQ(telemetry_header(1),
+            (std::vector<std::string>{"time_s", "angle_deg", "pressure_a_bar", "pressure_b_bar", "supply_bar",
+                                      "pressure_a_setpoint_bar", "pressure_b_setpoint_bar", "inlet_a_duty",
+                                      "outlet_a_duty", "inlet_b_duty", "outlet_b_duty"}));
   EXPECT_EQ(trajectory_header(1), (std::vector<std::string>{"time_s", "angle_deg"}));
   const Session one = testing::simulate_session(1);
   const Json manifest = manifest_to_json(one.manifest);
@@ -281,8 +285,10 @@ TEST(JointSessionFiles, OneJointIsWrittenAsAlways) {
 
 TEST(JointSessionFiles, EveryColumnIsDocumented) {
   const std::string docs = testing::read_text(fs::path(BELLOWS_SOURCE_DIR) / "docs" / "session-format.md");
-  for (const auto& column : samples_record_columns()) EXPECT_NE(docs.find("`" + std::string(column.name) + "`"), std::string::npos) << column.name;
-  for (const auto& column : telemetry_record_columns()) EXPECT_NE(docs.find(std::string(column.name)), std::string::npos) << column.name;
+  for (const auto& column : samples_record_columns())
+    EXPECT_NE(docs.find("`" + std::string(column.name) + "`"), std::string::npos) << column.name;
+  for (const auto& column : telemetry_record_columns())
+    EXPECT_NE(docs.find(std::string(column.name)), std::string::npos) << column.name;
 }
 
 TEST(JointSessionState, TheChainsStateGoesThroughTheManifestBitForBit) {
@@ -325,7 +331,8 @@ TEST(JointSessionState, TheChainsStateGoesThroughTheManifestBitForBit) {
     restore_chain_state(two, Json::parse(text), "session S: manifest.json");
     ADD_FAILURE() << "a 3-joint state restored into a 2-joint arm";
   } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()), "session S: manifest.json: /resume/device/joints: the session's arm has 3 joints, this arm 2");
+    EXPECT_EQ(std::string(error.what()),
+              "session S: manifest.json: /resume/device/joints: the session's arm has 3 joints, this arm 2");
   }
 }
 
@@ -347,8 +354,10 @@ TEST(JointSessionState, ARunSavedAndResumedContinuesBitForBit) {
     ASSERT_TRUE(rig.core.send(EngineCommand::of(CommandKind::kArm)));
     rig.clock.step();
     for (int i = 0; i < 2; ++i) {
-      const TrialRecord record = rig.trial(trajectory, joint_correction(n, joints, i), static_cast<std::uint32_t>(i + 1));
-      recording.save(record, joint_correction(n, joints, i + 1), joint_summary(i, record), &rig.arm, rig.core, &rig.clock);
+      const TrialRecord record =
+          rig.trial(trajectory, joint_correction(n, joints, i), static_cast<std::uint32_t>(i + 1));
+      recording.save(record, joint_correction(n, joints, i + 1), joint_summary(i, record), &rig.arm, rig.core,
+                     &rig.clock);
     }
     continued = rig.trial(trajectory, joint_correction(n, joints, 2), 3);
   }
@@ -376,8 +385,10 @@ TEST(JointSessionState, ARunSavedAndResumedContinuesBitForBit) {
     other.restore(&three.arm, three.core, &three.clock);
     ADD_FAILURE() << "a 2-joint session resumed on a 3-joint arm";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("was recorded with an arm of 2 joints; this run drives a simulated arm of 3"),
-              std::string::npos) << error.what();
+    EXPECT_NE(
+        std::string(error.what()).find("was recorded with an arm of 2 joints; this run drives a simulated arm of 3"),
+        std::string::npos)
+        << error.what();
   }
 }
 

@@ -140,7 +140,8 @@ void expect_same_session(const Session& loaded, const Session& saved) {
     expect_same(x.joint_samples(0).pressure_b_bar, y.joint_samples(0).pressure_b_bar, "pressure B");
     expect_same(x.joint_samples(0).setpoint_a_bar, y.joint_samples(0).setpoint_a_bar, "set point A");
     expect_same(x.joint_samples(0).setpoint_b_bar, y.joint_samples(0).setpoint_b_bar, "set point B");
-    expect_same(loaded.iterations[i].next_corrections_bar(), saved.iterations[i].next_corrections_bar(), "next correction");
+    expect_same(loaded.iterations[i].next_corrections_bar(), saved.iterations[i].next_corrections_bar(),
+                "next correction");
     expect_same_times(x.tick_time_s, y.tick_time_s, "ticks time");
     expect_same_angles(x.joint_ticks(0).angle_rad, y.joint_ticks(0).angle_rad, "ticks angle");
     expect_same(x.joint_ticks(0).pressure_a_bar, y.joint_ticks(0).pressure_a_bar, "ticks pressure A");
@@ -165,8 +166,8 @@ TEST(SessionStore, SaveAndLoadGiveBackEveryFieldAndSample) {
   expect_same_session(loaded, saved);
   // Saving what was loaded writes the same files again.
   save_session(loaded, dir / "copy");
-  for (const std::string& file : std::vector<std::string>{session_layout::samples_file(2), session_layout::telemetry_file(3),
-                                                         session_layout::kTrajectory}) {
+  for (const std::string& file : std::vector<std::string>{
+           session_layout::samples_file(2), session_layout::telemetry_file(3), session_layout::kTrajectory}) {
     EXPECT_EQ(testing::read_text(dir / "copy" / file), testing::read_text(dir / "s" / file)) << file;
   }
 }
@@ -266,7 +267,8 @@ TEST(SessionWriter, AutosavesEveryIterationAndEvent) {
   EXPECT_EQ(loaded.manifest.events.back().kind, "fault");
   EXPECT_EQ(loaded.manifest.events.back().iteration, 3);
   for (std::size_t i = 0; i < 3; ++i) {
-    expect_same(loaded.iterations[i].next_corrections_bar(), simulated.iterations[i].next_corrections_bar(), "correction");
+    expect_same(loaded.iterations[i].next_corrections_bar(), simulated.iterations[i].next_corrections_bar(),
+                "correction");
     EXPECT_EQ(loaded.manifest.iterations[i].summary.rms_deg, simulated.manifest.iterations[i].summary.rms_deg);
   }
   // Out of order is a programming error, not bad input.
@@ -376,8 +378,9 @@ TEST(SessionLock, IsReleasedWhenTheHolderDiesEvenByKill) {
   }
   char byte;
   ASSERT_EQ(::read(ready[0], &byte, 1), 1);
-  EXPECT_NE(error_of([&] { SessionLock lock(dir / "s", "parent"); }).find("is in use by child (pid " + std::to_string(child)),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { SessionLock lock(dir / "s", "parent"); }).find("is in use by child (pid " + std::to_string(child)),
+      std::string::npos);
   ::kill(child, SIGKILL);
   ::waitpid(child, nullptr, 0);
   EXPECT_NO_THROW(SessionLock(dir / "s", "parent"));

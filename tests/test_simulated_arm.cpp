@@ -21,8 +21,9 @@ ValveCommand inlet_a(double duty) {
 }
 
 double predicted_inlet_rate_Pa_per_s(const PlantParameters& p, double chamber_Pa, double volume_m3) {
-  const double flow = p.valves_per_port * iso6358_mass_flow_kg_per_s(p.supply_bar * 1e5, chamber_Pa, p.valve_conductance_m3_per_sPa,
-                                                                    p.valve_critical_ratio, p.gas.reference_density_kg_per_m3);
+  const double flow =
+      p.valves_per_port * iso6358_mass_flow_kg_per_s(p.supply_bar * 1e5, chamber_Pa, p.valve_conductance_m3_per_sPa,
+                                                     p.valve_critical_ratio, p.gas.reference_density_kg_per_m3);
   return flow * p.gas.gas_constant_J_per_kgK * p.gas.temperature_K / volume_m3;
 }
 
@@ -109,7 +110,8 @@ double largest_bounce_back_bar(const PlantParameters& plant) {
   EngineCore core(arm, controller, timing, SafetyParameters{});
   SimulatedClock clock(core, arm);
   const Trajectory paper = library_trajectory("paper", timing.sample_s());
-  NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{}, paper.learning_samples());
+  NormOptimalDense law(discretize_arm_model(ModelParameters{}, timing.sample_s()), IlcParameters{},
+                       paper.learning_samples());
   LearningSession session(clock, law, paper, timing, controller);
   session.run_trial();
   const TrialRecord& record = session.last_record();
@@ -127,7 +129,7 @@ TEST(SimulatedArm, FastMoveMakesTheDeflatingBellowsPushBack) {
   const double with_gas_law = largest_bounce_back_bar(plant);
   plant.volume_gain_per_rad = 0.0;  // no volume change: no compression of the shrinking bellows
   const double without = largest_bounce_back_bar(plant);
-  EXPECT_GT(with_gas_law, 0.01);        // more than 10 mbar above its set point
+  EXPECT_GT(with_gas_law, 0.01);  // more than 10 mbar above its set point
   EXPECT_GT(with_gas_law, 2.0 * without);
 }
 

@@ -46,7 +46,8 @@ TEST(SimulatedArmChain, OneJointReadsAsTheSingleJointSimulatedArm) {
     ASSERT_EQ(a.time_s, b.time_s);
     ASSERT_EQ(a.supply_bar, b.supply_bar);  // the same noise, drawn in the same order
     ASSERT_EQ(a.temperature_K, b.temperature_K);
-    for (int c = 0; c < 2; ++c) EXPECT_NEAR(a.joint[0].chamber_bar[c], b.joint[0].chamber_bar[c], 1e-9) << "tick " << tick;
+    for (int c = 0; c < 2; ++c)
+      EXPECT_NEAR(a.joint[0].chamber_bar[c], b.joint[0].chamber_bar[c], 1e-9) << "tick " << tick;
     if (a.joint[0].angle_rad != b.joint[0].angle_rad) ++readings_differing;  // only on a quantization edge
     EXPECT_NEAR(a.joint[0].angle_rad, b.joint[0].angle_rad, 0.1 * std::numbers::pi / 180.0 + 1e-12);
     largest_angle = std::max(largest_angle, std::abs(a.joint[0].angle_rad));

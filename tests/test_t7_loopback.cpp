@@ -66,7 +66,11 @@ bool eventually(const std::function<bool()>& done) {
 TEST(T7Loopback, ConnectingConfiguresTheWatchdogAndLeavesTheValvesVented) {
   SimThread sim;
   T7Device device(device_options(sim.port()));
-  ASSERT_TRUE(eventually([&] { const T7SimStatus s = sim.status(); return s.requests > 30 && s.watchdog_enabled && s.last_request_s > 0.0 && device.health().exchanges > 3 && s.requests > 60; }));
+  ASSERT_TRUE(eventually([&] {
+    const T7SimStatus s = sim.status();
+    return s.requests > 30 && s.watchdog_enabled && s.last_request_s > 0.0 && device.health().exchanges > 3 &&
+           s.requests > 60;
+  }));
   const T7SimStatus s = sim.status();
   EXPECT_EQ(s.watchdog_timeout_s, 1u);
   EXPECT_TRUE(s.safe);
@@ -97,7 +101,7 @@ TEST(T7Loopback, DutyCyclesReachTheLinesAndCalibratedReadingsComeBack) {
     return r.time_s > 0.0;
   }));
   const PlantParameters plant;
-  EXPECT_NEAR(r.supply_bar, plant.supply_bar, 0.05);            // through volts and back
+  EXPECT_NEAR(r.supply_bar, plant.supply_bar, 0.05);  // through volts and back
   EXPECT_NEAR(r.temperature_K, plant.gas.temperature_K, 0.5);
   EXPECT_LT(std::abs(r.joint[0].angle_rad), 0.2);
   EXPECT_GT(r.joint[0].chamber_bar[0], 0.9);
@@ -161,8 +165,9 @@ double highest_chamber_bar_while_inlets_open(const RigLimits& limits, T7SimStatu
   ValveCommand both_inlets_open;  // both chambers fill: the arm stays near its middle
   both_inlets_open.joint[0].inlet_duty = {1.0, 1.0};
   both_inlets_open.joint[0].outlet_duty = {0.0, 0.0};
-  return largest_while_writing(limits, both_inlets_open,
-                               [](const T7SimStatus& s) { return std::max(s.chamber_bar[0], s.chamber_bar[1]); }, last);
+  return largest_while_writing(
+      limits, both_inlets_open, [](const T7SimStatus& s) { return std::max(s.chamber_bar[0], s.chamber_bar[1]); },
+      last);
 }
 
 TEST(T7Loopback, TheRigKeepsItsPressureCeilingWhateverTheClientWrites) {
@@ -187,7 +192,8 @@ double widest_angle_rad_while_turning(const RigLimits& limits, T7SimStatus& last
   ValveCommand turn;
   turn.joint[0].inlet_duty = {1.0, 0.0};
   turn.joint[0].outlet_duty = {0.0, 1.0};
-  return largest_while_writing(limits, turn, [](const T7SimStatus& s) { return std::abs(s.angle_rad); }, last);
+  return largest_while_writing(
+      limits, turn, [](const T7SimStatus& s) { return std::abs(s.angle_rad); }, last);
 }
 
 TEST(T7Loopback, AnArmBeyondTheRigsAngleRangeIsVentedWhateverTheClientWrites) {
@@ -362,7 +368,8 @@ TEST(T7Loopback, AnAddressWhereNothingListensIsAnEnvironmentError) {
     T7Device device(options);
     FAIL() << "connected to nothing";
   } catch (const EnvironmentError& error) {
-    EXPECT_NE(std::string(error.what()).find("t7 127.0.0.1:" + std::to_string(port) + ": cannot connect"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("t7 127.0.0.1:" + std::to_string(port) + ": cannot connect"),
+              std::string::npos)
         << error.what();
   }
 }
@@ -410,7 +417,8 @@ TEST(T7SimStrict, RefusesWhatLabJackDocumentsAT7Refuses) {
   EXPECT_EQ(t7.u32(t7::kDioEfIndex(2), 1), P(failure, 2566)) << "a new index while enabled";
   EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 13), P(t7::kExceptionIllegalDataValue, 1203));
   EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 12), P(0, 0)) << "a T7-Pro samples at 12";
-  EXPECT_EQ(t7.refusal_of(t7.client.write_float(t7::kAin(0), 1.0)), P(t7::kExceptionIllegalDataAddress, 1202)) << "read only";
+  EXPECT_EQ(t7.refusal_of(t7.client.write_float(t7::kAin(0), 1.0)), P(t7::kExceptionIllegalDataAddress, 1202))
+      << "read only";
   std::uint16_t r[2];
   EXPECT_EQ(t7.refusal_of(t7.client.read(12345, 2, r)), P(t7::kExceptionIllegalDataAddress, 1202)) << "no such address";
   ASSERT_TRUE(eventually([&] { return sim.status().exceptions == 10u; })) << sim.status().exceptions;
@@ -449,12 +457,14 @@ TEST(T7SimStrict, BellowsSendsNothingAT7WouldRefuseAndHoldsOneConnection) {
     }
     ASSERT_TRUE(eventually([&] { return sim.status().clients == 0; }));
     {
-      T7Device again(device_options(sim.port()));  // what the first left running (clock 0, PWM) is reconfigured as documented
+      T7Device again(
+          device_options(sim.port()));  // what the first left running (clock 0, PWM) is reconfigured as documented
       ASSERT_TRUE(eventually([&] { return again.health().exchanges > 5; }));
     }
     ASSERT_TRUE(eventually([&] { return sim.status().clients == 0; }));
     const T7SimStatus s = sim.status();
-    EXPECT_EQ(s.exceptions, 0u) << "LabJack error " << s.last_refused_error << " (" << t7::error_name(s.last_refused_error) << ")";
+    EXPECT_EQ(s.exceptions, 0u) << "LabJack error " << s.last_refused_error << " ("
+                                << t7::error_name(s.last_refused_error) << ")";
     EXPECT_EQ(s.refusals, 0u);
     EXPECT_EQ(s.max_clients, 1) << "never two connections at once";
     EXPECT_TRUE(s.safe);
@@ -537,8 +547,10 @@ TEST(T7Connect, ASlowDeviceEndsTheConnectWithinItsTimeoutNamingTheAddress) {
     FAIL() << "configured a T7 that needs a minute for it";
   } catch (const EnvironmentError& error) {
     const std::string what = error.what();
-    EXPECT_NE(what.find("t7 127.0.0.1:" + std::to_string(sim.port()) + ": no answer within [t7] connect_timeout_s = 2 s"),
-              std::string::npos) << what;
+    EXPECT_NE(
+        what.find("t7 127.0.0.1:" + std::to_string(sim.port()) + ": no answer within [t7] connect_timeout_s = 2 s"),
+        std::string::npos)
+        << what;
   }
   EXPECT_LT(monotonic_seconds() - start, 2.0 + 1.0);
 }

@@ -62,15 +62,18 @@ class T7Processes : public ::testing::Test {
   }
 
   /// The runs tolerate a loaded test machine's scheduling (CI runs tests two at a time beside
-  /// builds): a 0.5 s answer, a 0.5 s command timeout of the link, 400 stale ticks, long missed-deadline streaks. The guards have their
-  /// own tests; the link's timing is the benchmark's business (bench/t7_round_trip.sh).
+  /// builds): a 0.5 s answer, a 0.5 s command timeout of the link, 400 stale ticks, long missed-deadline streaks. The
+  /// guards have their own tests; the link's timing is the benchmark's business (bench/t7_round_trip.sh).
   std::unique_ptr<Child> start_run(int iterations, const std::string& name) {
     const std::filesystem::path config =
-        testing::write_file(dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
-    return std::make_unique<Child>(
-        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try",  // a rig: the wall clock
-                                 "--config", config.string(), "--iterations", std::to_string(iterations), "--json", "--no-save"},
-        dir_ / (name + ".out"), dir_ / (name + ".err"));
+        testing::write_file(dir_, "loaded.toml",
+                            "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = "
+                            "400\nmissed_deadline_streak = 100000\n");
+    return std::make_unique<Child>(std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt",
+                                                            "try",  // a rig: the wall clock
+                                                            "--config", config.string(), "--iterations",
+                                                            std::to_string(iterations), "--json", "--no-save"},
+                                   dir_ / (name + ".out"), dir_ / (name + ".err"));
   }
 
   /// Runs bellows with `args` to the end (sessions into this test's XDG_DATA_HOME).
@@ -85,8 +88,10 @@ class T7Processes : public ::testing::Test {
     return r;
   }
 
-  bool no_session_saved() const { return !std::filesystem::exists(dir_ / "xdg" / "bellows" / "sessions") ||
-                                         std::filesystem::is_empty(dir_ / "xdg" / "bellows" / "sessions"); }
+  bool no_session_saved() const {
+    return !std::filesystem::exists(dir_ / "xdg" / "bellows" / "sessions") ||
+           std::filesystem::is_empty(dir_ / "xdg" / "bellows" / "sessions");
+  }
 
   nlohmann::json status() const {
     std::ifstream in(status_);
@@ -108,7 +113,8 @@ class T7Processes : public ::testing::Test {
   bool wait_for_trial() {
     return wait_for([&] {
       const nlohmann::json s = status();
-      return s.contains("valves") && (s["valves"]["inlet_a"].get<double>() > 0.0 || s["valves"]["inlet_b"].get<double>() > 0.0);
+      return s.contains("valves") &&
+             (s["valves"]["inlet_a"].get<double>() > 0.0 || s["valves"]["inlet_b"].get<double>() > 0.0);
     });
   }
 
@@ -128,8 +134,8 @@ TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
   auto run = start_run(1, "run");
   ASSERT_EQ(run->wait(120.0), 0) << run->err();
   const nlohmann::json t7 = nlohmann::json::parse(run->out());
-  const testing::ProcessResult local =
-      testing::run_process(kBellows + " run --iterations 1 --json --no-save --seed 1 --config " + (dir_ / "loaded.toml").string());
+  const testing::ProcessResult local = testing::run_process(
+      kBellows + " run --iterations 1 --json --no-save --seed 1 --config " + (dir_ / "loaded.toml").string());
   ASSERT_EQ(local.exit_code, 0) << local.err;
   const std::vector<double> remote_rms = rms_of(t7), local_rms = rms_of(nlohmann::json::parse(local.out));
   ASSERT_EQ(remote_rms.size(), local_rms.size());
@@ -137,7 +143,7 @@ TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
     EXPECT_NEAR(remote_rms[i], local_rms[i], 0.15 * local_rms[i]) << "iteration " << i;
   }
   EXPECT_EQ(t7.at("device"), "t7");
-  EXPECT_EQ(t7.at("clock"), "wall");  // no --clock: a rig runs on the wall clock
+  EXPECT_EQ(t7.at("clock"), "wall");                        // no --clock: a rig runs on the wall clock
   EXPECT_EQ(t7.at("model").at("source"), "configuration");  // the built-in profile has no [model]
   EXPECT_EQ(t7.at("model").at("kappa_rad_per_bar"), Configuration{}.model.kappa_rad_per_bar);
   const nlohmann::json link = t7.at("loop").at("link");
@@ -207,11 +213,13 @@ TEST_F(T7Processes, T7SimStoppedMidTrialFaultsTheRunNamingTheLink) {
 TEST_F(T7Processes, ATricklingLinkEndsTheRunVentedWithinTheStaleLimitAndOneResponseTimeout) {
   auto sim = start_sim({"--trickle-after", "1.5"});
   const std::filesystem::path config = testing::write_file(
-      dir_, "trickle.toml", "[t7]\nresponse_timeout_s = 0.004\n[safety]\nstale_ticks = 40\nmissed_deadline_streak = 100000\n");
-  Child run({kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config", config.string(), "--iterations", "3",
-             "--json", "--no-save"},
+      dir_, "trickle.toml",
+      "[t7]\nresponse_timeout_s = 0.004\n[safety]\nstale_ticks = 40\nmissed_deadline_streak = 100000\n");
+  Child run({kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config", config.string(),
+             "--iterations", "3", "--json", "--no-save"},
             dir_ / "run.out", dir_ / "run.err");
-  ASSERT_TRUE(wait_for([&] { return sim->out().find("answers trickle from now on") != std::string::npos; })) << sim->out();
+  ASSERT_TRUE(wait_for([&] { return sim->out().find("answers trickle from now on") != std::string::npos; }))
+      << sim->out();
   const auto trickle = std::chrono::steady_clock::now();
   ASSERT_EQ(run.wait(30.0), 3) << run.err();
   const double after_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - trickle).count();
@@ -239,10 +247,12 @@ TEST_F(T7Processes, ConnectingIsBoundedAndEndsAtOnceOnSigint) {
 
   const std::filesystem::path bounded = testing::write_file(dir_, "bounded.toml", "[t7]\nconnect_timeout_s = 2\n");
   const auto start = std::chrono::steady_clock::now();
-  const testing::ProcessResult r = run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", bounded.string(), "--no-save"});
+  const testing::ProcessResult r =
+      run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", bounded.string(), "--no-save"});
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0 + 1.0);
   EXPECT_EQ(r.exit_code, 4) << r.err;
-  EXPECT_NE(r.err.find("t7 " + address_ + ": no answer within [t7] connect_timeout_s = 2 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("t7 " + address_ + ": no answer within [t7] connect_timeout_s = 2 s"), std::string::npos)
+      << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_TRUE(no_session_saved());
 }
@@ -264,10 +274,11 @@ TEST_F(T7Processes, RigCheckWithoutAReadingSaysSoAndFails) {
 // then a good valve reads as dead (about 1 run in 7 under the suite's load).
 TEST_F(T7Processes, RigCheckPassesEveryValveOnTheStrictT7Pro) {
   auto sim = start_sim();
-  const std::filesystem::path config = testing::write_file(
-      dir_, "loaded.toml",
-      "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n"
-      "[rig_check]\nvalve_pulse_s = 0.1\n");
+  const std::filesystem::path config =
+      testing::write_file(dir_, "loaded.toml",
+                          "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = "
+                          "400\nmissed_deadline_streak = 100000\n"
+                          "[rig_check]\nvalve_pulse_s = 0.1\n");
   const testing::ProcessResult r =
       run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", config.string(), "--no-save", "--yes"});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -307,20 +318,23 @@ std::string text_of(const std::filesystem::path& path) {
   return text.str();
 }
 
-std::string paper_profile_text() { return text_of(std::filesystem::path(BELLOWS_SOURCE_DIR) / "profiles" / "paper-rig.toml"); }
+std::string paper_profile_text() {
+  return text_of(std::filesystem::path(BELLOWS_SOURCE_DIR) / "profiles" / "paper-rig.toml");
+}
 
 // The first day's identification on a T7 (t7-sim): the trials run through the rig, the fit goes into
 // the rig profile's [model], and all of it is recorded in a session (the device with its address and
 // rig profile, the identification trial as iteration 0, the fit, what was written where).
 TEST_F(T7Processes, IdentifyOnAT7StoresTheModelInTheProfileAndRecordsASession) {
   const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", paper_profile_text());
-  const std::filesystem::path config = testing::write_file(
-      dir_, "identify.toml",
-      "[identify]\nduration_s = 6.0\n[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+  const std::filesystem::path config =
+      testing::write_file(dir_, "identify.toml",
+                          "[identify]\nduration_s = 6.0\n[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = "
+                          "0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
   auto sim = start_sim();
   const testing::ProcessResult r =
-      run_cli({"identify", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",
-               config.string(), "--write-model", profile.string(), "--json"});
+      run_cli({"identify", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try",
+               "--config", config.string(), "--write-model", profile.string(), "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["written_as"], "rig_profile");
@@ -337,8 +351,9 @@ TEST_F(T7Processes, IdentifyOnAT7StoresTheModelInTheProfileAndRecordsASession) {
   bool fitted = false, written = false;
   for (const nlohmann::json& e : session["events"]) {
     fitted = fitted || e["kind"] == "identify-fit";
-    written = written || (e["kind"] == "model-written" &&
-                          e["message"].get<std::string>().find("into the rig profile " + profile.string()) != std::string::npos);
+    written = written ||
+              (e["kind"] == "model-written" &&
+               e["message"].get<std::string>().find("into the rig profile " + profile.string()) != std::string::npos);
   }
   EXPECT_TRUE(fitted) << session["events"];
   EXPECT_TRUE(written) << session["events"];
@@ -354,8 +369,10 @@ TEST_F(T7Processes, RunLearnsWithTheRigProfilesIdentifiedModel) {
   text.replace(text.find(name_line), name_line.size(), "name = \"bench-rig\"");
   text += "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
   const std::filesystem::path profile = testing::write_file(dir_, "bench-rig.toml", text);
-  const std::filesystem::path config = testing::write_file(
-      dir_, "loaded.toml", "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = 400\nmissed_deadline_streak = 100000\n");
+  const std::filesystem::path config =
+      testing::write_file(dir_, "loaded.toml",
+                          "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = "
+                          "400\nmissed_deadline_streak = 100000\n");
   auto sim = start_sim();
   const testing::ProcessResult r =
       run_cli({"run", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "try", "--config",
@@ -367,7 +384,8 @@ TEST_F(T7Processes, RunLearnsWithTheRigProfilesIdentifiedModel) {
   EXPECT_EQ(report["model"]["kappa_rad_per_bar"], 6.5);
   EXPECT_EQ(report["model"]["omega0_rad_per_s"], 12.0);
   EXPECT_EQ(report["model"]["damping"], 0.4);
-  const nlohmann::json manifest = nlohmann::json::parse(text_of(std::filesystem::path(report["session"].get<std::string>()) / "manifest.json"));
+  const nlohmann::json manifest =
+      nlohmann::json::parse(text_of(std::filesystem::path(report["session"].get<std::string>()) / "manifest.json"));
   EXPECT_EQ(manifest["model"]["source"], "rig_profile");
   EXPECT_EQ(manifest["model"]["kappa_rad_per_bar"], 6.5);
   EXPECT_EQ(manifest["configuration"]["model"]["kappa"], 6.5);
@@ -375,7 +393,8 @@ TEST_F(T7Processes, RunLearnsWithTheRigProfilesIdentifiedModel) {
   EXPECT_EQ(manifest["device_info"]["rig_profile"], "bench-rig");
   const testing::ProcessResult shown = run_cli({"sessions", "show", report["session"].get<std::string>()});
   ASSERT_EQ(shown.exit_code, 0) << shown.err;
-  EXPECT_NE(shown.out.find("model        kappa 6.5 rad/bar, omega0 12 1/s, damping 0.4 (from the rig_profile)"), std::string::npos)
+  EXPECT_NE(shown.out.find("model        kappa 6.5 rad/bar, omega0 12 1/s, damping 0.4 (from the rig_profile)"),
+            std::string::npos)
       << shown.out;
 }
 
@@ -389,7 +408,8 @@ TEST_F(T7Processes, ZeroingTheAngleWritesTheProfileAndTheArmThenReadsZero) {
   ASSERT_NE(text.find(zero_line), std::string::npos);
   text.replace(text.find(zero_line), zero_line.size(), "angle_zero_rad = 0.1");
   const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", text);
-  const std::vector<std::string> device = {"--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "off"};
+  const std::vector<std::string> device = {"--device",       "t7",   "--t7", address_, "--rig-profile",
+                                           profile.string(), "--rt", "off"};
   std::vector<std::string> zero = {"rig", "check", "--zero-angle", "--json"};
   zero.insert(zero.end(), device.begin(), device.end());
   const testing::ProcessResult r = run_cli(zero);
@@ -409,7 +429,8 @@ TEST_F(T7Processes, ZeroingTheAngleWritesTheProfileAndTheArmThenReadsZero) {
   EXPECT_NEAR(nlohmann::json::parse(after.out)["reading"]["angle_deg"].get<double>(), 0.0, 1.0);
 
   // The built-in profile has no file to write: one line, exit 2.
-  const testing::ProcessResult builtin = run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_, "--rt", "off"});
+  const testing::ProcessResult builtin =
+      run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_, "--rt", "off"});
   EXPECT_EQ(builtin.exit_code, 2);
   EXPECT_NE(builtin.err.find("--rig-profile FILE"), std::string::npos) << builtin.err;
 }
@@ -419,9 +440,11 @@ TEST_F(T7Processes, ZeroingTheAngleWritesTheProfileAndTheArmThenReadsZero) {
 TEST_F(T7Processes, ZeroingRidesOutALateAnswer) {
   auto sim = start_sim({"--stall-after", "0.3", "--stall-s", "0.2"});
   const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", paper_profile_text());
-  const std::filesystem::path config = testing::write_file(dir_, "slow-zero.toml", "[rig_check]\nzero_readings = 200\n");
-  const testing::ProcessResult r = run_cli({"rig", "check", "--zero-angle", "--json", "--device", "t7", "--t7", address_,
-                                            "--rig-profile", profile.string(), "--rt", "off", "--config", config.string()});
+  const std::filesystem::path config =
+      testing::write_file(dir_, "slow-zero.toml", "[rig_check]\nzero_readings = 200\n");
+  const testing::ProcessResult r =
+      run_cli({"rig", "check", "--zero-angle", "--json", "--device", "t7", "--t7", address_, "--rig-profile",
+               profile.string(), "--rt", "off", "--config", config.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["angle_zero"]["readings"], 200);
   EXPECT_NE(r.err.find("answers again"), std::string::npos) << r.err;
@@ -439,8 +462,9 @@ TEST_F(T7Processes, ZeroingEndsWhenTheLinkFallsSilentAndLeavesTheProfile) {
   const std::filesystem::path profile = testing::write_file(dir_, "my-rig.toml", text);
   const std::filesystem::path config = testing::write_file(
       dir_, "endless-zero.toml", "[rig_check]\nzero_readings = 1000000\n[t7]\nconnect_timeout_s = 2.5\n");
-  const testing::ProcessResult r = run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_,
-                                            "--rig-profile", profile.string(), "--rt", "off", "--config", config.string()});
+  const testing::ProcessResult r =
+      run_cli({"rig", "check", "--zero-angle", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(),
+               "--rt", "off", "--config", config.string()});
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("--zero-angle: no fresh reading from " + address_ + " for 2.5 s"), std::string::npos) << r.err;
   EXPECT_EQ(text_of(profile), text);
@@ -451,7 +475,8 @@ TEST_F(T7Processes, ZeroingEndsWhenTheLinkFallsSilentAndLeavesTheProfile) {
 // for every device).
 TEST_F(T7Processes, IdentifyWritesTheModelIntoARigProfile) {
   const std::filesystem::path profile = testing::write_file(dir_, "rig.toml", paper_profile_text());
-  const testing::ProcessResult r = run_cli({"identify", "--device", "sim", "--write-model", profile.string(), "--json"});
+  const testing::ProcessResult r =
+      run_cli({"identify", "--device", "sim", "--write-model", profile.string(), "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["written_as"], "rig_profile");
@@ -460,17 +485,19 @@ TEST_F(T7Processes, IdentifyWritesTheModelIntoARigProfile) {
   EXPECT_NE(written.find("# fitted by bellows identify"), std::string::npos) << written;
   // The profile with its model is valid: a rig check on it reads it.
   auto sim = start_sim();
-  const testing::ProcessResult check =
-      run_cli({"rig", "check", "--inputs-only", "--device", "t7", "--t7", address_, "--rig-profile", profile.string(), "--rt", "off"});
+  const testing::ProcessResult check = run_cli({"rig", "check", "--inputs-only", "--device", "t7", "--t7", address_,
+                                                "--rig-profile", profile.string(), "--rt", "off"});
   EXPECT_EQ(check.exit_code, 0) << check.err;
 }
 
 TEST_F(T7Processes, ABadRigProfileIsOneLineNamingFileAndKeyAndNoSession) {
-  const std::filesystem::path profile = testing::write_file(dir_, "bad.toml", "name = \"x\"\n[inputs.humidity]\nain = 7\n");
+  const std::filesystem::path profile =
+      testing::write_file(dir_, "bad.toml", "name = \"x\"\n[inputs.humidity]\nain = 7\n");
   const testing::ProcessResult r =
       run_cli({"run", "--device", "t7", "--t7", address_, "--clock", "wall", "--rig-profile", profile.string()});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_EQ(r.err, "bellows: rig profile " + profile.string() + ": [inputs.humidity]: unknown input (chamber_a, chamber_b, supply, angle, temperature)\n");
+  EXPECT_EQ(r.err, "bellows: rig profile " + profile.string() +
+                       ": [inputs.humidity]: unknown input (chamber_a, chamber_b, supply, angle, temperature)\n");
   EXPECT_TRUE(no_session_saved());
 }
 

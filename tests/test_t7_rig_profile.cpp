@@ -75,7 +75,8 @@ TEST(RigProfile, ALineUsedTwiceIsRefused) {
 }
 
 TEST(RigProfile, AnInputUsedTwiceIsRefused) {
-  const std::string text = replaced(paper_rig_profile_text(), "[inputs.chamber_b]\nain = 1", "[inputs.chamber_b]\nain = 0");
+  const std::string text =
+      replaced(paper_rig_profile_text(), "[inputs.chamber_b]\nain = 1", "[inputs.chamber_b]\nain = 0");
   const std::string message = error_of(text);
   EXPECT_NE(message.find("[inputs.chamber_b] ain"), std::string::npos) << message;
   EXPECT_NE(message.find("already chamber_a's input"), std::string::npos) << message;
@@ -88,8 +89,11 @@ TEST(RigProfile, ALineThatCannotCarryPwmIsRefused) {
 
 TEST(RigProfile, ACalibrationMappingTheValidRangeToNonsenseIsRefused) {
   // A gain in mbar per volt: 9.9 V would read 9901 bar.
-  const std::string text = replaced(paper_rig_profile_text(), "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1.0",
-                                    "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1000.0");
+  const std::string text = replaced(paper_rig_profile_text(),
+                                    "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar "
+                                    "relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1.0",
+                                    "[inputs.supply]\nain = 2\npart = \"Buerkert 8230 pressure transmitter, 0-10 bar "
+                                    "relative, 0-10 V\"\nrange_V = 10.0\ngain_per_V = 1000.0");
   const std::string message = error_of(text);
   EXPECT_NE(message.find("bad.toml: [inputs.supply] gain_per_V"), std::string::npos) << message;
   EXPECT_NE(message.find("outside anything a supply sensor can read"), std::string::npos) << message;
@@ -101,10 +105,14 @@ TEST(RigProfile, ValidVoltagesOutsideTheInputRangeAreRefused) {
 }
 
 TEST(RigProfile, UnknownKeysMissingValvesAndBadTypesAreRefused) {
-  EXPECT_NE(error_of("colour = \"red\"\n" + paper_rig_profile_text()).find("bad.toml: colour: unknown key"), std::string::npos);
-  EXPECT_NE(error_of(paper_rig_profile_text() + "\ninlet_c = 0\n").find("[valves] inlet_c: unknown valve"), std::string::npos);
-  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "outlet_b = 5\n", "")).find("[valves] outlet_b: missing"), std::string::npos);
-  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "ain = 4", "ain = \"four\"")).find("[inputs.temperature] ain: expected a whole number"),
+  EXPECT_NE(error_of("colour = \"red\"\n" + paper_rig_profile_text()).find("bad.toml: colour: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(paper_rig_profile_text() + "\ninlet_c = 0\n").find("[valves] inlet_c: unknown valve"),
+            std::string::npos);
+  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "outlet_b = 5\n", "")).find("[valves] outlet_b: missing"),
+            std::string::npos);
+  EXPECT_NE(error_of(replaced(paper_rig_profile_text(), "ain = 4", "ain = \"four\""))
+                .find("[inputs.temperature] ain: expected a whole number"),
             std::string::npos);
   EXPECT_NE(error_of("name = [").find("bad.toml:1"), std::string::npos) << error_of("name = [");
 }
@@ -132,25 +140,33 @@ TEST(RigProfile, AFifoIsRefusedWithoutWaiting) {
 }
 
 TEST(RigProfile, AnIdentifiedModelIsRead) {
-  const std::string text = paper_rig_profile_text() + "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
+  const std::string text =
+      paper_rig_profile_text() + "\n[model]\nkappa_rad_per_bar = 6.5\nomega0_rad_per_s = 12.0\ndamping = 0.4\n";
   const RigProfile p = parse_rig_profile(text, "rig.toml");
   ASSERT_TRUE(p.model.has_value());
   EXPECT_DOUBLE_EQ(p.model->kappa_rad_per_bar, 6.5);
-  EXPECT_NE(error_of(paper_rig_profile_text() + "\n[model]\ndamping = -1\n").find("[model] damping"), std::string::npos);
+  EXPECT_NE(error_of(paper_rig_profile_text() + "\n[model]\ndamping = -1\n").find("[model] damping"),
+            std::string::npos);
 }
 
 // What the first day learns goes into the profile file: only the keys concerned change (comments
 // and everything else stay), the result is a valid profile, and a value that would make it invalid
 // leaves the file as it was.
 TEST(TomlKeyEdit, SetsKeysInPlaceAddsMissingOnesAndKeepsComments) {
-  const std::string text = "# my rig\nname = \"r\"  # its name\nangle_zero_rad = 0.0\n\n[valves]\ninlet_a = 2\n\n[model]\n# fitted\ndamping = 0.3\n";
-  const std::string top = with_table_values(text, "", {{"angle_zero_rad", "0.25"}, {"pwm_frequency_hz", "100.0"}}, "why");
+  const std::string text =
+      "# my rig\nname = \"r\"  # its name\nangle_zero_rad = 0.0\n\n[valves]\ninlet_a = 2\n\n[model]\n# fitted\ndamping "
+      "= 0.3\n";
+  const std::string top =
+      with_table_values(text, "", {{"angle_zero_rad", "0.25"}, {"pwm_frequency_hz", "100.0"}}, "why");
   EXPECT_NE(top.find("angle_zero_rad = 0.25  # why\n"), std::string::npos) << top;
   EXPECT_EQ(top.find("angle_zero_rad = 0.0"), std::string::npos) << top;
-  EXPECT_LT(top.find("pwm_frequency_hz = 100.0"), top.find("[valves]")) << "a top-level key goes before the first table\n" << top;
+  EXPECT_LT(top.find("pwm_frequency_hz = 100.0"), top.find("[valves]"))
+      << "a top-level key goes before the first table\n"
+      << top;
   EXPECT_NE(top.find("# my rig\nname = \"r\"  # its name\n"), std::string::npos) << top;
   const std::string model = with_table_values(text, "model", {{"damping", "0.4"}, {"kappa_rad_per_bar", "7.5"}}, "fit");
-  EXPECT_NE(model.find("[model]\nkappa_rad_per_bar = 7.5  # fit\n# fitted\ndamping = 0.4  # fit\n"), std::string::npos) << model;
+  EXPECT_NE(model.find("[model]\nkappa_rad_per_bar = 7.5  # fit\n# fitted\ndamping = 0.4  # fit\n"), std::string::npos)
+      << model;
   const std::string added = with_table_values("name = \"r\"\n", "model", {{"damping", "0.4"}}, "fit");
   EXPECT_EQ(added, "name = \"r\"\n\n[model]\ndamping = 0.4  # fit\n");
   EXPECT_TRUE(has_table_header(text, "valves"));
@@ -180,21 +196,23 @@ TEST(LearningModel, TheRigProfilesIdentifiedModelIsUsedWhenItHasOne) {
   EXPECT_DOUBLE_EQ(chosen.model.damping, 0.4);
   EXPECT_DOUBLE_EQ(chosen.model.volume_gain_per_rad, 0.2) << "volume_gain stays the configuration's";
   EXPECT_TRUE(chosen.note.empty()) << "the configuration had the defaults: nothing replaced";
-  EXPECT_EQ(learning_model_line(chosen), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4)");
+  EXPECT_EQ(learning_model_line(chosen),
+            "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4)");
   EXPECT_EQ(learning_model_json(chosen)["source"], "rig_profile");
   EXPECT_EQ(learning_model_json(chosen)["kappa_rad_per_bar"], 6.5);
 
   config.model.kappa_rad_per_bar = 8.2;  // e.g. an earlier `identify --write-model lab.toml`
   const LearningModel replacing = choose_learning_model(config, {"t7", "", "127.0.0.1:5020", with_model});
   EXPECT_DOUBLE_EQ(replacing.model.kappa_rad_per_bar, 6.5);
-  EXPECT_EQ(learning_model_line(replacing), "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4), "
-                                            "not the configuration's (kappa 8.2, omega0 14.14, damping 0.31)");
+  EXPECT_EQ(learning_model_line(replacing),
+            "learning with the rig profile paper-rig's [model] (kappa 6.5, omega0 12, damping 0.4), "
+            "not the configuration's (kappa 8.2, omega0 14.14, damping 0.31)");
 
   // Without a [model] in the profile (the built-in paper rig has none), and off a T7: the configuration's.
   const std::string no_model = profile_copy("no-model");
-  for (const DeviceParameters& device : {DeviceParameters{"t7", "", "127.0.0.1:5020", ""},
-                                         DeviceParameters{"t7", "", "127.0.0.1:5020", no_model},
-                                         DeviceParameters{"sim", "", "", ""}, DeviceParameters{"lcm", "", "", ""}}) {
+  for (const DeviceParameters& device :
+       {DeviceParameters{"t7", "", "127.0.0.1:5020", ""}, DeviceParameters{"t7", "", "127.0.0.1:5020", no_model},
+        DeviceParameters{"sim", "", "", ""}, DeviceParameters{"lcm", "", "", ""}}) {
     const LearningModel configured = choose_learning_model(config, device);
     EXPECT_EQ(configured.source, "configuration") << device.kind << " " << device.rig_profile;
     EXPECT_DOUBLE_EQ(configured.model.kappa_rad_per_bar, 8.2);

@@ -17,10 +17,12 @@ TEST(TrapezoidalMove, PaperMoveHasTheSpecsPhasesAndCruiseSpeed) {
   const double t_a = 0.5 * (0.2 - std::sqrt(0.04 - 4.0 * 60.0 / 12000.0));
   EXPECT_NEAR(t_a, 0.0293, 1e-4);
   const double h = 1e-6;
-  const double cruise = (trapezoidal_move_angle_deg(move, 0.1 + h) - trapezoidal_move_angle_deg(move, 0.1 - h)) / (2 * h);
+  const double cruise =
+      (trapezoidal_move_angle_deg(move, 0.1 + h) - trapezoidal_move_angle_deg(move, 0.1 - h)) / (2 * h);
   EXPECT_NEAR(cruise, 351.0, 1.0);
   const double accel = (trapezoidal_move_angle_deg(move, 0.01 + h) - 2 * trapezoidal_move_angle_deg(move, 0.01) +
-                        trapezoidal_move_angle_deg(move, 0.01 - h)) / (h * h);
+                        trapezoidal_move_angle_deg(move, 0.01 - h)) /
+                       (h * h);
   EXPECT_NEAR(accel, 12000.0, 50.0);
   EXPECT_DOUBLE_EQ(trapezoidal_move_angle_deg(move, -1.0), 0.0);
   EXPECT_NEAR(trapezoidal_move_angle_deg(move, 0.1), 30.0, 1e-9);  // symmetric profile
@@ -64,7 +66,8 @@ std::string csv(const std::vector<std::pair<double, double>>& rows, const std::s
 }
 
 TEST(TrajectoryCsv, ParsesAUniformFile) {
-  const Trajectory t = parse_trajectory_csv(csv({{0.0, 0.0}, {0.02, 1.0}, {0.04, 2.5}, {0.06, 3.0}}), "dir/ramp.csv", 0.02, {});
+  const Trajectory t =
+      parse_trajectory_csv(csv({{0.0, 0.0}, {0.02, 1.0}, {0.04, 2.5}, {0.06, 3.0}}), "dir/ramp.csv", 0.02, {});
   EXPECT_EQ(t.name, "ramp");
   EXPECT_EQ(t.learning_samples(), 3);
   EXPECT_NEAR(t.joint(0)(2), 2.5 * kDeg, 1e-12);

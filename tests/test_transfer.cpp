@@ -89,7 +89,8 @@ TEST_F(TransferOnTheSimulatedArm, AfterFiveIterationsAtMostHalfOfLearningFromScr
 TEST_F(TransferOnTheSimulatedArm, PredictsTheFirstTrialWithinAFactorOfThree) {
   for (const Outcome& o : outcomes()) {
     // Feedback only is predicted from the reference alone (measured: within 28 %, the triangle worst).
-    EXPECT_NEAR(o.transfer.predicted_feedback_only_rms_deg, o.scratch.rms_deg[0], 0.35 * o.scratch.rms_deg[0]) << o.name;
+    EXPECT_NEAR(o.transfer.predicted_feedback_only_rms_deg, o.scratch.rms_deg[0], 0.35 * o.scratch.rms_deg[0])
+        << o.name;
     EXPECT_LT(o.transfer.predicted_rms_deg, 3.0 * o.transferred.rms_deg[0]) << o.name;
     EXPECT_GT(o.transfer.predicted_rms_deg, o.transferred.rms_deg[0] / 3.0) << o.name;
   }

@@ -24,15 +24,16 @@ class TransferCli : public ::testing::Test {
     dir_ = new TempDir();
     const std::string data = data_dir();
     for (const char* trajectory : {"paper", "steps"}) {
-      const ProcessResult r = run_bellows({"run", "--trajectory", trajectory, "--iterations", "10", "--data-dir", data, "--name",
-                                           std::string("trained-") + trajectory});
+      const ProcessResult r = run_bellows({"run", "--trajectory", trajectory, "--iterations", "10", "--data-dir", data,
+                                           "--name", std::string("trained-") + trajectory});
       ASSERT_EQ(r.exit_code, 0) << r.err;
     }
     const Trajectory triangle = testing::unseen_trajectories(Configuration{}.timing.sample_s())[3];
     std::ofstream csv(target_csv());
     csv << "time_s,angle_deg\n";
     for (Eigen::Index k = 0; k <= triangle.learning_samples(); ++k) {
-      csv << static_cast<double>(k) * triangle.sample_time_s << "," << triangle.joint(0)(k) * 180.0 / std::numbers::pi << "\n";
+      csv << static_cast<double>(k) * triangle.sample_time_s << "," << triangle.joint(0)(k) * 180.0 / std::numbers::pi
+          << "\n";
     }
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -48,14 +49,15 @@ class TransferCli : public ::testing::Test {
 TempDir* TransferCli::dir_ = nullptr;
 
 TEST_F(TransferCli, TheFirstTrialStartsFromWhatTheSessionsTaught) {
-  const ProcessResult plain = run_bellows({"run", "--trajectory", target_csv(), "--iterations", "0", "--no-save", "--json"});
+  const ProcessResult plain =
+      run_bellows({"run", "--trajectory", target_csv(), "--iterations", "0", "--no-save", "--json"});
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   const double feedback_only = nlohmann::json::parse(plain.out)["iterations"][0]["rms_deg"].get<double>();
 
   // One source by name, one by directory.
-  const ProcessResult r = run_bellows({"run", "--trajectory", target_csv(), "--iterations", "2", "--data-dir", data_dir(),
-                                       "--name", "taught", "--transfer-from", "trained-paper", "--transfer-from",
-                                       data_dir() + "/trained-steps", "--json"});
+  const ProcessResult r = run_bellows({"run", "--trajectory", target_csv(), "--iterations", "2", "--data-dir",
+                                       data_dir(), "--name", "taught", "--transfer-from", "trained-paper",
+                                       "--transfer-from", data_dir() + "/trained-steps", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   const nlohmann::json& transfer = report["transfer"];
@@ -65,11 +67,13 @@ TEST_F(TransferCli, TheFirstTrialStartsFromWhatTheSessionsTaught) {
   EXPECT_EQ(transfer["sources"][1]["trajectory"], "steps");
   EXPECT_EQ(transfer["sources"][1]["trials"], 11);
   EXPECT_EQ(transfer["status"], "transferred") << transfer["reason"];
-  EXPECT_TRUE(transfer["method"] == "reference-fir" || transfer["method"] == "basis" || transfer["method"] == "inverse-fir");
+  EXPECT_TRUE(transfer["method"] == "reference-fir" || transfer["method"] == "basis" ||
+              transfer["method"] == "inverse-fir");
   EXPECT_EQ(transfer["method_validation_ratios"].size(), 3u);
   const double first = report["iterations"][0]["rms_deg"].get<double>();
   EXPECT_LT(first, 0.6 * feedback_only);
-  EXPECT_LT(transfer["prediction"]["rms_deg"].get<double>(), transfer["prediction"]["feedback_only_rms_deg"].get<double>());
+  EXPECT_LT(transfer["prediction"]["rms_deg"].get<double>(),
+            transfer["prediction"]["feedback_only_rms_deg"].get<double>());
   EXPECT_GT(report["iterations"][0]["max_abs_correction_bar"].get<double>(), 0.0);  // iteration 0 ran with it
   EXPECT_NE(r.err.find("transfer from trained-paper, trained-steps: "), std::string::npos) << r.err;
 
@@ -87,15 +91,19 @@ TEST_F(TransferCli, SessionsThatDoNotFitAreRefusedByNameWithNothingCreated) {
   const std::string other_rate = write("40hz.toml", "[timing]\nticks_per_sample = 5\nsettle_s = 0.2\n");
   const std::string other_arm = write("arm.toml", "[plant]\nkappa = 6.5\n[timing]\nsettle_s = 0.2\n");
   for (const auto& [name, config] : {std::pair{"at-40-hz", other_rate}, std::pair{"other-arm", other_arm}}) {
-    ASSERT_EQ(run_bellows({"run", "--iterations", "1", "--config", config, "--data-dir", data_dir(), "--name", name}).exit_code, 0);
+    ASSERT_EQ(run_bellows({"run", "--iterations", "1", "--config", config, "--data-dir", data_dir(), "--name", name})
+                  .exit_code,
+              0);
   }
   struct Case {
     std::string source, expected;
   };
-  for (const Case& c : {Case{"at-40-hz", "sampled every 0.025 s"}, Case{"other-arm", "another simulated arm ([plant] kappa "},
-                        Case{"no-such-session", "no-such-session"}}) {
-    const ProcessResult r = run_bellows({"run", "--trajectory", target_csv(), "--iterations", "1", "--data-dir", data_dir(),
-                                         "--name", "refused", "--transfer-from", "trained-paper", "--transfer-from", c.source});
+  for (const Case& c :
+       {Case{"at-40-hz", "sampled every 0.025 s"}, Case{"other-arm", "another simulated arm ([plant] kappa "},
+        Case{"no-such-session", "no-such-session"}}) {
+    const ProcessResult r =
+        run_bellows({"run", "--trajectory", target_csv(), "--iterations", "1", "--data-dir", data_dir(), "--name",
+                     "refused", "--transfer-from", "trained-paper", "--transfer-from", c.source});
     EXPECT_EQ(r.exit_code, 2) << c.source << ": " << r.err;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(c.source), std::string::npos) << r.err;

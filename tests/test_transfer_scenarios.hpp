@@ -43,8 +43,12 @@ inline double fade(double t, double duration_s, double fade_s) {
 inline std::vector<Trajectory> unseen_trajectories(double sample_time_s) {
   std::vector<Trajectory> out;
   out.push_back(trajectory_from_moves("fast-steps", 0.0,
-                                      {{0.4, 0, 25, 0.15, 12000}, {1.2, 25, -15, 0.15, 12000}, {2.0, -15, 35, 0.15, 12000},
-                                       {2.8, 35, 10, 0.15, 12000}, {3.6, 10, -35, 0.15, 12000}, {4.4, -35, 0, 0.15, 12000}},
+                                      {{0.4, 0, 25, 0.15, 12000},
+                                       {1.2, 25, -15, 0.15, 12000},
+                                       {2.0, -15, 35, 0.15, 12000},
+                                       {2.8, 35, 10, 0.15, 12000},
+                                       {3.6, 10, -35, 0.15, 12000},
+                                       {4.4, -35, 0, 0.15, 12000}},
                                       6.0, sample_time_s));
   out.push_back(trajectory_of("smooth-random", 8.0, sample_time_s, [](double t) {
     // Fixed "random" amplitudes, frequencies and phases: a band-limited random motion.
@@ -53,8 +57,9 @@ inline std::vector<Trajectory> unseen_trajectories(double sample_time_s) {
     for (int i = 0; i < 4; ++i) s += a[i] * std::sin(2 * std::numbers::pi * f[i] * t + p[i]) - a[i] * std::sin(p[i]);
     return fade(t, 8.0, 1.0) * s;
   }));
-  out.push_back(trajectory_of("fast-sine", 6.0, sample_time_s,
-                              [](double t) { return fade(t, 6.0, 0.8) * 25.0 * std::sin(2 * std::numbers::pi * 1.2 * t); }));
+  out.push_back(trajectory_of("fast-sine", 6.0, sample_time_s, [](double t) {
+    return fade(t, 6.0, 0.8) * 25.0 * std::sin(2 * std::numbers::pi * 1.2 * t);
+  }));
   out.push_back(trajectory_of("triangle", 8.0, sample_time_s, [](double t) {
     // +-35 deg at 0.5 Hz (140 deg/s), starting and ending at rest at 0.
     if (t < 1.0 || t > 7.0) return 0.0;
@@ -62,8 +67,11 @@ inline std::vector<Trajectory> unseen_trajectories(double sample_time_s) {
     return phase < 0.5 ? 70.0 * phase : (phase < 1.5 ? 35.0 - 70.0 * (phase - 0.5) : -35.0 + 70.0 * (phase - 1.5));
   }));
   out.push_back(trajectory_from_moves("pick-and-place", 0.0,
-                                      {{0.5, 0, 50, 0.35, 6000}, {1.7, 50, -40, 0.4, 6000}, {3.1, -40, 20, 0.35, 6000},
-                                       {4.5, 20, -25, 0.35, 6000}, {5.9, -25, 0, 0.3, 6000}},
+                                      {{0.5, 0, 50, 0.35, 6000},
+                                       {1.7, 50, -40, 0.4, 6000},
+                                       {3.1, -40, 20, 0.35, 6000},
+                                       {4.5, 20, -25, 0.35, 6000},
+                                       {5.9, -25, 0, 0.3, 6000}},
                                       8.0, sample_time_s));
   return out;
 }

@@ -37,7 +37,7 @@ TEST(UiCanvas, WideGlyphsTakeTwoCells) {
   Canvas c(30, 2);
   EXPECT_EQ(c.put(0, 0, message, Role::kNormal, false, 20), 20);
   EXPECT_EQ(c.line(0), "S: '\uff10.\uff15' is not a");  // cut at 20 cells, not at 20 code points
-  EXPECT_EQ(fit("\uff10.\uff15", 4), "\uff10. ");   // the wide 5 does not fit half
+  EXPECT_EQ(fit("\uff10.\uff15", 4), "\uff10. ");       // the wide 5 does not fit half
   EXPECT_EQ(text_width(fit(message, 11)), 11);
   for (const std::string& line : wrap(message, 12)) EXPECT_LE(text_width(line), 12) << line;
   EXPECT_EQ(tail_fit("ab\uff10", 3), "b\uff10");
@@ -48,7 +48,10 @@ TEST(UiCanvas, WideGlyphsTakeTwoCells) {
 
 TEST(UiCanvas, ControlsFromFilesOrTheBusNeverReachTheTerminal) {
   Canvas canvas(24, 1);
-  canvas.put(0, 0, "a\x1b[2J\nb\xc2\x9b\xe2\x80\xae" "c", Role::kNormal);
+  canvas.put(0, 0,
+             "a\x1b[2J\nb\xc2\x9b\xe2\x80\xae"
+             "c",
+             Role::kNormal);
   EXPECT_EQ(canvas.line(0), "a?[2J?b??c");
 }
 
@@ -62,7 +65,9 @@ TEST(UiCanvas, Utf8RoundTripsAndCountsCodePoints) {
   EXPECT_EQ(c.at(1, 0).role, Role::kTitle);
   EXPECT_TRUE(c.at(1, 0).bold);
   // Invalid and truncated sequences become '?' instead of breaking the line.
-  EXPECT_EQ(decode_utf8("a\xff" "b"), U"a?b");
+  EXPECT_EQ(decode_utf8("a\xff"
+                        "b"),
+            U"a?b");
   EXPECT_EQ(decode_utf8("a\xe2\x94"), U"a?");
 }
 

@@ -21,7 +21,6 @@ namespace {
 using testing::ConsoleFixture;
 using testing::MemorySessions;
 
-
 TEST(UiController, ArmingAsksForConfirmation) {
   ConsoleFixture f;
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
@@ -100,7 +99,8 @@ TEST(UiController, BatchIsInterruptible) {
   f.key(key::kBackspace);
   f.type("50");
   f.key(key::kEnter);
-  ASSERT_TRUE(f.pump_until([&] { return f.state().experiment.trials.size() == 2 && f.core.state() == EngineState::kRunning; }));
+  ASSERT_TRUE(
+      f.pump_until([&] { return f.state().experiment.trials.size() == 2 && f.core.state() == EngineState::kRunning; }));
   f.key('x');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   EXPECT_EQ(f.state().experiment.trials.size(), 2u);  // the running trial was aborted, not counted
@@ -153,7 +153,8 @@ TEST(UiController, EmergencyStopFromAnyScreenAndDialogThenResetAndRearm) {
   EXPECT_TRUE(f.state().experiment.trials.empty());
   EXPECT_EQ(f.state().fault_view.black_box.back().state, EngineState::kFault);
   const auto& box = f.state().fault_view.black_box;
-  EXPECT_TRUE(std::any_of(box.begin(), box.end(), [](const TickRecord& t) { return t.state == EngineState::kRunning; }));
+  EXPECT_TRUE(
+      std::any_of(box.begin(), box.end(), [](const TickRecord& t) { return t.state == EngineState::kRunning; }));
   // Arming is refused until the fault is reset.
   f.key('a');
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
@@ -238,7 +239,7 @@ TEST(UiController, TuningChangesGainsAndWeightsBetweenTrialsAndRecordsThem) {
   EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
   // A weight rebuilds the law.
   for (int i = 0; i < 4; ++i) f.key(key::kDown);  // k_i, k_d, law, M
-  f.key(key::kDown);                               // S
+  f.key(key::kDown);                              // S
   f.key(key::kEnter);
   for (int i = 0; i < 3; ++i) f.key(key::kBackspace);
   f.type("0.2");
@@ -273,7 +274,8 @@ TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
   f.key(key::kRight);  // noilc-constrained, noilc-learned, pd
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
   EXPECT_EQ(f.state().law_name, "pd");
-  for (int i = 0; i < 5; ++i) f.key(key::kLeft);  // noilc-learned, noilc-constrained, noilc-dense, noilc, round to the last
+  for (int i = 0; i < 5; ++i)
+    f.key(key::kLeft);  // noilc-learned, noilc-constrained, noilc-dense, noilc, round to the last
   ASSERT_EQ(learning_law_names().back(), "inverse");
   EXPECT_EQ(f.state().config.ilc.law, "inverse");
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
@@ -297,7 +299,7 @@ TEST(UiController, TuningChoosesTheLearningLawBetweenTrials) {
 TEST(UiController, EachIterationsLogLineCarriesTheLearningDiagnostics) {
   ConsoleFixture f;
   f.arm_valves();
-  f.run_batch(2);  // iterations 0..2
+  f.run_batch(2);                                          // iterations 0..2
   for (const ui::LogEntry& e : f.state().log.entries()) {  // the first trial has nothing to contract from
     if (e.text.rfind("iteration 0: RMS", 0) == 0) {
       EXPECT_EQ(e.text.find("contraction"), std::string::npos) << e.text;
@@ -547,7 +549,7 @@ TEST(UiController, AfterAnEmergencyStopTheLivePanelShowsTheRealState) {
   ASSERT_TRUE(f.pump_until([&] { return f.state().run.sample > 150; }));  // mid-trial, the arm well off zero
   f.key(' ');
   ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }));
-  f.pump_for(3.0);  // vented, the arm sags
+  f.pump_for(3.0);          // vented, the arm sags
   f.key(ui::key::kEscape);  // from the fault screen the stop opened, back to the main one
   ASSERT_EQ(f.state().screen, Screen::kMain);
   const TickRecord& live = f.state().live;
@@ -556,7 +558,8 @@ TEST(UiController, AfterAnEmergencyStopTheLivePanelShowsTheRealState) {
   EXPECT_NE(screen.find("set point  none: vented"), std::string::npos) << screen;
   EXPECT_NE(screen.find("error      no trial"), std::string::npos) << screen;
   // The angle shown is the latest reading, not where the trial was.
-  EXPECT_NE(screen.find(format("angle      %7.2f deg", live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi)), std::string::npos)
+  EXPECT_NE(screen.find(format("angle      %7.2f deg", live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi)),
+            std::string::npos)
       << screen;
   EXPECT_GT(std::abs(live.joint(0).desired_rad - live.reading.joint[0].angle_rad) * 180.0 / std::numbers::pi, 1.0)
       << "the engine keeps its last set point: the panel must not show it as a tracking error";

@@ -21,13 +21,26 @@ class TamperedArm final : public Device {
   SensorReading read_sensors() override {
     SensorReading r = arm_.read_sensors();
     switch (fault) {
-      case FaultCode::kAngleLimit: r.joint[0].angle_rad = 100.0 * M_PI / 180.0; break;
-      case FaultCode::kOverpressure: r.joint[0].chamber_bar[0] = 3.0; break;
-      case FaultCode::kSupplyLow: r.supply_bar = 1.0; break;
-      case FaultCode::kSensorNotANumber: r.joint[0].angle_rad = std::numeric_limits<double>::quiet_NaN(); break;
-      case FaultCode::kSensorOutOfRange: r.supply_bar = 50.0; break;
-      case FaultCode::kSensorStale: r.time_s = frozen_time_s; break;
-      default: break;
+      case FaultCode::kAngleLimit:
+        r.joint[0].angle_rad = 100.0 * M_PI / 180.0;
+        break;
+      case FaultCode::kOverpressure:
+        r.joint[0].chamber_bar[0] = 3.0;
+        break;
+      case FaultCode::kSupplyLow:
+        r.supply_bar = 1.0;
+        break;
+      case FaultCode::kSensorNotANumber:
+        r.joint[0].angle_rad = std::numeric_limits<double>::quiet_NaN();
+        break;
+      case FaultCode::kSensorOutOfRange:
+        r.supply_bar = 50.0;
+        break;
+      case FaultCode::kSensorStale:
+        r.time_s = frozen_time_s;
+        break;
+      default:
+        break;
     }
     if (fault != FaultCode::kSensorStale) frozen_time_s = r.time_s;
     return r;
@@ -56,15 +69,21 @@ TEST_P(GuardFault, ReachesTheLogAndTheSessionUnderItsOwnName) {
   ASSERT_EQ(f.state().experiment.trials.size(), 1u);
 
   switch (code) {
-    case FaultCode::kEmergencyStop: f.key(' '); break;
+    case FaultCode::kEmergencyStop:
+      f.key(' ');
+      break;
     case FaultCode::kMissedDeadlines:
       for (int i = 0; i < config.safety.missed_deadline_streak + 1; ++i) {
         f.core.tick(f.clock.now_s() + i * config.timing.tick_s, f.clock.now_s(), 1);
         device.advance(config.timing.tick_s);
       }
       break;
-    case FaultCode::kHeartbeatLost: f.clock.step(static_cast<long>(2.0 * config.safety.heartbeat_timeout_s / config.timing.tick_s)); break;
-    default: device.fault = code; break;
+    case FaultCode::kHeartbeatLost:
+      f.clock.step(static_cast<long>(2.0 * config.safety.heartbeat_timeout_s / config.timing.tick_s));
+      break;
+    default:
+      device.fault = code;
+      break;
   }
   ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }, 5.0));
   EXPECT_EQ(f.core.fault(), code);

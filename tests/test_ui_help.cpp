@@ -59,8 +59,9 @@ HelpText read_help(ConsoleState s) {
 }
 
 bool has_key(const HelpText& h, const std::string& label) {
-  return std::regex_search(h.keys, std::regex("(^|\\n)" + std::regex_replace(label, std::regex("[?/.^$*+()\\[\\]{}|\\\\]"), "\\$&") +
-                                              " *\\n"));
+  return std::regex_search(
+      h.keys,
+      std::regex("(^|\\n)" + std::regex_replace(label, std::regex("[?/.^$*+()\\[\\]{}|\\\\]"), "\\$&") + " *\\n"));
 }
 
 TEST(UiHelp, EveryKeyOfEveryScreenIsInTheHelpAt80x24) {
@@ -114,7 +115,8 @@ TEST(UiHelp, AtEightyByTwentyFourItScrollsAndSaysWhereItIs) {
   EXPECT_NE(first.find("lines 1-18 of " + std::to_string(total)), std::string::npos) << first;
   s.help_scroll = total;  // past the end: the last page, not an empty one
   const std::vector<std::string> last = render_lines(s);
-  EXPECT_NE(last[2].find(std::to_string(total - 17) + "-" + std::to_string(total) + " of"), std::string::npos) << last[2];
+  EXPECT_NE(last[2].find(std::to_string(total - 17) + "-" + std::to_string(total) + " of"), std::string::npos)
+      << last[2];
   EXPECT_NE(last[20].find("close the help"), std::string::npos) << last[20];
 }
 
@@ -127,12 +129,14 @@ namespace {
 // One rule of when `q` asks, written once: the help shows kQuitRule and docs/console.md quotes it.
 TEST(UiHelp, TheQuitRuleIsWrittenOnceForTheHelpAndTheDocs) {
   bool in_help = false;
-  for (const HelpEntry& e : help_entries(testing::sample_state(1, true))) in_help |= e.keys == "q" && e.what == kQuitRule;
+  for (const HelpEntry& e : help_entries(testing::sample_state(1, true)))
+    in_help |= e.keys == "q" && e.what == kQuitRule;
   EXPECT_TRUE(in_help);
   std::ifstream docs(std::string(BELLOWS_SOURCE_DIR) + "/docs/console.md");
   ASSERT_TRUE(docs) << "docs/console.md";
   const std::string text((std::istreambuf_iterator<char>(docs)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find(std::string("`q` ") + kQuitRule), std::string::npos) << "docs/console.md does not quote kQuitRule";
+  EXPECT_NE(text.find(std::string("`q` ") + kQuitRule), std::string::npos)
+      << "docs/console.md does not quote kQuitRule";
   EXPECT_EQ(text.find("asks only when a save failed"), std::string::npos);
 }
 

@@ -67,7 +67,8 @@ TEST(UiInput, EmergencyStopFromEveryScreenAndEveryDialog) {
   expect_stop_from(f, "trajectory chooser", armed([&] { f.key('t'); }));
   expect_stop_from(f, "trajectory path dialog", armed([&] {
                      f.key('t');
-                     for (std::size_t i = 0; i < trajectory_library_names().size(); ++i) f.key(key::kDown);  // to "from a file..."
+                     for (std::size_t i = 0; i < trajectory_library_names().size(); ++i)
+                       f.key(key::kDown);  // to "from a file..."
                      f.key(key::kEnter);
                      ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
                    }));

@@ -90,7 +90,8 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   // Iteration 0 ran with no correction; 1 and 2 with learned ones, on both joints.
   EXPECT_TRUE(e.trials[0].correction_bar.isZero());
   for (int j = 0; j < 2; ++j) EXPECT_GT(e.trials[2].correction_bar.col(j).cwiseAbs().maxCoeff(), 0.0) << j;
-  for (int j = 0; j < 2; ++j) EXPECT_LT(e.trials[2].summary.joint_rms_deg(j), e.trials[0].summary.joint_rms_deg(j)) << j;
+  for (int j = 0; j < 2; ++j)
+    EXPECT_LT(e.trials[2].summary.joint_rms_deg(j), e.trials[0].summary.joint_rms_deg(j)) << j;
   EXPECT_TRUE(f.logged("iteration 2: RMS per joint"));
   {  // At 80x24 the header keeps the joint beside the state, trajectory, iteration and RMS.
     ConsoleState small = f.state();
@@ -111,7 +112,8 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   const std::string joints = format("%7.3f%7.3f", last.summary.joint_rms_deg(0), last.summary.joint_rms_deg(1));
   EXPECT_TRUE(std::regex_search(screen, std::regex(std::regex_replace(row, std::regex("\\."), "\\.") + ".?" +
                                                    std::regex_replace(joints, std::regex("\\."), "\\."))))
-      << row << joints << "\n" << screen;
+      << row << joints << "\n"
+      << screen;
   EXPECT_NE(screen.find(format("RMS %.3f deg", last.summary.rms_deg)), std::string::npos) << screen;
 }
 
@@ -135,9 +137,12 @@ TEST(UiJoints, TheInspectorAndTheLiveStripShowTheSelectedJoint) {
   const double elbow_deg = t.record.joint_samples(1).angle_rad(k) * 180.0 / std::numbers::pi;
   const double shoulder_deg = t.record.joint_samples(0).angle_rad(k) * 180.0 / std::numbers::pi;
   ASSERT_NE(readout(elbow_deg), readout(shoulder_deg));  // the check below tells the joints apart
-  EXPECT_TRUE(std::regex_search(screen, std::regex("angle +" + std::regex_replace(readout(elbow_deg), std::regex("\\."), "\\."))))
-      << readout(elbow_deg) << "\n" << screen;
-  EXPECT_NE(screen.find(format("u_ilc      %.4f bar", t.record.joint_samples(1).u_ilc_bar(k))), std::string::npos) << screen;
+  EXPECT_TRUE(std::regex_search(
+      screen, std::regex("angle +" + std::regex_replace(readout(elbow_deg), std::regex("\\."), "\\."))))
+      << readout(elbow_deg) << "\n"
+      << screen;
+  EXPECT_NE(screen.find(format("u_ilc      %.4f bar", t.record.joint_samples(1).u_ilc_bar(k))), std::string::npos)
+      << screen;
 
   // The live strip follows the selection: the elbow's angle, not the shoulder's.
   f.key(key::kEscape);
@@ -157,10 +162,12 @@ TEST(UiJoints, AGuardNamesTheJointAndTheChamberItFiredOn) {
   tick.reading.joint_count = 2;
   for (JointReading& j : tick.reading.joint) j.chamber_bar = {1.2, 1.2};
   tick.reading.joint[1].angle_rad = 100.0 * std::numbers::pi / 180.0;
-  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, c), "joint 2 (elbow): angle 100.0 deg beyond its limit of 95 deg");
+  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, c),
+            "joint 2 (elbow): angle 100.0 deg beyond its limit of 95 deg");
   Configuration own = c;
   own.safety.joint_angle_limit_deg[1] = 99.5;  // the elbow's own limit, not [safety] angle_limit_deg
-  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, own), "joint 2 (elbow): angle 100.0 deg beyond its limit of 99.5 deg");
+  EXPECT_EQ(fault_location(FaultCode::kAngleLimit, 1, tick, own),
+            "joint 2 (elbow): angle 100.0 deg beyond its limit of 99.5 deg");
   tick.reading.joint[1].angle_rad = 0.0;
   tick.reading.joint[0].chamber_bar[1] = 3.0;
   EXPECT_EQ(fault_location(FaultCode::kOverpressure, 0, tick, c),
@@ -188,9 +195,11 @@ TEST(UiJoints, AJointsOwnAngleLimitFaultsTheConsoleNamingThatJointAndItsLimit) {
   EXPECT_EQ(f.state().fault, FaultCode::kAngleLimit);
   EXPECT_EQ(f.state().fault_view.joint, 1);
   const std::string& where = f.state().fault_view.where;
-  EXPECT_TRUE(std::regex_match(where, std::regex("joint 2 \\(elbow\\): angle -?(2[5-9]|3[0-9])\\.[0-9] deg beyond its limit of 25 deg")))
+  EXPECT_TRUE(std::regex_match(
+      where, std::regex("joint 2 \\(elbow\\): angle -?(2[5-9]|3[0-9])\\.[0-9] deg beyond its limit of 25 deg")))
       << where;
-  const double shoulder_deg = f.state().fault_view.black_box.back().reading.joint[0].angle_rad * 180.0 / std::numbers::pi;
+  const double shoulder_deg =
+      f.state().fault_view.black_box.back().reading.joint[0].angle_rad * 180.0 / std::numbers::pi;
   EXPECT_LT(std::abs(shoulder_deg), 25.0) << "the shoulder stayed inside 25 deg";
   EXPECT_TRUE(f.logged("angle-limit fired on joint 2 (elbow)"));
   const std::string screen = screen_text(f.state());
@@ -204,7 +213,8 @@ TEST(UiJoints, AnEmergencyStopOnArm2ShowsTheSelectedJointsBlackBox) {
   f.pump_for(1.0);
   f.key('j');
   f.key(' ');
-  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault && !f.state().fault_view.black_box.empty(); }));
+  ASSERT_TRUE(f.pump_until(
+      [&] { return f.state().engine_state == EngineState::kFault && !f.state().fault_view.black_box.empty(); }));
   EXPECT_EQ(f.state().screen, Screen::kFault);
   const std::string screen = screen_text(f.state());
   EXPECT_NE(screen.find("Last ticks before the fault, joint 2/2 elbow"), std::string::npos) << screen;

@@ -20,7 +20,9 @@ namespace {
 
 using testing::ConsoleFixture;
 
-bool prompt_has(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
+bool prompt_has(const std::string& text, const std::string& fragment) {
+  return text.find(fragment) != std::string::npos;
+}
 
 // Every command key of the console but Space (the emergency stop, which works in prompts too):
 // typed into a prompt, none may run.
@@ -120,7 +122,8 @@ TEST(UiPrompts, EveryPromptKeepsTheFocusUntilAnAnswerIsTaken) {
   ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
 
   SCOPED_TRACE("K (N)");
-  expect_prompt_keeps_focus(f, DialogKind::kAskIterations, [&] { f.key('N'); }, "2.5");
+  expect_prompt_keeps_focus(
+      f, DialogKind::kAskIterations, [&] { f.key('N'); }, "2.5");
   {
     SCOPED_TRACE("K out of range");
     f.key('N');
@@ -133,7 +136,8 @@ TEST(UiPrompts, EveryPromptKeepsTheFocusUntilAnAnswerIsTaken) {
   {
     SCOPED_TRACE("the CSV path (t, the file entry)");
     to_file_entry(f);
-    expect_prompt_keeps_focus(f, DialogKind::kTrajectoryPath, [&] { f.key(key::kEnter); }, "/nonexistent.csv");
+    expect_prompt_keeps_focus(
+        f, DialogKind::kTrajectoryPath, [&] { f.key(key::kEnter); }, "/nonexistent.csv");
     EXPECT_EQ(f.state().screen, Screen::kTrajectory);
     f.key(key::kEscape);
   }
@@ -141,10 +145,13 @@ TEST(UiPrompts, EveryPromptKeepsTheFocusUntilAnAnswerIsTaken) {
     SCOPED_TRACE("a gain or weight (w, Enter)");
     f.key('w');
     const double k_p = f.state().config.controller.k_p;
-    expect_prompt_keeps_focus(f, DialogKind::kEditValue, [&] {
-      f.key(key::kDown);  // k_p
-      f.key(key::kEnter);
-    }, "０.５");
+    expect_prompt_keeps_focus(
+        f, DialogKind::kEditValue,
+        [&] {
+          f.key(key::kDown);  // k_p
+          f.key(key::kEnter);
+        },
+        "０.５");
     EXPECT_EQ(f.state().config.controller.k_p, k_p);
     EXPECT_FALSE(f.logged("changed"));
     f.key('w');
@@ -161,14 +168,16 @@ TEST(UiPrompts, EveryPromptKeepsTheFocusUntilAnAnswerIsTaken) {
 TEST(UiPrompts, EveryQuestionTakesOnlyItsAnswers) {
   ConsoleFixture f;
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
-  expect_question_keeps_focus(f, DialogKind::kConfirmArm, [&] { f.key('a'); }, "yYnNq");
+  expect_question_keeps_focus(
+      f, DialogKind::kConfirmArm, [&] { f.key('a'); }, "yYnNq");
   f.arm_valves();
   {
     SCOPED_TRACE("the valve test (b, v)");
     f.key('d');
     ASSERT_TRUE(f.pump_until([&] { return f.core.state() == EngineState::kSafe; }));
     f.key('b');
-    expect_question_keeps_focus(f, DialogKind::kConfirmValveTest, [&] { f.key('v'); }, "yYnNq");
+    expect_question_keeps_focus(
+        f, DialogKind::kConfirmValveTest, [&] { f.key('v'); }, "yYnNq");
     f.key(key::kEscape);
   }
 }
@@ -181,7 +190,8 @@ TEST(UiPrompts, QuitAsksWhileTheValvesAreLiveAndTheEngineGoesOnUntilYes) {
   EXPECT_TRUE(prompt_has(render_lines(f.state()).back(), "q Quit")) << "q Quit left the function bar while RUNNING";
   f.key('q');
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmQuit);
-  EXPECT_TRUE(prompt_has(prompt_screen_text(f.state()), "A trial is running with the valves live.")) << prompt_screen_text(f.state());
+  EXPECT_TRUE(prompt_has(prompt_screen_text(f.state()), "A trial is running with the valves live."))
+      << prompt_screen_text(f.state());
   f.pump_for(0.5);
   EXPECT_EQ(f.core.state(), EngineState::kRunning);  // the engine goes on while the question waits
   EXPECT_FALSE(f.console->quit_requested());
@@ -248,11 +258,13 @@ TEST(UiPrompts, AStatusBelongsToTheScreenItWasSaidOn) {
   ConsoleFixture f;
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
   f.key('z');  // "z does nothing here", on the main screen
-  ASSERT_TRUE(prompt_has(render_lines(f.state())[static_cast<std::size_t>(f.state().height - 2)], "z does nothing here"));
+  ASSERT_TRUE(
+      prompt_has(render_lines(f.state())[static_cast<std::size_t>(f.state().height - 2)], "z does nothing here"));
   f.key('l');
   for (const std::string& line : render_lines(f.state())) EXPECT_FALSE(prompt_has(line, "z does nothing here")) << line;
   f.key(key::kEscape);
-  EXPECT_TRUE(prompt_has(render_lines(f.state())[static_cast<std::size_t>(f.state().height - 2)], "z does nothing here"));
+  EXPECT_TRUE(
+      prompt_has(render_lines(f.state())[static_cast<std::size_t>(f.state().height - 2)], "z does nothing here"));
 }
 
 /// The name prompt on the real session store: a refused name keeps it open; a taken one renames the
@@ -269,7 +281,8 @@ TEST(UiPrompts, TheNamePromptChecksTheNameBeforeItCloses) {
     std::filesystem::create_directories(data / "taken");
     for (const std::string bad : {"../escape", ".hidden", "taken", "a/b"}) {
       SCOPED_TRACE(bad);
-      expect_prompt_keeps_focus(f, DialogKind::kSessionName, [&] { f.key('s'); }, bad);
+      expect_prompt_keeps_focus(
+          f, DialogKind::kSessionName, [&] { f.key('s'); }, bad);
     }
     const std::string old_location = f.state().experiment.session_location;
     EXPECT_TRUE(std::filesystem::is_directory(old_location));

@@ -145,7 +145,8 @@ TEST(UiRender, BelowTheMinimumSizeAClearMessage) {
   ConsoleState small = sample_state(2, true);
   small.width = 70;
   small.height = 20;
-  small.dialog = {DialogKind::kConfirmQuit, "Quit?", {"2 iterations are not saved."}, "", "q quit without saving   Esc cancel", ""};
+  small.dialog = {
+      DialogKind::kConfirmQuit, "Quit?", {"2 iterations are not saved."}, "", "q quit without saving   Esc cancel", ""};
   const std::string small_text = all(render_lines(small));
   EXPECT_NE(small_text.find("Quit?"), std::string::npos) << small_text;
   EXPECT_NE(small_text.find("q quit without saving   Esc cancel"), std::string::npos);
@@ -162,7 +163,8 @@ TEST(UiRender, BelowTheMinimumSizeAClearMessage) {
 
 TEST(UiRender, EveryScreenAtEverySizeInBothGlyphSets) {
   for (bool unicode : {false, true}) {
-    for (auto [w, h] : {std::pair{80, 24}, std::pair{81, 25}, std::pair{100, 30}, std::pair{120, 40}, std::pair{240, 70}}) {
+    for (auto [w, h] :
+         {std::pair{80, 24}, std::pair{81, 25}, std::pair{100, 30}, std::pair{120, 40}, std::pair{240, 70}}) {
       for (Screen screen : {Screen::kMain, Screen::kHelp, Screen::kTrajectory, Screen::kInspector, Screen::kTuning,
                             Screen::kLog, Screen::kSessions, Screen::kFault}) {
         for (bool dialog : {false, true}) {
@@ -174,7 +176,13 @@ TEST(UiRender, EveryScreenAtEverySizeInBothGlyphSets) {
           s.fault_view.code = FaultCode::kHeartbeatLost;
           s.chooser.names = {"paper", "from a file..."};
           s.chooser.preview = s.experiment.trajectory;
-          if (dialog) s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"text"}, "12345678901234567890123456789012345678901234567890123456789012345678901234567890", "hint", ""};
+          if (dialog)
+            s.dialog = {DialogKind::kAskIterations,
+                        "Run K iterations",
+                        {"text"},
+                        "12345678901234567890123456789012345678901234567890123456789012345678901234567890",
+                        "hint",
+                        ""};
           const auto lines = render_lines(s);
           ASSERT_EQ(static_cast<int>(lines.size()), h);
           for (const auto& line : lines) EXPECT_LE(text_width(line), w);
@@ -217,7 +225,8 @@ TEST(UiRender, InspectorReadsTheValuesAtTheCursor) {
 
 TEST(UiRender, DialogsShowTheirTextInputAndKeys) {
   ConsoleState s = sample_state(1, true);
-  s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"Each iteration learns."}, "12", "Enter run   Esc cancel", ""};
+  s.dialog = {
+      DialogKind::kAskIterations, "Run K iterations", {"Each iteration learns."}, "12", "Enter run   Esc cancel", ""};
   const std::string text = all(render_lines(s));
   EXPECT_NE(text.find("Run K iterations"), std::string::npos);
   EXPECT_NE(text.find("Each iteration learns."), std::string::npos);

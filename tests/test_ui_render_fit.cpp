@@ -32,7 +32,8 @@ TEST(UiRenderFit, HeaderKeepsStateTrajectoryIterationAndRmsAt80Columns) {
       const std::vector<std::string> lines = render_lines(s);
       const std::string& header = lines[0];
       SCOPED_TRACE(header);
-      EXPECT_NE(header.find(state == EngineState::kFault ? "FAULT: heartbeat-lost" : to_string(state)), std::string::npos);
+      EXPECT_NE(header.find(state == EngineState::kFault ? "FAULT: heartbeat-lost" : to_string(state)),
+                std::string::npos);
       EXPECT_NE(header.find("sim: ok"), std::string::npos);
       EXPECT_NE(header.find("paper (8.0 s)"), std::string::npos);
       EXPECT_NE(header.find("it 2  RMS 3.333 deg"), std::string::npos);
@@ -49,7 +50,8 @@ TEST(UiRenderFit, HeaderKeepsStateTrajectoryIterationAndRmsAt80Columns) {
   ConsoleState wide = small_state(EngineState::kArmed);
   wide.width = 160;
   const std::string header = render_lines(wide)[0];
-  EXPECT_NE(header.find("ARMED  valves live  device sim: ok  trajectory paper (8.0 s)  iteration 2  RMS"), std::string::npos)
+  EXPECT_NE(header.find("ARMED  valves live  device sim: ok  trajectory paper (8.0 s)  iteration 2  RMS"),
+            std::string::npos)
       << header;
   EXPECT_NE(header.find("(best 3.333)"), std::string::npos) << header;
 }
@@ -71,8 +73,9 @@ TEST(UiRenderFit, TheLogScreenWrapsLongEntries) {
 
 TEST(UiRenderFit, ARefusedAnswerShowsInItsDialogWithWhatWasTyped) {
   ConsoleState s = small_state(EngineState::kArmed);
-  s.dialog = {DialogKind::kAskIterations, "Run K iterations", {"Each iteration learns."}, "2.5", "Enter run   Esc cancel",
-              "K must be a whole number from 1 to 1000, not '2.5'"};
+  s.dialog = {DialogKind::kAskIterations, "Run K iterations",
+              {"Each iteration learns."}, "2.5",
+              "Enter run   Esc cancel",   "K must be a whole number from 1 to 1000, not '2.5'"};
   const std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("> 2.5_"), std::string::npos) << screen;
   EXPECT_NE(screen.find("K must be a whole number from 1 to 1000, not '2.5'"), std::string::npos) << screen;
@@ -81,11 +84,18 @@ TEST(UiRenderFit, ARefusedAnswerShowsInItsDialogWithWhatWasTyped) {
 
 TEST(UiRenderFit, ADialogWrapsALongLineInsteadOfCuttingIt) {
   ConsoleState s = small_state(EngineState::kArmed);  // 80 columns
-  const std::string why = "Saving is not available: no data directory: neither XDG_DATA_HOME nor HOME is an absolute "
-                          "path; pass --data-dir";
-  s.dialog = {DialogKind::kConfirmQuit, "Quit?", {"1 iteration is not saved.", why}, "", "q quit without saving   Esc cancel", ""};
+  const std::string why =
+      "Saving is not available: no data directory: neither XDG_DATA_HOME nor HOME is an absolute "
+      "path; pass --data-dir";
+  s.dialog = {DialogKind::kConfirmQuit,
+              "Quit?",
+              {"1 iteration is not saved.", why},
+              "",
+              "q quit without saving   Esc cancel",
+              ""};
   const std::string screen = all(render_lines(s));
-  for (const std::string words : {"1 iteration is not saved.", "absolute path; pass --data-dir", "q quit without saving"}) {
+  for (const std::string words :
+       {"1 iteration is not saved.", "absolute path; pass --data-dir", "q quit without saving"}) {
     EXPECT_NE(screen.find(words), std::string::npos) << words << "\n" << screen;  // cut at the box's edge before
   }
 }
@@ -165,8 +175,9 @@ TEST(UiRenderFit, TheFunctionBarKeepsStopBackHelpAndQuitAt80Columns) {
 TEST(UiRenderFit, TheStatusLineWrapsAtAWordAndNeverCutsOne) {
   ConsoleState s = small_state(EngineState::kArmed);
   s.unicode = false;
-  s.status = "Run: arm the valves first (a); the learning law is rebuilt after every change of the weights, "
-             "which takes a moment on a slow machine ENDWORD";
+  s.status =
+      "Run: arm the valves first (a); the learning law is rebuilt after every change of the weights, "
+      "which takes a moment on a slow machine ENDWORD";
   std::vector<std::string> lines = render_lines(s);
   const std::string two = lines[lines.size() - 3] + "\n" + lines[lines.size() - 2];
   EXPECT_NE(two.find("Run: arm the valves first (a);"), std::string::npos) << two;

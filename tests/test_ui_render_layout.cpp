@@ -18,14 +18,17 @@ namespace {
 using testing::all;
 using testing::sample_state;
 
-bool layout_has(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
+bool layout_has(const std::string& text, const std::string& fragment) {
+  return text.find(fragment) != std::string::npos;
+}
 
 const std::vector<std::pair<int, int>> kLayoutSizes = {{80, 24}, {120, 40}, {200, 60}};
 
 TEST(UiRenderLayout, TheRmsListKeepsInsideItsPanel) {
   for (const auto& [width, height] : kLayoutSizes) {
     for (int trials : {3, 16, 40}) {
-      SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(trials) + " iterations");
+      SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(trials) +
+                   " iterations");
       ConsoleState s = sample_state(trials, true);
       s.width = width;
       s.height = height;
@@ -47,10 +50,11 @@ TEST(UiRenderLayout, TheLogPanelUsesTheWidthAWideWindowHas) {
   ConsoleState s = sample_state(3, true);
   s.width = 200;
   s.height = 60;
-  s.log.add({"12:00:03", 2.0, LogSource::kOperator,
-             "a log line that a 200 column window shows whole", false, false, "", 0});
+  s.log.add(
+      {"12:00:03", 2.0, LogSource::kOperator, "a log line that a 200 column window shows whole", false, false, "", 0});
   const std::string screen = all(render_lines(s));
-  EXPECT_TRUE(layout_has(screen, "a log line that a 200 column window shows whole")) << screen;  // cut at 29 columns before
+  EXPECT_TRUE(layout_has(screen, "a log line that a 200 column window shows whole"))
+      << screen;  // cut at 29 columns before
 }
 
 TEST(UiRenderLayout, TheHeaderNamesOnlyTheWeightsOfTheActiveLaw) {

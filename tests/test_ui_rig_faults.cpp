@@ -19,7 +19,8 @@ constexpr const char* kRigTrip =
     "the rig stopped joint 1 at -90.3 deg beyond its angle range ([lcm] rig_angle_limit_deg): check the chamber wiring "
     "(bellows rig check --device lcm pulses each chamber)";
 constexpr const char* kSilence =
-    "the LCM rig 5e1f0c has been silent for 41 ms (no state on BELLOWS_IO_STATE): check that the rig runs and the network to it";
+    "the LCM rig 5e1f0c has been silent for 41 ms (no state on BELLOWS_IO_STATE): check that the rig runs and the "
+    "network to it";
 
 /// The simulated arm as a rig over a link: on demand it trips (its own limit, reported once as a
 /// device fault) or falls silent (its readings stop advancing: the engine's stale limit asks why).
@@ -42,7 +43,9 @@ class LinkedRig final : public Device {
     fault.set(FaultCode::kRigLimit, 0, "%s", kRigTrip);
     return true;
   }
-  void explain_silence(double, DeviceFault& fault) const override { fault.set(FaultCode::kLinkLost, -1, "%s", kSilence); }
+  void explain_silence(double, DeviceFault& fault) const override {
+    fault.set(FaultCode::kLinkLost, -1, "%s", kSilence);
+  }
 
   bool trip = false;
   bool silent = false;
@@ -130,7 +133,8 @@ INSTANTIATE_TEST_SUITE_P(TripAndSilence, RigFaultOnTheConsole,
                          ::testing::Values(Case{"rig-limit", FaultCode::kRigLimit, kRigTrip},
                                            Case{"link-lost", FaultCode::kLinkLost, kSilence}),
                          [](const ::testing::TestParamInfo<Case>& param) {
-                           return param.param.code == FaultCode::kRigLimit ? std::string("RigTrip") : std::string("LinkLost");
+                           return param.param.code == FaultCode::kRigLimit ? std::string("RigTrip")
+                                                                           : std::string("LinkLost");
                          });
 
 }  // namespace

@@ -130,7 +130,9 @@ TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
   EXPECT_TRUE(change_logged);
   // Each iteration's next correction is what the next one ran with: iteration 1 was saved with its
   // own, and rewritten with the learned one before iteration 2 started.
-  const auto applied = [&](std::size_t i) { return Eigen::VectorXd(loaded.iterations[i].record.joint_samples(0).u_ilc_bar.head(400)); };
+  const auto applied = [&](std::size_t i) {
+    return Eigen::VectorXd(loaded.iterations[i].record.joint_samples(0).u_ilc_bar.head(400));
+  };
   EXPECT_TRUE(loaded.iterations[0].next_corrections_bar().isApprox(applied(1)));
   EXPECT_TRUE(loaded.iterations[1].next_corrections_bar().isApprox(applied(2)));
   EXPECT_FALSE(applied(2).isApprox(applied(1)));
@@ -141,7 +143,7 @@ TEST_F(UiSessions, AFaultsBlackBoxIsSavedWithTheSessionAndReopened) {
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
   f.run_batch(1);  // iterations 0..1
-  f.key(' ');  // emergency stop before iteration 2
+  f.key(' ');      // emergency stop before iteration 2
   ASSERT_TRUE(f.pump_until([&] { return !f.state().fault_view.black_box.empty(); }));
   ASSERT_EQ(f.state().experiment.faults.size(), 1u);
   save_and_wait(f);
@@ -238,7 +240,8 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
 }
 
 TEST_F(UiSessions, NamingRenamesTheSessionAndSavingGoesOnThere) {
-  StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(), (data_home_ / "elsewhere").string());  // --data-dir
+  StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(),
+                              (data_home_ / "elsewhere").string());  // --data-dir
   ConsoleFixture f(Configuration{}, 3, &gateway);
   f.arm_valves();
   f.key('r');
@@ -251,7 +254,8 @@ TEST_F(UiSessions, NamingRenamesTheSessionAndSavingGoesOnThere) {
   f.type("morning-run");
   f.key(ui::key::kEnter);
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
-  EXPECT_EQ(f.state().experiment.session_location, (data_home_ / "elsewhere" / "morning-run").string()) << f.state().status;
+  EXPECT_EQ(f.state().experiment.session_location, (data_home_ / "elsewhere" / "morning-run").string())
+      << f.state().status;
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   save_and_wait(f);

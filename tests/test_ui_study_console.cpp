@@ -79,7 +79,8 @@ TEST(UiStudyConsole, EachTrialRecordsTheLawAndWeightsThatLearnedItsCorrection) {
   Configuration after = f.config;
   after.ilc.s = 0.2;
   EXPECT_EQ(trials[2].summary.learned_with, learned_with(after));
-  EXPECT_EQ(trials[2].summary.learned_with.weights, (std::vector<std::pair<std::string, double>>{{"m", 1.0}, {"s", 0.2}, {"w", 2e-5}}));
+  EXPECT_EQ(trials[2].summary.learned_with.weights,
+            (std::vector<std::pair<std::string, double>>{{"m", 1.0}, {"s", 0.2}, {"w", 2e-5}}));
   // Saved with the session.
   ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
   ASSERT_EQ(f.sessions.saved.size(), 1u);
@@ -89,7 +90,8 @@ TEST(UiStudyConsole, EachTrialRecordsTheLawAndWeightsThatLearnedItsCorrection) {
 // The console on the simulated clock as `bellows console --clock sim` runs it: engine time passes
 // (tick by tick on this thread) only while the controller says the engine has work.
 struct SimulatedConsole {
-  SimulatedConsole() : arm(config.plant, 7), core(arm, config.controller, config.timing, config.safety), clock(core, arm) {
+  SimulatedConsole()
+      : arm(config.plant, 7), core(arm, config.controller, config.timing, config.safety), clock(core, arm) {
     ConsoleEnvironment env;
     env.core = &core;
     env.telemetry = &core.add_telemetry_tap(4096);
@@ -136,7 +138,9 @@ TEST(UiStudyConsole, OnTheSimulatedClockTimePassesOnlyWhileTheEngineHasWork) {
   EXPECT_FALSE(s.console->needs_engine_time());  // ARMED and idle: time stands still
   s.console->update(s.clock.now_s());
   s.key('r');
-  ASSERT_TRUE(s.run_until([&] { return s.console->state().experiment.trials.size() == 1 && s.console->state().run.mode == RunProgress::Mode::kIdle; }));
+  ASSERT_TRUE(s.run_until([&] {
+    return s.console->state().experiment.trials.size() == 1 && s.console->state().run.mode == RunProgress::Mode::kIdle;
+  }));
   const std::uint64_t after_trial = s.core.ticks();
   EXPECT_EQ(s.core.state(), EngineState::kArmed);
   s.run_until([&] { return true; });
@@ -164,8 +168,9 @@ TEST(UiStudyConsole, OnTheSimulatedClockTheNumbersAreThoseOfAHeadlessRunExactly)
   s.key(key::kEnter);
   ASSERT_TRUE(s.run_until([&] {
     return s.console->state().experiment.trials.size() == 4 && s.console->state().run.mode == RunProgress::Mode::kIdle;
-  })) << s.console->state().status << " / dialog " << s.console->state().dialog.input << " / trials "
-        << s.console->state().experiment.trials.size() << " / ticks " << s.core.ticks();
+  })) << s.console->state().status
+      << " / dialog " << s.console->state().dialog.input << " / trials " << s.console->state().experiment.trials.size()
+      << " / ticks " << s.core.ticks();
 
   // `bellows run --iterations 3 --seed 7` in process: the same arm, law and trajectory.
   const Configuration config;
@@ -181,7 +186,8 @@ TEST(UiStudyConsole, OnTheSimulatedClockTheNumbersAreThoseOfAHeadlessRunExactly)
     const IterationSummary summary = run.run_trial();
     run.learn();
     EXPECT_EQ(trials[static_cast<std::size_t>(i)].summary.rms_deg, summary.rms_deg) << "iteration " << i;
-    EXPECT_EQ(trials[static_cast<std::size_t>(i)].summary.max_abs_error_deg, summary.max_abs_error_deg) << "iteration " << i;
+    EXPECT_EQ(trials[static_cast<std::size_t>(i)].summary.max_abs_error_deg, summary.max_abs_error_deg)
+        << "iteration " << i;
   }
   EXPECT_EQ(s.core.ticks(), core.ticks());
 }
@@ -210,14 +216,17 @@ TEST(SessionLearnedWith, RoundTripsIsOptionalAndRefusesWhatNoLawReads) {
   m.iterations.push_back({second, "2026-12-01T20:00:01.000Z"});
   m.resume = ResumeState{};
   const std::string text = format_manifest(m);
-  EXPECT_NE(text.find("\"learned_with\": {\n        \"law\": \"noilc\",\n        \"m\": 1.0,\n        \"s\": 0.2,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"learned_with\": {\n        \"law\": \"noilc\",\n        \"m\": 1.0,\n        \"s\": 0.2,"),
+            std::string::npos)
+      << text;
   const SessionManifest read = parse_manifest(text, "manifest.json");
   ASSERT_EQ(read.iterations.size(), 2u);
   EXPECT_FALSE(read.iterations[0].summary.learned_with.known());
   EXPECT_EQ(read.iterations[1].summary.learned_with, second.learned_with);
   EXPECT_EQ(format_manifest(read), text);
-  for (const auto& [from, to] : {std::pair{"\"s\": 0.2", "\"pd_kp\": 0.2"}, std::pair{"\"law\": \"noilc\"", "\"law\": \"best\""},
-                                 std::pair{"\"s\": 0.2", "\"s\": -1.0"}}) {
+  for (const auto& [from, to] :
+       {std::pair{"\"s\": 0.2", "\"pd_kp\": 0.2"}, std::pair{"\"law\": \"noilc\"", "\"law\": \"best\""},
+        std::pair{"\"s\": 0.2", "\"s\": -1.0"}}) {
     std::string bad = text;
     bad.replace(bad.find(from, bad.find("\"learned_with\"")), std::string(from).size(), to);
     try {

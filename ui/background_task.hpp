@@ -22,7 +22,9 @@ class BackgroundTask {
     future_ = std::async(std::launch::async, std::forward<Work>(work));
   }
   bool busy() const { return future_.valid(); }
-  bool ready() const { return future_.valid() && future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; }
+  bool ready() const {
+    return future_.valid() && future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+  }
   /// The result (rethrows the work's exception). Only after ready().
   T take() { return future_.get(); }
   void wait() {

@@ -49,7 +49,7 @@ int Canvas::put(int x, int y, std::string_view text, Role role, bool bold, int c
     // Text from files and the bus may hold controls: a cell never sends one to the terminal.
     if (is_terminal_control(glyph)) glyph = U'?';
     const int cells = glyph_width(glyph);
-    if (cells == 0) continue;  // a combining mark has no cell of its own
+    if (cells == 0) continue;      // a combining mark has no cell of its own
     if (x + cells > right) break;  // a wide glyph that does not fit whole is not drawn
     if (x >= 0) {
       set_cell(x, y, Cell{glyph, role, bold});
@@ -241,7 +241,8 @@ std::vector<std::string> wrap(std::string_view text, int width) {
     // As many glyphs as `width` cells hold (at least one), then back to the last space if cut.
     std::size_t end = start;
     int used = 0;
-    while (end < glyphs.size() && (end == start || used + glyph_width(glyphs[end]) <= width)) used += glyph_width(glyphs[end++]);
+    while (end < glyphs.size() && (end == start || used + glyph_width(glyphs[end]) <= width))
+      used += glyph_width(glyphs[end++]);
     if (end < glyphs.size()) {
       const std::size_t space = glyphs.rfind(U' ', end);
       if (space != std::u32string::npos && space > start) end = space;

@@ -12,17 +12,17 @@ namespace bellows::ui {
 /// What a cell means; the terminal maps each role to colours, or to attributes without colours.
 enum class Role : std::uint8_t {
   kNormal,
-  kDim,        // greyed: not available now
-  kTitle,      // panel titles, headers
-  kSelected,   // the highlighted row of a list
-  kKey,        // a key in the function bar or help
-  kSafe,       // engine states
+  kDim,       // greyed: not available now
+  kTitle,     // panel titles, headers
+  kSelected,  // the highlighted row of a list
+  kKey,       // a key in the function bar or help
+  kSafe,      // engine states
   kArmed,
   kRunning,
   kFault,
   kWarning,
   kGood,
-  kSeries1,    // plot series: current, previous, chosen
+  kSeries1,  // plot series: current, previous, chosen
   kSeries2,
   kSeries3,
   kCursor,

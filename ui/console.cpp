@@ -13,8 +13,8 @@ namespace bellows::ui {
 namespace {
 
 constexpr int kKeyTimeoutMs = 33;
-constexpr double kDisarmWaitS = 1.0;          // on quit: how long the engine may take to disarm
-constexpr double kFinalSaveWaitS = 10.0;      // on exit: how long the last autosave may take
+constexpr double kDisarmWaitS = 1.0;              // on quit: how long the engine may take to disarm
+constexpr double kFinalSaveWaitS = 10.0;          // on exit: how long the last autosave may take
 constexpr std::size_t kTelemetryCapacity = 4096;  // ~20 s of ticks at 200 Hz between two frames
 
 double seconds_of(clockid_t clock) {
@@ -37,7 +37,8 @@ struct LoopStopper {
 /// the telemetry tap holds before the controller drains it, nor more than a frame's wall time.
 class SimulatedTime {
  public:
-  SimulatedTime(SimulatedClock& clock, const TelemetryRing& tap, double speed) : clock_(clock), tap_(tap), speed_(speed) {}
+  SimulatedTime(SimulatedClock& clock, const TelemetryRing& tap, double speed)
+      : clock_(clock), tap_(tap), speed_(speed) {}
 
   /// True if engine time passed.
   bool advance(const ConsoleController& controller, double now_s) {
@@ -174,8 +175,9 @@ ConsoleReport run_console(ConsoleSetup setup) {
   }
   report.unsaved = controller->unsaved_work();
   // "saved as it went" only when everything is on disk: a failed save is never reported as saved.
-  report.save_status = controller->saves_settled() && report.unsaved.empty() ? controller->state().experiment.session_location
-                                                                              : std::string();
+  report.save_status = controller->saves_settled() && report.unsaved.empty()
+                           ? controller->state().experiment.session_location
+                           : std::string();
   report.unsaved_work_lost = controller->quitting_loses_work();
   report.seconds = monotonic_s() - start_s;
   report.ui_cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID) - cpu_start_s;

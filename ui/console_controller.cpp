@@ -15,12 +15,13 @@
 namespace bellows::ui {
 namespace {
 
-constexpr double kHeartbeatPeriodS = 0.05;    // well inside the engine's timeout (1 s by default)
-constexpr double kLoopStatsPeriodS = 0.25;    // the latency summary walks a histogram: not every frame
-constexpr double kStaleSnapshotS = 0.5;       // no fresh tick for this long: the device shows no data
-constexpr double kStripSeconds = 5.0;         // the live plot's window
-constexpr double kStopOverdueS = 0.5;         // an unacted stop this old is shown as overdue (100 ticks)
-constexpr const char* kStopOverdueText = "EMERGENCY STOP requested: the engine has not acted on it yet (is its loop stalled?)";
+constexpr double kHeartbeatPeriodS = 0.05;  // well inside the engine's timeout (1 s by default)
+constexpr double kLoopStatsPeriodS = 0.25;  // the latency summary walks a histogram: not every frame
+constexpr double kStaleSnapshotS = 0.5;     // no fresh tick for this long: the device shows no data
+constexpr double kStripSeconds = 5.0;       // the live plot's window
+constexpr double kStopOverdueS = 0.5;       // an unacted stop this old is shown as overdue (100 ticks)
+constexpr const char* kStopOverdueText =
+    "EMERGENCY STOP requested: the engine has not acted on it yet (is its loop stalled?)";
 
 std::string system_clock_text() {
   const std::time_t now = std::time(nullptr);
@@ -93,7 +94,8 @@ bool ConsoleController::needs_engine_time() const {
 
 bool ConsoleController::send(const EngineCommand& command, const char* what) {
   const CommandKind k = command.kind;
-  const bool setting = k == CommandKind::kSelectTrajectory || k == CommandKind::kSetGains || k == CommandKind::kHeartbeat;
+  const bool setting =
+      k == CommandKind::kSelectTrajectory || k == CommandKind::kSetGains || k == CommandKind::kHeartbeat;
   if (!setting) note_action_sent();
   if (env_.core->send(command)) return true;
   log(LogSource::kOperator, std::string("command queue full: ") + what + " not sent", true);
@@ -119,9 +121,9 @@ void ConsoleController::start(double now_s) {
   }
   send_gains();
   rebuild_law();
-  log(LogSource::kOperator, format("console started: device %s, %s clock, speed x%s, trajectory %s", env_.device_name.c_str(),
-                                   env_.simulated_clock ? "simulated" : "wall", env_.speed.c_str(),
-                                   state_.experiment.trajectory->name.c_str()));
+  log(LogSource::kOperator, format("console started: device %s, %s clock, speed x%s, trajectory %s",
+                                   env_.device_name.c_str(), env_.simulated_clock ? "simulated" : "wall",
+                                   env_.speed.c_str(), state_.experiment.trajectory->name.c_str()));
   if (!env_.model_note.empty()) log(LogSource::kOperator, env_.model_note);  // saved with the session
   set_status("a arms the valves, t chooses a trajectory, ? lists every key");
 }
@@ -169,11 +171,12 @@ void ConsoleController::update(double now_s) {
     state_.fault_view.black_box = env_.core->black_box().copy_frozen();
     black_box_pending_ = false;
     if (!state_.fault_view.black_box.empty()) {
-      state_.fault_view.where = fault_location(state_.fault_view.code, state_.fault_view.joint, state_.fault_view.black_box.back(),
-                                              state_.config);
+      state_.fault_view.where = fault_location(state_.fault_view.code, state_.fault_view.joint,
+                                               state_.fault_view.black_box.back(), state_.config);
       if (!state_.fault_view.where.empty()) {
-        log(LogSource::kEngine, format("%s fired on %s", fault_name(state_.fault_view.code), state_.fault_view.where.c_str()),
-            true, state_.fault_view.time_s);
+        log(LogSource::kEngine,
+            format("%s fired on %s", fault_name(state_.fault_view.code), state_.fault_view.where.c_str()), true,
+            state_.fault_view.time_s);
       }
     }
     if (!state_.fault_view.black_box.empty()) {  // kept for the session, saved with the next save
@@ -193,8 +196,10 @@ void ConsoleController::update(double now_s) {
   state_.loop.ticks = env_.core->ticks();
   state_.loop.dropped_telemetry = env_.core->dropped_telemetry();
   if (const std::uint64_t dropped = env_.core->dropped_events(); dropped != state_.loop.dropped_events) {
-    log(LogSource::kEngine, format("%llu engine events dropped (the event queue was full)",
-                                   static_cast<unsigned long long>(dropped - state_.loop.dropped_events)), true);
+    log(LogSource::kEngine,
+        format("%llu engine events dropped (the event queue was full)",
+               static_cast<unsigned long long>(dropped - state_.loop.dropped_events)),
+        true);
     state_.loop.dropped_events = dropped;
   }
   if (stop_pending_) {
@@ -233,16 +238,17 @@ void ConsoleController::on_event(const EngineEvent& event) {
   switch (event.kind) {
     case EventKind::kStateChanged:
       state_.engine_state = event.to;
-    {
-      // A trial's own ARMED <-> RUNNING changes (its start, its end) are routine: the trial's lines say it better.
-      const bool routine = (event.command == CommandKind::kStartTrial && event.to == EngineState::kRunning) ||
-                           event.command == CommandKind::kTrialEnd;
-      // Into FAULT: the fault's own name (a guard is not an emergency stop); else the engine's cause.
-      const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone ? fault_name(event.fault)
-                                                                                           : to_string(event.command);
-      log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
-          event.to == EngineState::kFault, event.time_s, routine);
-    }
+      {
+        // A trial's own ARMED <-> RUNNING changes (its start, its end) are routine: the trial's lines say it better.
+        const bool routine = (event.command == CommandKind::kStartTrial && event.to == EngineState::kRunning) ||
+                             event.command == CommandKind::kTrialEnd;
+        // Into FAULT: the fault's own name (a guard is not an emergency stop); else the engine's cause.
+        const char* cause = event.to == EngineState::kFault && event.fault != FaultCode::kNone
+                                ? fault_name(event.fault)
+                                : to_string(event.command);
+        log(LogSource::kEngine, format("%s -> %s (%s)", to_string(event.from), to_string(event.to), cause),
+            event.to == EngineState::kFault, event.time_s, routine);
+      }
       if (event.command == CommandKind::kArm && event.to == EngineState::kArmed) {
         set_status("armed: r runs a trial, n learns and runs, N runs K iterations, Space stops");
       } else if (event.command == CommandKind::kDisarm && event.to == EngineState::kSafe) {
@@ -255,10 +261,16 @@ void ConsoleController::on_event(const EngineEvent& event) {
       return;
     case EventKind::kFault:
       state_.fault = event.fault;
-      state_.fault_view = FaultView{event.fault, event.time_s, {}, {}, event.fault_joint,
-                                    event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(event.fault))};
+      state_.fault_view = FaultView{
+          event.fault,
+          event.time_s,
+          {},
+          {},
+          event.fault_joint,
+          event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(event.fault))};
       black_box_pending_ = true;
-      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), state_.fault_view.detail.c_str()), true, event.time_s);
+      log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), state_.fault_view.detail.c_str()), true,
+          event.time_s);
       set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), state_.fault_view.detail.c_str()), true);
       state_.dialog = {};
       state_.screen = Screen::kFault;
@@ -304,7 +316,8 @@ void ConsoleController::poll_snapshot_and_telemetry(double now_s) {
     bool finite = std::isfinite(r.supply_bar);
     for (int j = 0; j < std::clamp(r.joint_count, 1, kMaxJoints); ++j) {
       const JointReading& joint = r.joint[static_cast<std::size_t>(j)];
-      finite = finite && std::isfinite(joint.angle_rad) && std::isfinite(joint.chamber_bar[0]) && std::isfinite(joint.chamber_bar[1]);
+      finite = finite && std::isfinite(joint.angle_rad) && std::isfinite(joint.chamber_bar[0]) &&
+               std::isfinite(joint.chamber_bar[1]);
     }
     if (!finite) {
       health.status = "sensor not a number";

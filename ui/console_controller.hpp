@@ -47,8 +47,8 @@ struct PromptAnswer {
 /// What the console needs from the program around it.
 struct ConsoleEnvironment {
   EngineCore* core = nullptr;
-  TelemetryRing* telemetry = nullptr;            // a tap added before the loop started (optional)
-  std::function<LatencySummary()> latency;       // the loop's statistics; empty on a simulated clock
+  TelemetryRing* telemetry = nullptr;       // a tap added before the loop started (optional)
+  std::function<LatencySummary()> latency;  // the loop's statistics; empty on a simulated clock
   std::string rt_description = "other";
   std::string speed = "1";
   /// The simulated arm on simulated time (console --clock sim): the program around the controller
@@ -60,17 +60,17 @@ struct ConsoleEnvironment {
   std::function<Trajectory(const std::string&)> load_trajectory;
   SessionGateway* sessions = nullptr;
   std::string device_name = "sim";
-  std::string device_where;                      // the link, e.g. an LCM URL ("in-process" for sim)
-  std::string rig_profile;                       // the rig profile's name, "" without one
-  std::string model_note;                        // where config.model came from, when not the configuration (logged at start)
+  std::string device_where;  // the link, e.g. an LCM URL ("in-process" for sim)
+  std::string rig_profile;   // the rig profile's name, "" without one
+  std::string model_note;    // where config.model came from, when not the configuration (logged at start)
   std::function<bellows::DeviceHealth()> device_health;  // Device::health() (any thread); optional
-  std::function<RawInputs()> raw_inputs;         // Device::raw_inputs() (any thread); optional
+  std::function<RawInputs()> raw_inputs;                 // Device::raw_inputs() (any thread); optional
   /// Makes `read_rad` (the angle read now) the rig profile's zero: the file and the device; returns
   /// what it did in words, throws InputError. Empty: this device has no profile file to write.
   std::function<std::string(double read_rad)> zero_angle;
   std::uint64_t seed = 1;
-  int stop_after_rises = 3;                      // a batch stops when the RMS rose this many times in a row
-  std::function<std::string()> clock_text;       // local time "HH:MM:SS"; default: the system clock
+  int stop_after_rises = 3;                 // a batch stops when the RMS rose this many times in a row
+  std::function<std::string()> clock_text;  // local time "HH:MM:SS"; default: the system clock
   /// Draws the figures of the saved session at `session_location` (SessionGateway::save's answer),
   /// its first `iterations` iterations, from its files (on a background task); returns where.
   /// Empty: not available.
@@ -204,12 +204,12 @@ class ConsoleController {
   bool handle_transfer_key(int key);
 
   // Sessions (console_sessions.cpp).
-  void autosave();   // starts a save when something is unsaved and none is running
+  void autosave();  // starts a save when something is unsaved and none is running
   void start_save();
   void start_rename(const std::string& name);
   void start_listing();
   void start_open(const std::string& location);
-  void start_figures();   // when every trial so far is saved; else after the save that does it
+  void start_figures();  // when every trial so far is saved; else after the save that does it
   void launch_figures();
   void poll_session_tasks();
   void adopt(SessionSnapshot snapshot, bool at_start);
@@ -252,13 +252,13 @@ class ConsoleController {
   bellows::DeviceHealth link_{};  // the device's link, refreshed with the loop statistics
   std::unique_ptr<ValveTest> valve_test_;
   bool black_box_pending_ = false;
-  bool stop_pending_ = false;        // an emergency stop requested, not yet acted on by the engine
+  bool stop_pending_ = false;  // an emergency stop requested, not yet acted on by the engine
   double stop_requested_s_ = 0.0;
-  bool begin_after_save_ = false;    // a trial waits for the autosave
-  int figures_after_save_ = 0;       // figures of this many trials wait for the autosave (0: none)
-  bool autosave_failed_ = false;     // the last save failed: no retry loop, the operator is told
+  bool begin_after_save_ = false;  // a trial waits for the autosave
+  int figures_after_save_ = 0;     // figures of this many trials wait for the autosave (0: none)
+  bool autosave_failed_ = false;   // the last save failed: no retry loop, the operator is told
   TrialDiagnostics diagnostics_;
-  void export_strip();  // the selected joint's ring into state_.strip
+  void export_strip();              // the selected joint's ring into state_.strip
   std::vector<double> strip_time_;  // ring at the ILC rate; angles and set points of every joint
   std::vector<std::array<double, kMaxJoints>> strip_angle_, strip_setpoint_;
   std::size_t strip_next_ = 0, strip_count_ = 0;
@@ -279,9 +279,9 @@ class ConsoleController {
   BackgroundTask<SessionSnapshot> open_task_;
   BackgroundTask<std::string> figure_task_;
   BackgroundTask<TransferOffer> transfer_task_;
-  std::vector<TransferSource> taught_;  // earlier experiments of this console
+  std::vector<TransferSource> taught_;            // earlier experiments of this console
   std::vector<TransferSourceNote> taught_notes_;  // one per taught_ source, for the session's first_correction
-  std::vector<std::string> taught_locations_;  // where they are saved (not read back as "saved" sources)
+  std::vector<std::string> taught_locations_;     // where they are saved (not read back as "saved" sources)
   TransferOffer transfer_offer_;
   bool transfer_wanted_ = false;
   int saving_trials_ = 0;

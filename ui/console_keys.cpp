@@ -113,19 +113,28 @@ bool ConsoleController::handle_dialog_key(int k) {
   }
   switch (d.kind) {
     case DialogKind::kConfirmArm:
-      answer_yes_no(k, [this] { arm(); }, "not armed");
+      answer_yes_no(
+          k, [this] { arm(); }, "not armed");
       return true;
     case DialogKind::kConfirmZeroAngle:
-      answer_yes_no(k, [this] { zero_angle(); }, "angle zero unchanged");
+      answer_yes_no(
+          k, [this] { zero_angle(); }, "angle zero unchanged");
       return true;
     case DialogKind::kConfirmValveTest:
-      answer_yes_no(k, [this] { start_valve_test(); }, "valve test cancelled: no valve opened");
+      answer_yes_no(
+          k, [this] { start_valve_test(); }, "valve test cancelled: no valve opened");
       return true;
     case DialogKind::kConfirmDiscard: {
       // Taken out before the answer: a "no" drops it, a "yes" runs it once.
       auto action = std::move(pending_discard_action_);
       pending_discard_action_ = nullptr;
-      if (!answer_yes_no(k, [&action] { if (action) action(); }, "cancelled")) pending_discard_action_ = std::move(action);
+      if (!answer_yes_no(
+              k,
+              [&action] {
+                if (action) action();
+              },
+              "cancelled"))
+        pending_discard_action_ = std::move(action);
       return true;
     }
     case DialogKind::kConfirmQuit:
@@ -141,7 +150,8 @@ bool ConsoleController::handle_dialog_key(int k) {
         state_.dialog = {};
         set_status("cancelled: the console goes on");
       } else if (k == 's') {
-        d.error = state_.sessions_available ? "nothing to save again: Esc, or q to quit" : "cannot save: " + state_.sessions_unavailable_reason;
+        d.error = state_.sessions_available ? "nothing to save again: Esc, or q to quit"
+                                            : "cannot save: " + state_.sessions_unavailable_reason;
       } else {
         not_an_answer(k);
       }
@@ -160,7 +170,8 @@ void ConsoleController::arm() {
       why_not = error.what();
     }
     if (why_not.empty()) {
-      log(LogSource::kOperator, "arm where the session stopped (the engine, the arm and the clock as run --resume puts them)");
+      log(LogSource::kOperator,
+          "arm where the session stopped (the engine, the arm and the clock as run --resume puts them)");
       return;
     }
     log(LogSource::kSession, "arming afresh, not where the session stopped: " + why_not);
@@ -199,7 +210,8 @@ PromptAnswer ConsoleController::judge_input() {
       const NumberParse parsed = parse_number(trim(d.input), k);
       if (parsed != NumberParse::kNumber || k < 1 || k > kMaxBatch || std::floor(k) != k) {
         return {format("K must be a whole number from 1 to %d, not '", kMaxBatch) + d.input + "'" +
-                (parsed == NumberParse::kOutOfRange ? " (out of range)" : ""), {}};
+                    (parsed == NumberParse::kOutOfRange ? " (out of range)" : ""),
+                {}};
       }
       if (const Availability a = availability(Action::kRunIterations, state_); !a.available) {
         return {"cannot run iterations now: " + a.reason, {}};
@@ -209,8 +221,9 @@ PromptAnswer ConsoleController::judge_input() {
                 state_.run.mode = RunProgress::Mode::kBatch;
                 state_.run.batch_first = state_.experiment.next_iteration();
                 state_.run.batch_total = trials_for_iterations(static_cast<int>(k), !state_.experiment.trials.empty());
-                log(LogSource::kOperator, format("run iterations %s (stops by itself after %d rises of the RMS in a row)",
-                                                 batch_span(state_.run).c_str(), state_.stop_after_rises));
+                log(LogSource::kOperator,
+                    format("run iterations %s (stops by itself after %d rises of the RMS in a row)",
+                           batch_span(state_.run).c_str(), state_.stop_after_rises));
                 step();
               }};
     }
@@ -303,11 +316,12 @@ void ConsoleController::perform(Action action) {
       step();
       return;
     case Action::kRunIterations:
-      open_dialog(DialogKind::kAskIterations, "Run K iterations",
-                  {"Each iteration learns from the last trial, then runs;",
-                   "with no trial yet, iteration 0 (feedback only) runs first.",
-                   format("x interrupts; it stops by itself when the RMS rises %d times in a row.", state_.stop_after_rises)},
-                  "Enter run   Esc cancel", "10");
+      open_dialog(
+          DialogKind::kAskIterations, "Run K iterations",
+          {"Each iteration learns from the last trial, then runs;",
+           "with no trial yet, iteration 0 (feedback only) runs first.",
+           format("x interrupts; it stops by itself when the RMS rises %d times in a row.", state_.stop_after_rises)},
+          "Enter run   Esc cancel", "10");
       return;
     case Action::kStopRun:
       state_.run.stop_requested = true;
@@ -325,17 +339,24 @@ void ConsoleController::perform(Action action) {
       state_.screen = Screen::kInspector;
       return;
     }
-    case Action::kWorstError: jump_to_error_peak(+1); return;
+    case Action::kWorstError:
+      jump_to_error_peak(+1);
+      return;
     case Action::kRmsScale:
       state_.rms_log_scale = !state_.rms_log_scale;
-      set_status(state_.rms_log_scale ? "the RMS plot on a log scale (L: linear)" : "the RMS plot on a linear scale (L: log)");
+      set_status(state_.rms_log_scale ? "the RMS plot on a log scale (L: linear)"
+                                      : "the RMS plot on a linear scale (L: log)");
       return;
-    case Action::kTuning: state_.screen = Screen::kTuning; return;
+    case Action::kTuning:
+      state_.screen = Screen::kTuning;
+      return;
     case Action::kLog:
       state_.log_scroll = 0;
       state_.screen = Screen::kLog;
       return;
-    case Action::kFaultView: state_.screen = Screen::kFault; return;
+    case Action::kFaultView:
+      state_.screen = Screen::kFault;
+      return;
     case Action::kSave: {
       const std::string& location = state_.experiment.session_location;
       const std::string current = location.substr(location.find_last_of('/') + 1);
@@ -344,8 +365,12 @@ void ConsoleController::perform(Action action) {
                   "Enter rename   Esc cancel", current);
       return;
     }
-    case Action::kRig: state_.screen = Screen::kRig; return;
-    case Action::kFigures: start_figures(); return;
+    case Action::kRig:
+      state_.screen = Screen::kRig;
+      return;
+    case Action::kFigures:
+      start_figures();
+      return;
     case Action::kOpen:
       state_.screen = Screen::kSessions;
       start_listing();
@@ -356,12 +381,13 @@ void ConsoleController::perform(Action action) {
       std::vector<std::string> text;
       if (valves_live(state_.engine_state) || state_.run.mode != RunProgress::Mode::kIdle) {
         text.push_back(state_.engine_state == EngineState::kRunning ? "A trial is running with the valves live."
-                                                                   : "The valves are live (ARMED).");
+                                                                    : "The valves are live (ARMED).");
       }
       const int unsaved_faults = static_cast<int>(e.faults.size()) - e.saved_faults;
       if (saves_settled() && e.unsaved() && (!e.trials.empty() || unsaved_faults > 0)) {
         text.push_back(e.unsaved_sentence());
-        if (!state_.sessions_available) text.push_back("Saving is not available: " + state_.sessions_unavailable_reason);
+        if (!state_.sessions_available)
+          text.push_back("Saving is not available: " + state_.sessions_unavailable_reason);
       }
       if (text.empty()) {
         quit_when_saved();
@@ -369,8 +395,9 @@ void ConsoleController::perform(Action action) {
       }
       text.push_back("Quitting vents the valves before the console exits; the engine goes on until you answer.");
       const bool retry = state_.sessions_available && autosave_failed_;
-      open_dialog(DialogKind::kConfirmQuit, "Quit?", text,
-                  retry ? "s save and quit   q or y quit without saving   n or Esc stay" : "q or y quit   n or Esc stay");
+      open_dialog(
+          DialogKind::kConfirmQuit, "Quit?", text,
+          retry ? "s save and quit   q or y quit without saving   n or Esc stay" : "q or y quit   n or Esc stay");
       return;
     }
     case Action::kHeartbeatDrill:
@@ -386,7 +413,9 @@ void ConsoleController::perform(Action action) {
       set_status("showing " + joint_label(joints, state_.joint) + " (j: the next joint)");
       return;
     }
-    case Action::kMain: state_.screen = Screen::kMain; return;
+    case Action::kMain:
+      state_.screen = Screen::kMain;
+      return;
   }
 }
 

@@ -23,7 +23,8 @@ bool ConsoleController::handle_rig_key(int k) {
       set_status("zeroing the angle: only while SAFE (disarm first), with the arm at rest", true);
     } else {
       open_dialog(DialogKind::kConfirmZeroAngle, "Zero the angle here?",
-                  {format("The arm reads %+.3f deg now: this becomes 0 deg.", state_.live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi),
+                  {format("The arm reads %+.3f deg now: this becomes 0 deg.",
+                          state_.live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi),
                    "Hold the arm at rest where it should read zero (hanging straight).",
                    "The rig profile's angle_zero_rad is written to its file."},
                   "y zero it   n cancel");
@@ -33,7 +34,8 @@ bool ConsoleController::handle_rig_key(int k) {
   if (k != 'v') return false;
   if (valve_test_ && valve_test_->running()) {
     set_status("the valve test is running (Space stops it)", true);
-  } else if (state_.run.mode != RunProgress::Mode::kIdle || in_flight_ || state_.engine_state == EngineState::kRunning) {
+  } else if (state_.run.mode != RunProgress::Mode::kIdle || in_flight_ ||
+             state_.engine_state == EngineState::kRunning) {
     set_status("valve test: not while trials run (x stops them)", true);
   } else if (state_.engine_state == EngineState::kFault) {
     set_status("valve test: a fault is latched: reset it (R) first", true);
@@ -61,9 +63,9 @@ void ConsoleController::zero_angle() {
 }
 
 void ConsoleController::start_valve_test() {
-  valve_test_ = std::make_unique<ValveTest>(env_.config.rig_check, env_.config.safety, env_.config.controller.gas.ambient_bar,
-                                            env_.config.timing.tick_s, env_.config.model.volume_gain_per_rad,
-                                            env_.device_health ? link_lag_s(env_.device_health()) : 0.0);
+  valve_test_ = std::make_unique<ValveTest>(
+      env_.config.rig_check, env_.config.safety, env_.config.controller.gas.ambient_bar, env_.config.timing.tick_s,
+      env_.config.model.volume_gain_per_rad, env_.device_health ? link_lag_s(env_.device_health()) : 0.0);
   const SensorReading latest = state_.live_valid ? state_.live.reading : SensorReading{};
   state_.rig.verdicts_logged = false;
   if (!send_valve_test_commands(valve_test_->begin(state_.engine_state, latest))) return;
@@ -114,7 +116,8 @@ void ConsoleController::show_valve_verdicts() {
     int failed = 0;
     for (const RigView::ValveLine& line : rig.valves) {
       failed += line.pass ? 0 : 1;
-      log(LogSource::kOperator, "valve test: " + line.valve + (line.pass ? " pass (" : " FAIL: ") + line.text + (line.pass ? ")" : ""),
+      log(LogSource::kOperator,
+          "valve test: " + line.valve + (line.pass ? " pass (" : " FAIL: ") + line.text + (line.pass ? ")" : ""),
           !line.pass);
     }
     set_status(failed == 0 ? "valve test: every valve passed"
@@ -142,8 +145,9 @@ void ConsoleController::add_link_health(DeviceHealth& health) {
     health.ok = false;
     health.status = l.exchanges == 0 ? "no link yet" : "link lost";
   }
-  health.status += format(", rt p99 %.1f ms, %llu err, %llu stale", l.round_trip_p99_ms,
-                          static_cast<unsigned long long>(l.link_errors), static_cast<unsigned long long>(l.stale_readings));
+  health.status +=
+      format(", rt p99 %.1f ms, %llu err, %llu stale", l.round_trip_p99_ms,
+             static_cast<unsigned long long>(l.link_errors), static_cast<unsigned long long>(l.stale_readings));
 }
 
 }  // namespace bellows::ui

@@ -29,7 +29,8 @@ void ConsoleController::jump_to_error_peak(int step) {
   const Trial& t = state_.experiment.trials[static_cast<std::size_t>(v.trial)];
   if (!t.in_memory()) {
     set_status(format("iteration %d is on disk only (the console keeps the newest %d trials in memory)", t.iteration,
-                      Experiment::kTrialsKeptInMemory), true);
+                      Experiment::kTrialsKeptInMemory),
+               true);
     return;
   }
   const int joint = selected_joint(state_) < t.record.joint_count() ? selected_joint(state_) : 0;
@@ -43,8 +44,8 @@ void ConsoleController::jump_to_error_peak(int step) {
   v.sample = peaks[static_cast<std::size_t>(v.peak)];
   const TrialSamples& samples = t.record.joint_samples(joint);
   set_status(format("iteration %d: |error| peak %d of %d, %.2f deg at %.2f s (sample %d); e next, E back", t.iteration,
-                    v.peak + 1, count, std::abs(samples.error_rad(v.sample)) * kDegPerRad, t.record.sample_time_s(v.sample),
-                    v.sample));
+                    v.peak + 1, count, std::abs(samples.error_rad(v.sample)) * kDegPerRad,
+                    t.record.sample_time_s(v.sample), v.sample));
 }
 
 bool ConsoleController::handle_screen_key(int k) {
@@ -57,15 +58,35 @@ bool ConsoleController::handle_screen_key(int k) {
       const int n = state_.experiment.trials[static_cast<std::size_t>(v.trial)].record.learning_samples;
       const int page = std::max(1, n / 10);
       switch (k) {
-        case key::kLeft: v.sample = std::max(0, v.sample - 1); return true;
-        case key::kRight: v.sample = std::min(n, v.sample + 1); return true;
-        case key::kPageUp: v.sample = std::max(0, v.sample - page); return true;
-        case key::kPageDown: v.sample = std::min(n, v.sample + page); return true;
-        case key::kHome: v.sample = 0; return true;
-        case key::kEnd: v.sample = n; return true;
-        case key::kUp: v.trial = std::max(0, v.trial - 1); v.peak = -1; return true;
-        case key::kDown: v.trial = std::min(trials - 1, v.trial + 1); v.peak = -1; return true;
-        case 'E': jump_to_error_peak(-1); return true;
+        case key::kLeft:
+          v.sample = std::max(0, v.sample - 1);
+          return true;
+        case key::kRight:
+          v.sample = std::min(n, v.sample + 1);
+          return true;
+        case key::kPageUp:
+          v.sample = std::max(0, v.sample - page);
+          return true;
+        case key::kPageDown:
+          v.sample = std::min(n, v.sample + page);
+          return true;
+        case key::kHome:
+          v.sample = 0;
+          return true;
+        case key::kEnd:
+          v.sample = n;
+          return true;
+        case key::kUp:
+          v.trial = std::max(0, v.trial - 1);
+          v.peak = -1;
+          return true;
+        case key::kDown:
+          v.trial = std::min(trials - 1, v.trial + 1);
+          v.peak = -1;
+          return true;
+        case 'E':
+          jump_to_error_peak(-1);
+          return true;
         case 'm':
           v.chosen = v.chosen == v.trial ? -1 : v.trial;
           return true;
@@ -77,15 +98,19 @@ bool ConsoleController::handle_screen_key(int k) {
           }
           if (!t.in_memory()) {
             set_status(format("iteration %d is on disk only (the console keeps the newest %d trials in memory)",
-                              t.iteration, Experiment::kTrialsKeptInMemory), true);
+                              t.iteration, Experiment::kTrialsKeptInMemory),
+                       true);
             return true;
           }
-          state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration), t.summary.learned_with);
-          log(LogSource::kOperator, format("go back to the correction of iteration %d for the next trial", t.iteration));
+          state_.experiment.set_next(t.correction_bar, "correction of " + std::to_string(t.iteration),
+                                     t.summary.learned_with);
+          log(LogSource::kOperator,
+              format("go back to the correction of iteration %d for the next trial", t.iteration));
           set_status(format("the next trial applies the correction of iteration %d", t.iteration));
           return true;
         }
-        default: return false;
+        default:
+          return false;
       }
     }
     case Screen::kTrajectory: {
@@ -99,8 +124,9 @@ bool ConsoleController::handle_screen_key(int k) {
       if (k == key::kEnter) {
         const bool file_entry = ch.selected == count - 1;
         if (file_entry && (!ch.preview || !ch.preview_error.empty() || ch.file_path.empty())) {
-          open_dialog(DialogKind::kTrajectoryPath, "Trajectory file", {"A CSV file with the header time_s,angle_deg,",
-                      "sampled every " + format("%.3f s", env_.config.timing.sample_s()) + " from t = 0."},
+          open_dialog(DialogKind::kTrajectoryPath, "Trajectory file",
+                      {"A CSV file with the header time_s,angle_deg,",
+                       "sampled every " + format("%.3f s", env_.config.timing.sample_s()) + " from t = 0."},
                       "Enter load and preview   Esc cancel", ch.file_path);
           return true;
         }
@@ -111,7 +137,8 @@ bool ConsoleController::handle_screen_key(int k) {
     }
     case Screen::kTuning: {
       if (k == key::kUp || k == key::kDown) {
-        state_.tuning.selected = std::clamp(state_.tuning.selected + (k == key::kUp ? -1 : 1), 0, TuningForm::kRows - 1);
+        state_.tuning.selected =
+            std::clamp(state_.tuning.selected + (k == key::kUp ? -1 : 1), 0, TuningForm::kRows - 1);
         return true;
       }
       const bool on_law = state_.tuning.selected == TuningForm::kLawRow;
@@ -144,8 +171,8 @@ bool ConsoleController::handle_screen_key(int k) {
         if (!l.error.empty()) {
           set_status(l.name + " cannot be opened: " + l.error, true);
         } else if (!l.refusal.empty()) {
-          set_status(l.name + " cannot be opened here: " + l.refusal + " (bellows console --device " + l.device + " --session " +
-                         l.location + ")",
+          set_status(l.name + " cannot be opened here: " + l.refusal + " (bellows console --device " + l.device +
+                         " --session " + l.location + ")",
                      true);
         } else if (!availability(Action::kOpen, state_).available) {
           set_status("cannot open now: " + availability(Action::kOpen, state_).reason, true);
@@ -243,9 +270,10 @@ void ConsoleController::confirm_discard(std::string what, std::function<void()> 
   }
   pending_discard_action_ = std::move(action);
   const int unsaved = static_cast<int>(e.trials.size()) - e.saved_trials;
-  open_dialog(DialogKind::kConfirmDiscard, "Discard unsaved work?",
-              {format("%d iteration%s not saved; %s starts afresh.", unsaved, unsaved == 1 ? " is" : "s are", what.c_str())},
-              "y discard   n or Esc cancel");
+  open_dialog(
+      DialogKind::kConfirmDiscard, "Discard unsaved work?",
+      {format("%d iteration%s not saved; %s starts afresh.", unsaved, unsaved == 1 ? " is" : "s are", what.c_str())},
+      "y discard   n or Esc cancel");
 }
 
 void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> trajectory) {
@@ -268,8 +296,8 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
     state_.experiment = Experiment::start(trajectory);
     state_.inspector = InspectorView{};
     if (trajectory->learning_samples() != old_samples || !law_) rebuild_law();
-    log(LogSource::kOperator, format("trajectory %s (%.1f s, N = %d)", trajectory->name.c_str(), trajectory->duration_s(),
-                                     trajectory->learning_samples()));
+    log(LogSource::kOperator, format("trajectory %s (%.1f s, N = %d)", trajectory->name.c_str(),
+                                     trajectory->duration_s(), trajectory->learning_samples()));
     set_status("trajectory " + trajectory->name + ": iteration 0 runs with feedback only");
     state_.screen = Screen::kMain;
     offer_transfer();
@@ -294,16 +322,20 @@ void ConsoleController::choose_law_step(int step) {
   state_.experiment.settings_changed = true;
   log(LogSource::kOperator, format("law changed %s -> %s ([ilc] law)", old.c_str(), candidate.ilc.law.c_str()));
   rebuild_law();
-  set_status("law " + candidate.ilc.law + " from the next learning step on: " + learning_law_description(candidate.ilc.law));
+  set_status("law " + candidate.ilc.law +
+             " from the next learning step on: " + learning_law_description(candidate.ilc.law));
 }
 
 std::string ConsoleController::apply_tuning(int field, const std::string& text) {
   const TuningField& f = tuning_fields()[static_cast<std::size_t>(field)];
   double value = 0;
   switch (parse_number(trim(text), value)) {
-    case NumberParse::kNumber: break;
-    case NumberParse::kNotANumber: return std::string(f.label) + ": '" + text + "' is not a number";
-    case NumberParse::kOutOfRange: return std::string(f.label) + ": '" + text + "' is out of range";
+    case NumberParse::kNumber:
+      break;
+    case NumberParse::kNotANumber:
+      return std::string(f.label) + ": '" + text + "' is not a number";
+    case NumberParse::kOutOfRange:
+      return std::string(f.label) + ": '" + text + "' is out of range";
   }
   Configuration candidate = state_.config;
   const double old = *f.value(candidate);

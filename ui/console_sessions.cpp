@@ -49,13 +49,15 @@ void ConsoleController::start_save() {
   snapshot.experiment.session_location = e.session_location;
   snapshot.experiment.saved_events = e.saved_events;
   snapshot.experiment.settings_changed = e.settings_changed;
-  snapshot.experiment.faults = e.faults;  // saved ones hold no ticks (released)
+  snapshot.experiment.faults = e.faults;                      // saved ones hold no ticks (released)
   snapshot.experiment.first_correction = e.first_correction;  // a new session records it
   snapshot.first_trial = first;
-  const std::size_t new_events = std::min(state_.log.entries().size(), state_.log.total() - std::min(e.saved_events, state_.log.total()));
+  const std::size_t new_events =
+      std::min(state_.log.entries().size(), state_.log.total() - std::min(e.saved_events, state_.log.total()));
   const bool all_events = e.session_location.empty();
-  snapshot.events.assign(all_events ? state_.log.entries().begin() : state_.log.entries().end() - static_cast<long>(new_events),
-                         state_.log.entries().end());
+  snapshot.events.assign(
+      all_events ? state_.log.entries().begin() : state_.log.entries().end() - static_cast<long>(new_events),
+      state_.log.entries().end());
   snapshot.events_total = state_.log.total();
   snapshot.device_name = env_.device_name;
   snapshot.seed = env_.seed;
@@ -79,7 +81,9 @@ void ConsoleController::start_figures() {
   // Drawn from the saved session's files, as `bellows sessions plot` draws them: memory holds only
   // the newest trials. Trials not saved yet are saved first.
   if (!state_.sessions_available) {
-    set_status("figures are drawn from the saved session, and saving is not available: " + state_.sessions_unavailable_reason, true);
+    set_status(
+        "figures are drawn from the saved session, and saving is not available: " + state_.sessions_unavailable_reason,
+        true);
     return;
   }
   if (autosave_failed_) {
@@ -89,7 +93,8 @@ void ConsoleController::start_figures() {
   figures_after_save_ = static_cast<int>(state_.experiment.trials.size());
   log(LogSource::kSession, format("writing figures of %d iterations", figures_after_save_));
   autosave();
-  if (!save_task_.busy() && !rename_task_.busy() && state_.experiment.saved_trials >= figures_after_save_) launch_figures();
+  if (!save_task_.busy() && !rename_task_.busy() && state_.experiment.saved_trials >= figures_after_save_)
+    launch_figures();
 }
 
 void ConsoleController::launch_figures() {
@@ -150,7 +155,8 @@ void ConsoleController::poll_session_tasks() {
       const std::string unsaved = state_.experiment.unsaved_sentence();
       log(LogSource::kSession, std::string("save failed: ") + error.what() + "; " + unsaved, true);
       set_status(std::string("save failed: ") + error.what() + "; " + unsaved +
-                     " Kept in memory; the next trial (or s when quitting) retries the save", true);
+                     " Kept in memory; the next trial (or s when quitting) retries the save",
+                 true);
       if (state_.run.mode != RunProgress::Mode::kIdle) end_run("stopped: the session cannot be saved", true);
       if (figures_after_save_ > 0) log(LogSource::kSession, "figures not written: the session is not saved", true);
       figures_after_save_ = 0;
@@ -183,7 +189,8 @@ void ConsoleController::poll_session_tasks() {
       set_status(std::string("naming failed: ") + error.what(), true);
     }
     ++revision_;
-    if (figures_after_save_ > 0 && !save_task_.busy() && state_.experiment.saved_trials >= figures_after_save_) launch_figures();
+    if (figures_after_save_ > 0 && !save_task_.busy() && state_.experiment.saved_trials >= figures_after_save_)
+      launch_figures();
   }
   if (figure_task_.ready()) {
     try {
@@ -255,9 +262,10 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.inspector = InspectorView{};
   state_.inspector.trial = static_cast<int>(state_.experiment.trials.size()) - 1;
   const Experiment& adopted = state_.experiment;
-  log(LogSource::kSession, format("opened %s: %s, iterations %s, best RMS %.3f deg", adopted.session_location.c_str(),
-                                  adopted.trajectory->name.c_str(), iteration_range(static_cast<long long>(adopted.trials.size())).c_str(),
-                                  adopted.best_rms_deg()));
+  log(LogSource::kSession,
+      format("opened %s: %s, iterations %s, best RMS %.3f deg", adopted.session_location.c_str(),
+             adopted.trajectory->name.c_str(), iteration_range(static_cast<long long>(adopted.trials.size())).c_str(),
+             adopted.best_rms_deg()));
   if (!at_start) {
     select_trajectory(adopted.trajectory);
     send_gains();

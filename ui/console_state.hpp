@@ -22,24 +22,24 @@ enum class Screen { kMain, kHelp, kTrajectory, kInspector, kTuning, kLog, kSessi
 
 enum class DialogKind {
   kNone,
-  kConfirmArm,       // y/n
-  kAskIterations,    // a number K
-  kTrajectoryPath,   // a file path
-  kEditValue,        // a number for the tuning field
-  kConfirmQuit,      // s / q / Esc
-  kConfirmDiscard,   // y/n: unsaved trials would be lost
-  kConfirmValveTest, // y/n: the valves open one by one, the arm moves
-  kConfirmZeroAngle, // y/n: the angle read now becomes the rig profile's zero (its file is written)
-  kSessionName,      // a name for the session saved as the console goes
+  kConfirmArm,        // y/n
+  kAskIterations,     // a number K
+  kTrajectoryPath,    // a file path
+  kEditValue,         // a number for the tuning field
+  kConfirmQuit,       // s / q / Esc
+  kConfirmDiscard,    // y/n: unsaved trials would be lost
+  kConfirmValveTest,  // y/n: the valves open one by one, the arm moves
+  kConfirmZeroAngle,  // y/n: the angle read now becomes the rig profile's zero (its file is written)
+  kSessionName,       // a name for the session saved as the console goes
 };
 
 struct Dialog {
   DialogKind kind = DialogKind::kNone;
   std::string title;
   std::vector<std::string> text;
-  std::string input;   // what the operator typed (prompts)
-  std::string hint;    // the keys, e.g. "y arm   n cancel"
-  std::string error;   // why the last answer was not taken (the dialog stays open, the input kept)
+  std::string input;  // what the operator typed (prompts)
+  std::string hint;   // the keys, e.g. "y arm   n cancel"
+  std::string error;  // why the last answer was not taken (the dialog stays open, the input kept)
 };
 
 struct DeviceHealth {
@@ -50,19 +50,19 @@ struct DeviceHealth {
 
 /// The Rig screen (the first day at the bench): the inputs live and the valve test.
 struct RigView {
-  std::string where;          // the link: "in-process", an LCM URL, a T7's address
-  std::string rig_profile;    // its name ("" without one)
-  RawInputs raw;              // raw volts beside calibrated values (none for the simulated arm)
+  std::string where;        // the link: "in-process", an LCM URL, a T7's address
+  std::string rig_profile;  // its name ("" without one)
+  RawInputs raw;            // raw volts beside calibrated values (none for the simulated arm)
   struct ValveLine {
-    std::string valve;        // "inlet A"
+    std::string valve;  // "inlet A"
     bool tested = false;
     bool pass = false;
-    std::string text;         // the changes, or the problem
+    std::string text;  // the changes, or the problem
   };
   std::vector<ValveLine> valves;  // the last valve test's verdicts (empty: none yet)
   bool test_running = false;
   bool verdicts_logged = false;  // the finished test's verdicts are in the log
-  std::string test_progress;  // "inlet B: pulsing (2 of 4)", "done", "stopped: ..."
+  std::string test_progress;     // "inlet B: pulsing (2 of 4)", "done", "stopped: ..."
 };
 
 struct LoopHealth {
@@ -70,12 +70,12 @@ struct LoopHealth {
   std::uint64_t missed = 0;
   double p50_us = 0, p99_us = 0, max_us = 0;
   std::string rt = "other";
-  std::string speed = "1";       // "1", "2", "5", "10", "max"
+  std::string speed = "1";  // "1", "2", "5", "10", "max"
   double tick_hz = 200.0;
   std::uint64_t dropped_telemetry = 0;
-  std::uint64_t dropped_events = 0;   // engine events lost to a full event queue
-  bool realtime = true;          // false on a simulated clock (no latency to show)
-  std::string clock = "wall";    // "wall" (the real-time loop) or "sim" (console --clock sim)
+  std::uint64_t dropped_events = 0;  // engine events lost to a full event queue
+  bool realtime = true;              // false on a simulated clock (no latency to show)
+  std::string clock = "wall";        // "wall" (the real-time loop) or "sim" (console --clock sim)
 };
 
 /// The last seconds of the live signals at the ILC rate, oldest first, for the live plot; time in
@@ -90,10 +90,10 @@ struct RunProgress {
   Mode mode = Mode::kIdle;
   enum class Phase { kNone, kLearning, kSettling, kRunning };
   Phase phase = Phase::kNone;
-  int batch_first = 0;   // a batch runs iterations batch_first..batch_first + batch_total - 1
-  int batch_total = 0;   // trials of a batch: K, or K + 1 with iteration 0 (docs/iterations.md)
-  int batch_done = 0;    // trials finished in the batch
-  int sample = -1;       // sample of the running trial
+  int batch_first = 0;  // a batch runs iterations batch_first..batch_first + batch_total - 1
+  int batch_total = 0;  // trials of a batch: K, or K + 1 with iteration 0 (docs/iterations.md)
+  int batch_done = 0;   // trials finished in the batch
+  int sample = -1;      // sample of the running trial
   bool stop_requested = false;
 };
 
@@ -103,19 +103,19 @@ inline std::string batch_span(const RunProgress& r) {
 }
 
 struct InspectorView {
-  int trial = -1;     // index into experiment.trials
-  int sample = 0;     // cursor, 0..N
-  int chosen = -1;    // an iteration overlaid for comparison (-1: none)
-  int peak = -1;      // which of the trial's |error| peaks e last jumped to (0: the largest; -1: none)
+  int trial = -1;   // index into experiment.trials
+  int sample = 0;   // cursor, 0..N
+  int chosen = -1;  // an iteration overlaid for comparison (-1: none)
+  int peak = -1;    // which of the trial's |error| peaks e last jumped to (0: the largest; -1: none)
 };
 
 struct TrajectoryChooser {
-  std::vector<std::string> names;         // library names, then the file entry
+  std::vector<std::string> names;  // library names, then the file entry
   std::vector<std::string> descriptions;
   int selected = 0;
   std::shared_ptr<const Trajectory> preview;
   std::string preview_error;
-  std::string file_path;                  // the file entry's path, once given
+  std::string file_path;  // the file entry's path, once given
 };
 
 /// The tuning screen's rows, in order: k_ff, k_p, k_i, k_d, the learning law, M, S, W.
@@ -140,7 +140,7 @@ struct FaultView {
   std::vector<TickRecord> black_box;  // oldest first, ending with the fault tick
   std::string where;                  // on a J-joint arm: the joint (and chamber) the guard fired on
   int joint = -1;                     // the joint the engine named (0-based); -1: no joint's
-  std::string detail;                 // the fault's own sentence (a device's words: the rig's reason, the link's silence)
+  std::string detail;  // the fault's own sentence (a device's words: the rig's reason, the link's silence)
 };
 
 struct ConsoleState;
@@ -156,12 +156,12 @@ struct ConsoleState {
   Screen screen = Screen::kMain;
   Screen previous_screen = Screen::kMain;  // where help was opened from
   Dialog dialog;
-  std::string status;          // the latest message for the operator
+  std::string status;  // the latest message for the operator
   bool status_important = false;
   Screen status_screen = Screen::kMain;  // where it was said: another screen does not show it
-  int log_scroll = 0;          // log screen: entries scrolled back from the newest
-  int help_scroll = 0;         // help screen: its first line shown
-  bool rms_log_scale = false;  // the RMS plot's y axis (L toggles)
+  int log_scroll = 0;                    // log screen: entries scrolled back from the newest
+  int help_scroll = 0;                   // help screen: its first line shown
+  bool rms_log_scale = false;            // the RMS plot's y axis (L toggles)
 
   // The engine and the rig.
   EngineState engine_state = EngineState::kSafe;
@@ -169,20 +169,20 @@ struct ConsoleState {
   DeviceHealth device;
   LoopHealth loop;
   bool live_valid = false;
-  TickRecord live;             // the latest tick
+  TickRecord live;  // the latest tick
   LiveStrip strip;
   bool heartbeat_drill = false;  // heartbeats withheld on purpose
 
   // The learning.
-  Configuration config;        // current gains and weights included
+  Configuration config;  // current gains and weights included
   Experiment experiment;
-  int joint = 0;               // the joint the live strip, plots and inspector show (0-based; j selects)
+  int joint = 0;  // the joint the live strip, plots and inspector show (0-based; j selects)
   std::string law_name;
   bool law_ready = false;
-  std::string convergence;        // the law's predicted contraction per trial, in words
+  std::string convergence;           // the law's predicted contraction per trial, in words
   bool convergence_warning = false;  // it may diverge for a plausible model error
   bool learner_busy = false;
-  std::string learner_task;    // "building the learning law", "learning", "saving", ...
+  std::string learner_task;  // "building the learning law", "learning", "saving", ...
   RunProgress run;
   int stop_after_rises = 3;
 

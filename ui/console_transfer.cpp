@@ -9,8 +9,9 @@
 namespace bellows::ui {
 
 std::string TransferOffer::offer_line() const {
-  return format("%c: start from what %d session%s taught (%s): predicted %.1f deg RMS, feedback only %.1f deg", kTransferKey,
-                source_count, source_count == 1 ? "" : "s", method.c_str(), predicted_rms_deg, feedback_only_rms_deg);
+  return format("%c: start from what %d session%s taught (%s): predicted %.1f deg RMS, feedback only %.1f deg",
+                kTransferKey, source_count, source_count == 1 ? "" : "s", method.c_str(), predicted_rms_deg,
+                feedback_only_rms_deg);
 }
 
 TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config) {
@@ -22,7 +23,8 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
   const Eigen::Index n = experiment.samples();
   for (const Trial& trial : experiment.trials) {
     const TrialSamples& s = trial.record.joint_samples(0);
-    if (!trial.record.complete || s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1) continue;
+    if (!trial.record.complete || s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1)
+      continue;
     source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
   }
   return source;
@@ -38,10 +40,10 @@ TransferSourceNote transfer_note_of(const Experiment& experiment, std::string na
   return note;
 }
 
-TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, const std::string& rig_profile,
-                                     const std::shared_ptr<const Trajectory>& target, int max_saved,
-                                     const std::vector<std::string>& taught_locations,
+TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions,
+                                     const Configuration& config, const std::string& device,
+                                     const std::string& rig_profile, const std::shared_ptr<const Trajectory>& target,
+                                     int max_saved, const std::vector<std::string>& taught_locations,
                                      const std::vector<TransferSourceNote>& taught_notes) {
   TransferOffer offer;
   offer.trajectory = target;
@@ -51,7 +53,8 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
     for (std::size_t i = 0; i < taught.size(); ++i) {
       TransferSource& s = taught[i];
       if (s.trials.empty()) continue;
-      record->sources.push_back(i < taught_notes.size() ? taught_notes[i] : TransferSourceNote{s.name, "", s.name, 0, 0.0});
+      record->sources.push_back(i < taught_notes.size() ? taught_notes[i]
+                                                        : TransferSourceNote{s.name, "", s.name, 0, 0.0});
       record->sources.back().trials = static_cast<int>(s.trials.size());
       sources.push_back(std::move(s));
     }
@@ -62,11 +65,13 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
       for (const SessionListing& listing : listed) {
         if (used >= max_saved) break;
         if (!listing.error.empty() || listing.iterations == 0) continue;
-        if (std::find(taught_locations.begin(), taught_locations.end(), listing.location) != taught_locations.end()) continue;
+        if (std::find(taught_locations.begin(), taught_locations.end(), listing.location) != taught_locations.end())
+          continue;
         try {
           const SessionSnapshot snapshot = sessions->read_trials(listing.location);
           if (!transfer_mismatch(snapshot.config, snapshot.device_name, config, device).empty()) continue;
-          if (!rig_profile_mismatch(snapshot.rig_profile, rig_profile).empty()) continue;  // another arm, or wired otherwise
+          if (!rig_profile_mismatch(snapshot.rig_profile, rig_profile).empty())
+            continue;  // another arm, or wired otherwise
           TransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
           if (source.trials.empty()) continue;
           source.name = listing.name + " (saved)";
@@ -121,14 +126,14 @@ void ConsoleController::offer_transfer() {
   transfer_offer_ = TransferOffer{};
   if (!state_.experiment.trials.empty() || state_.experiment.next_correction_bar.cwiseAbs().maxCoeff() > 0.0) return;
   if (state_.experiment.joints() > 1) return;  // transfers learn one joint's dynamics
-  if (transfer_task_.busy()) {  // one at a time: ask again when the running one is done
+  if (transfer_task_.busy()) {                 // one at a time: ask again when the running one is done
     transfer_wanted_ = true;
     return;
   }
   transfer_wanted_ = false;
-  transfer_task_.start([taught = taught_, notes = taught_notes_, locations = taught_locations_, sessions = env_.sessions,
-                        config = env_.config, device = env_.device_name, profile = env_.rig_profile,
-                        target = state_.experiment.trajectory] {
+  transfer_task_.start([taught = taught_, notes = taught_notes_, locations = taught_locations_,
+                        sessions = env_.sessions, config = env_.config, device = env_.device_name,
+                        profile = env_.rig_profile, target = state_.experiment.trajectory] {
     return compute_transfer_offer(taught, sessions, config, device, profile, target, 4, locations, notes);
   });
 }
@@ -154,7 +159,8 @@ void ConsoleController::poll_transfer() {
 bool ConsoleController::handle_transfer_key(int k) {
   if (k != kTransferKey || state_.screen != Screen::kMain) return false;
   if (!transfer_offer_.useful || transfer_offer_.trajectory != state_.experiment.trajectory) {
-    set_status(format("%c: no transfer is offered for this trajectory (offered when one with no correction is chosen)", kTransferKey),
+    set_status(format("%c: no transfer is offered for this trajectory (offered when one with no correction is chosen)",
+                      kTransferKey),
                true);
     return true;
   }
@@ -165,8 +171,9 @@ bool ConsoleController::handle_transfer_key(int k) {
   const TransferOffer& o = transfer_offer_;
   state_.experiment.set_next(o.correction_bar, "transferred (" + o.method + ")");
   state_.experiment.first_correction = o.record;  // the session records it with iteration 0
-  log(LogSource::kOperator, format("first correction transferred from %s (%s): predicted %.2f deg RMS, feedback only %.2f deg",
-                                   o.sources.c_str(), o.method.c_str(), o.predicted_rms_deg, o.feedback_only_rms_deg));
+  log(LogSource::kOperator,
+      format("first correction transferred from %s (%s): predicted %.2f deg RMS, feedback only %.2f deg",
+             o.sources.c_str(), o.method.c_str(), o.predicted_rms_deg, o.feedback_only_rms_deg));
   set_status(format("iteration 0 runs with the transferred correction: predicted %.1f deg RMS", o.predicted_rms_deg));
   transfer_offer_ = TransferOffer{};
   return true;

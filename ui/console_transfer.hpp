@@ -22,11 +22,11 @@ struct TransferOffer {
   std::shared_ptr<const Trajectory> trajectory;  // what it was computed for
   Eigen::VectorXd correction_bar;
   std::string method;
-  std::string sources;     // "paper, steps (saved)"
+  std::string sources;  // "paper, steps (saved)"
   int source_count = 0;
   double predicted_rms_deg = 0.0;
   double feedback_only_rms_deg = 0.0;
-  std::string why_not;     // when not useful
+  std::string why_not;                            // when not useful
   std::shared_ptr<const FirstCorrection> record;  // what the session records when it is taken
   /// "T: start from what 2 sessions taught (inverse-fir): predicted 2.0 deg RMS, feedback only 12.6 deg"
   std::string offer_line() const;
@@ -39,11 +39,12 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 /// newest saved sessions that fit this run (transfer_mismatch; on a rig, the same rig profile:
 /// rig_profile_mismatch against `rig_profile`, "" without one), for `target`. Never throws: a
 /// transfer that cannot be computed or would not help comes back with `why_not`. `taught_locations`:
-/// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so the same trials are not used twice.
-TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions, const Configuration& config,
-                                     const std::string& device, const std::string& rig_profile,
-                                     const std::shared_ptr<const Trajectory>& target, int max_saved = 4,
-                                     const std::vector<std::string>& taught_locations = {},
+/// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so
+/// the same trials are not used twice.
+TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions,
+                                     const Configuration& config, const std::string& device,
+                                     const std::string& rig_profile, const std::shared_ptr<const Trajectory>& target,
+                                     int max_saved = 4, const std::vector<std::string>& taught_locations = {},
                                      const std::vector<TransferSourceNote>& taught_notes = {});
 /// `experiment`'s trials as a transfer source's note (what a session records about it).
 TransferSourceNote transfer_note_of(const Experiment& experiment, std::string name);

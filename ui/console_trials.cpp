@@ -21,25 +21,28 @@ void ConsoleController::rebuild_law() {
   state_.law_ready = false;
   law_samples_ = state_.experiment.samples();
   state_.law_name = state_.config.ilc.law;
-  law_build_.start([config = state_.config, model = model_, samples = law_samples_, joints = state_.experiment.joints()] {
-    BuiltLaw built;
-    built.law = make_joint_learning(config, model, joints, samples);
-    built.learned_with = learned_with(config);
-    // Predicted for one joint's law (the single-joint model); several joints learn without one.
-    const LearningLaw* single = built.law->single_joint_law();
-    const ConvergencePrediction p = single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
-    if (p.available) {
-      built.convergence = format("predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
-                                 "off by up to %.0f %%",
-                                 p.nominal.contraction, p.worst.contraction, 100.0 * p.model_error);
-      built.warning = !p.warning.empty();
-      if (built.warning) built.convergence = p.warning;
-    } else {
-      built.convergence = single != nullptr ? "no convergence prediction for this law"
-                                            : "no convergence prediction for several joints";
-    }
-    return built;
-  });
+  law_build_.start(
+      [config = state_.config, model = model_, samples = law_samples_, joints = state_.experiment.joints()] {
+        BuiltLaw built;
+        built.law = make_joint_learning(config, model, joints, samples);
+        built.learned_with = learned_with(config);
+        // Predicted for one joint's law (the single-joint model); several joints learn without one.
+        const LearningLaw* single = built.law->single_joint_law();
+        const ConvergencePrediction p =
+            single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
+        if (p.available) {
+          built.convergence = format(
+              "predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
+              "off by up to %.0f %%",
+              p.nominal.contraction, p.worst.contraction, 100.0 * p.model_error);
+          built.warning = !p.warning.empty();
+          if (built.warning) built.convergence = p.warning;
+        } else {
+          built.convergence = single != nullptr ? "no convergence prediction for this law"
+                                                : "no convergence prediction for several joints";
+        }
+        return built;
+      });
   ++revision_;
 }
 
@@ -50,14 +53,16 @@ void ConsoleController::poll_tasks() {
       BuiltLaw built = law_build_.take();
       law_ = std::move(built.law);
       law_learned_with_ = std::move(built.learned_with);
-      if (law_->samples() != state_.experiment.samples() || law_->joints() != state_.experiment.joints()) rebuild_pending_ = true;
+      if (law_->samples() != state_.experiment.samples() || law_->joints() != state_.experiment.joints())
+        rebuild_pending_ = true;
       state_.law_ready = !rebuild_pending_;
       if (state_.law_ready) {
         if (law_->joints() > 1) state_.law_name = law_->name();  // how the joints are modelled, too
         state_.convergence = built.convergence;
         state_.convergence_warning = built.warning;
-        log(LogSource::kLearner, format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(),
-                                        law_->samples(), state_.config.ilc.m, state_.config.ilc.s, state_.config.ilc.w));
+        log(LogSource::kLearner,
+            format("learning law %s ready (N = %d, M %g, S %g, W %g)", law_->name().c_str(), law_->samples(),
+                   state_.config.ilc.m, state_.config.ilc.s, state_.config.ilc.w));
         if (built.warning) log(LogSource::kLearner, built.convergence, true);
       }
     } catch (const std::exception& error) {
@@ -117,7 +122,8 @@ void ConsoleController::begin_trial() {
   auto trial = std::make_unique<InFlight>();
   trial->trajectory = e.trajectory;
   trial->correction_bar = e.next_correction_bar;
-  trial->origin = e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
+  trial->origin =
+      e.next_tried && !e.trials.empty() ? "same as " + std::to_string(e.trials.back().iteration) : e.next_origin;
   trial->learned_with = e.next_learned_with;
   // The operator arms (a): the runner never does here. It prepares the record and sends the trial.
   note_action_sent();
@@ -189,16 +195,18 @@ void ConsoleController::finish_trial(double time_s) {
   log(LogSource::kEngine,
       format("iteration %d: RMS %.3f deg, max error %.2f deg, max correction %.4f bar%s%s", s.iteration, s.rms_deg,
              s.max_abs_error_deg, s.max_abs_correction_bar,
-             d.contraction ? format(", contraction %.3f, correction changed %.4f bar", *d.contraction,
-                                    d.correction_change_bar).c_str()
-                           : "",
+             d.contraction
+                 ? format(", contraction %.3f, correction changed %.4f bar", *d.contraction, d.correction_change_bar)
+                       .c_str()
+                 : "",
              s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
       false, time_s);
   if (diagnostics_.windup_just_detected()) {
     log(LogSource::kLearner,
         format("wind-up since iteration %d: the correction keeps growing where the set points saturate (%.3f bar "
                "clamped away); the law noilc-constrained avoids it",
-               diagnostics_.windup().first_iteration.value_or(s.iteration), diagnostics_.windup().max_clamped_excess_bar),
+               diagnostics_.windup().first_iteration.value_or(s.iteration),
+               diagnostics_.windup().max_clamped_excess_bar),
         true, time_s);
   }
   if (s.joint_rms_deg.size() > 1) {
@@ -207,7 +215,8 @@ void ConsoleController::finish_trial(double time_s) {
       if (!per_joint.empty()) per_joint += ' ';
       per_joint += format("%.3f", r);
     }
-    log(LogSource::kEngine, format("iteration %d: RMS per joint %s deg", s.iteration, per_joint.c_str()), false, time_s);
+    log(LogSource::kEngine, format("iteration %d: RMS per joint %s deg", s.iteration, per_joint.c_str()), false,
+        time_s);
     set_status(format("iteration %d: RMS %.3f deg (per joint %s)", s.iteration, s.rms_deg, per_joint.c_str()));
   } else {
     set_status(format("iteration %d: RMS %.3f deg", s.iteration, s.rms_deg));
@@ -238,13 +247,15 @@ void ConsoleController::continue_run() {
   ++r.batch_done;
   if (r.stop_requested) {
     end_run(format("iterations %s stopped by the operator after iteration %d", batch_span(r).c_str(),
-                   state_.experiment.trials.back().iteration), false);
+                   state_.experiment.trials.back().iteration),
+            false);
   } else if (state_.experiment.rms_rising(state_.stop_after_rises)) {
-    end_run(format("iterations %s stopped by itself after iteration %d: the RMS rose %d times in a row", batch_span(r).c_str(),
-                   state_.experiment.trials.back().iteration, state_.stop_after_rises),
+    end_run(format("iterations %s stopped by itself after iteration %d: the RMS rose %d times in a row",
+                   batch_span(r).c_str(), state_.experiment.trials.back().iteration, state_.stop_after_rises),
             true);
   } else if (r.batch_done >= r.batch_total) {
-    end_run(format("iterations %s done: RMS %.3f deg", batch_span(r).c_str(), state_.experiment.trials.back().summary.rms_deg),
+    end_run(format("iterations %s done: RMS %.3f deg", batch_span(r).c_str(),
+                   state_.experiment.trials.back().summary.rms_deg),
             false);
   } else {
     step();

@@ -61,10 +61,14 @@ inline std::string utc_timestamp() {
 
 inline const char* to_string(LogSource source) {
   switch (source) {
-    case LogSource::kOperator: return "operator";
-    case LogSource::kEngine: return "engine";
-    case LogSource::kLearner: return "learner";
-    case LogSource::kSession: return "session";
+    case LogSource::kOperator:
+      return "operator";
+    case LogSource::kEngine:
+      return "engine";
+    case LogSource::kLearner:
+      return "learner";
+    case LogSource::kSession:
+      return "session";
   }
   return "?";
 }

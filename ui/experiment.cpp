@@ -21,7 +21,9 @@ std::string Experiment::unsaved_sentence() const {
   const int first = std::max(saved_trials, 0), last = static_cast<int>(trials.size()) - 1;
   // Which trials are not on disk, by number: the operator checks them against the history.
   if (iterations == 1) parts.push_back("iteration " + std::to_string(last));
-  if (iterations > 1) parts.push_back(std::to_string(iterations) + " iterations (" + std::to_string(first) + "-" + std::to_string(last) + ")");
+  if (iterations > 1)
+    parts.push_back(std::to_string(iterations) + " iterations (" + std::to_string(first) + "-" + std::to_string(last) +
+                    ")");
   if (black_boxes > 0) {
     parts.push_back(std::to_string(black_boxes) + (black_boxes == 1 ? " fault's black box" : " faults' black boxes"));
   }
@@ -75,7 +77,8 @@ std::vector<double> Experiment::joint_rms_history_deg(int joint) const {
   rms.reserve(trials.size());
   for (const Trial& t : trials) {
     const bool known = joint >= 0 && joint < t.summary.joint_rms_deg.size();
-    rms.push_back(known ? t.summary.joint_rms_deg(joint) : (joint == 0 ? t.summary.rms_deg : std::numeric_limits<double>::quiet_NaN()));
+    rms.push_back(known ? t.summary.joint_rms_deg(joint)
+                        : (joint == 0 ? t.summary.rms_deg : std::numeric_limits<double>::quiet_NaN()));
   }
   return rms;
 }
@@ -92,7 +95,8 @@ bool Experiment::rms_rising(int count) const {
   const int n = static_cast<int>(trials.size());
   if (count <= 0 || n < count + 1) return false;
   for (int i = n - count; i < n; ++i) {
-    if (!(trials[static_cast<std::size_t>(i)].summary.rms_deg > trials[static_cast<std::size_t>(i - 1)].summary.rms_deg)) {
+    if (!(trials[static_cast<std::size_t>(i)].summary.rms_deg >
+          trials[static_cast<std::size_t>(i - 1)].summary.rms_deg)) {
       return false;
     }
   }

@@ -42,8 +42,8 @@ struct FaultRecord {
 
 /// A source of a learning transfer, as the session that started from it records it.
 struct TransferSourceNote {
-  std::string name;        // the saved session's name, or the trajectory taught in this console
-  std::string directory;   // where it is saved ("" if it never was)
+  std::string name;       // the saved session's name, or the trajectory taught in this console
+  std::string directory;  // where it is saved ("" if it never was)
   std::string trajectory;
   int trials = 0;
   double last_rms_deg = 0.0;
@@ -66,16 +66,16 @@ struct Experiment {
   std::vector<Trial> trials;
   Eigen::MatrixXd next_correction_bar;  // what the next trial applies, N x J
   std::string next_origin = "feedback only";
-  LearnedWith next_learned_with;        // the law and weights that learned it (empty: not learned)
-  bool next_tried = false;              // a trial already ran with it: a step learns first
-  int saved_trials = 0;                 // trials already in the saved session
-  bool settings_changed = false;        // gains or weights changed since the last save
-  bool next_unsaved = false;            // the next correction changed since the last trial was saved
-  std::uint64_t next_revision = 0;      // bumped by every set_next()
-  std::string session_location;         // where it was saved or opened from; empty if never
-  std::size_t saved_events = 0;         // log entries (EventLog::total()) already in that session
-  std::vector<FaultRecord> faults;      // black boxes, in the order the faults fired
-  int saved_faults = 0;                 // black boxes already in the saved session
+  LearnedWith next_learned_with;    // the law and weights that learned it (empty: not learned)
+  bool next_tried = false;          // a trial already ran with it: a step learns first
+  int saved_trials = 0;             // trials already in the saved session
+  bool settings_changed = false;    // gains or weights changed since the last save
+  bool next_unsaved = false;        // the next correction changed since the last trial was saved
+  std::uint64_t next_revision = 0;  // bumped by every set_next()
+  std::string session_location;     // where it was saved or opened from; empty if never
+  std::size_t saved_events = 0;     // log entries (EventLog::total()) already in that session
+  std::vector<FaultRecord> faults;  // black boxes, in the order the faults fired
+  int saved_faults = 0;             // black boxes already in the saved session
   /// Set when the operator takes a transfer (T) before iteration 0; null: feedback only.
   std::shared_ptr<const FirstCorrection> first_correction;
 

@@ -36,7 +36,8 @@ std::string fault_location(FaultCode code, int joint, const TickRecord& tick, co
   const auto chamber = [](int c) { return c == 0 ? 'A' : 'B'; };
   switch (code) {
     case FaultCode::kAngleLimit:
-      return format("%s: angle %.1f deg beyond its limit of %g deg", where.c_str(), angle_deg, limits.angle_limit_deg_of(joint));
+      return format("%s: angle %.1f deg beyond its limit of %g deg", where.c_str(), angle_deg,
+                    limits.angle_limit_deg_of(joint));
     case FaultCode::kOverpressure:
       for (int c = 0; c < kActuatorCount; ++c) {
         if (r.chamber_bar[static_cast<std::size_t>(c)] > p_limit_bar) {

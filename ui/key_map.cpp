@@ -12,10 +12,14 @@ Availability no(std::string why) { return {false, std::move(why)}; }
 
 Availability needs_armed_idle(const ConsoleState& s) {
   switch (s.engine_state) {
-    case EngineState::kSafe: return no("arm the valves first (a)");
-    case EngineState::kFault: return no("a fault is latched: reset it (R), then arm");
-    case EngineState::kRunning: return no("a trial is running");
-    case EngineState::kArmed: break;
+    case EngineState::kSafe:
+      return no("arm the valves first (a)");
+    case EngineState::kFault:
+      return no("a fault is latched: reset it (R), then arm");
+    case EngineState::kRunning:
+      return no("a trial is running");
+    case EngineState::kArmed:
+      break;
   }
   if (!run_idle(s)) return no("trials are running (x stops them)");
   return {};
@@ -41,11 +45,15 @@ const std::vector<KeyBinding>& key_bindings() {
       {Action::kFaultView, 'f', key::kNone, "f", "Fault", "the last fault: which guard fired and the black box"},
       {Action::kSave, 's', key::kNone, "s", "Name", "name the session (it is saved as you go)"},
       {Action::kOpen, 'o', key::kNone, "o", "Open", "open a saved session"},
-      {Action::kFigures, 'g', key::kNone, "g", "Figures", "figures from the saved files: RMS, angle, error, u_ilc, pressures as PNG and SVG"},
+      {Action::kFigures, 'g', key::kNone, "g", "Figures",
+       "figures from the saved files: RMS, angle, error, u_ilc, pressures as PNG and SVG"},
       {Action::kQuit, 'q', key::kNone, "q", "Quit", kQuitRule},
-      {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill", "heartbeat drill: withhold heartbeats until the engine vents"},
-      {Action::kRig, 'b', key::kNone, "b", "Rig", "the Rig screen (the first day at the bench): inputs live, valve test"},
-      {Action::kJoint, 'j', key::kNone, "j", "Joint", "next joint: the live strip, plots and inspector show it (arms with several joints)"},
+      {Action::kHeartbeatDrill, 'H', key::kNone, "H", "Drill",
+       "heartbeat drill: withhold heartbeats until the engine vents"},
+      {Action::kRig, 'b', key::kNone, "b", "Rig",
+       "the Rig screen (the first day at the bench): inputs live, valve test"},
+      {Action::kJoint, 'j', key::kNone, "j", "Joint",
+       "next joint: the live strip, plots and inspector show it (arms with several joints)"},
       {Action::kMain, key::kEscape, key::kNone, "Esc", "Back", "back to the main screen"},
       {Action::kWorstError, 'e', key::kNone, "e", "Worst",
        "the inspector at the largest |error| of the trial; again: the next largest (E: back)"},
@@ -117,11 +125,13 @@ Availability availability(Action action, const ConsoleState& s) {
       return {};
     case Action::kSave:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
-      if (s.experiment.session_location.empty()) return no("nothing to name yet: the session is saved from the first trial on");
+      if (s.experiment.session_location.empty())
+        return no("nothing to name yet: the session is saved from the first trial on");
       return {};
     case Action::kFigures:
       if (s.experiment.trials.empty()) return no("no trial has run yet");
-      if (!s.sessions_available) return no("figures are drawn from the saved session: " + s.sessions_unavailable_reason);
+      if (!s.sessions_available)
+        return no("figures are drawn from the saved session: " + s.sessions_unavailable_reason);
       return {};
     case Action::kOpen:
       if (!s.sessions_available) return no(s.sessions_unavailable_reason);
@@ -145,15 +155,16 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
   if (s.engine_state == EngineState::kFault) {
     candidates = {Action::kReset, Action::kFaultView, Action::kLog, Action::kTrajectory, Action::kHelp, Action::kQuit};
   } else if (!run_idle(s) || s.engine_state == EngineState::kRunning) {
-    candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kJoint, Action::kInspector,
-                  Action::kLog, Action::kHelp, Action::kQuit};
+    candidates = {Action::kEmergencyStop, Action::kStopRun, Action::kDisarm, Action::kJoint,
+                  Action::kInspector,     Action::kLog,     Action::kHelp,   Action::kQuit};
   } else if (s.engine_state == EngineState::kArmed) {
     candidates = {Action::kEmergencyStop, Action::kRunTrial, Action::kNextIteration, Action::kRunIterations,
-                  Action::kDisarm, Action::kJoint, Action::kInspector, Action::kTrajectory, Action::kTuning, Action::kSave,
-                  Action::kHelp, Action::kQuit};
+                  Action::kDisarm,        Action::kJoint,    Action::kInspector,     Action::kTrajectory,
+                  Action::kTuning,        Action::kSave,     Action::kHelp,          Action::kQuit};
   } else {
-    candidates = {Action::kArm, Action::kJoint, Action::kTrajectory, Action::kInspector, Action::kTuning, Action::kSave,
-                  Action::kOpen, Action::kRig, Action::kLog, Action::kHelp, Action::kQuit};
+    candidates = {Action::kArm,    Action::kJoint, Action::kTrajectory, Action::kInspector,
+                  Action::kTuning, Action::kSave,  Action::kOpen,       Action::kRig,
+                  Action::kLog,    Action::kHelp,  Action::kQuit};
   }
   if (s.screen == Screen::kInspector) candidates.insert(candidates.begin() + 1, Action::kWorstError);
   if (s.screen != Screen::kMain) {  // on every other screen: the way back, right after the stop
@@ -169,21 +180,36 @@ std::vector<Action> function_bar_actions(const ConsoleState& s) {
 
 std::string key_name(int k) {
   switch (k) {
-    case key::kEnter: return "Enter";
-    case key::kEscape: return "Esc";
-    case key::kUp: return "Up";
-    case key::kDown: return "Down";
-    case key::kLeft: return "Left";
-    case key::kRight: return "Right";
-    case key::kPageUp: return "PgUp";
-    case key::kPageDown: return "PgDn";
-    case key::kHome: return "Home";
-    case key::kEnd: return "End";
-    case key::kBackspace: return "Backspace";
-    case key::kF1: return "F1";
-    case key::kTab: return "Tab";
-    case ' ': return "Space";
-    default: break;
+    case key::kEnter:
+      return "Enter";
+    case key::kEscape:
+      return "Esc";
+    case key::kUp:
+      return "Up";
+    case key::kDown:
+      return "Down";
+    case key::kLeft:
+      return "Left";
+    case key::kRight:
+      return "Right";
+    case key::kPageUp:
+      return "PgUp";
+    case key::kPageDown:
+      return "PgDn";
+    case key::kHome:
+      return "Home";
+    case key::kEnd:
+      return "End";
+    case key::kBackspace:
+      return "Backspace";
+    case key::kF1:
+      return "F1";
+    case key::kTab:
+      return "Tab";
+    case ' ':
+      return "Space";
+    default:
+      break;
   }
   if (k > 0x20 && k < 0x7f) return std::string(1, static_cast<char>(k));
   if (k >= 0 && k < 0x20) return "Ctrl-" + std::string(1, static_cast<char>('@' + k));
@@ -198,13 +224,14 @@ std::string key_name(int k) {
 std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
   switch (screen) {
     case Screen::kInspector:
-      return {{"Left/Right", "cursor along time, one sample"},
-              {"PgUp/PgDn", "cursor along time, a tenth of the trial"},
-              {"Home/End", "start / end of the trial"},
-              {"Up/Down", "earlier / later iteration"},
-              {"e / E", "the largest |error| of the trial, then the next largest / back to the larger one"},
-              {"m", "overlay this iteration for comparison, with the differences du, de and their RMS (m again: remove)"},
-              {"u", "use this iteration's correction for the next trial"}};
+      return {
+          {"Left/Right", "cursor along time, one sample"},
+          {"PgUp/PgDn", "cursor along time, a tenth of the trial"},
+          {"Home/End", "start / end of the trial"},
+          {"Up/Down", "earlier / later iteration"},
+          {"e / E", "the largest |error| of the trial, then the next largest / back to the larger one"},
+          {"m", "overlay this iteration for comparison, with the differences du, de and their RMS (m again: remove)"},
+          {"u", "use this iteration's correction for the next trial"}};
     case Screen::kTrajectory:
       return {{"Up/Down", "choose; the preview follows"}, {"Enter", "use it (the file entry asks for a path)"}};
     case Screen::kTuning:
@@ -222,22 +249,33 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
       return {{key_name(kTransferKey), "start a new trajectory from what earlier sessions taught (only while offered)"},
               {"L", "the RMS plot on a log or a linear scale"}};
     case Screen::kHelp:
-      return {{"Up/Down, PgUp/PgDn", "scroll"}, {"Home/End", "top / bottom"}, {"q, Esc, ?/F1", "close the help: back to the screen it was opened from"}};
+      return {{"Up/Down, PgUp/PgDn", "scroll"},
+              {"Home/End", "top / bottom"},
+              {"q, Esc, ?/F1", "close the help: back to the screen it was opened from"}};
   }
   return {};
 }
 
 const char* screen_title(Screen screen) {
   switch (screen) {
-    case Screen::kMain: return "Main screen";
-    case Screen::kHelp: return "This help";
-    case Screen::kTrajectory: return "Trajectory chooser (t)";
-    case Screen::kInspector: return "Correction inspector (c)";
-    case Screen::kTuning: return "Tuning (w)";
-    case Screen::kLog: return "Event log (l)";
-    case Screen::kSessions: return "Session browser (o)";
-    case Screen::kFault: return "Fault view (f)";
-    case Screen::kRig: return "Rig screen (b)";
+    case Screen::kMain:
+      return "Main screen";
+    case Screen::kHelp:
+      return "This help";
+    case Screen::kTrajectory:
+      return "Trajectory chooser (t)";
+    case Screen::kInspector:
+      return "Correction inspector (c)";
+    case Screen::kTuning:
+      return "Tuning (w)";
+    case Screen::kLog:
+      return "Event log (l)";
+    case Screen::kSessions:
+      return "Session browser (o)";
+    case Screen::kFault:
+      return "Fault view (f)";
+    case Screen::kRig:
+      return "Rig screen (b)";
   }
   return "";
 }
@@ -253,7 +291,8 @@ std::vector<HelpEntry> help_entries(const ConsoleState& s) {
   const Screen from = s.previous_screen;
   if (from != Screen::kMain) add_screen(from, std::string("On the screen you came from: ") + screen_title(from));
   out.push_back({true, "", "Everywhere (greyed: not available now)", {}});
-  for (const KeyBinding& b : key_bindings()) out.push_back({false, b.key_label, b.description, availability(b.action, s)});
+  for (const KeyBinding& b : key_bindings())
+    out.push_back({false, b.key_label, b.description, availability(b.action, s)});
   for (Screen screen : {Screen::kMain, Screen::kInspector, Screen::kTrajectory, Screen::kTuning, Screen::kSessions,
                         Screen::kLog, Screen::kFault, Screen::kRig, Screen::kHelp}) {
     if (screen != from || from == Screen::kMain) add_screen(screen, screen_title(screen));

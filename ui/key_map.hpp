@@ -33,16 +33,16 @@ enum class Action {
   kRig,
   kJoint,
   kMain,
-  kWorstError,   // the inspector's cursor to the largest |error| of the trial, then the next ones
-  kRmsScale,     // the RMS plot on a log or a linear scale
+  kWorstError,  // the inspector's cursor to the largest |error| of the trial, then the next ones
+  kRmsScale,    // the RMS plot on a log or a linear scale
 };
 
 struct KeyBinding {
   Action action;
   int key;
-  int alt_key;              // key::kNone if none
-  const char* key_label;    // as the help screen shows it, e.g. "?/F1"
-  const char* bar_label;    // short, for the function bar
+  int alt_key;            // key::kNone if none
+  const char* key_label;  // as the help screen shows it, e.g. "?/F1"
+  const char* bar_label;  // short, for the function bar
   const char* description;
 };
 

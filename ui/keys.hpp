@@ -21,7 +21,7 @@ inline constexpr int kF1 = kSpecial + 12;
 inline constexpr int kResize = kSpecial + 13;
 inline constexpr int kTab = kSpecial + 14;
 inline constexpr int kOther = kSpecial + 15;  // a function key the console has no use for
-inline constexpr int kClearLine = 0x15;  // Ctrl-U: clears a prompt's field
-inline constexpr int kRepaint = 0x0c;    // Ctrl-L: repaints the whole screen
+inline constexpr int kClearLine = 0x15;       // Ctrl-U: clears a prompt's field
+inline constexpr int kRepaint = 0x0c;         // Ctrl-L: repaints the whole screen
 
 }  // namespace bellows::ui::key

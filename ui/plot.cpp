@@ -17,8 +17,13 @@ constexpr unsigned kBrailleBits[2][4] = {{0x01, 0x02, 0x04, 0x40}, {0x08, 0x10, 
 class DotGrid {
  public:
   DotGrid(int cols, int rows, bool braille)
-      : cols_(cols), rows_(rows), braille_(braille), dots_x_(braille ? cols * 2 : cols), dots_y_(braille ? rows * 4 : rows),
-        bits_(static_cast<std::size_t>(cols * rows), 0u), roles_(static_cast<std::size_t>(cols * rows), Role::kNormal),
+      : cols_(cols),
+        rows_(rows),
+        braille_(braille),
+        dots_x_(braille ? cols * 2 : cols),
+        dots_y_(braille ? rows * 4 : rows),
+        bits_(static_cast<std::size_t>(cols * rows), 0u),
+        roles_(static_cast<std::size_t>(cols * rows), Role::kNormal),
         marks_(static_cast<std::size_t>(cols * rows), ' ') {}
 
   int dots_x() const { return dots_x_; }
@@ -116,8 +121,8 @@ PlotRange plot_range(const std::vector<PlotSeries>& series, const PlotOptions& o
 }
 
 namespace {
-void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options,
-                      bool log_labels);
+void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series,
+                      const PlotOptions& options, bool log_labels);
 }  // namespace
 
 void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options) {
@@ -134,15 +139,17 @@ void draw_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& 
   }
   PlotOptions linear = options;
   linear.log_y = false;
-  const auto log_of = [](std::optional<double> v) { return v && *v > 0.0 ? std::optional<double>(std::log10(*v)) : std::optional<double>(); };
+  const auto log_of = [](std::optional<double> v) {
+    return v && *v > 0.0 ? std::optional<double>(std::log10(*v)) : std::optional<double>();
+  };
   linear.y_min = log_of(options.y_min);
   linear.y_max = log_of(options.y_max);
   draw_linear_plot(canvas, area, logged, linear, true);
 }
 
 namespace {
-void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series, const PlotOptions& options,
-                      bool log_labels) {
+void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSeries>& series,
+                      const PlotOptions& options, bool log_labels) {
   const int cols = area.width - kLabelWidth - 1;
   const int rows = area.height - 1;  // the bottom row holds the x labels
   if (cols < 4 || rows < 2) return;
@@ -152,10 +159,12 @@ void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSe
 
   // Axes and labels.
   for (int y = 0; y < rows; ++y) canvas.put_glyph(left - 1, top + y, options.braille ? U'│' : U'|', Role::kDim);
-  const auto y_label = [&](double y) { return fit(label(options.y_format, log_labels ? std::pow(10.0, y) : y), kLabelWidth); };
+  const auto y_label = [&](double y) {
+    return fit(label(options.y_format, log_labels ? std::pow(10.0, y) : y), kLabelWidth);
+  };
   canvas.put(area.x, top, y_label(r.y_max), Role::kDim);
   canvas.put(area.x, top + rows - 1, y_label(r.y_min), Role::kDim);
-  if (log_labels && rows >= 5) {  // a log axis: its middle too (the geometric mean)
+  if (log_labels && rows >= 5) {            // a log axis: its middle too (the geometric mean)
     const int middle_row = (rows - 1) / 2;  // a whole row: the label names that row's value
     canvas.put(area.x, top + middle_row, y_label(r.y_max - (r.y_max - r.y_min) * middle_row / (rows - 1)), Role::kDim);
   }
@@ -163,7 +172,8 @@ void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSe
     const int zero_row = static_cast<int>(std::lround((r.y_max / (r.y_max - r.y_min)) * (rows - 1)));
     if (zero_row > 0 && zero_row < rows - 1) {
       canvas.put(area.x, top + zero_row, fit("0", kLabelWidth), Role::kDim);
-      for (int x = 0; x < cols; ++x) canvas.put_glyph(left + x, top + zero_row, options.braille ? U'┈' : U'.', Role::kDim);
+      for (int x = 0; x < cols; ++x)
+        canvas.put_glyph(left + x, top + zero_row, options.braille ? U'┈' : U'.', Role::kDim);
     }
   }
   const char* x_fmt = options.integer_x ? "%.0f" : "%.1f";
@@ -203,7 +213,8 @@ void draw_linear_plot(Canvas& canvas, const Rect& area, const std::vector<PlotSe
     const int cx = static_cast<int>(std::lround((*options.cursor_x - r.x_min) / (r.x_max - r.x_min) * (cols - 1)));
     for (int y = 0; y < rows; ++y) {
       const Cell& c = canvas.at(left + cx, top + y);
-      if (c.glyph == U' ' || c.role == Role::kDim) canvas.put_glyph(left + cx, top + y, options.braille ? U'┆' : U':', Role::kCursor);
+      if (c.glyph == U' ' || c.role == Role::kDim)
+        canvas.put_glyph(left + cx, top + y, options.braille ? U'┆' : U':', Role::kCursor);
       else canvas.set_role({left + cx, top + y, 1, 1}, Role::kCursor, true);
     }
   }

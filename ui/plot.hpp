@@ -21,12 +21,12 @@ struct PlotSeries {
 
 struct PlotOptions {
   bool braille = true;
-  const char* x_unit = "";            // e.g. "s"
-  const char* y_format = "%.1f";      // printf format of the y labels
-  std::optional<double> cursor_x;     // a vertical cursor line at this x
-  std::optional<double> y_min, y_max; // fixed range; otherwise from the data (with a margin)
-  bool integer_x = false;             // x labels as whole numbers (iterations)
-  bool log_y = false;                 // y on a log10 scale (values <= 0 are left out); y_min, y_max as values
+  const char* x_unit = "";             // e.g. "s"
+  const char* y_format = "%.1f";       // printf format of the y labels
+  std::optional<double> cursor_x;      // a vertical cursor line at this x
+  std::optional<double> y_min, y_max;  // fixed range; otherwise from the data (with a margin)
+  bool integer_x = false;              // x labels as whole numbers (iterations)
+  bool log_y = false;                  // y on a log10 scale (values <= 0 are left out); y_min, y_max as values
 };
 
 /// The data range the plot would use for `series` (for tests and for sharing scales).

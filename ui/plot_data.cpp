@@ -19,7 +19,8 @@ std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v, double
 TrialSeries trial_series(const TrialRecord& record, int joint) {
   const TrialSamples& s = record.joint_samples(joint > 0 && joint < record.joint_count() ? joint : 0);
   const Eigen::Index n = record.sample_time_s.size();
-  return {to_vector(record.sample_time_s, 1.0, n), to_vector(s.angle_rad, kDegPerRad, n), to_vector(s.setpoint_rad, kDegPerRad, n)};
+  return {to_vector(record.sample_time_s, 1.0, n), to_vector(s.angle_rad, kDegPerRad, n),
+          to_vector(s.setpoint_rad, kDegPerRad, n)};
 }
 
 RmsSeries rms_series(const Experiment& experiment, int joint) {
@@ -67,7 +68,8 @@ TrialDifference trial_difference(const Experiment& e, int trial, int other, int 
     d.why = format("iteration %d is on disk only", !a.in_memory() ? a.iteration : b.iteration);
     return d;
   }
-  if (joint >= a.record.joint_count() || joint >= b.record.joint_count() || a.record.learning_samples != b.record.learning_samples) {
+  if (joint >= a.record.joint_count() || joint >= b.record.joint_count() ||
+      a.record.learning_samples != b.record.learning_samples) {
     d.why = "the two records differ in shape";
     return d;
   }
@@ -108,13 +110,16 @@ CorrectionOverlay correction_overlay(const Experiment& e, int primary, int chose
   const auto correction_of = [&](int i) { return matrix_of(i).col(joint); };
   const auto label_of = [&](int i) { return i < 0 ? std::string("next") : "it " + std::to_string(i); };
   const int previous = primary < 0 ? trials - 1 : primary - 1;
-  if (previous >= 0 && in_memory(previous)) out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
+  if (previous >= 0 && in_memory(previous))
+    out.series.push_back({label_of(previous), Role::kSeries2, '.', to_vector(correction_of(previous), 1.0, n)});
   if (chosen >= 0 && chosen < trials && chosen != primary && chosen != previous && in_memory(chosen)) {
     out.series.push_back({label_of(chosen), Role::kSeries3, 'o', to_vector(correction_of(chosen), 1.0, n)});
   }
-  if (primary < trials && in_memory(primary)) out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
+  if (primary < trials && in_memory(primary))
+    out.series.push_back({label_of(primary), Role::kSeries1, '*', to_vector(correction_of(primary), 1.0, n)});
   // A transferred start stays in view beside what was learned from it.
-  if (trials > 0 && in_memory(0) && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 && previous != 0 && chosen != 0) {
+  if (trials > 0 && in_memory(0) && e.trials.front().origin.rfind("transferred", 0) == 0 && primary != 0 &&
+      previous != 0 && chosen != 0) {
     out.series.insert(out.series.begin(), {"transferred", Role::kSeries3, '+', to_vector(correction_of(0), 1.0, n)});
   }
   return out;

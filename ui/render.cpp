@@ -12,20 +12,28 @@ namespace detail {
 
 Role state_role(EngineState state) {
   switch (state) {
-    case EngineState::kSafe: return Role::kSafe;
-    case EngineState::kArmed: return Role::kArmed;
-    case EngineState::kRunning: return Role::kRunning;
-    case EngineState::kFault: return Role::kFault;
+    case EngineState::kSafe:
+      return Role::kSafe;
+    case EngineState::kArmed:
+      return Role::kArmed;
+    case EngineState::kRunning:
+      return Role::kRunning;
+    case EngineState::kFault:
+      return Role::kFault;
   }
   return Role::kNormal;
 }
 
 const char* state_words(EngineState state) {
   switch (state) {
-    case EngineState::kSafe: return "vented";
-    case EngineState::kArmed: return "valves live";
-    case EngineState::kRunning: return "trial running";
-    case EngineState::kFault: return "vented, latched";
+    case EngineState::kSafe:
+      return "vented";
+    case EngineState::kArmed:
+      return "valves live";
+    case EngineState::kRunning:
+      return "trial running";
+    case EngineState::kFault:
+      return "vented, latched";
   }
   return "";
 }
@@ -96,7 +104,8 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
   out.push_back({1, state, state_role(s.engine_state), true});
   if (labels) out.push_back({0, format(" %s ", state_words(s.engine_state)), Role::kDim, false});
   if (labels) out.push_back({1, "device ", Role::kDim, false});
-  out.push_back({labels ? 0 : 2, s.device.name + ": " + s.device.status, s.device.ok ? Role::kGood : Role::kWarning, false});
+  out.push_back(
+      {labels ? 0 : 2, s.device.name + ": " + s.device.status, s.device.ok ? Role::kGood : Role::kWarning, false});
   const Experiment& e = s.experiment;
   if (e.trajectory) {
     if (labels) out.push_back({2, "trajectory ", Role::kDim, false});
@@ -107,7 +116,8 @@ std::vector<Segment> header_segments(const ConsoleState& s, int level) {
   if (e.joints() > 1) out.push_back({2, joint_label(e.joints(), selected_joint(s)), Role::kNormal, true});
   // The newest iteration run, whose RMS follows (docs/iterations.md); "-" before the first.
   out.push_back({2, labels ? "iteration " : "it ", Role::kDim, false});
-  out.push_back({0, e.trials.empty() ? std::string("-") : format("%d", e.trials.back().iteration), Role::kNormal, true});
+  out.push_back(
+      {0, e.trials.empty() ? std::string("-") : format("%d", e.trials.back().iteration), Role::kNormal, true});
   if (!e.trials.empty()) {
     out.push_back({2, "RMS ", Role::kDim, false});
     out.push_back({0, format("%.3f deg", e.trials.back().summary.rms_deg), Role::kNormal, true});
@@ -130,12 +140,13 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
   const LoopHealth& l = s.loop;
   std::vector<Segment> out;
   out.push_back({1, level < 3 ? "loop " : "", Role::kDim, false});
-  out.push_back({0, format("%.0f Hz x%s%s%s", l.tick_hz, l.speed.c_str(), l.rt.empty() ? "" : " ", l.rt.c_str()), Role::kNormal, false});
+  out.push_back({0, format("%.0f Hz x%s%s%s", l.tick_hz, l.speed.c_str(), l.rt.empty() ? "" : " ", l.rt.c_str()),
+                 Role::kNormal, false});
   // Which clock runs: a simulated one repeats `bellows run`'s numbers; the wall clock does not.
   out.push_back({1, level < 2 ? l.clock + " clock" : l.clock, l.clock == "sim" ? Role::kGood : Role::kDim, false});
   out.push_back({2, "missed ", Role::kDim, false});
-  out.push_back({0, format("%llu", static_cast<unsigned long long>(l.missed)), l.missed > 0 ? Role::kWarning : Role::kGood,
-                 false});
+  out.push_back({0, format("%llu", static_cast<unsigned long long>(l.missed)),
+                 l.missed > 0 ? Role::kWarning : Role::kGood, false});
   if (l.realtime && l.speed != "max") {
     out.push_back({2, level < 3 ? "latency " : "", Role::kDim, false});
     out.push_back({0,
@@ -146,10 +157,12 @@ std::vector<Segment> loop_segments(const ConsoleState& s, int level) {
     out.push_back({2, "unpaced", Role::kDim, false});
   }
   out.push_back({2, "law ", Role::kDim, false});
-  out.push_back({0, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning, false});
+  out.push_back(
+      {0, s.law_name + (s.law_ready ? "" : " (preparing)"), s.law_ready ? Role::kNormal : Role::kWarning, false});
   if (level == 0) out.push_back({2, law_weights(s.config.ilc), Role::kDim, false});
   if (l.dropped_events > 0) {  // a loss, said like every other
-    out.push_back({2, format("%llu events dropped", static_cast<unsigned long long>(l.dropped_events)), Role::kWarning, false});
+    out.push_back(
+        {2, format("%llu events dropped", static_cast<unsigned long long>(l.dropped_events)), Role::kWarning, false});
   }
   if (s.experiment.unsaved() && !s.experiment.trials.empty()) out.push_back({2, "unsaved", Role::kWarning, false});
   return out;
@@ -297,15 +310,33 @@ void render(const ConsoleState& s, Canvas& c) {
   render_header(s, c);
   const Rect body{0, 2, c.width(), c.height() - 4};
   switch (s.screen) {
-    case Screen::kMain: render_dashboard(s, c, body); break;
-    case Screen::kInspector: render_inspector(s, c, body); break;
-    case Screen::kFault: render_fault(s, c, body); break;
-    case Screen::kHelp: render_help(s, c, body); break;
-    case Screen::kTrajectory: render_trajectory(s, c, body); break;
-    case Screen::kTuning: render_tuning(s, c, body); break;
-    case Screen::kLog: render_log(s, c, body); break;
-    case Screen::kSessions: render_sessions(s, c, body); break;
-    case Screen::kRig: render_rig(s, c, body); break;
+    case Screen::kMain:
+      render_dashboard(s, c, body);
+      break;
+    case Screen::kInspector:
+      render_inspector(s, c, body);
+      break;
+    case Screen::kFault:
+      render_fault(s, c, body);
+      break;
+    case Screen::kHelp:
+      render_help(s, c, body);
+      break;
+    case Screen::kTrajectory:
+      render_trajectory(s, c, body);
+      break;
+    case Screen::kTuning:
+      render_tuning(s, c, body);
+      break;
+    case Screen::kLog:
+      render_log(s, c, body);
+      break;
+    case Screen::kSessions:
+      render_sessions(s, c, body);
+      break;
+    case Screen::kRig:
+      render_rig(s, c, body);
+      break;
   }
   render_status(s, c);
   render_function_bar(s, c);

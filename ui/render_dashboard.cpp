@@ -28,15 +28,18 @@ void duty_row(Canvas& c, const Rect& area, int row, const std::string& label, do
 std::string run_phase_text(const ConsoleState& s) {
   const RunProgress& r = s.run;
   switch (r.phase) {
-    case RunProgress::Phase::kLearning: return "learning";
-    case RunProgress::Phase::kSettling: return "settling at the start";
+    case RunProgress::Phase::kLearning:
+      return "learning";
+    case RunProgress::Phase::kSettling:
+      return "settling at the start";
     case RunProgress::Phase::kRunning:
       if (s.experiment.trajectory) {
         return format("running %.1f / %.1f s", std::max(r.sample, 0) * s.experiment.trajectory->sample_time_s,
                       s.experiment.trajectory->duration_s());
       }
       return "running";
-    case RunProgress::Phase::kNone: break;
+    case RunProgress::Phase::kNone:
+      break;
   }
   return "idle";
 }
@@ -82,10 +85,12 @@ void render_live(const ConsoleState& s, Canvas& c, const Rect& area, const Glyph
   duty_row(c, in, row++, "out A", valves.outlet_duty[0], g);
   duty_row(c, in, row++, "in B", valves.inlet_duty[1], g);
   duty_row(c, in, row++, "out B", valves.outlet_duty[1], g);
-  value_row(c, in, row++, "trial", run_phase_text(s), s.run.phase == RunProgress::Phase::kNone ? Role::kDim : Role::kRunning);
+  value_row(c, in, row++, "trial", run_phase_text(s),
+            s.run.phase == RunProgress::Phase::kNone ? Role::kDim : Role::kRunning);
   if (s.run.mode == RunProgress::Mode::kBatch) {
-    value_row(c, in, row++, "batch", format("it %s, %d done%s", batch_span(s.run).c_str(), s.run.batch_done,
-                                            s.run.stop_requested ? ", stopping" : ""));
+    value_row(c, in, row++, "batch",
+              format("it %s, %d done%s", batch_span(s.run).c_str(), s.run.batch_done,
+                     s.run.stop_requested ? ", stopping" : ""));
   } else {
     value_row(c, in, row++, "next", s.experiment.next_origin, Role::kDim);
   }
@@ -102,17 +107,22 @@ void render_trial_plot(const ConsoleState& s, Canvas& c, const Rect& area, const
     c.frame(area, g, format("Iteration %d%s: angle and set point (deg)", t.iteration, joint_suffix(s).c_str()));
     legend(c, area, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
     const TrialSeries data = trial_series(t.record, selected_joint(s));
-    draw_plot(c, in, {{data.time_s, data.angle_deg, Role::kSeries1, '*'}, {data.time_s, data.setpoint_deg, Role::kSeries2, '.'}},
-              options);
+    draw_plot(
+        c, in,
+        {{data.time_s, data.angle_deg, Role::kSeries1, '*'}, {data.time_s, data.setpoint_deg, Role::kSeries2, '.'}},
+        options);
     return;
   }
   c.frame(area, g, "Live" + joint_suffix(s) + ": angle and set point (deg), last seconds");
   legend(c, area, {{"angle", Role::kSeries1, '*'}, {"set point", Role::kSeries2, '.'}}, g);
   if (s.strip.time_s.size() < 2) {
-    c.put(in.x + 1, in.y, "no trial yet: arm (a), then run a trial (r) or an iteration (n)", Role::kDim, false, in.right());
+    c.put(in.x + 1, in.y, "no trial yet: arm (a), then run a trial (r) or an iteration (n)", Role::kDim, false,
+          in.right());
     return;
   }
-  draw_plot(c, in, {{s.strip.time_s, s.strip.angle_deg, Role::kSeries1, '*'}, {s.strip.time_s, s.strip.setpoint_deg, Role::kSeries2, '.'}},
+  draw_plot(c, in,
+            {{s.strip.time_s, s.strip.angle_deg, Role::kSeries1, '*'},
+             {s.strip.time_s, s.strip.setpoint_deg, Role::kSeries2, '.'}},
             options);
 }
 
@@ -147,8 +157,7 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     std::string line = joints > 1 ? format("%4d %7.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : " ")
                                   : format("%4d %9.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : "");
     for (int j = 0; joints > 1 && j < joints; ++j) {
-      line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j))
-                                                            : std::string("      -");
+      line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j)) : std::string("      -");
     }
     c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1, list.right());
   }
@@ -165,8 +174,10 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
     // The largest |error| of each iteration beside its RMS (over every joint), drawn under it.
     series.push_back({data.iteration, data.max_error_deg, Role::kSeries3, 'x'});
     // Its legend on the frame's bottom edge: the top one holds the title.
-    legend(c, {area.x, area.bottom() - 1, area.width, 1}, {{"RMS", Role::kSeries1, '*'}, {"max|e|", Role::kSeries3, 'x'}}, g);
-    const RmsSeries joint = joints > 1 ? rms_series(s.experiment, selected_joint(s)) : RmsSeries{};  // the series refer to it
+    legend(c, {area.x, area.bottom() - 1, area.width, 1},
+           {{"RMS", Role::kSeries1, '*'}, {"max|e|", Role::kSeries3, 'x'}}, g);
+    const RmsSeries joint =
+        joints > 1 ? rms_series(s.experiment, selected_joint(s)) : RmsSeries{};  // the series refer to it
     if (joints > 1) series.push_back({joint.iteration, joint.rms_deg, Role::kSeries2, '.'});
     series.push_back({data.iteration, data.rms_deg, Role::kSeries1, '*'});
     draw_plot(c, plot, series, options);
@@ -211,8 +222,9 @@ void render_dashboard(const ConsoleState& s, Canvas& c, const Rect& body) {
   render_trial_plot(s, c, {right.x, right.y, right.width, trial_height}, g);
   const Rect bottom{right.x, right.y + trial_height, right.width, right.height - trial_height};
   // Several joints' RMS columns need more room (the correction keeps at least 30 columns).
-  const int rms_width = s.experiment.joints() > 1 ? std::clamp(bottom.width * 3 / 5, 22, std::max(22, bottom.width - 30))
-                                                  : std::clamp(bottom.width / 2, 22, 50);
+  const int rms_width = s.experiment.joints() > 1
+                            ? std::clamp(bottom.width * 3 / 5, 22, std::max(22, bottom.width - 30))
+                            : std::clamp(bottom.width / 2, 22, 50);
   render_rms(s, c, {bottom.x, bottom.y, rms_width, bottom.height}, g);
   render_correction(s, c, {bottom.x + rms_width, bottom.y, bottom.width - rms_width, bottom.height}, g);
 }

@@ -19,7 +19,8 @@ struct ReadoutRow {
 /// The readout beside the plots: as many rows as fit, the most important kept, in their order.
 void readout(Canvas& c, const Rect& in, std::vector<ReadoutRow> rows) {
   while (static_cast<int>(rows.size()) > in.height && !rows.empty()) {
-    rows.erase(std::max_element(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.priority < b.priority; }));
+    rows.erase(std::max_element(rows.begin(), rows.end(),
+                                [](const auto& a, const auto& b) { return a.priority < b.priority; }));
   }
   int y = in.y;
   for (const ReadoutRow& r : rows) {
@@ -57,7 +58,8 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
 
   int x = c.put(body.x + 1, body.y, format("Iteration %d", t.iteration), Role::kTitle, true);
   x = c.put(x, body.y, format(" of 0..%d", e.trials.back().iteration), Role::kDim);
-  if (t.record.joint_count() > 1) x = c.put(x + 2, body.y, joint_label(t.record.joint_count(), joint), Role::kNormal, true);
+  if (t.record.joint_count() > 1)
+    x = c.put(x + 2, body.y, joint_label(t.record.joint_count(), joint), Role::kNormal, true);
   x = c.put(x + 2, body.y, "(" + t.origin + ")", Role::kDim);
   x = c.put(x + 2, body.y, format("RMS %.3f deg", t.summary.rms_deg), Role::kNormal, true);
   if (joint < t.summary.joint_rms_deg.size() && t.record.joint_count() > 1) {
@@ -73,8 +75,9 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   const int rows = side_by_side ? 2 : 3;
   const int row_height = plots.height / rows;
   const Rect correction_area{plots.x, plots.y, side_by_side ? plots.width / 2 : plots.width, row_height};
-  const Rect error_area = side_by_side ? Rect{correction_area.right(), plots.y, plots.width - correction_area.width, row_height}
-                                       : Rect{plots.x, plots.y + row_height, plots.width, row_height};
+  const Rect error_area = side_by_side
+                              ? Rect{correction_area.right(), plots.y, plots.width - correction_area.width, row_height}
+                              : Rect{plots.x, plots.y + row_height, plots.width, row_height};
   const int angle_y = plots.y + row_height * (rows - 1);
   const Rect angle_area{plots.x, angle_y, plots.width, plots.bottom() - angle_y};
 
@@ -137,8 +140,9 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
   const std::vector<int> peaks = s.inspector.peak >= 0 ? error_peaks(t.record, joint) : std::vector<int>{};
   if (s.inspector.peak >= 0 && s.inspector.peak < static_cast<int>(peaks.size()) &&
       peaks[static_cast<std::size_t>(s.inspector.peak)] == k) {
-    rows_shown.insert(rows_shown.begin() + 6,
-                      ReadoutRow{"|e| peak", format("%d of %zu", s.inspector.peak + 1, peaks.size()), 1, Role::kWarning});
+    rows_shown.insert(
+        rows_shown.begin() + 6,
+        ReadoutRow{"|e| peak", format("%d of %zu", s.inspector.peak + 1, peaks.size()), 1, Role::kWarning});
   }
   if (diff.available) {
     const auto du_at = static_cast<std::size_t>(std::min(k, static_cast<int>(diff.du_bar.size()) - 1));
@@ -171,11 +175,13 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   // The guard and what it means, then when it vented: wrapped, never cut off.
   int y = body.y;
   const int x = c.put(body.x + 1, y, format(" %s ", fault_name(f.code)), Role::kFault, true);
-  for (const std::string& line : wrap(f.detail.empty() ? std::string(fault_message(f.code)) : f.detail, body.right() - x - 2)) {
+  for (const std::string& line :
+       wrap(f.detail.empty() ? std::string(fault_message(f.code)) : f.detail, body.right() - x - 2)) {
     c.put(x + 1, y++, line, Role::kWarning, true);
   }
   if (!f.where.empty()) {  // which joint (and chamber), on an arm with several
-    for (const std::string& line : wrap("on " + f.where, body.right() - x - 2)) c.put(x + 1, y++, line, Role::kWarning, true);
+    for (const std::string& line : wrap("on " + f.where, body.right() - x - 2))
+      c.put(x + 1, y++, line, Role::kWarning, true);
   }
   const bool latched = s.engine_state == EngineState::kFault;
   const std::string when = format("vented at engine time %.3f s, in the tick the fault was seen; %s", f.time_s,
@@ -217,21 +223,25 @@ void render_fault(const ConsoleState& s, Canvas& c, const Rect& body) {
   legend(c, right, {{"A", Role::kSeries1, 'a'}, {"B", Role::kSeries2, 'b'}, {"supply", Role::kSeries3, 's'}}, g);
   options.y_format = "%.2f";
   draw_plot(c, inner(right),
-            {{time, supply, Role::kSeries3, 's'}, {time, pb, Role::kSeries2, 'b'}, {time, pa, Role::kSeries1, 'a'}}, options);
+            {{time, supply, Role::kSeries3, 's'}, {time, pb, Role::kSeries2, 'b'}, {time, pa, Role::kSeries1, 'a'}},
+            options);
 
   const Rect table{body.x, left.bottom(), body.width, body.bottom() - left.bottom()};
   c.frame(table, g, "Last ticks before the fault" + of_joint);
   const Rect in = inner(table);
-  c.put(in.x + 1, in.y, "  time s   state      angle deg  p A bar  p B bar  supply  in A  out A  in B  out B", Role::kDim);
+  c.put(in.x + 1, in.y, "  time s   state      angle deg  p A bar  p B bar  supply  in A  out A  in B  out B",
+        Role::kDim);
   const std::size_t rows = static_cast<std::size_t>(std::max(in.height - 1, 0));
   const std::size_t first = n > rows ? n - rows : 0;
   for (std::size_t i = first; i < n; ++i) {
     const TickRecord& t = f.black_box[i];
-    c.put(in.x + 1, in.y + 1 + static_cast<int>(i - first),
-          format("%8.3f   %-9s %9.2f %8.3f %8.3f %7.3f %5.2f %6.2f %5.2f %6.2f", t.time_s - f.time_s, to_string(t.state),
-                 to_deg(t.reading.joint[ji].angle_rad), t.reading.joint[ji].chamber_bar[0], t.reading.joint[ji].chamber_bar[1], t.reading.supply_bar,
-                 t.valves.joint[ji].inlet_duty[0], t.valves.joint[ji].outlet_duty[0], t.valves.joint[ji].inlet_duty[1], t.valves.joint[ji].outlet_duty[1]),
-          t.state == EngineState::kFault ? Role::kFault : Role::kNormal, false, in.right());
+    c.put(
+        in.x + 1, in.y + 1 + static_cast<int>(i - first),
+        format("%8.3f   %-9s %9.2f %8.3f %8.3f %7.3f %5.2f %6.2f %5.2f %6.2f", t.time_s - f.time_s, to_string(t.state),
+               to_deg(t.reading.joint[ji].angle_rad), t.reading.joint[ji].chamber_bar[0],
+               t.reading.joint[ji].chamber_bar[1], t.reading.supply_bar, t.valves.joint[ji].inlet_duty[0],
+               t.valves.joint[ji].outlet_duty[0], t.valves.joint[ji].inlet_duty[1], t.valves.joint[ji].outlet_duty[1]),
+        t.state == EngineState::kFault ? Role::kFault : Role::kNormal, false, in.right());
   }
 }
 

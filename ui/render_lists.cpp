@@ -65,7 +65,8 @@ void render_help(const ConsoleState& s, Canvas& c, const Rect& body) {
       c.put(in.x + 1, y, l.text, Role::kTitle, true, in.right());
       continue;
     }
-    if (!l.keys.empty()) c.put(in.x + 1, y, fit(l.keys, kHelpKeyColumn), l.available ? Role::kKey : Role::kDim, l.available);
+    if (!l.keys.empty())
+      c.put(in.x + 1, y, fit(l.keys, kHelpKeyColumn), l.available ? Role::kKey : Role::kDim, l.available);
     c.put(in.x + 2 + kHelpKeyColumn, y, l.text, l.available ? Role::kNormal : Role::kDim, false, in.right());
   }
 }
@@ -84,7 +85,8 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
     std::string label = ch.names[i];
     if (i + 1 == ch.names.size() && !ch.file_path.empty()) label = "file: " + ch.file_path;
     if (label == current) label += "  (in use)";
-    c.put(in.x, y, fit((selected ? "> " : "  ") + label, in.width), selected ? Role::kSelected : Role::kNormal, selected);
+    c.put(in.x, y, fit((selected ? "> " : "  ") + label, in.width), selected ? Role::kSelected : Role::kNormal,
+          selected);
     if (i < ch.descriptions.size()) c.put(in.x + 2, y + 1, ch.descriptions[i], Role::kDim, false, in.right());
   }
   const Rect preview{list.right(), body.y, body.width - list_width, body.height};
@@ -139,7 +141,8 @@ std::string tuning_hint(const ConsoleState& s) {
     return "Up/Down choose   changes wait: trials are running (x stops them)";
   }
   if (s.engine_state == EngineState::kFault) return "Up/Down choose   changes wait: a fault is latched (R resets)";
-  if (s.tuning.selected == TuningForm::kLawRow) return "Up/Down choose   Enter or Right: next law   Left: the one before";
+  if (s.tuning.selected == TuningForm::kLawRow)
+    return "Up/Down choose   Enter or Right: next law   Left: the one before";
   return "Up/Down choose   Enter edit: type the value, Enter applies, Esc cancels";
 }
 
@@ -158,10 +161,13 @@ void render_tuning(const ConsoleState& s, Canvas& c, const Rect& body) {
     const bool selected = row == s.tuning.selected;
     const int field = TuningForm::field_of(row);
     if (field < 0) {
-      c.put(in.x + 1, y++, "Learning law: Enter or Right the next of " + std::to_string(learning_law_names().size()) + ", Left the one before", Role::kTitle, true);
+      c.put(in.x + 1, y++,
+            "Learning law: Enter or Right the next of " + std::to_string(learning_law_names().size()) +
+                ", Left the one before",
+            Role::kTitle, true);
       if (y >= in.bottom()) break;
-      const std::string line = format("%s %-5s %12s %-4s  %-24s %s", selected ? ">" : " ", "law", s.config.ilc.law.c_str(),
-                                      "", "[ilc] law", law_summary(s.config.ilc.law).c_str());
+      const std::string line = format("%s %-5s %12s %-4s  %-24s %s", selected ? ">" : " ", "law",
+                                      s.config.ilc.law.c_str(), "", "[ilc] law", law_summary(s.config.ilc.law).c_str());
       c.put(in.x + 1, y++, fit(line, in.width - 1), selected ? Role::kSelected : Role::kNormal, selected);
       continue;
     }
@@ -253,12 +259,14 @@ void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
     const std::vector<std::string> lines = log_entry_lines(e, cells);
     for (std::size_t j = lines.size(); j-- > 0;) page.insert(page.begin(), {&e, lines[j], j == 0});
   }
-  if (static_cast<int>(page.size()) > in.height) page.erase(page.begin(), page.end() - in.height);  // the oldest cut at the top
+  if (static_cast<int>(page.size()) > in.height)
+    page.erase(page.begin(), page.end() - in.height);  // the oldest cut at the top
   // At the top (the oldest entry shown) a page is still full: newer entries fill it below.
   for (int k = last + 1; i < 0 && k < count && static_cast<int>(page.size()) < in.height; ++k) {
     const LogEntry& e = entries[static_cast<std::size_t>(k)];
     const std::vector<std::string> lines = log_entry_lines(e, cells);
-    for (std::size_t j = 0; j < lines.size() && static_cast<int>(page.size()) < in.height; ++j) page.push_back({&e, lines[j], j == 0});
+    for (std::size_t j = 0; j < lines.size() && static_cast<int>(page.size()) < in.height; ++j)
+      page.push_back({&e, lines[j], j == 0});
   }
   for (int r = 0; r < static_cast<int>(page.size()); ++r) {
     const Row& row = page[static_cast<std::size_t>(r)];
@@ -266,7 +274,8 @@ void render_log(const ConsoleState& s, Canvas& c, const Rect& body) {
     const LogEntry& e = *row.entry;
     if (row.first) {
       int x = c.put(in.x + 1, y, e.clock, Role::kDim);
-      x = c.put(x + 1, y, e.engine_time_s >= 0.0 ? format("%9.2f s", e.engine_time_s) : std::string(11, ' '), Role::kDim);
+      x = c.put(x + 1, y, e.engine_time_s >= 0.0 ? format("%9.2f s", e.engine_time_s) : std::string(11, ' '),
+                Role::kDim);
       c.put(x + 1, y, fit(to_string(e.source), 9), Role::kTitle);
     }
     c.put(text_x, y, row.text, e.important ? Role::kWarning : Role::kNormal, e.important, in.right());
@@ -308,7 +317,8 @@ void render_sessions(const ConsoleState& s, Canvas& c, const Rect& body) {
       row = format("%s %s: cannot be read: %s", selected ? ">" : " ", l.name.c_str(), l.error.c_str());
     }
     const bool openable = l.error.empty() && l.refusal.empty();
-    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (openable ? Role::kNormal : Role::kDim), selected);
+    c.put(in.x + 1, y, fit(row, in.width - 1), selected ? Role::kSelected : (openable ? Role::kNormal : Role::kDim),
+          selected);
   }
   if (b.selected >= 0 && b.selected < count) {
     const SessionListing& l = b.sessions[static_cast<std::size_t>(b.selected)];

@@ -23,11 +23,13 @@ void render_rig(const ConsoleState& s, Canvas& c, const Rect& body) {
     c.put(in.x + 1, y++, fit("input", 14) + fit("raw V", 10) + "value", Role::kTitle, true, in.right());
     for (int i = 0; i < rig.raw.count && y < in.bottom(); ++i) {
       const RawInput& input = rig.raw.inputs[static_cast<std::size_t>(i)];
-      c.put(in.x + 1, y++, fit(input.name, 14) + fit(number("%.4f", input.volts), 10) + number("%.4f ", input.value) + input.unit,
+      c.put(in.x + 1, y++,
+            fit(input.name, 14) + fit(number("%.4f", input.volts), 10) + number("%.4f ", input.value) + input.unit,
             Role::kNormal, false, in.right());
     }
   } else {
-    c.put(in.x + 1, y++, "no volts: " + s.device.name + " reports calibrated values only", Role::kDim, false, in.right());
+    c.put(in.x + 1, y++, "no volts: " + s.device.name + " reports calibrated values only", Role::kDim, false,
+          in.right());
     c.put(in.x + 1, y++, fit("input", 14) + "value (as the engine reads it)", Role::kTitle, true, in.right());
     const std::pair<const char*, std::string> rows[] = {
         {"angle", number("%.3f deg", to_deg(r.joint[0].angle_rad))},
@@ -52,8 +54,10 @@ void render_rig(const ConsoleState& s, Canvas& c, const Rect& body) {
   in = inner(valves);
   y = in.y;
   if (rig.valves.empty()) {
-    c.put(in.x + 1, y++, "Not run yet. v pulses each valve alone and checks that the right", Role::kDim, false, in.right());
-    c.put(in.x + 1, y++, "chamber moves the right way: swapped tubes or wires, a dead valve", Role::kDim, false, in.right());
+    c.put(in.x + 1, y++, "Not run yet. v pulses each valve alone and checks that the right", Role::kDim, false,
+          in.right());
+    c.put(in.x + 1, y++, "chamber moves the right way: swapped tubes or wires, a dead valve", Role::kDim, false,
+          in.right());
     c.put(in.x + 1, y++, "and no supply are each named.", Role::kDim, false, in.right());
     return;
   }

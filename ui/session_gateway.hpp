@@ -20,27 +20,27 @@ namespace bellows::ui {
 /// What a saved session holds, as the console sees it.
 struct SessionSnapshot {
   Configuration config;
-  Experiment experiment;          // trajectory, trials, next correction, where it is saved
-  int first_trial = 0;            // experiment.trials holds iterations first_trial.. (a save needs
-                                  // only the unsaved ones and the last saved one, not the history)
-  std::vector<LogEntry> events;   // the operator's and the engine's log (the newest entries)
-  std::size_t events_total = 0;   // entries ever logged (EventLog::total()), to tell new ones apart
-  std::string device_name;        // e.g. "sim"
-  std::string rig_profile;        // the rig profile's name it was recorded with ("" without one)
+  Experiment experiment;         // trajectory, trials, next correction, where it is saved
+  int first_trial = 0;           // experiment.trials holds iterations first_trial.. (a save needs
+                                 // only the unsaved ones and the last saved one, not the history)
+  std::vector<LogEntry> events;  // the operator's and the engine's log (the newest entries)
+  std::size_t events_total = 0;  // entries ever logged (EventLog::total()), to tell new ones apart
+  std::string device_name;       // e.g. "sim"
+  std::string rig_profile;       // the rig profile's name it was recorded with ("" without one)
   std::uint64_t seed = 1;
 };
 
 /// One saved session as the browser lists it.
 struct SessionListing {
-  std::string location;     // what open() takes (a directory)
+  std::string location;  // what open() takes (a directory)
   std::string name;
-  std::string date;         // when it started, local time, "2024-05-01 14:03"
+  std::string date;  // when it started, local time, "2024-05-01 14:03"
   std::string trajectory;
   int iterations = 0;
-  double best_rms_deg = -1; // negative: no iteration
-  std::string error;        // not empty: the session cannot be read (the reason)
-  std::string device;       // the device it was recorded on (its manifest's "device")
-  std::string refusal;      // not empty: this console cannot drive it (the reason; see drive_refusal)
+  double best_rms_deg = -1;  // negative: no iteration
+  std::string error;         // not empty: the session cannot be read (the reason)
+  std::string device;        // the device it was recorded on (its manifest's "device")
+  std::string refusal;       // not empty: this console cannot drive it (the reason; see drive_refusal)
 };
 
 /// Why a console driving `console_device` cannot open a session recorded on `listing.device`
@@ -68,7 +68,9 @@ class SessionGateway {
   /// Reads a session's configuration, device, trajectory and trials only, to learn from (a transfer):
   /// no lock is taken and the session the console saves into stays what it was. Throws when it
   /// cannot be read; the default says it is not available.
-  virtual SessionSnapshot read_trials(const std::string& /*location*/) { throw std::runtime_error(unavailable_reason()); }
+  virtual SessionSnapshot read_trials(const std::string& /*location*/) {
+    throw std::runtime_error(unavailable_reason());
+  }
   /// Names the session last saved or opened (renames its directory to `name` in the data
   /// directory) and returns its new location. Throws InputError (bad or taken name).
   virtual std::string rename(const std::string& name) { throw InputError("naming sessions is not available: " + name); }

@@ -17,27 +17,66 @@
 namespace bellows::ui {
 namespace {
 
-enum Pair : short { kPairTitle = 1, kPairKey, kPairSafe, kPairArmed, kPairRunning, kPairFault, kPairWarning, kPairGood,
-                    kPairSeries1, kPairSeries2, kPairSeries3, kPairCursor };
+enum Pair : short {
+  kPairTitle = 1,
+  kPairKey,
+  kPairSafe,
+  kPairArmed,
+  kPairRunning,
+  kPairFault,
+  kPairWarning,
+  kPairGood,
+  kPairSeries1,
+  kPairSeries2,
+  kPairSeries3,
+  kPairCursor
+};
 
 attr_t colour_attributes(Role role, short& pair) {
   pair = 0;
   switch (role) {
-    case Role::kNormal: return A_NORMAL;
-    case Role::kDim: return A_DIM;
-    case Role::kTitle: pair = kPairTitle; return A_NORMAL;
-    case Role::kSelected: return A_REVERSE;
-    case Role::kKey: pair = kPairKey; return A_NORMAL;
-    case Role::kSafe: pair = kPairSafe; return A_BOLD;
-    case Role::kArmed: pair = kPairArmed; return A_BOLD;
-    case Role::kRunning: pair = kPairRunning; return A_BOLD;
-    case Role::kFault: pair = kPairFault; return A_BOLD;
-    case Role::kWarning: pair = kPairWarning; return A_BOLD;
-    case Role::kGood: pair = kPairGood; return A_NORMAL;
-    case Role::kSeries1: pair = kPairSeries1; return A_NORMAL;
-    case Role::kSeries2: pair = kPairSeries2; return A_NORMAL;
-    case Role::kSeries3: pair = kPairSeries3; return A_NORMAL;
-    case Role::kCursor: pair = kPairCursor; return A_BOLD;
+    case Role::kNormal:
+      return A_NORMAL;
+    case Role::kDim:
+      return A_DIM;
+    case Role::kTitle:
+      pair = kPairTitle;
+      return A_NORMAL;
+    case Role::kSelected:
+      return A_REVERSE;
+    case Role::kKey:
+      pair = kPairKey;
+      return A_NORMAL;
+    case Role::kSafe:
+      pair = kPairSafe;
+      return A_BOLD;
+    case Role::kArmed:
+      pair = kPairArmed;
+      return A_BOLD;
+    case Role::kRunning:
+      pair = kPairRunning;
+      return A_BOLD;
+    case Role::kFault:
+      pair = kPairFault;
+      return A_BOLD;
+    case Role::kWarning:
+      pair = kPairWarning;
+      return A_BOLD;
+    case Role::kGood:
+      pair = kPairGood;
+      return A_NORMAL;
+    case Role::kSeries1:
+      pair = kPairSeries1;
+      return A_NORMAL;
+    case Role::kSeries2:
+      pair = kPairSeries2;
+      return A_NORMAL;
+    case Role::kSeries3:
+      pair = kPairSeries3;
+      return A_NORMAL;
+    case Role::kCursor:
+      pair = kPairCursor;
+      return A_BOLD;
   }
   return A_NORMAL;
 }
@@ -46,21 +85,36 @@ attr_t colour_attributes(Role role, short& pair) {
 attr_t mono_attributes(Role role) {
   // NOLINTBEGIN(bugprone-branch-clone): a table, one role a line; equal attributes are the design
   switch (role) {
-    case Role::kNormal: return A_NORMAL;
-    case Role::kDim: return A_DIM;
-    case Role::kTitle: return A_BOLD;
-    case Role::kSelected: return A_REVERSE;
-    case Role::kKey: return A_REVERSE;
-    case Role::kSafe: return A_BOLD;
-    case Role::kArmed: return A_REVERSE;
-    case Role::kRunning: return A_REVERSE;
-    case Role::kFault: return A_REVERSE | A_BOLD;
-    case Role::kWarning: return A_BOLD;
-    case Role::kGood: return A_NORMAL;
-    case Role::kSeries1: return A_BOLD;
-    case Role::kSeries2: return A_NORMAL;
-    case Role::kSeries3: return A_UNDERLINE;
-    case Role::kCursor: return A_REVERSE;
+    case Role::kNormal:
+      return A_NORMAL;
+    case Role::kDim:
+      return A_DIM;
+    case Role::kTitle:
+      return A_BOLD;
+    case Role::kSelected:
+      return A_REVERSE;
+    case Role::kKey:
+      return A_REVERSE;
+    case Role::kSafe:
+      return A_BOLD;
+    case Role::kArmed:
+      return A_REVERSE;
+    case Role::kRunning:
+      return A_REVERSE;
+    case Role::kFault:
+      return A_REVERSE | A_BOLD;
+    case Role::kWarning:
+      return A_BOLD;
+    case Role::kGood:
+      return A_NORMAL;
+    case Role::kSeries1:
+      return A_BOLD;
+    case Role::kSeries2:
+      return A_NORMAL;
+    case Role::kSeries3:
+      return A_UNDERLINE;
+    case Role::kCursor:
+      return A_REVERSE;
   }
   // NOLINTEND(bugprone-branch-clone)
   return A_NORMAL;
@@ -70,29 +124,47 @@ int translate(int status, wint_t ch) {
   if (status == ERR) return key::kNone;
   if (status == KEY_CODE_YES) {
     switch (ch) {
-      case KEY_RESIZE: return key::kResize;
-      case KEY_UP: return key::kUp;
-      case KEY_DOWN: return key::kDown;
-      case KEY_LEFT: return key::kLeft;
-      case KEY_RIGHT: return key::kRight;
-      case KEY_PPAGE: return key::kPageUp;
-      case KEY_NPAGE: return key::kPageDown;
-      case KEY_HOME: return key::kHome;
-      case KEY_END: return key::kEnd;
-      case KEY_BACKSPACE: return key::kBackspace;
-      case KEY_ENTER: return key::kEnter;
-      case KEY_F(1): return key::kF1;
-      default: return key::kOther;  // said to do nothing, rather than ignored in silence
+      case KEY_RESIZE:
+        return key::kResize;
+      case KEY_UP:
+        return key::kUp;
+      case KEY_DOWN:
+        return key::kDown;
+      case KEY_LEFT:
+        return key::kLeft;
+      case KEY_RIGHT:
+        return key::kRight;
+      case KEY_PPAGE:
+        return key::kPageUp;
+      case KEY_NPAGE:
+        return key::kPageDown;
+      case KEY_HOME:
+        return key::kHome;
+      case KEY_END:
+        return key::kEnd;
+      case KEY_BACKSPACE:
+        return key::kBackspace;
+      case KEY_ENTER:
+        return key::kEnter;
+      case KEY_F(1):
+        return key::kF1;
+      default:
+        return key::kOther;  // said to do nothing, rather than ignored in silence
     }
   }
   switch (ch) {
     case '\n':
-    case '\r': return key::kEnter;
-    case 27: return key::kEscape;
+    case '\r':
+      return key::kEnter;
+    case 27:
+      return key::kEscape;
     case 127:
-    case 8: return key::kBackspace;
-    case '\t': return key::kTab;
-    default: return static_cast<int>(ch);
+    case 8:
+      return key::kBackspace;
+    case '\t':
+      return key::kTab;
+    default:
+      return static_cast<int>(ch);
   }
 }
 

@@ -7,7 +7,8 @@ namespace bellows::ui {
 const IterationDiagnostics& TrialDiagnostics::observe_latest(const Experiment& experiment) {
   if (experiment.trials.empty()) throw std::logic_error("TrialDiagnostics: the experiment has no trial");
   const std::size_t seen = monitor_ ? monitor_->history().size() : 0;
-  const bool same_experiment = monitor_ && trajectory_ == experiment.trajectory.get() && seen + 1 == experiment.trials.size();
+  const bool same_experiment =
+      monitor_ && trajectory_ == experiment.trajectory.get() && seen + 1 == experiment.trials.size();
   const bool was_detected = same_experiment && monitor_->windup().detected;
   if (!same_experiment) {
     monitor_.emplace(input_limit_bar_, experiment.samples());

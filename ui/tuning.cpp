@@ -4,7 +4,8 @@ namespace bellows::ui {
 
 const std::vector<TuningField>& tuning_fields() {
   static const std::vector<TuningField> fields = {
-      {"k_ff", "[controller] k_ff", "", "feed-forward gain", false, [](Configuration& c) { return &c.controller.k_ff; }},
+      {"k_ff", "[controller] k_ff", "", "feed-forward gain", false,
+       [](Configuration& c) { return &c.controller.k_ff; }},
       {"k_p", "[controller] k_p", "", "proportional gain", false, [](Configuration& c) { return &c.controller.k_p; }},
       {"k_i", "[controller] k_i", "1/s", "integral gain", false,
        [](Configuration& c) { return &c.controller.k_i_per_s; }},

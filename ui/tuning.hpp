@@ -9,11 +9,11 @@
 namespace bellows::ui {
 
 struct TuningField {
-  const char* label;        // "k_p"
-  const char* config_key;   // "[controller] k_p"
-  const char* unit;         // "", "1/s", "s"
+  const char* label;       // "k_p"
+  const char* config_key;  // "[controller] k_p"
+  const char* unit;        // "", "1/s", "s"
   const char* description;
-  bool learning_weight;     // true: M, S, W (rebuild the law); false: a PID gain (set gains)
+  bool learning_weight;  // true: M, S, W (rebuild the law); false: a PID gain (set gains)
   double* (*value)(Configuration&);
 };
 

@@ -31,20 +31,28 @@ std::size_t utf8_sequence(std::string_view text, char32_t& code_point) {
 }  // namespace
 
 bool is_terminal_control(char32_t c) {
-  return c < 0x20 || c == 0x7f || (c >= 0x80 && c <= 0x9f) ||                       // C1 controls (CSI, OSC, ...)
-         c == 0x061c || c == 0x200e || c == 0x200f ||      // bidirectional marks
+  return c < 0x20 || c == 0x7f || (c >= 0x80 && c <= 0x9f) ||             // C1 controls (CSI, OSC, ...)
+         c == 0x061c || c == 0x200e || c == 0x200f ||                     // bidirectional marks
          (c >= 0x202a && c <= 0x202e) || (c >= 0x2066 && c <= 0x2069) ||  // bidirectional overrides
-         c == 0x2028 || c == 0x2029 || c == 0xfeff;        // line and paragraph separators, BOM
+         c == 0x2028 || c == 0x2029 || c == 0xfeff;                       // line and paragraph separators, BOM
 }
 
 namespace {
 
 void append_escaped_byte(std::string& out, unsigned char c) {
   switch (c) {
-    case '\n': out += "\\n"; return;
-    case '\r': out += "\\r"; return;
-    case '\t': out += "\\t"; return;
-    case 0x1b: out += "\\e"; return;
+    case '\n':
+      out += "\\n";
+      return;
+    case '\r':
+      out += "\\r";
+      return;
+    case '\t':
+      out += "\\t";
+      return;
+    case 0x1b:
+      out += "\\e";
+      return;
     default: {
       char escaped[8];
       std::snprintf(escaped, sizeof escaped, "\\x%02x", c);

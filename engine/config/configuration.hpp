@@ -50,10 +50,10 @@ struct ParameterBinding {
   std::string key;
   std::string unit;
   std::string description;
-  Range range;                                        // numbers and whole numbers only
-  std::function<double*(Configuration&)> real;        // set for numbers
-  std::function<int*(Configuration&)> integer;        // set for whole numbers
-  std::function<std::string*(Configuration&)> text;   // set for names
+  Range range;                                       // numbers and whole numbers only
+  std::function<double*(Configuration&)> real;       // set for numbers
+  std::function<int*(Configuration&)> integer;       // set for whole numbers
+  std::function<std::string*(Configuration&)> text;  // set for names
 };
 
 /// Every parameter, in the order the docs list them.

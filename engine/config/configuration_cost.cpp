@@ -17,7 +17,8 @@ std::int64_t ratio_count(double numerator, double denominator) {
   return count > 0.0 ? static_cast<std::int64_t>(count) : 0;
 }
 
-[[noreturn]] void over_budget(const std::string& what, std::int64_t amount, std::int64_t budget, const std::string& fix) {
+[[noreturn]] void over_budget(const std::string& what, std::int64_t amount, std::int64_t budget,
+                              const std::string& fix) {
   std::ostringstream message;
   message << what << " = " << amount << ", above the budget of " << budget << "; " << fix;
   throw InputError(message.str());
@@ -56,16 +57,19 @@ void check_trial_cost(const Configuration& config, std::int64_t learning_samples
   using namespace cost_budget;
   const std::int64_t per_sample = config.timing.ticks_per_sample;
   const std::int64_t settle_ticks = ratio_count(config.timing.settle_s, config.timing.tick_s);
-  const std::int64_t ticks = learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * per_sample + settle_ticks;
+  const std::int64_t ticks =
+      learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * per_sample + settle_ticks;
   if (ticks > kMaxTicksPerTrial) {
-    over_budget("ticks per trial (" + std::to_string(learning_samples) + " learning samples x [timing] ticks_per_sample, plus settling)",
+    over_budget("ticks per trial (" + std::to_string(learning_samples) +
+                    " learning samples x [timing] ticks_per_sample, plus settling)",
                 ticks, kMaxTicksPerTrial, "use a shorter trajectory or a longer [timing] tick_s");
   }
   if (config.ilc.law == "noilc-dense" && learning_samples > kMaxDenseLawSamples) {
     over_budget("[ilc] law = 'noilc-dense': learning samples", learning_samples, kMaxDenseLawSamples,
                 "use law 'noilc' (the same optimum in O(N) memory) or a shorter trajectory");
   }
-  const std::int64_t admm_work = learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * config.ilc.admm_max_iterations;
+  const std::int64_t admm_work =
+      learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * config.ilc.admm_max_iterations;
   if (config.ilc.law == "noilc-constrained" && admm_work > kMaxAdmmWork) {
     over_budget("[ilc] admm_max_iterations x learning samples (" + std::to_string(learning_samples) + ")", admm_work,
                 kMaxAdmmWork, "lower admm_max_iterations or use a shorter trajectory");

@@ -30,7 +30,7 @@ ActuatedArm actuated_arm(const ModelParameters& arm, double tau_p_s, double ambi
   augmented.topLeftCorner<2, 2>() = Ac;
   augmented.block<2, 1>(0, 2) = Bc;  // the arm is driven by the achieved pressure difference
   augmented(2, 2) = -1.0 / tau_p_s;
-  augmented(2, 3) = 1.0 / tau_p_s;   // which follows the commanded one with time constant tau_p
+  augmented(2, 3) = 1.0 / tau_p_s;  // which follows the commanded one with time constant tau_p
   augmented(2, 1) = -2.0 * ambient_bar * arm.volume_gain_per_rad * kVelocityScale;  // minus the bounce-back
   const Eigen::Matrix4d exponential = (augmented * sample_time_s).exp();
   ActuatedArm d;

@@ -6,10 +6,10 @@
 // so the true map from correction to error is the closed loop Pcl = z G / (1 + G C_pid), G the arm
 // (kappa and omega0 scaled by the model error) behind the pressure controllers' designed first-order
 // response (tau_p), including the damping of the bellows' volume change with angle ([model]
-// volume_gain), which the pressure loop leaves uncompensated. Then U_{j+1} = lambda U_j + Le R with lambda = Lu - Le Pcl: each frequency of the
-// correction (and of the error) contracts by |lambda| per trial. The predicted contraction is the
-// largest |lambda| over the frequencies a trial of N samples resolves, [1/(N T), Nyquist];
-// above 1 somewhere, learning may diverge there.
+// volume_gain), which the pressure loop leaves uncompensated. Then U_{j+1} = lambda U_j + Le R with lambda = Lu - Le
+// Pcl: each frequency of the correction (and of the error) contracts by |lambda| per trial. The predicted contraction
+// is the largest |lambda| over the frequencies a trial of N samples resolves, [1/(N T), Nyquist]; above 1 somewhere,
+// learning may diverge there.
 #pragma once
 
 #include <string>
@@ -29,14 +29,14 @@ struct ContractionEstimate {
 };
 
 struct ConvergencePrediction {
-  bool available = false;     // false for laws without a frequency response
+  bool available = false;  // false for laws without a frequency response
   double band_low_hz = 0.0, band_high_hz = 0.0;
-  double model_error = 0.0;   // the grid spans 1 -+ model_error in kappa and omega0
+  double model_error = 0.0;  // the grid spans 1 -+ model_error in kappa and omega0
   ContractionEstimate nominal;
   ContractionEstimate worst;  // over the grid
   std::vector<ContractionEstimate> grid;
-  int diverging_points = 0;   // grid points with contraction > 1 + 1e-3
-  std::string warning;        // empty when every grid point contracts
+  int diverging_points = 0;  // grid points with contraction > 1 + 1e-3
+  std::string warning;       // empty when every grid point contracts
 };
 
 /// The prediction for `law` on trials of `samples` samples, with the grid of [ilc] prediction_*.

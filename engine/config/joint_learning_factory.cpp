@@ -22,7 +22,8 @@ FaultError update_failed(const std::string& law, MultiJointNoilcStatus status) {
 class JointNormOptimal final : public JointLearning {
  public:
   JointNormOptimal(const MultiJointModel& model, const IlcParameters& weights, int samples) {
-    const MultiJointNoilcStatus status = solver_.setup(model, MultiJointWeights::uniform(weights, model.joints()), samples);
+    const MultiJointNoilcStatus status =
+        solver_.setup(model, MultiJointWeights::uniform(weights, model.joints()), samples);
     if (status != MultiJointNoilcStatus::kOk) throw InputError(std::string("[ilc] weights: ") + to_string(status));
   }
   void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
@@ -41,9 +42,11 @@ class JointNormOptimal final : public JointLearning {
 /// noilc-constrained for J joints: the same cost, each joint's u_pid + u_ilc kept within its reach.
 class JointNormOptimalConstrained final : public JointLearning {
  public:
-  JointNormOptimalConstrained(const MultiJointModel& model, const IlcParameters& ilc, int samples) : margin_bar_(ilc.limit_margin_bar) {
+  JointNormOptimalConstrained(const MultiJointModel& model, const IlcParameters& ilc, int samples)
+      : margin_bar_(ilc.limit_margin_bar) {
     const MultiJointAdmmSettings admm{ilc.admm_rho, ilc.admm_max_iterations, ilc.admm_tolerance};
-    const MultiJointNoilcStatus status = solver_.setup(model, MultiJointWeights::uniform(ilc, model.joints()), samples, admm);
+    const MultiJointNoilcStatus status =
+        solver_.setup(model, MultiJointWeights::uniform(ilc, model.joints()), samples, admm);
     if (status != MultiJointNoilcStatus::kOk) throw InputError(std::string("[ilc] weights: ") + to_string(status));
     lower_.resize(samples, model.joints());
     upper_.resize(samples, model.joints());
@@ -60,7 +63,8 @@ class JointNormOptimalConstrained final : public JointLearning {
               Eigen::Ref<Eigen::MatrixXd> u_next) override {
     const MultiJointNoilcStatus status = solver_.solve(u_j, e_j, u_next);
     // Not converged still gives a feasible correction: better than none, and the report says so.
-    if (status != MultiJointNoilcStatus::kOk && status != MultiJointNoilcStatus::kNotConverged) throw update_failed(name(), status);
+    if (status != MultiJointNoilcStatus::kOk && status != MultiJointNoilcStatus::kNotConverged)
+      throw update_failed(name(), status);
   }
   std::string name() const override { return "noilc-constrained"; }
   int samples() const override { return solver_.info().samples; }
@@ -75,7 +79,8 @@ class JointNormOptimalConstrained final : public JointLearning {
 /// noilc-learned for J joints: the closed loop of the J-joint model ([ilc] joint_model) as the prior.
 class JointNormOptimalLearned final : public JointLearning {
  public:
-  JointNormOptimalLearned(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples) : core_(prior, settings, samples) {}
+  JointNormOptimalLearned(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples)
+      : core_(prior, settings, samples) {}
   void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
               Eigen::Ref<Eigen::MatrixXd> u_next) override {
     core_.update(u_j, e_j, u_next);
@@ -99,10 +104,12 @@ class PerJointLearning final : public JointLearning {
   explicit PerJointLearning(std::vector<std::unique_ptr<LearningLaw>> laws) : laws_(std::move(laws)) {}
   void update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
               Eigen::Ref<Eigen::MatrixXd> u_next) override {
-    for (int j = 0; j < joints(); ++j) laws_[static_cast<std::size_t>(j)]->update(u_j.col(j), e_j.col(j), u_next.col(j));
+    for (int j = 0; j < joints(); ++j)
+      laws_[static_cast<std::size_t>(j)]->update(u_j.col(j), e_j.col(j), u_next.col(j));
   }
   void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) override {
-    for (int j = 0; j < joints(); ++j) laws_[static_cast<std::size_t>(j)]->set_input_context(feedback_bar.col(j), input_limit_bar);
+    for (int j = 0; j < joints(); ++j)
+      laws_[static_cast<std::size_t>(j)]->set_input_context(feedback_bar.col(j), input_limit_bar);
   }
   void set_held_outputs(const std::vector<unsigned char>& held) override {
     for (const auto& law : laws_) law->set_held_outputs(held);
@@ -144,29 +151,36 @@ MultiJointModel joint_learning_model(const ChainParameters& chain, const std::st
   throw InputError("[ilc] joint_model = '" + joint_model + "': unknown (known: coupled, independent, identified)");
 }
 
-std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model, int joints,
-                                                   int samples) {
-  if (joints == 1 && !config.arm.has_chain()) return std::make_unique<SingleJointLearning>(make_learning_law(config, model, samples));
+std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model,
+                                                   int joints, int samples) {
+  if (joints == 1 && !config.arm.has_chain())
+    return std::make_unique<SingleJointLearning>(make_learning_law(config, model, samples));
   const ChainParameters chain = chain_of(config.arm);
   if (chain.joints != joints) {
-    throw InputError("the trajectory has " + std::to_string(joints) + " joints; the arm has " + std::to_string(chain.joints) +
-                     " (" + config.arm.name() + ")");
+    throw InputError("the trajectory has " + std::to_string(joints) + " joints; the arm has " +
+                     std::to_string(chain.joints) + " (" + config.arm.name() + ")");
   }
   const std::string& law = config.ilc.law;
   const double sample_s = config.timing.sample_s();
   try {
-    if (law == "noilc") return std::make_unique<JointNormOptimal>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
+    if (law == "noilc")
+      return std::make_unique<JointNormOptimal>(
+          joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
     if (law == "noilc-constrained") {
-      return std::make_unique<JointNormOptimalConstrained>(joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
+      return std::make_unique<JointNormOptimalConstrained>(
+          joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified), config.ilc, samples);
     }
     if (law == "noilc-learned") {
-      const MultiJointModel joints_model = joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified);
+      const MultiJointModel joints_model =
+          joint_learning_model(chain, config.ilc.joint_model, sample_s, config.identified);
       return std::make_unique<JointNormOptimalLearned>(
-          closed_loop_prior(joints_model.A, joints_model.B, sample_s, config.model.volume_gain_per_rad, config.controller),
+          closed_loop_prior(joints_model.A, joints_model.B, sample_s, config.model.volume_gain_per_rad,
+                            config.controller),
           learned_noilc_settings(config.ilc), samples);
     }
     std::vector<std::unique_ptr<LearningLaw>> laws;
-    for (const DiscreteArmModel& joint : independent_joint_models(chain, sample_s)) laws.push_back(make_learning_law(config, joint, samples));
+    for (const DiscreteArmModel& joint : independent_joint_models(chain, sample_s))
+      laws.push_back(make_learning_law(config, joint, samples));
     return std::make_unique<PerJointLearning>(std::move(laws));
   } catch (const InputError& error) {
     const std::string what = error.what();

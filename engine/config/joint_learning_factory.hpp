@@ -31,7 +31,7 @@ MultiJointModel joint_learning_model(const ChainParameters& chain, const std::st
 /// The learning for `joints` joints of `samples` samples. `model` is the single-joint model (one
 /// joint only). Throws InputError for a law, model or weights that cannot be used, or a joint count
 /// other than the [arm]'s.
-std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model, int joints,
-                                                   int samples);
+std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model,
+                                                   int joints, int samples);
 
 }  // namespace bellows

@@ -35,7 +35,15 @@ std::vector<std::string> learning_law_weight_keys(const std::string& name) {
     return {"m", "s", "w", "admm_rho", "admm_max_iterations", "admm_tolerance", "limit_margin_bar", "limit_recovery_s"};
   }
   if (name == "noilc-learned") {
-    return {"m", "learned_s", "w", "learned_forgetting", "learned_ridge", "learned_guard", "learned_taps", "limit_margin_bar", "limit_recovery_s"};
+    return {"m",
+            "learned_s",
+            "w",
+            "learned_forgetting",
+            "learned_ridge",
+            "learned_guard",
+            "learned_taps",
+            "limit_margin_bar",
+            "limit_recovery_s"};
   }
   if (name == "pd") return {"pd_kp", "pd_kd_s", "pd_q_cutoff_hz"};
   if (name == "gradient") return {"gradient_step"};
@@ -54,7 +62,8 @@ LearnedWith learned_with(const Configuration& config) {
   return out;
 }
 
-std::unique_ptr<LearningLaw> make_learning_law(const Configuration& config, const DiscreteArmModel& model, int samples) {
+std::unique_ptr<LearningLaw> make_learning_law(const Configuration& config, const DiscreteArmModel& model,
+                                               int samples) {
   const std::string& law = config.ilc.law;
   check_trial_cost(config, samples);  // before any matrix of the law is allocated
   try {

@@ -12,7 +12,8 @@
 namespace bellows {
 namespace {
 
-constexpr TransferMethod kMethods[] = {TransferMethod::kReferenceFir, TransferMethod::kBasis, TransferMethod::kInverseFir};
+constexpr TransferMethod kMethods[] = {TransferMethod::kReferenceFir, TransferMethod::kBasis,
+                                       TransferMethod::kInverseFir};
 
 Eigen::VectorXd normalized(const Eigen::VectorXd& angle_rad) { return angle_rad / std::numbers::pi; }
 
@@ -53,8 +54,8 @@ std::string rig_profile_mismatch(const std::string& source_profile, const std::s
          printable(target_profile) + "'";
 }
 
-std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
-                              const std::string& target_device) {
+std::string transfer_mismatch(const Configuration& source, const std::string& source_device,
+                              const Configuration& target, const std::string& target_device) {
   const double theirs = source.timing.sample_s(), ours = target.timing.sample_s();
   char line[200];
   if (std::abs(theirs - ours) > 1e-9 * ours) {
@@ -67,7 +68,8 @@ std::string transfer_mismatch(const Configuration& source, const std::string& so
   if (target_device != "sim") return {};
   Configuration a = source, b = target;  // the bindings hand out pointers into a mutable configuration
   for (const ParameterBinding& binding : parameter_bindings()) {
-    if (binding.section != "plant" || binding.key.rfind("fault", 0) == 0 || binding.key.rfind("spike", 0) == 0) continue;
+    if (binding.section != "plant" || binding.key.rfind("fault", 0) == 0 || binding.key.rfind("spike", 0) == 0)
+      continue;
     const bool differs = binding.real ? std::abs(*binding.real(a) - *binding.real(b)) >
                                             1e-9 * std::max(std::abs(*binding.real(a)), std::abs(*binding.real(b)))
                                       : binding.integer && *binding.integer(a) != *binding.integer(b);
@@ -83,17 +85,21 @@ std::string transfer_mismatch(const Configuration& source, const std::string& so
 
 std::string transfer_method_name(TransferMethod method) {
   switch (method) {
-    case TransferMethod::kAuto: return "auto";
-    case TransferMethod::kReferenceFir: return "reference-fir";
-    case TransferMethod::kBasis: return "basis";
-    case TransferMethod::kInverseFir: return "inverse-fir";
+    case TransferMethod::kAuto:
+      return "auto";
+    case TransferMethod::kReferenceFir:
+      return "reference-fir";
+    case TransferMethod::kBasis:
+      return "basis";
+    case TransferMethod::kInverseFir:
+      return "inverse-fir";
   }
   return "auto";
 }
 
 TransferMethod parse_transfer_method(const std::string& name) {
-  for (const TransferMethod m : {TransferMethod::kAuto, TransferMethod::kReferenceFir, TransferMethod::kBasis,
-                                 TransferMethod::kInverseFir}) {
+  for (const TransferMethod m :
+       {TransferMethod::kAuto, TransferMethod::kReferenceFir, TransferMethod::kBasis, TransferMethod::kInverseFir}) {
     if (transfer_method_name(m) == name) return m;
   }
   throw InputError("transfer method must be auto, reference-fir, basis or inverse-fir, not '" + name + "'");
@@ -124,13 +130,14 @@ void LearningTransfer::setup(std::vector<TransferSource> sources, const Controll
   sources_.clear();
   for (TransferSource& source : sources) {
     if (std::abs(source.trajectory.sample_time_s - sample_time_s) > 1e-9 * sample_time_s) {
-      throw InputError("session '" + source.name + "' was sampled every " + std::to_string(source.trajectory.sample_time_s) +
-                       " s, not every " + std::to_string(sample_time_s) + " s: it cannot teach this run");
+      throw InputError("session '" + source.name + "' was sampled every " +
+                       std::to_string(source.trajectory.sample_time_s) + " s, not every " +
+                       std::to_string(sample_time_s) + " s: it cannot teach this run");
     }
     const Eigen::Index n = source.trajectory.learning_samples();
     std::erase_if(source.trials, [n](const TransferTrial& t) {
-      return t.u_ilc_bar.size() != n || t.u_pid_bar.size() != n || t.angle_rad.size() != n + 1 || !t.angle_rad.allFinite() ||
-             !t.u_ilc_bar.allFinite() || !t.u_pid_bar.allFinite();
+      return t.u_ilc_bar.size() != n || t.u_pid_bar.size() != n || t.angle_rad.size() != n + 1 ||
+             !t.angle_rad.allFinite() || !t.u_ilc_bar.allFinite() || !t.u_pid_bar.allFinite();
     });
     if (source.trials.empty()) throw InputError("session '" + source.name + "' has no complete trial to learn from");
     sources_.push_back(std::move(source));
@@ -148,7 +155,9 @@ void LearningTransfer::setup(std::vector<TransferSource> sources, const Controll
     for (std::size_t j = 1; j < s.trials.size(); ++j) {
       const Eigen::VectorXd du = s.trials[j].u_ilc_bar - s.trials[j - 1].u_ilc_bar;
       const Eigen::VectorXd de = trial_error(s.trajectory, s.trials[j - 1]) - trial_error(s.trajectory, s.trials[j]);
-      closed_loop.add(g, build_causal_regressors(du, settings_.closed_loop_taps, settings_.slow_time_constants_s, sample_time_s), de);
+      closed_loop.add(
+          g, build_causal_regressors(du, settings_.closed_loop_taps, settings_.slow_time_constants_s, sample_time_s),
+          de);
     }
   }
   closed_loop_theta_ = closed_loop.solve(settings_.relative_ridge);
@@ -171,7 +180,8 @@ void LearningTransfer::setup(std::vector<TransferSource> sources, const Controll
     }
     const TransferTrial& last = s.trials.back();
     for (std::size_t m = 0; m < 2; ++m) {  // reference-fir, basis: r -> the last trial's total input
-      inverse[m].add(g, build_regressors(r, shape_of(kMethods[m], settings_), 1, n, sample_time_s), applied_total_bar(last, s.controller));
+      inverse[m].add(g, build_regressors(r, shape_of(kMethods[m], settings_), 1, n, sample_time_s),
+                     applied_total_bar(last, s.controller));
     }
     for (const TransferTrial& trial : s.trials) {  // inverse-fir: y -> u over every trial
       inverse[2].add(g, build_regressors(normalized(trial.angle_rad), reference_shape, 1, n, sample_time_s),
@@ -182,20 +192,24 @@ void LearningTransfer::setup(std::vector<TransferSource> sources, const Controll
   }
   feedback_error_theta_ = feedback_error.solve(settings_.relative_ridge);
   inverse_fits_ = std::move(inverse);
-  for (std::size_t m = 0; m < 3; ++m) theta_all_[static_cast<std::size_t>(kMethods[m])] = inverse_fits_[m].solve(settings_.relative_ridge);
+  for (std::size_t m = 0; m < 3; ++m)
+    theta_all_[static_cast<std::size_t>(kMethods[m])] = inverse_fits_[m].solve(settings_.relative_ridge);
   info_.sources = groups;
   info_.ready = true;
 }
 
 Eigen::VectorXd LearningTransfer::inverse_theta(TransferMethod method, int left_out) const {
   for (std::size_t m = 0; m < 3; ++m) {
-    if (kMethods[m] == method) return left_out < 0 ? theta_all_[static_cast<std::size_t>(method)] : inverse_fits_[m].solve(settings_.relative_ridge, left_out);
+    if (kMethods[m] == method)
+      return left_out < 0 ? theta_all_[static_cast<std::size_t>(method)]
+                          : inverse_fits_[m].solve(settings_.relative_ridge, left_out);
   }
   return {};
 }
 
-Eigen::VectorXd LearningTransfer::predict_correction(TransferMethod method, const Eigen::VectorXd& theta, const Trajectory& target,
-                                                     const ControllerParameters& controller, int* clamped) const {
+Eigen::VectorXd LearningTransfer::predict_correction(TransferMethod method, const Eigen::VectorXd& theta,
+                                                     const Trajectory& target, const ControllerParameters& controller,
+                                                     int* clamped) const {
   const int n = target.learning_samples();
   const Eigen::VectorXd r = normalized(target.joint(0));
   // inverse-fir maps an angle to the input that produced it: fed the reference, it gives the input
@@ -217,13 +231,15 @@ Eigen::VectorXd LearningTransfer::predict_correction(TransferMethod method, cons
 }
 
 Eigen::VectorXd LearningTransfer::predicted_error_change(const Eigen::VectorXd& correction) const {
-  return build_causal_regressors(correction, settings_.closed_loop_taps, settings_.slow_time_constants_s, sample_time_s_) *
+  return build_causal_regressors(correction, settings_.closed_loop_taps, settings_.slow_time_constants_s,
+                                 sample_time_s_) *
          closed_loop_theta_;
 }
 
 Eigen::VectorXd LearningTransfer::predicted_feedback_error(const Trajectory& target) const {
   const Eigen::VectorXd r = normalized(target.joint(0));
-  return build_regressors(r, shape_of(TransferMethod::kReferenceFir, settings_), 1, target.learning_samples(), sample_time_s_) *
+  return build_regressors(r, shape_of(TransferMethod::kReferenceFir, settings_), 1, target.learning_samples(),
+                          sample_time_s_) *
          feedback_error_theta_;
 }
 
@@ -292,8 +308,8 @@ TransferResult LearningTransfer::solve(const Trajectory& target) const {
   if (!u.allFinite()) return fall_back("the fitted model gave a non-finite correction");
   result.predicted_rms_deg = rms_deg(e0 - predicted_error_change(u));
   if (!(result.predicted_rms_deg <= settings_.largest_accepted_ratio * result.predicted_feedback_only_rms_deg)) {
-    std::snprintf(line, sizeof line, "on this trajectory %s predicts %.2f deg RMS, feedback only %.2f deg", result.method.c_str(),
-                  result.predicted_rms_deg, result.predicted_feedback_only_rms_deg);
+    std::snprintf(line, sizeof line, "on this trajectory %s predicts %.2f deg RMS, feedback only %.2f deg",
+                  result.method.c_str(), result.predicted_rms_deg, result.predicted_feedback_only_rms_deg);
     return fall_back(line);
   }
   result.status = TransferStatus::kTransferred;

@@ -50,8 +50,8 @@ struct TransferSource {
 /// Why trials recorded with `source` on the device `source_device` cannot teach a run with `target`
 /// on `target_device` (another sample time, device, or simulated arm: a physical [plant] key differs);
 /// empty when they can. Gains, weights, laws, seeds and lengths may differ.
-std::string transfer_mismatch(const Configuration& source, const std::string& source_device, const Configuration& target,
-                              const std::string& target_device);
+std::string transfer_mismatch(const Configuration& source, const std::string& source_device,
+                              const Configuration& target, const std::string& target_device);
 
 /// Why trials recorded with the rig profile `source_profile` (a session's device_info "rig_profile";
 /// empty when it had none) cannot teach a run with `target_profile`: another rig profile is another
@@ -65,13 +65,13 @@ TransferMethod parse_transfer_method(const std::string& name);
 
 struct TransferSettings {
   TransferMethod method = TransferMethod::kAuto;
-  int taps_behind = 25;       // reference samples before the output sample (0.5 s at 50 Hz)
-  int taps_ahead = 12;        // and after it: the correction leads the reference
+  int taps_behind = 25;  // reference samples before the output sample (0.5 s at 50 Hz)
+  int taps_ahead = 12;   // and after it: the correction leads the reference
   std::vector<double> slow_time_constants_s = {0.3, 1.0, 3.0};  // creep and the integral's tails
   double relative_ridge = 1e-5;
   std::vector<int> nonlinear_leads = {-6, -3, 0, 3, 6, 9};  // samples; see RegressorShape
-  int closed_loop_taps = 40;  // G, the correction's effect on the error (0.8 s)
-  double limit_margin_bar = 0.01;  // keep expected feedback + correction this far inside the limits
+  int closed_loop_taps = 40;                                // G, the correction's effect on the error (0.8 s)
+  double limit_margin_bar = 0.01;        // keep expected feedback + correction this far inside the limits
   double largest_accepted_ratio = 0.95;  // predicted RMS / feedback-only RMS above this: fall back to zero
 };
 
@@ -82,13 +82,14 @@ enum class TransferStatus {
 
 struct TransferResult {
   TransferStatus status = TransferStatus::kFallback;
-  std::string method;       // the method used (or tried, on fallback)
-  std::string reason;       // why it fell back; empty when transferred
-  Eigen::VectorXd correction_bar;  // N of the target; zero on fallback
+  std::string method;                            // the method used (or tried, on fallback)
+  std::string reason;                            // why it fell back; empty when transferred
+  Eigen::VectorXd correction_bar;                // N of the target; zero on fallback
   double predicted_feedback_only_rms_deg = 0.0;  // the new trajectory's first trial without transfer
   double predicted_rms_deg = 0.0;                // with this correction (equal on fallback)
-  double validation_ratio = 0.0;  // predicted / measured-feedback-only RMS on held-out source sessions (in-sample with one source)
-  int clamped_samples = 0;        // samples the pressure limits cut
+  double validation_ratio =
+      0.0;  // predicted / measured-feedback-only RMS on held-out source sessions (in-sample with one source)
+  int clamped_samples = 0;                                    // samples the pressure limits cut
   std::vector<std::pair<std::string, double>> method_ratios;  // every method's validation ratio (auto)
 };
 
@@ -124,10 +125,10 @@ class LearningTransfer {
   std::vector<TransferSource> sources_;
   ControllerParameters target_controller_;
   double sample_time_s_ = 0.0;
-  Eigen::VectorXd closed_loop_theta_;    // G
-  Eigen::VectorXd feedback_error_theta_; // e0(r)
+  Eigen::VectorXd closed_loop_theta_;           // G
+  Eigen::VectorXd feedback_error_theta_;        // e0(r)
   std::vector<RidgeAccumulator> inverse_fits_;  // per method of kMethods, by source
-  std::vector<Eigen::VectorXd> theta_all_;  // per method (index = enum), fitted on all sources
+  std::vector<Eigen::VectorXd> theta_all_;      // per method (index = enum), fitted on all sources
   TransferInfo info_;
 };
 

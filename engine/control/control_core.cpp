@@ -9,8 +9,10 @@ ControlCore::ControlCore(const ControllerParameters& controller, const TimingPar
     : controller_(controller), timing_(timing) {
   loops_.reserve(kMaxJoints);
   for (int j = 0; j < kMaxJoints; ++j) {
-    loops_.push_back(JointLoop{PidController(controller, timing.sample_s()), PressureController(controller),
-                               PressureController(controller), {}});
+    loops_.push_back(JointLoop{PidController(controller, timing.sample_s()),
+                               PressureController(controller),
+                               PressureController(controller),
+                               {}});
     reset_loop(loops_.back());
   }
 }
@@ -40,11 +42,13 @@ void ControlCore::hold(const JointVector& angles_rad) {
   trajectory_ = nullptr;
 }
 
-void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction_bar, TrialRecord& record) {
+void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::VectorXd& correction_bar,
+                              TrialRecord& record) {
   start(trajectory, correction_bar.data(), correction_bar.size(), 1, record);
 }
 
-void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::MatrixXd& correction_bar, TrialRecord& record) {
+void ControlCore::start_trial(const Trajectory& trajectory, const Eigen::MatrixXd& correction_bar,
+                              TrialRecord& record) {
   start(trajectory, correction_bar.data(), correction_bar.rows(), correction_bar.cols(), record);
 }
 
@@ -199,8 +203,10 @@ ValveCommand ControlCore::step(const SensorReading& reading, bool fresh) {
     JointLoop& c = loop(j);
     const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
     // Held: every valve closed, the pressure controllers not stepped on a reading they have seen.
-    const DutyCycles a = fresh ? c.pressure_a.step(c.setpoints.a_bar, r.chamber_bar[0], reading.supply_bar) : DutyCycles{};
-    const DutyCycles b = fresh ? c.pressure_b.step(c.setpoints.b_bar, r.chamber_bar[1], reading.supply_bar) : DutyCycles{};
+    const DutyCycles a =
+        fresh ? c.pressure_a.step(c.setpoints.a_bar, r.chamber_bar[0], reading.supply_bar) : DutyCycles{};
+    const DutyCycles b =
+        fresh ? c.pressure_b.step(c.setpoints.b_bar, r.chamber_bar[1], reading.supply_bar) : DutyCycles{};
     JointValves& valves = command.joint[static_cast<std::size_t>(j)];
     valves.inlet_duty = {a.inlet, b.inlet};
     valves.outlet_duty = {a.outlet, b.outlet};

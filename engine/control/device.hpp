@@ -14,7 +14,7 @@ inline constexpr int kActuatorCount = 2;  // per joint: A (index 0) and B (index
 
 /// One joint's sensors: its encoder and its two chambers.
 struct JointReading {
-  double angle_rad = 0.0;     // encoder, quantized by the device
+  double angle_rad = 0.0;                            // encoder, quantized by the device
   std::array<double, kActuatorCount> chamber_bar{};  // absolute pressures of A and B
 };
 
@@ -28,11 +28,11 @@ struct JointReading {
 /// controller on it; [safety] stale_ticks such ticks in a row are a fault, named by
 /// Device::explain_silence().
 struct SensorReading {
-  double time_s = 0.0;        // device time of the reading
+  double time_s = 0.0;  // device time of the reading
   int joint_count = 1;
   std::array<JointReading, kMaxJoints> joint{};
-  double supply_bar = 0.0;    // absolute supply pressure
-  double temperature_K = 0.0; // supply temperature
+  double supply_bar = 0.0;     // absolute supply pressure
+  double temperature_K = 0.0;  // supply temperature
 };
 
 /// One joint's valves for one PWM period: duty cycles in [0, 1] per actuator.
@@ -66,14 +66,14 @@ inline JointValves single_joint_valves(const ValveCommand& command) {
 /// How the link to a rig is doing (all zero for an in-process device). The round trip is one
 /// exchange with the rig (for a T7: one read of the inputs and one write of the duties).
 struct DeviceHealth {
-  bool has_link = false;              // false: in-process, nothing to report
-  bool connected = false;             // the link answers
+  bool has_link = false;   // false: in-process, nothing to report
+  bool connected = false;  // the link answers
   double round_trip_p50_ms = 0.0;
   double round_trip_p99_ms = 0.0;
   double round_trip_max_ms = 0.0;
-  std::uint64_t exchanges = 0;        // completed exchanges
-  std::uint64_t link_errors = 0;      // failed or timed-out exchanges
-  std::uint64_t stale_readings = 0;   // reads that brought nothing new
+  std::uint64_t exchanges = 0;       // completed exchanges
+  std::uint64_t link_errors = 0;     // failed or timed-out exchanges
+  std::uint64_t stale_readings = 0;  // reads that brought nothing new
 };
 
 /// How long after a command a reading shows it: the round trip's p99 (0 in process).
@@ -81,8 +81,8 @@ inline double link_lag_s(const DeviceHealth& health) { return health.has_link ? 
 
 /// One analog input as the rig sees it: the raw volts and the calibrated value (rig bring-up).
 struct RawInput {
-  const char* name = "";    // e.g. "chamber_a" (static storage)
-  const char* unit = "";    // unit of `value`: "bar", "deg", "K"
+  const char* name = "";  // e.g. "chamber_a" (static storage)
+  const char* unit = "";  // unit of `value`: "bar", "deg", "K"
   double volts = 0.0;
   double value = 0.0;
 };
@@ -131,7 +131,8 @@ class Device {
   /// kLinkLost, naming itself (the rig, the address) and how long it has been silent; one whose
   /// link answers with frozen values leaves the default, kSensorStale.
   virtual void explain_silence(double silent_s, DeviceFault& fault) const {
-    fault.set(FaultCode::kSensorStale, -1, "no fresh reading for %.0f ms: %s", silent_s * 1e3, fault_message(FaultCode::kSensorStale));
+    fault.set(FaultCode::kSensorStale, -1, "no fresh reading for %.0f ms: %s", silent_s * 1e3,
+              fault_message(FaultCode::kSensorStale));
   }
 };
 

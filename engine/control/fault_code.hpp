@@ -23,16 +23,16 @@ enum class FaultCode : std::uint8_t {
   kSupplyLow,
   kSensorNotANumber,
   kSensorOutOfRange,
-  kSensorStale,      // readings arrive but their values are frozen (a sensor's time did not advance)
+  kSensorStale,  // readings arrive but their values are frozen (a sensor's time did not advance)
   kMissedDeadlines,
   kHeartbeatLost,
-  kLinkLost,         // the link to the rig stopped answering: nothing at all arrived for the stale limit
-  kRigLimit,         // the rig's own limit tripped (its angle range, its pressure ceiling)
-  kRigTimeout,       // the rig vented by itself: the engine's commands stopped reaching it
-  kRigFault,         // the rig says it cannot read its sensors or drive its valves
-  kDeviceError,      // the device refused a request (e.g. a Modbus exception of a T7)
-  kForeignSender,    // another sender is commanding the rig, or publishes states as it
-  kRigUnavailable,   // no rig served this run (before arming: a run's failure, never latched by a tick)
+  kLinkLost,        // the link to the rig stopped answering: nothing at all arrived for the stale limit
+  kRigLimit,        // the rig's own limit tripped (its angle range, its pressure ceiling)
+  kRigTimeout,      // the rig vented by itself: the engine's commands stopped reaching it
+  kRigFault,        // the rig says it cannot read its sensors or drive its valves
+  kDeviceError,     // the device refused a request (e.g. a Modbus exception of a T7)
+  kForeignSender,   // another sender is commanding the rig, or publishes states as it
+  kRigUnavailable,  // no rig served this run (before arming: a run's failure, never latched by a tick)
 };
 inline constexpr FaultCode kLastFaultCode = FaultCode::kRigUnavailable;
 
@@ -47,8 +47,8 @@ using FaultDetail = std::array<char, kFaultDetailChars>;
 /// A fault a device reports to the engine, with its words.
 struct DeviceFault {
   FaultCode code = FaultCode::kNone;
-  int joint = -1;       // the joint (0-based) it concerns, -1: no joint's
-  FaultDetail text{};   // e.g. "the rig stopped joint 1 at -100 deg beyond its range 100 deg: check the chamber wiring"
+  int joint = -1;      // the joint (0-based) it concerns, -1: no joint's
+  FaultDetail text{};  // e.g. "the rig stopped joint 1 at -100 deg beyond its range 100 deg: check the chamber wiring"
 
   /// Sets code, joint and the text from a printf format (truncated to fit; no allocation).
   void set(FaultCode fault, int fault_joint, const char* format, ...) __attribute__((format(printf, 4, 5)));

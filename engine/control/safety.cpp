@@ -43,7 +43,8 @@ GuardFault find_guard_fault(const SensorReading& r, const GuardInputs& in, const
   }
   if (r.supply_bar < limits.supply_min_bar) return {FaultCode::kSupplyLow, -1};
   if (in.missed_streak >= limits.missed_deadline_streak) return {FaultCode::kMissedDeadlines, -1};
-  if (limits.heartbeat_timeout_s > 0.0 && in.heartbeat_age_s > limits.heartbeat_timeout_s) return {FaultCode::kHeartbeatLost, -1};
+  if (limits.heartbeat_timeout_s > 0.0 && in.heartbeat_age_s > limits.heartbeat_timeout_s)
+    return {FaultCode::kHeartbeatLost, -1};
   return {};
 }
 

@@ -29,15 +29,18 @@ ClosedLoopPrior closed_loop_prior(const Eigen::MatrixXd& A, const Eigen::MatrixX
   ClosedLoopPrior prior;
   prior.arm_A = continuous.topLeftCorner(n, n);
   prior.arm_B = continuous.topRightCorner(n, J);
-  if (!prior.arm_A.allFinite() || !prior.arm_B.allFinite()) throw InputError("noilc-learned: the arm's model is not finite");
-  prior.bounce_back = Eigen::VectorXd::Constant(J, -2.0 * controller.gas.ambient_bar * volume_gain_per_rad * kVelocityScale);
+  if (!prior.arm_A.allFinite() || !prior.arm_B.allFinite())
+    throw InputError("noilc-learned: the arm's model is not finite");
+  prior.bounce_back =
+      Eigen::VectorXd::Constant(J, -2.0 * controller.gas.ambient_bar * volume_gain_per_rad * kVelocityScale);
   prior.tau_p_s = controller.tau_p_s;
   prior.pid = controller;
   prior.sample_time_s = sample_time_s;
   return prior;
 }
 
-StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const CorrectionShape& shape, const Eigen::MatrixXd& correction) {
+StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const CorrectionShape& shape,
+                                  const Eigen::MatrixXd& correction) {
   const int J = prior.joints(), arm = 2 * J, actuated = 3 * J, per_joint = shape.per_joint();
   const double T = prior.sample_time_s;
   // Arm behind the pressure lag, continuous, then exact zero-order hold (as convergence.cpp).
@@ -88,7 +91,8 @@ StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const Correction
   return m;
 }
 
-Eigen::MatrixXd correction_regressors(const Eigen::Ref<const Eigen::VectorXd>& du, const CorrectionShape& shape, double sample_time_s) {
+Eigen::MatrixXd correction_regressors(const Eigen::Ref<const Eigen::VectorXd>& du, const CorrectionShape& shape,
+                                      double sample_time_s) {
   const Eigen::Index N = du.size();
   Eigen::MatrixXd phi = Eigen::MatrixXd::Zero(N, shape.per_joint());
   for (Eigen::Index t = 1; t <= N; ++t) {

@@ -19,10 +19,10 @@ namespace bellows {
 /// The known part: the arm's continuous model in the normalized coordinates of
 /// engine/model/coupled_joint_dynamics (joint i owns states 2i, 2i+1), the pressure lag and the PID.
 struct ClosedLoopPrior {
-  Eigen::MatrixXd arm_A, arm_B;       // continuous, 2J x 2J and 2J x J
-  Eigen::VectorXd bounce_back;        // per joint: d(dp)/dt per unit of x2 = alpha_dot / (10 pi)
+  Eigen::MatrixXd arm_A, arm_B;  // continuous, 2J x 2J and 2J x J
+  Eigen::VectorXd bounce_back;   // per joint: d(dp)/dt per unit of x2 = alpha_dot / (10 pi)
   double tau_p_s = 0.02;
-  ControllerParameters pid;           // k_p, k_i_per_s, k_d_s are used
+  ControllerParameters pid;  // k_p, k_i_per_s, k_d_s are used
   double sample_time_s = 0.02;
   int joints() const { return static_cast<int>(arm_B.cols()); }
 };
@@ -42,10 +42,12 @@ struct CorrectionShape {
 };
 
 /// The model with the correction's coefficients `correction` (per_joint() x J, column per joint).
-StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const CorrectionShape& shape, const Eigen::MatrixXd& correction);
+StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const CorrectionShape& shape,
+                                  const Eigen::MatrixXd& correction);
 
 /// Regressors of the correction for one joint's input change du(0..N-1): row t-1 holds what the
 /// correction states hold at sample t (N x per_joint()), so that y_correction = Phi * coefficients.
-Eigen::MatrixXd correction_regressors(const Eigen::Ref<const Eigen::VectorXd>& du, const CorrectionShape& shape, double sample_time_s);
+Eigen::MatrixXd correction_regressors(const Eigen::Ref<const Eigen::VectorXd>& du, const CorrectionShape& shape,
+                                      double sample_time_s);
 
 }  // namespace bellows

@@ -9,7 +9,10 @@
 namespace bellows {
 
 InverseIlc::InverseIlc(const DiscreteArmModel& model, const IlcParameters& parameters, int samples)
-    : model_(model), samples_(samples), gain_(parameters.inverse_gain), filter_(parameters.inverse_q_cutoff_hz, model.sample_time_s) {
+    : model_(model),
+      samples_(samples),
+      gain_(parameters.inverse_gain),
+      filter_(parameters.inverse_q_cutoff_hz, model.sample_time_s) {
   if (samples < 1) throw InputError("inverse-model ILC needs at least 1 sample, got " + std::to_string(samples));
   if (!(gain_ > 0.0) || gain_ > 1.0) throw InputError("[ilc] inverse_gain must be in (0, 1]");
   const double first_markov = model.C * model.B;

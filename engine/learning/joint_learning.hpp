@@ -27,7 +27,8 @@ class JointLearning {
   /// Per joint (columns), the last trial's feedback u_pid(0..N-1) in bar, and the largest |u_pid +
   /// u_ilc| the set-point clamp lets through; before update(). Laws that keep the correction inside
   /// the pressure limits use it.
-  virtual void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& /*feedback_bar*/, double /*input_limit_bar*/) {}
+  virtual void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& /*feedback_bar*/,
+                                 double /*input_limit_bar*/) {}
   /// As LearningLaw::set_held_outputs (one row per sample, for every joint); before update().
   virtual void set_held_outputs(const std::vector<unsigned char>& /*held*/) {}
   /// The single-joint law underneath when J = 1 (for the convergence prediction), else null.

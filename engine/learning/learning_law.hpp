@@ -32,7 +32,8 @@ class LearningLaw {
   /// What the last trial's feedback contributed, u_pid(0..N-1) in bar, and the largest |u_pid + u_ilc|
   /// the set-point clamp lets through (p_max - p0). Called before update(); laws that keep the
   /// correction within the pressure limits use it, the others ignore it.
-  virtual void set_input_context(const Eigen::Ref<const Eigen::VectorXd>& /*feedback_bar*/, double /*input_limit_bar*/) {}
+  virtual void set_input_context(const Eigen::Ref<const Eigen::VectorXd>& /*feedback_bar*/,
+                                 double /*input_limit_bar*/) {}
 
   /// Which samples k = 0..N of the last trial were held (no fresh reading: error 0, TrialRecord::held).
   /// Called before update(); laws that learn a model from the trials leave those outputs out.

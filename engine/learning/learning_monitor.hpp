@@ -23,7 +23,7 @@ struct IterationDiagnostics {
 };
 
 struct WindupSummary {
-  bool detected = false;               // wind-up in `persistence` consecutive trials
+  bool detected = false;  // wind-up in `persistence` consecutive trials
   int iterations_with_windup = 0;
   std::optional<int> first_iteration;  // first trial of the first persistent stretch
   double max_clamped_excess_bar = 0.0;

@@ -21,8 +21,8 @@ Eigen::VectorXd lowpass(const Eigen::VectorXd& s, double tau_s, double sample_ti
 }  // namespace
 
 int RegressorShape::count() const {
-  return (constant ? 1 : 0) + taps_behind + taps_ahead + 1 + derivatives + static_cast<int>(lowpass_time_constants_s.size()) +
-         2 * static_cast<int>(nonlinear_leads.size());
+  return (constant ? 1 : 0) + taps_behind + taps_ahead + 1 + derivatives +
+         static_cast<int>(lowpass_time_constants_s.size()) + 2 * static_cast<int>(nonlinear_leads.size());
 }
 
 Eigen::MatrixXd build_regressors(const Eigen::VectorXd& signal, const RegressorShape& shape, int first_center, int rows,
@@ -52,8 +52,8 @@ Eigen::MatrixXd build_regressors(const Eigen::VectorXd& signal, const RegressorS
   return phi;
 }
 
-Eigen::MatrixXd build_causal_regressors(const Eigen::VectorXd& input, int taps, const std::vector<double>& lowpass_time_constants_s,
-                                        double sample_time_s) {
+Eigen::MatrixXd build_causal_regressors(const Eigen::VectorXd& input, int taps,
+                                        const std::vector<double>& lowpass_time_constants_s, double sample_time_s) {
   const Eigen::Index n = input.size();
   std::vector<Eigen::VectorXd> slow;
   for (const double tau : lowpass_time_constants_s) {

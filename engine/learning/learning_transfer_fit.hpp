@@ -29,8 +29,8 @@ Eigen::MatrixXd build_regressors(const Eigen::VectorXd& signal, const RegressorS
 
 /// Causal FIR of an input u(0..N-1) to outputs at samples 1..N: row t-1 holds u(t-1-k), k = 0..taps-1,
 /// and first-order low-passes of u (the closed loop's slow tails). No constant.
-Eigen::MatrixXd build_causal_regressors(const Eigen::VectorXd& input, int taps, const std::vector<double>& lowpass_time_constants_s,
-                                        double sample_time_s);
+Eigen::MatrixXd build_causal_regressors(const Eigen::VectorXd& input, int taps,
+                                        const std::vector<double>& lowpass_time_constants_s, double sample_time_s);
 
 /// Normal equations Phi'Phi, Phi'y accumulated group by group (a group is one source session), so
 /// that a fit leaving one group out costs one solve.

@@ -4,7 +4,8 @@
 
 namespace bellows {
 
-void apply_lifted(const DiscreteArmModel& model, const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> out) {
+void apply_lifted(const DiscreteArmModel& model, const Eigen::Ref<const Eigen::VectorXd>& v,
+                  Eigen::Ref<Eigen::VectorXd> out) {
   Eigen::Vector2d x = Eigen::Vector2d::Zero();
   for (Eigen::Index t = 0; t < v.size(); ++t) {
     x = model.A * x + model.B * v(t);

@@ -12,7 +12,8 @@
 namespace bellows {
 
 /// out = P v. `out` must not alias `v`.
-void apply_lifted(const DiscreteArmModel& model, const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> out);
+void apply_lifted(const DiscreteArmModel& model, const Eigen::Ref<const Eigen::VectorXd>& v,
+                  Eigen::Ref<Eigen::VectorXd> out);
 
 /// out = P' e. `out` must not alias `e`.
 void apply_lifted_transpose(const DiscreteArmModel& model, const Eigen::Ref<const Eigen::VectorXd>& e,

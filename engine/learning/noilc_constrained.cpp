@@ -13,7 +13,8 @@ namespace {
 constexpr double kRelaxation = 1.6;
 }  // namespace
 
-NormOptimalConstrained::NormOptimalConstrained(const DiscreteArmModel& model, const IlcParameters& parameters, int samples)
+NormOptimalConstrained::NormOptimalConstrained(const DiscreteArmModel& model, const IlcParameters& parameters,
+                                               int samples)
     : model_(model),
       parameters_(parameters),
       recovery_samples_(static_cast<int>(std::lround(parameters.limit_recovery_s / model.sample_time_s))),
@@ -60,7 +61,8 @@ void NormOptimalConstrained::set_bounds(const Eigen::Ref<const Eigen::VectorXd>&
   if (lower_bar.size() != samples() || upper_bar.size() != samples()) {
     throw InputError("noilc-constrained: bounds must have " + std::to_string(samples()) + " samples");
   }
-  if ((lower_bar.array() > upper_bar.array()).any()) throw InputError("noilc-constrained: a lower bound exceeds its upper bound");
+  if ((lower_bar.array() > upper_bar.array()).any())
+    throw InputError("noilc-constrained: a lower bound exceeds its upper bound");
   lower_ = lower_bar;
   upper_ = upper_bar;
   has_trial_context_ = false;
@@ -87,8 +89,8 @@ void NormOptimalConstrained::leave_out_limited_errors(const Eigen::Ref<const Eig
   }
 }
 
-void NormOptimalConstrained::update(const Eigen::Ref<const Eigen::VectorXd>& u_j, const Eigen::Ref<const Eigen::VectorXd>& e_j,
-                                    Eigen::Ref<Eigen::VectorXd> u_next) {
+void NormOptimalConstrained::update(const Eigen::Ref<const Eigen::VectorXd>& u_j,
+                                    const Eigen::Ref<const Eigen::VectorXd>& e_j, Eigen::Ref<Eigen::VectorXd> u_next) {
   report_ = {};
   weighted_error_ = e_j;
   leave_out_limited_errors(u_j);
@@ -114,7 +116,8 @@ void NormOptimalConstrained::update(const Eigen::Ref<const Eigen::VectorXd>& u_j
     report_.admm_iterations = k;
     report_.primal_residual = (x_ - z_).cwiseAbs().maxCoeff();
     report_.dual_residual = rho * (z_ - z_previous_).cwiseAbs().maxCoeff();
-    if (report_.primal_residual <= parameters_.admm_tolerance && report_.dual_residual <= parameters_.admm_tolerance) break;
+    if (report_.primal_residual <= parameters_.admm_tolerance && report_.dual_residual <= parameters_.admm_tolerance)
+      break;
   }
   report_.converged =
       report_.primal_residual <= parameters_.admm_tolerance && report_.dual_residual <= parameters_.admm_tolerance;

@@ -25,10 +25,10 @@ namespace bellows {
 class NormOptimalConstrained final : public LearningLaw {
  public:
   struct Report {
-    int admm_iterations = 0;     // 0 when the unconstrained optimum was feasible
-    bool converged = true;       // residuals below tolerance within the iteration limit
-    int active_samples = 0;      // samples on a bound
-    int unweighted_errors = 0;   // error samples left out after inputs on the pressure limit
+    int admm_iterations = 0;    // 0 when the unconstrained optimum was feasible
+    bool converged = true;      // residuals below tolerance within the iteration limit
+    int active_samples = 0;     // samples on a bound
+    int unweighted_errors = 0;  // error samples left out after inputs on the pressure limit
     double primal_residual = 0.0;
     double dual_residual = 0.0;
   };
@@ -44,7 +44,8 @@ class NormOptimalConstrained final : public LearningLaw {
 
   /// Bounds for the next update directly (instead of from the feedback); lower <= upper elementwise.
   /// Drops the trial context: the next update is the plain bounded optimum.
-  void set_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower_bar, const Eigen::Ref<const Eigen::VectorXd>& upper_bar);
+  void set_bounds(const Eigen::Ref<const Eigen::VectorXd>& lower_bar,
+                  const Eigen::Ref<const Eigen::VectorXd>& upper_bar);
   const Eigen::VectorXd& lower_bound() const { return lower_; }
   const Eigen::VectorXd& upper_bound() const { return upper_; }
   const Report& last_report() const { return report_; }
@@ -58,7 +59,7 @@ class NormOptimalConstrained final : public LearningLaw {
 
   DiscreteArmModel model_;
   IlcParameters parameters_;
-  int recovery_samples_;                // outputs left out after an input on the limit
+  int recovery_samples_;         // outputs left out after an input on the limit
   RiccatiNoilcSolver free_;      // rho = 0: the unconstrained optimum
   RiccatiNoilcSolver proximal_;  // rho = admm_rho: the ADMM step
   Eigen::VectorXd lower_, upper_;

@@ -27,13 +27,14 @@ NormOptimalDense::NormOptimalDense(const DiscreteArmModel& model, const IlcParam
   const Eigen::MatrixXd hessian = tracking_plus_change_ + weights.w * rate_.transpose() * rate_;
   factor_.compute(hessian);
   if (factor_.info() != Eigen::Success) {
-    throw InputError("norm-optimal ILC: the weights do not give a positive definite cost (m, s, w must be >= 0, s + w > 0)");
+    throw InputError(
+        "norm-optimal ILC: the weights do not give a positive definite cost (m, s, w must be >= 0, s + w > 0)");
   }
   rhs_.resize(samples);
 }
 
-void NormOptimalDense::update(const Eigen::Ref<const Eigen::VectorXd>& u_j, const Eigen::Ref<const Eigen::VectorXd>& e_j,
-                              Eigen::Ref<Eigen::VectorXd> u_next) {
+void NormOptimalDense::update(const Eigen::Ref<const Eigen::VectorXd>& u_j,
+                              const Eigen::Ref<const Eigen::VectorXd>& e_j, Eigen::Ref<Eigen::VectorXd> u_next) {
   rhs_.noalias() = tracking_plus_change_ * u_j;
   rhs_.noalias() += weights_.m * lifted_.transpose() * e_j;
   u_next = factor_.solve(rhs_);

@@ -37,8 +37,8 @@ class NormOptimalDense final : public LearningLaw {
  private:
   DiscreteArmModel model_;
   IlcParameters weights_;
-  Eigen::MatrixXd lifted_;          // P
-  Eigen::MatrixXd rate_;            // D
+  Eigen::MatrixXd lifted_;                // P
+  Eigen::MatrixXd rate_;                  // D
   Eigen::MatrixXd tracking_plus_change_;  // P'MP + S
   Eigen::LLT<Eigen::MatrixXd> factor_;    // of P'MP + S + D'WD
   Eigen::VectorXd rhs_;

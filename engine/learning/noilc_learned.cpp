@@ -15,9 +15,12 @@ constexpr double kSmallestStep = 0.125;
 
 LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples)
     : prior_(prior), settings_(settings), samples_(samples) {
-  if (!(settings.forgetting > 0.0) || settings.forgetting > 1.0) throw InputError("[ilc] learned_forgetting must be in (0, 1]");
-  if (!(settings.relative_ridge > 0.0) || !std::isfinite(settings.relative_ridge)) throw InputError("[ilc] learned_ridge must be positive");
-  if (!(settings.guard >= 0.0) || !std::isfinite(settings.guard)) throw InputError("[ilc] learned_guard must be a finite, non-negative fraction");
+  if (!(settings.forgetting > 0.0) || settings.forgetting > 1.0)
+    throw InputError("[ilc] learned_forgetting must be in (0, 1]");
+  if (!(settings.relative_ridge > 0.0) || !std::isfinite(settings.relative_ridge))
+    throw InputError("[ilc] learned_ridge must be positive");
+  if (!(settings.guard >= 0.0) || !std::isfinite(settings.guard))
+    throw InputError("[ilc] learned_guard must be a finite, non-negative fraction");
   if (settings.shape.taps < 0) throw InputError("[ilc] the correction's taps must not be negative");
   for (const double tau : settings.shape.lowpass_time_constants_s) {
     if (!(tau > 0.0) || !std::isfinite(tau)) throw InputError("[ilc] the correction's time constants must be positive");
@@ -27,8 +30,10 @@ LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const Learned
   gram_.assign(static_cast<std::size_t>(J), Eigen::MatrixXd::Zero(p, p));
   moment_.assign(static_cast<std::size_t>(J), Eigen::VectorXd::Zero(p));
   data_scale_ = Eigen::VectorXd::Zero(J);
-  if (!(settings.limit_margin_bar >= 0.0) || !std::isfinite(settings.limit_margin_bar)) throw InputError("[ilc] limit_margin_bar must be a finite, non-negative pressure");
-  if (!(settings.limit_recovery_s >= 0.0) || !std::isfinite(settings.limit_recovery_s)) throw InputError("[ilc] limit_recovery_s must be a finite, non-negative time");
+  if (!(settings.limit_margin_bar >= 0.0) || !std::isfinite(settings.limit_margin_bar))
+    throw InputError("[ilc] limit_margin_bar must be a finite, non-negative pressure");
+  if (!(settings.limit_recovery_s >= 0.0) || !std::isfinite(settings.limit_recovery_s))
+    throw InputError("[ilc] limit_recovery_s must be a finite, non-negative time");
   learnable_ = Eigen::MatrixXd::Ones(samples, J);
   feedback_ = Eigen::MatrixXd::Zero(samples, J);
   prior_model_ = closed_loop_model(prior_, settings_.shape, correction_);
@@ -40,9 +45,11 @@ void LearnedModelNoilc::rebuild() {
   solver_.setup(model_, settings_.weights, samples_);
 }
 
-void LearnedModelNoilc::set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar) {
+void LearnedModelNoilc::set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar,
+                                          double input_limit_bar) {
   if (feedback_bar.rows() != samples_ || feedback_bar.cols() != joints()) {
-    throw InputError("noilc-learned: the feedback is not " + std::to_string(samples_) + " x " + std::to_string(joints()));
+    throw InputError("noilc-learned: the feedback is not " + std::to_string(samples_) + " x " +
+                     std::to_string(joints()));
   }
   reach_bar_ = input_limit_bar - settings_.limit_margin_bar;
   if (!(reach_bar_ > 0.0)) throw InputError("[ilc] limit_margin_bar leaves no room below the pressure limit");
@@ -57,7 +64,8 @@ void LearnedModelNoilc::set_held_outputs(const std::vector<unsigned char>& held)
   }
 }
 
-void LearnedModelNoilc::refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual, const Eigen::MatrixXd& learnable) {
+void LearnedModelNoilc::refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual,
+                              const Eigen::MatrixXd& learnable) {
   const double T = prior_.sample_time_s;
   const int p = settings_.shape.per_joint();
   for (int i = 0; i < joints(); ++i) {
@@ -96,12 +104,13 @@ void LearnedModelNoilc::leave_out_limited_outputs(const Eigen::Ref<const Eigen::
   }
 }
 
-void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
-                               Eigen::Ref<Eigen::MatrixXd> u_next) {
+void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
+                               const Eigen::Ref<const Eigen::MatrixXd>& e_j, Eigen::Ref<Eigen::MatrixXd> u_next) {
   if (u_j.rows() != samples_ || e_j.rows() != samples_ || u_j.cols() != joints() || e_j.cols() != joints()) {
     throw InputError("noilc-learned: the data are not " + std::to_string(samples_) + " x " + std::to_string(joints()));
   }
-  if (!u_j.allFinite() || !e_j.allFinite()) throw FaultError("learning law noilc-learned: the trial's data hold a NaN or an infinity");
+  if (!u_j.allFinite() || !e_j.allFinite())
+    throw FaultError("learning law noilc-learned: the trial's data hold a NaN or an infinity");
   const int trial = report_.trial + 1;
   report_ = {};
   report_.trial = trial;
@@ -113,7 +122,9 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, con
     const Eigen::MatrixXd du = u_j - u_previous_;
     const Eigen::MatrixXd dy = e_previous_ - e_j;  // e = yD - y: the change of output
     const double measured = dy.norm();
-    const auto miss = [&](const Eigen::MatrixXd& predicted) { return measured > 0.0 ? (dy - predicted).norm() / measured : 0.0; };
+    const auto miss = [&](const Eigen::MatrixXd& predicted) {
+      return measured > 0.0 ? (dy - predicted).norm() / measured : 0.0;
+    };
     const Eigen::MatrixXd predicted = model_.simulate(du), prior_predicted = prior_model_.simulate(du);
     report_.measured_change = measured;
     report_.predicted_change = predicted.norm();
@@ -131,10 +142,11 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, con
       data_scale_ *= 0.5;
       correction_ *= 0.5;
       rebuild();
-      std::snprintf(text, sizeof text,
-                    "noilc-learned: trial %d raised ||e||^2 by %.0f %% over the best trial: the model falls half way back "
-                    "to the prior, the next update starts from the best trial with step %.3g",
-                    trial, 100.0 * (cost / best_cost_ - 1.0), step_);
+      std::snprintf(
+          text, sizeof text,
+          "noilc-learned: trial %d raised ||e||^2 by %.0f %% over the best trial: the model falls half way back "
+          "to the prior, the next update starts from the best trial with step %.3g",
+          trial, 100.0 * (cost / best_cost_ - 1.0), step_);
       note_ = text;
     } else {
       // Within the guard but no descent (the cost is above the best trial's: at the noise floor, or
@@ -156,12 +168,13 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, con
         report_.refit_miss = miss(model_.simulate(du));
       }
       if (descended) step_ = std::min(1.0, 2.0 * step_);  // a trial that descended earns the step back
-      std::snprintf(text, sizeof text,
-                    "noilc-learned: model %s from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
-                    "the prior alone %.0f %%, the refit %.0f %%)%s",
-                    report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured, 100.0 * report_.prediction_miss,
-                    100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
-                    descended ? "" : "; no descent: the next update starts from the best trial with a smaller step");
+      std::snprintf(
+          text, sizeof text,
+          "noilc-learned: model %s from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
+          "the prior alone %.0f %%, the refit %.0f %%)%s",
+          report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured,
+          100.0 * report_.prediction_miss, 100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
+          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step");
       note_ = text;
     }
   }

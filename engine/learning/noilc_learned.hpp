@@ -43,27 +43,27 @@ namespace bellows {
 struct LearnedNoilcSettings {
   StateSpaceNoilcWeights weights;
   CorrectionShape shape;
-  double forgetting = 1.0;       // weight of the older trials' data per trial, in (0, 1]
-  double relative_ridge = 1e-3;  // ridge of the correction's fit, relative to the data's scale
-  double guard = 0.25;           // relative rise of ||e||^2 over the best trial that counts as worse
-  bool refit = true;             // false: the prior only (what the closed loop alone does)
-  double limit_margin_bar = 0.0;  // a set point within this of the pressure limit is on the limit
-  double limit_recovery_s = 0.08; // outputs this long after an input on the limit are not learned from
+  double forgetting = 1.0;         // weight of the older trials' data per trial, in (0, 1]
+  double relative_ridge = 1e-3;    // ridge of the correction's fit, relative to the data's scale
+  double guard = 0.25;             // relative rise of ||e||^2 over the best trial that counts as worse
+  bool refit = true;               // false: the prior only (what the closed loop alone does)
+  double limit_margin_bar = 0.0;   // a set point within this of the pressure limit is on the limit
+  double limit_recovery_s = 0.08;  // outputs this long after an input on the limit are not learned from
 };
 
 /// What the last update did, for the session and the console.
 struct LearnedNoilcReport {
-  int trial = 0;                   // updates made so far
-  bool refitted = false;           // the model was refit from the last trial
-  bool fell_back = false;          // the last trial got worse: back to the prior and the best trial
-  bool no_descent = false;         // the last trial's cost was above the best's (within the guard)
-  double step = 1.0;               // the fraction of the norm-optimal step taken
-  double measured_change = 0.0;    // ||e_j - e_{j-1}|| (normalized units)
-  double predicted_change = 0.0;   // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
-  double prediction_miss = 0.0;    // ||-(e_j - e_{j-1}) - P_model du|| / ||e_j - e_{j-1}||, same model
-  double prior_miss = 0.0;         // the same with the prior alone
-  double refit_miss = 0.0;         // the same with the model refit from this trial
-  int left_out = 0;                // output entries the refit did not learn from (limit-shaped, held)
+  int trial = 0;                  // updates made so far
+  bool refitted = false;          // the model was refit from the last trial
+  bool fell_back = false;         // the last trial got worse: back to the prior and the best trial
+  bool no_descent = false;        // the last trial's cost was above the best's (within the guard)
+  double step = 1.0;              // the fraction of the norm-optimal step taken
+  double measured_change = 0.0;   // ||e_j - e_{j-1}|| (normalized units)
+  double predicted_change = 0.0;  // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
+  double prediction_miss = 0.0;   // ||-(e_j - e_{j-1}) - P_model du|| / ||e_j - e_{j-1}||, same model
+  double prior_miss = 0.0;        // the same with the prior alone
+  double refit_miss = 0.0;        // the same with the model refit from this trial
+  int left_out = 0;               // output entries the refit did not learn from (limit-shaped, held)
 };
 
 class LearnedModelNoilc {
@@ -99,12 +99,12 @@ class LearnedModelNoilc {
   int samples_;
   StateSpaceModel prior_model_, model_;
   StateSpaceNoilc solver_;
-  Eigen::MatrixXd correction_;            // per_joint x J
-  std::vector<Eigen::MatrixXd> gram_;     // per joint
-  std::vector<Eigen::VectorXd> moment_;   // per joint
-  Eigen::VectorXd data_scale_;            // per joint: the largest mean square regressor of one trial
+  Eigen::MatrixXd correction_;           // per_joint x J
+  std::vector<Eigen::MatrixXd> gram_;    // per joint
+  std::vector<Eigen::VectorXd> moment_;  // per joint
+  Eigen::VectorXd data_scale_;           // per joint: the largest mean square regressor of one trial
   Eigen::MatrixXd u_previous_, e_previous_, u_best_, e_best_, planned_;
-  Eigen::MatrixXd feedback_;                  // N x J: this trial's feedback (bar), with has_context_
+  Eigen::MatrixXd feedback_;  // N x J: this trial's feedback (bar), with has_context_
   double reach_bar_ = 0.0;
   bool has_context_ = false;
   Eigen::MatrixXd learnable_, learnable_previous_, learnable_best_;  // N x J: 1 where the output may be learned from
@@ -122,7 +122,8 @@ namespace bellows {
 /// `noilc-learned` for one joint, as a LearningLaw.
 class NoilcLearnedLaw final : public LearningLaw {
  public:
-  NoilcLearnedLaw(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples) : core_(prior, settings, samples) {}
+  NoilcLearnedLaw(const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings, int samples)
+      : core_(prior, settings, samples) {}
   void update(const Eigen::Ref<const Eigen::VectorXd>& u_j, const Eigen::Ref<const Eigen::VectorXd>& e_j,
               Eigen::Ref<Eigen::VectorXd> u_next) override {
     core_.update(u_j, e_j, u_next);

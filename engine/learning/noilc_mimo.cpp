@@ -28,18 +28,28 @@ MultiJointWeights MultiJointWeights::per_joint(std::span<const IlcParameters> pe
 
 const char* to_string(MultiJointNoilcStatus status) {
   switch (status) {
-    case MultiJointNoilcStatus::kOk: return "ok";
-    case MultiJointNoilcStatus::kNotSetUp: return "not set up";
-    case MultiJointNoilcStatus::kBadJointCount: return "the joint count must be 1 to 4";
-    case MultiJointNoilcStatus::kTooFewSamples: return "norm-optimal ILC needs at least 2 samples";
-    case MultiJointNoilcStatus::kBadModel: return "the model is not 2J x 2J, 2J x J, J x 2J and finite with T > 0";
+    case MultiJointNoilcStatus::kOk:
+      return "ok";
+    case MultiJointNoilcStatus::kNotSetUp:
+      return "not set up";
+    case MultiJointNoilcStatus::kBadJointCount:
+      return "the joint count must be 1 to 4";
+    case MultiJointNoilcStatus::kTooFewSamples:
+      return "norm-optimal ILC needs at least 2 samples";
+    case MultiJointNoilcStatus::kBadModel:
+      return "the model is not 2J x 2J, 2J x J, J x 2J and finite with T > 0";
     case MultiJointNoilcStatus::kBadWeights:
       return "the weights m, s, w must be symmetric positive semidefinite J x J matrices and rho >= 0";
-    case MultiJointNoilcStatus::kNotPositiveDefinite: return "the weights do not give a positive definite cost";
-    case MultiJointNoilcStatus::kShapeMismatch: return "the data are not N x J";
-    case MultiJointNoilcStatus::kNonFiniteData: return "the data hold a NaN or an infinity";
-    case MultiJointNoilcStatus::kBadBounds: return "the bounds are not N x J or a lower bound exceeds its upper bound";
-    case MultiJointNoilcStatus::kNotConverged: return "the bounded update did not converge within its iterations";
+    case MultiJointNoilcStatus::kNotPositiveDefinite:
+      return "the weights do not give a positive definite cost";
+    case MultiJointNoilcStatus::kShapeMismatch:
+      return "the data are not N x J";
+    case MultiJointNoilcStatus::kNonFiniteData:
+      return "the data hold a NaN or an infinity";
+    case MultiJointNoilcStatus::kBadBounds:
+      return "the bounds are not N x J or a lower bound exceeds its upper bound";
+    case MultiJointNoilcStatus::kNotConverged:
+      return "the bounded update did not converge within its iterations";
   }
   return "unknown";
 }
@@ -59,8 +69,9 @@ namespace {
 /// allocate), and four fixed-size copies of it (J = 1..4, matrices up to 12 x 12) took GCC two
 /// minutes at -O3. The per-iteration sweeps of solve() stay fixed-size.
 MultiJointNoilcStatus riccati_stages(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& C,
-                                     const Eigen::MatrixXd& m, const Eigen::MatrixXd& s, const Eigen::MatrixXd& rate_weight,
-                                     int samples, std::vector<Eigen::MatrixXd>& gains, std::vector<Eigen::MatrixXd>& inverses) {
+                                     const Eigen::MatrixXd& m, const Eigen::MatrixXd& s,
+                                     const Eigen::MatrixXd& rate_weight, int samples,
+                                     std::vector<Eigen::MatrixXd>& gains, std::vector<Eigen::MatrixXd>& inverses) {
   using Dynamic = Eigen::MatrixXd;
   const Eigen::Index J = B.cols(), states = A.rows(), augmented = states + J;  // z = [dx; v(t-1)]
   gains.assign(static_cast<std::size_t>(samples), Dynamic());
@@ -121,7 +132,8 @@ class FixedStages final : public MultiJointNoilc::Stages {
     inverse_curvature_.resize(static_cast<std::size_t>(samples));
     feedforward_.resize(static_cast<std::size_t>(samples));
     std::vector<Eigen::MatrixXd> gains, inverses;
-    const MultiJointNoilcStatus status = riccati_stages(A_, B_, C_, m_, weights.s + rho * JJ::Identity(), rate_weight_, samples, gains, inverses);
+    const MultiJointNoilcStatus status =
+        riccati_stages(A_, B_, C_, m_, weights.s + rho * JJ::Identity(), rate_weight_, samples, gains, inverses);
     if (status != MultiJointNoilcStatus::kOk) return status;
     for (std::size_t t = 0; t < gains.size(); ++t) {
       gains_[t] = gains[t];
@@ -158,7 +170,8 @@ class FixedStages final : public MultiJointNoilc::Stages {
     for (int t = 0; t < n; ++t) {
       const auto stage = static_cast<std::size_t>(t);
       const Gain& K = gains_[stage];
-      const JVec change = K.template leftCols<kStates>() * dx + K.template rightCols<J>() * previous_change + feedforward_[stage];
+      const JVec change =
+          K.template leftCols<kStates>() * dx + K.template rightCols<J>() * previous_change + feedforward_[stage];
       u_next.row(t) = u_j.row(t) + change.transpose();
       dx = A_ * dx + B_ * change;
       previous_change = change;
@@ -184,14 +197,14 @@ class FixedStages final : public MultiJointNoilc::Stages {
   Eigen::Matrix<double, kStates, J> output_to_state_;
   double rho_ = 0.0;
   int samples_ = 0;
-  std::vector<Gain> gains_;              // K_t
-  std::vector<JJ> inverse_curvature_;    // H_uu(t)^-1
-  std::vector<JVec> feedforward_;        // k_t, rewritten each solve
+  std::vector<Gain> gains_;            // K_t
+  std::vector<JJ> inverse_curvature_;  // H_uu(t)^-1
+  std::vector<JVec> feedforward_;      // k_t, rewritten each solve
 };
 
 template <int J>
-MultiJointNoilcStatus make_stages(const MultiJointModel& model, const MultiJointWeights& weights, int samples, double rho,
-                                  std::unique_ptr<MultiJointNoilc::Stages>& out) {
+MultiJointNoilcStatus make_stages(const MultiJointModel& model, const MultiJointWeights& weights, int samples,
+                                  double rho, std::unique_ptr<MultiJointNoilc::Stages>& out) {
   auto stages = std::make_unique<FixedStages<J>>();
   const MultiJointNoilcStatus status = stages->setup(model, weights, samples, rho);
   if (status == MultiJointNoilcStatus::kOk) out = std::move(stages);
@@ -216,8 +229,8 @@ MultiJointNoilc::~MultiJointNoilc() = default;
 MultiJointNoilc::MultiJointNoilc(MultiJointNoilc&&) noexcept = default;
 MultiJointNoilc& MultiJointNoilc::operator=(MultiJointNoilc&&) noexcept = default;
 
-MultiJointNoilcStatus MultiJointNoilc::setup(const MultiJointModel& model, const MultiJointWeights& weights, int samples,
-                                             double proximal_weight) {
+MultiJointNoilcStatus MultiJointNoilc::setup(const MultiJointModel& model, const MultiJointWeights& weights,
+                                             int samples, double proximal_weight) {
   stages_.reset();
   info_ = MultiJointNoilcInfo{};
   const int J = model.joints();
@@ -235,11 +248,20 @@ MultiJointNoilcStatus MultiJointNoilc::setup(const MultiJointModel& model, const
   }
   MultiJointNoilcStatus status = MultiJointNoilcStatus::kBadJointCount;
   switch (J) {
-    case 1: status = make_stages<1>(model, weights, samples, proximal_weight, stages_); break;
-    case 2: status = make_stages<2>(model, weights, samples, proximal_weight, stages_); break;
-    case 3: status = make_stages<3>(model, weights, samples, proximal_weight, stages_); break;
-    case 4: status = make_stages<4>(model, weights, samples, proximal_weight, stages_); break;
-    default: break;
+    case 1:
+      status = make_stages<1>(model, weights, samples, proximal_weight, stages_);
+      break;
+    case 2:
+      status = make_stages<2>(model, weights, samples, proximal_weight, stages_);
+      break;
+    case 3:
+      status = make_stages<3>(model, weights, samples, proximal_weight, stages_);
+      break;
+    case 4:
+      status = make_stages<4>(model, weights, samples, proximal_weight, stages_);
+      break;
+    default:
+      break;
   }
   if (status != MultiJointNoilcStatus::kOk) return fail(status);
   info_.status = status;

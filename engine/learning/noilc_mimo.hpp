@@ -36,16 +36,16 @@ struct MultiJointWeights {
 
 enum class MultiJointNoilcStatus {
   kOk,
-  kNotSetUp,            // solve() before a successful setup()
-  kBadJointCount,       // J outside 1..kMaxJoints
-  kTooFewSamples,       // N < 2
-  kBadModel,            // A, B, C not 2J x 2J, 2J x J, J x 2J, or not finite, or T <= 0
-  kBadWeights,          // a weight not J x J, not symmetric, not finite, or not positive semidefinite; rho < 0
-  kNotPositiveDefinite, // the cost is not strictly convex (e.g. S = W = 0 with a singular model)
-  kShapeMismatch,       // solve()'s data are not N x J
-  kNonFiniteData,       // solve()'s u_j, e_j or target hold a NaN or an infinity
-  kBadBounds,           // constrained: bounds not N x J, NaN, or a lower bound above its upper bound
-  kNotConverged,        // constrained: ADMM stopped at its iteration limit; the result is feasible, not optimal
+  kNotSetUp,             // solve() before a successful setup()
+  kBadJointCount,        // J outside 1..kMaxJoints
+  kTooFewSamples,        // N < 2
+  kBadModel,             // A, B, C not 2J x 2J, 2J x J, J x 2J, or not finite, or T <= 0
+  kBadWeights,           // a weight not J x J, not symmetric, not finite, or not positive semidefinite; rho < 0
+  kNotPositiveDefinite,  // the cost is not strictly convex (e.g. S = W = 0 with a singular model)
+  kShapeMismatch,        // solve()'s data are not N x J
+  kNonFiniteData,        // solve()'s u_j, e_j or target hold a NaN or an infinity
+  kBadBounds,            // constrained: bounds not N x J, NaN, or a lower bound above its upper bound
+  kNotConverged,         // constrained: ADMM stopped at its iteration limit; the result is feasible, not optimal
 };
 
 const char* to_string(MultiJointNoilcStatus status);
@@ -55,8 +55,8 @@ struct MultiJointNoilcInfo {
   int joints = 0;
   int samples = 0;
   double proximal_weight = 0.0;
-  long solves = 0;                // successful solves since setup()
-  std::size_t memory_bytes = 0;   // gains and workspace: what grows with N
+  long solves = 0;               // successful solves since setup()
+  std::size_t memory_bytes = 0;  // gains and workspace: what grows with N
 };
 
 class MultiJointNoilc {
@@ -73,11 +73,12 @@ class MultiJointNoilc {
   /// u_next = argmin J(u); `target` is read only when rho > 0. All N x J; u_next may not alias the
   /// inputs. On a status other than kOk, u_next is left unchanged. Allocates nothing for plain
   /// column-major matrices (Eigen::Ref would copy a strided argument).
-  MultiJointNoilcStatus solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
+  MultiJointNoilcStatus solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
+                              const Eigen::Ref<const Eigen::MatrixXd>& e_j,
                               const Eigen::Ref<const Eigen::MatrixXd>& target, Eigen::Ref<Eigen::MatrixXd> u_next);
   /// The plain norm-optimal update (no proximal term): solve(u_j, e_j, u_j, u_next).
-  MultiJointNoilcStatus update(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
-                               Eigen::Ref<Eigen::MatrixXd> u_next) {
+  MultiJointNoilcStatus update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
+                               const Eigen::Ref<const Eigen::MatrixXd>& e_j, Eigen::Ref<Eigen::MatrixXd> u_next) {
     return solve(u_j, e_j, u_j, u_next);
   }
 

@@ -11,7 +11,8 @@ constexpr double kAdmmOverRelaxation = 1.6;
 MultiJointNoilcStatus MultiJointNoilcConstrained::setup(const MultiJointModel& model, const MultiJointWeights& weights,
                                                         int samples, const MultiJointAdmmSettings& admm) {
   ready_ = false;
-  if (!(admm.rho > 0.0) || admm.max_iterations < 1 || !(admm.tolerance > 0.0)) return MultiJointNoilcStatus::kBadWeights;
+  if (!(admm.rho > 0.0) || admm.max_iterations < 1 || !(admm.tolerance > 0.0))
+    return MultiJointNoilcStatus::kBadWeights;
   MultiJointNoilcStatus status = free_.setup(model, weights, samples);
   if (status != MultiJointNoilcStatus::kOk) return status;
   status = proximal_.setup(model, weights, samples, admm.rho);

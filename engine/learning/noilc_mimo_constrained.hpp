@@ -18,9 +18,9 @@ struct MultiJointAdmmSettings {
 };
 
 struct MultiJointConstrainedReport {
-  int admm_iterations = 0;   // 0 when the unconstrained optimum was feasible
+  int admm_iterations = 0;  // 0 when the unconstrained optimum was feasible
   bool converged = true;
-  int active_entries = 0;    // entries (sample, joint) on a bound
+  int active_entries = 0;  // entries (sample, joint) on a bound
   double primal_residual = 0.0;
   double dual_residual = 0.0;
 };
@@ -36,8 +36,8 @@ class MultiJointNoilcConstrained {
                                    const Eigen::Ref<const Eigen::MatrixXd>& upper);
   /// u_next = argmin J(u) subject to the bounds. kOk, or kNotConverged with a feasible u_next; on any
   /// other status u_next is left unchanged.
-  MultiJointNoilcStatus solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
-                              Eigen::Ref<Eigen::MatrixXd> u_next);
+  MultiJointNoilcStatus solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
+                              const Eigen::Ref<const Eigen::MatrixXd>& e_j, Eigen::Ref<Eigen::MatrixXd> u_next);
 
   const MultiJointConstrainedReport& last_report() const { return report_; }
   const MultiJointNoilcInfo& info() const { return free_.info(); }

@@ -55,11 +55,13 @@ Eigen::MatrixXd MultiJointNoilcDense::solve(const Eigen::MatrixXd& u_j, const Ei
 }
 
 Eigen::VectorXd MultiJointNoilcDense::cost_gradient(const Eigen::MatrixXd& u_j, const Eigen::MatrixXd& e_j,
-                                                    const Eigen::MatrixXd& target, const Eigen::MatrixXd& u_next) const {
+                                                    const Eigen::MatrixXd& target,
+                                                    const Eigen::MatrixXd& u_next) const {
   // J = 1/2 [e'(I (x) M)e + v'(I (x) S)v + u'((D'D) (x) W)u] + rho/2 |u - target|^2, e = e_j - P v, v = u - u_j
   const Eigen::VectorXd u = stack_time_major(u_next), v = u - stack_time_major(u_j);
   const Eigen::VectorXd predicted_error = stack_time_major(e_j) - lifted_ * v;
-  Eigen::VectorXd gradient = -lifted_.transpose() * (output_weight_ * predicted_error) + change_weight_ * v + rate_weight_ * u;
+  Eigen::VectorXd gradient =
+      -lifted_.transpose() * (output_weight_ * predicted_error) + change_weight_ * v + rate_weight_ * u;
   if (rho_ > 0.0) gradient += rho_ * (u - stack_time_major(target));
   return gradient;
 }

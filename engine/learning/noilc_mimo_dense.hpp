@@ -2,7 +2,8 @@
 // (engine/learning/noilc_mimo). Time-major stacking (engine/model/multi_joint_model), P the NJ x NJ lifted model,
 // and with Kronecker products the weights of the cost in noilc_mimo.hpp:
 //
-//   u_{j+1} = (P'(I (x) M)P + I (x) S + (D'D) (x) W + rho I)^-1 [ (P'(I (x) M)P + I (x) S) u_j + P'(I (x) M) e_j + rho target ]
+//   u_{j+1} = (P'(I (x) M)P + I (x) S + (D'D) (x) W + rho I)^-1 [ (P'(I (x) M)P + I (x) S) u_j + P'(I (x) M) e_j + rho
+//   target ]
 //
 // O(N^2 J^2) memory and O(N^3 J^3) set-up: for tests and benchmarks, not for the loop.
 #pragma once
@@ -31,10 +32,10 @@ class MultiJointNoilcDense {
  private:
   int joints_;
   double rho_;
-  Eigen::MatrixXd lifted_;           // P
-  Eigen::MatrixXd output_weight_;    // I (x) M
-  Eigen::MatrixXd change_weight_;    // I (x) S
-  Eigen::MatrixXd rate_weight_;      // (D'D) (x) W
+  Eigen::MatrixXd lifted_;                // P
+  Eigen::MatrixXd output_weight_;         // I (x) M
+  Eigen::MatrixXd change_weight_;         // I (x) S
+  Eigen::MatrixXd rate_weight_;           // (D'D) (x) W
   Eigen::MatrixXd tracking_plus_change_;  // P'(I (x) M)P + I (x) S
   Eigen::LLT<Eigen::MatrixXd> factor_;
 };

@@ -58,7 +58,8 @@ double RiccatiNoilcSolver::rate_weight(int t) const {
   return t == samples() - 1 ? 2.0 * rate_weight_ : rate_weight_;
 }
 
-void RiccatiNoilcSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& u_j, const Eigen::Ref<const Eigen::VectorXd>& e_j,
+void RiccatiNoilcSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& u_j,
+                               const Eigen::Ref<const Eigen::VectorXd>& e_j,
                                const Eigen::Ref<const Eigen::VectorXd>& target, Eigen::Ref<Eigen::VectorXd> u_next) {
   const int n = samples();
   const bool proximal = proximal_weight_ > 0.0;
@@ -100,8 +101,8 @@ std::size_t RiccatiNoilcSolver::memory_bytes() const {
 NormOptimalRiccati::NormOptimalRiccati(const DiscreteArmModel& model, const IlcParameters& weights, int samples)
     : model_(model), weights_(weights), solver_(model, weights, samples) {}
 
-void NormOptimalRiccati::update(const Eigen::Ref<const Eigen::VectorXd>& u_j, const Eigen::Ref<const Eigen::VectorXd>& e_j,
-                                Eigen::Ref<Eigen::VectorXd> u_next) {
+void NormOptimalRiccati::update(const Eigen::Ref<const Eigen::VectorXd>& u_j,
+                                const Eigen::Ref<const Eigen::VectorXd>& e_j, Eigen::Ref<Eigen::VectorXd> u_next) {
   solver_.solve(u_j, e_j, u_j, u_next);
 }
 

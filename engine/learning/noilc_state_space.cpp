@@ -92,7 +92,8 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
     if (t < samples - 1 && !tail_.empty()) {
       const double size = 1.0 + stage.gain.cwiseAbs().maxCoeff();
       if ((stage.gain - tail_.back().gain).cwiseAbs().maxCoeff() <= kSettledGain * size &&
-          (stage.inverse - tail_.back().inverse).cwiseAbs().maxCoeff() <= kSettledGain * (1.0 + stage.inverse.cwiseAbs().maxCoeff())) {
+          (stage.inverse - tail_.back().inverse).cwiseAbs().maxCoeff() <=
+              kSettledGain * (1.0 + stage.inverse.cwiseAbs().maxCoeff())) {
         settled_ = std::move(stage);
         settled = true;
         break;
@@ -129,7 +130,8 @@ void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const 
                             Eigen::Ref<Eigen::MatrixXd> u_next) {
   const int N = samples_;
   const Eigen::Index n = A_.rows(), J = B_.cols();
-  if (u_j.rows() != N || e_j.rows() != N || u_next.rows() != N || u_j.cols() != J || e_j.cols() != J || u_next.cols() != J) {
+  if (u_j.rows() != N || e_j.rows() != N || u_next.rows() != N || u_j.cols() != J || e_j.cols() != J ||
+      u_next.cols() != J) {
     throw InputError("norm-optimal ILC: the data are not " + std::to_string(N) + " x " + std::to_string(J));
   }
   // Backward pass for the affine terms p = [p_x; p_v], from p_N = -m C' e(N). Row t-1 of e_j is sample t.
@@ -173,7 +175,8 @@ void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const 
 
 std::size_t StateSpaceNoilc::memory_bytes() const {
   const auto per_stage = static_cast<std::size_t>(first_.gain.size() + first_.inverse.size());
-  return sizeof(double) * (per_stage * static_cast<std::size_t>(stored_stages()) + static_cast<std::size_t>(feedforward_.size()));
+  return sizeof(double) *
+         (per_stage * static_cast<std::size_t>(stored_stages()) + static_cast<std::size_t>(feedforward_.size()));
 }
 
 }  // namespace bellows

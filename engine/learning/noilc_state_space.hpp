@@ -57,7 +57,7 @@ class StateSpaceNoilc {
   double m_ = 0.0, s_ = 0.0, rate_weight_ = 0.0;
   int samples_ = 0;
   Stage first_, settled_;
-  std::vector<Stage> tail_;  // stages N-1, N-2, ... until the gains settled (tail_[k] is stage N-1-k)
+  std::vector<Stage> tail_;      // stages N-1, N-2, ... until the gains settled (tail_[k] is stage N-1-k)
   Eigen::MatrixXd feedforward_;  // J x N, rewritten each solve
   Eigen::VectorXd p_x_, next_x_, dx_, next_dx_;
   Eigen::VectorXd p_v_, h_, rate_, change_, previous_change_;

@@ -58,10 +58,14 @@ void for_each_point_mass(const ChainParameters& chain, F&& f) {
 template <typename F>
 decltype(auto) with_joint_count(int joints, F&& f) {
   switch (joints) {
-    case 1: return f(std::integral_constant<int, 1>{});
-    case 2: return f(std::integral_constant<int, 2>{});
-    case 3: return f(std::integral_constant<int, 3>{});
-    default: return f(std::integral_constant<int, kMaxJoints>{});  // validate_chain allows 1..kMaxJoints
+    case 1:
+      return f(std::integral_constant<int, 1>{});
+    case 2:
+      return f(std::integral_constant<int, 2>{});
+    case 3:
+      return f(std::integral_constant<int, 3>{});
+    default:
+      return f(std::integral_constant<int, kMaxJoints>{});  // validate_chain allows 1..kMaxJoints
   }
 }
 

@@ -21,9 +21,9 @@ class ArmChain {
  public:
   struct State {
     double time_s = 0.0;
-    JointVector angle_rad;                // q
-    JointVector velocity_rad_per_s;       // q_dot
-    JointVector creep_rad;                // z
+    JointVector angle_rad;           // q
+    JointVector velocity_rad_per_s;  // q_dot
+    JointVector creep_rad;           // z
   };
 
   /// Validates the chain (InputError, also for a mass matrix that is singular at q = 0); starts at
@@ -41,10 +41,10 @@ class ArmChain {
   RigidBodyTerms rigid_body_terms(const JointVector& q, const JointVector& q_dot) const;
 
   // The rigid body (spec section 1), for any q, q_dot of joints() entries.
-  JointMatrix mass_matrix(const JointVector& q) const;                                  // M(q)
-  JointVector coriolis_torque(const JointVector& q, const JointVector& q_dot) const;    // C(q, q_dot) q_dot
-  JointVector gravity_torque(const JointVector& q) const;                               // G(q) = dV_g/dq
-  JointMatrix gravity_stiffness(const JointVector& q) const;                            // dG/dq
+  JointMatrix mass_matrix(const JointVector& q) const;                                // M(q)
+  JointVector coriolis_torque(const JointVector& q, const JointVector& q_dot) const;  // C(q, q_dot) q_dot
+  JointVector gravity_torque(const JointVector& q) const;                             // G(q) = dV_g/dq
+  JointMatrix gravity_stiffness(const JointVector& q) const;                          // dG/dq
   /// K (kappa o dp - q - z): what the bellows exert.
   JointVector bellows_torque(const JointVector& q, const JointVector& z, const JointVector& dp_bar) const;
   /// The hard stops beyond each joint's range: M_ii(0) (k_stop * overshoot + c_stop * q_dot_i), opposing.

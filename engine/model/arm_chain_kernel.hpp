@@ -66,12 +66,14 @@ struct Trig {
 /// Solves M x = b for a symmetric positive definite J x J M: by the adjugate up to 3 x 3 (one
 /// division, short dependency chains), LDL' beyond.
 template <int J>
-inline Eigen::Matrix<double, J, 1> solve_spd(const Eigen::Matrix<double, J, J>& M, const Eigen::Matrix<double, J, 1>& b) {
+inline Eigen::Matrix<double, J, 1> solve_spd(const Eigen::Matrix<double, J, J>& M,
+                                             const Eigen::Matrix<double, J, 1>& b) {
   if constexpr (J == 1) {
     return Eigen::Matrix<double, 1, 1>(b(0) / M(0, 0));
   } else if constexpr (J == 2) {
     const double inv_det = 1.0 / (M(0, 0) * M(1, 1) - M(1, 0) * M(1, 0));
-    return Eigen::Matrix<double, 2, 1>((M(1, 1) * b(0) - M(1, 0) * b(1)) * inv_det, (M(0, 0) * b(1) - M(1, 0) * b(0)) * inv_det);
+    return Eigen::Matrix<double, 2, 1>((M(1, 1) * b(0) - M(1, 0) * b(1)) * inv_det,
+                                       (M(0, 0) * b(1) - M(1, 0) * b(0)) * inv_det);
   } else if constexpr (J == 3) {
     const double m00 = M(0, 0), m01 = M(1, 0), m02 = M(2, 0), m11 = M(1, 1), m12 = M(2, 1), m22 = M(2, 2);
     const double c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
@@ -124,8 +126,8 @@ class Kernel {
       // the distance d from its joint: sum m, sum m d, sum m d^2 + I.
       mass_[i] = l.mass_kg + l.tip_mass_kg;
       first_moment_[i] = l.mass_kg * l.center_of_mass_m + l.tip_mass_kg * l.length_m;
-      second_moment_[i] = l.mass_kg * l.center_of_mass_m * l.center_of_mass_m + l.tip_mass_kg * l.length_m * l.length_m +
-                          l.inertia_kg_m2;
+      second_moment_[i] = l.mass_kg * l.center_of_mass_m * l.center_of_mass_m +
+                          l.tip_mass_kg * l.length_m * l.length_m + l.inertia_kg_m2;
       stiffness_(i) = l.stiffness_Nm_per_rad;
       kappa_(i) = l.kappa_rad_per_bar;
       stiffness_kappa_(i) = l.stiffness_Nm_per_rad * l.kappa_rad_per_bar;
@@ -260,7 +262,9 @@ class Kernel {
     return acceleration(Trig<J>::exact(q), q, q_dot, z, dp_bar);
   }
 
-  Vec creep_rate(const Vec& q, const Vec& z) const { return (creep_gain_.cwiseProduct(q) - z).cwiseProduct(creep_rate_); }
+  Vec creep_rate(const Vec& q, const Vec& z) const {
+    return (creep_gain_.cwiseProduct(q) - z).cwiseProduct(creep_rate_);
+  }
 
   /// One classical RK4 step of (q, q_dot, z) with the pressure differences held; `trig` is at q
   /// before and after.

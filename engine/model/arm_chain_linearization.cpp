@@ -18,13 +18,14 @@ CoupledJointDynamics chain_dynamics(const ArmChain& arm, const JointVector& pose
     input_torque(i, i) = l.stiffness_Nm_per_rad * l.kappa_rad_per_bar;
   }
   CoupledJointDynamics d;
-  d.per_angle = -inverse_mass * stiffness;                                           // rad/s^2 per rad
+  d.per_angle = -inverse_mass * stiffness;  // rad/s^2 per rad
   d.per_velocity = -inverse_mass * Eigen::MatrixXd(arm.damping_Nms_per_rad().asDiagonal());
-  d.per_bar = inverse_mass * input_torque;                                           // rad/s^2 per bar
+  d.per_bar = inverse_mass * input_torque;  // rad/s^2 per bar
   return d;
 }
 
-void continuous_chain_model(const ArmChain& arm, const JointVector& pose_rad, Eigen::MatrixXd& Ac, Eigen::MatrixXd& Bc) {
+void continuous_chain_model(const ArmChain& arm, const JointVector& pose_rad, Eigen::MatrixXd& Ac,
+                            Eigen::MatrixXd& Bc) {
   continuous_joint_model(chain_dynamics(arm, pose_rad), Ac, Bc);
 }
 

@@ -11,7 +11,8 @@
 namespace bellows {
 namespace {
 
-ChainLink preset_link(double m, double l, double c, double I, double m_a, double K, double kappa, double w0, double delta) {
+ChainLink preset_link(double m, double l, double c, double I, double m_a, double K, double kappa, double w0,
+                      double delta) {
   ChainLink out;
   out.mass_kg = m;
   out.length_m = l;
@@ -33,13 +34,13 @@ ChainParameters chain_preset(std::string_view name) {
   ChainParameters chain;
   if (name == "arm2") {
     chain.joints = 2;
-    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 2.81, 5.0, 8.0, 0.31);   // shoulder
-    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.0, 0.60, 7.91, 14.14, 0.31);   // elbow: the paper's arm
+    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 2.81, 5.0, 8.0, 0.31);  // shoulder
+    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.0, 0.60, 7.91, 14.14, 0.31);  // elbow: the paper's arm
   } else if (name == "arm3") {
     chain.joints = 3;
-    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 4.13, 5.0, 6.0, 0.31);   // shoulder
-    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.15, 2.63, 6.0, 10.0, 0.31);    // elbow
-    chain.links[2] = preset_link(0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31);   // wrist
+    chain.links[0] = preset_link(0.40, 0.25, 0.125, 2.08e-3, 0.30, 4.13, 5.0, 6.0, 0.31);  // shoulder
+    chain.links[1] = preset_link(0.10, 0.30, 0.15, 7.5e-4, 0.15, 2.63, 6.0, 10.0, 0.31);   // elbow
+    chain.links[2] = preset_link(0.06, 0.20, 0.10, 2.0e-4, 0.0, 0.16, 7.91, 14.14, 0.31);  // wrist
   } else {
     std::string known;
     for (std::string_view preset : kArmPresets) known += (known.empty() ? "" : ", ") + std::string(preset);
@@ -50,7 +51,8 @@ ChainParameters chain_preset(std::string_view name) {
 
 void validate_chain(const ChainParameters& chain) {
   if (chain.joints < 1 || chain.joints > kMaxJoints) {
-    throw InputError("an arm needs 1 to " + std::to_string(kMaxJoints) + " joints, got " + std::to_string(chain.joints));
+    throw InputError("an arm needs 1 to " + std::to_string(kMaxJoints) + " joints, got " +
+                     std::to_string(chain.joints));
   }
   auto check = [](bool ok, int joint, const char* what, double value) {
     if (!ok) throw InputError("arm joint " + std::to_string(joint + 1) + ": " + what + " = " + std::to_string(value));
@@ -72,8 +74,10 @@ void validate_chain(const ChainParameters& chain) {
     check(l.creep_tau_s > 0.0 && std::isfinite(l.creep_tau_s), i, "creep_tau_s must be > 0", l.creep_tau_s);
     check(l.hard_stop_deg > 0.0, i, "hard_stop_deg must be > 0", l.hard_stop_deg);
   }
-  if (!(chain.gravity_m_per_s2 >= 0.0) || !(chain.hard_stop_stiffness_per_s2 >= 0.0) || !(chain.hard_stop_damping_per_s >= 0.0) || !(chain.integration_step_s > 0.0)) {
-    throw InputError("arm: gravity_m_per_s2 and the hard stops' stiffness and damping must be >= 0, integration_step_s > 0");
+  if (!(chain.gravity_m_per_s2 >= 0.0) || !(chain.hard_stop_stiffness_per_s2 >= 0.0) ||
+      !(chain.hard_stop_damping_per_s >= 0.0) || !(chain.integration_step_s > 0.0)) {
+    throw InputError(
+        "arm: gravity_m_per_s2 and the hard stops' stiffness and damping must be >= 0, integration_step_s > 0");
   }
 }
 

@@ -14,30 +14,30 @@ namespace bellows {
 
 /// One link and the joint that drives it (joint i turns link i relative to link i-1).
 struct ChainLink {
-  double mass_kg = 0.0;                 // m_i
-  double length_m = 0.0;                // l_i, joint to the next joint
-  double center_of_mass_m = 0.0;        // c_i, from the joint
-  double inertia_kg_m2 = 0.0;           // I_i, about the link's centre of mass
-  double tip_mass_kg = 0.0;             // m_a,i, point mass at the distal end (next joint's bellows)
-  double stiffness_Nm_per_rad = 0.0;    // K_i, the bellows' spring-like retraction
-  double kappa_rad_per_bar = 0.0;       // torque per bar is K_i kappa_i
+  double mass_kg = 0.0;                    // m_i
+  double length_m = 0.0;                   // l_i, joint to the next joint
+  double center_of_mass_m = 0.0;           // c_i, from the joint
+  double inertia_kg_m2 = 0.0;              // I_i, about the link's centre of mass
+  double tip_mass_kg = 0.0;                // m_a,i, point mass at the distal end (next joint's bellows)
+  double stiffness_Nm_per_rad = 0.0;       // K_i, the bellows' spring-like retraction
+  double kappa_rad_per_bar = 0.0;          // torque per bar is K_i kappa_i
   double omega0_straight_rad_per_s = 0.0;  // w0 with the arm straight: K_i = w0^2 M_ii(q = 0)
-  double damping_ratio = 0.0;           // delta: D_i = 2 delta w0 M_ii(q = 0)
-  double creep_gain = 0.25;             // c_z, as for one joint (reference-system.md section 4)
-  double creep_tau_s = 0.8;             // tau_z
-  double hard_stop_deg = 95.0;          // stops beyond +-this, relative to the previous link
+  double damping_ratio = 0.0;              // delta: D_i = 2 delta w0 M_ii(q = 0)
+  double creep_gain = 0.25;                // c_z, as for one joint (reference-system.md section 4)
+  double creep_tau_s = 0.8;                // tau_z
+  double hard_stop_deg = 95.0;             // stops beyond +-this, relative to the previous link
 };
 
 struct ChainParameters {
   int joints = 0;
   std::array<ChainLink, kMaxJoints> links{};
-  bool gravity = true;                  // false: the arm moves in the horizontal plane
+  bool gravity = true;  // false: the arm moves in the horizontal plane
   double gravity_m_per_s2 = 9.81;
   // Hard stops as for one joint (PlantParameters), in angular acceleration per rad and per rad/s,
   // scaled by each joint's straight-arm inertia M_ii(0) into torques.
   double hard_stop_stiffness_per_s2 = 1.0e4;
   double hard_stop_damping_per_s = 140.0;
-  double integration_step_s = 1.0e-4;   // fixed internal step (RK4), as for one joint
+  double integration_step_s = 1.0e-4;  // fixed internal step (RK4), as for one joint
 };
 
 /// "arm2" (shoulder, elbow) or "arm3" (shoulder, elbow, wrist) with the spec's numbers; throws

@@ -112,7 +112,7 @@ class BellowsPneumatics {
     const double stretch = beta_ * angle_rad;
     const double volume_a = v0_m3_ * (1.0 + stretch), volume_b = v0_m3_ * (1.0 - stretch);
     const double inverse_product = 1.0 / (volume_a * volume_b);  // one division for both chambers
-    const double volume_rate_a = v0_beta_ * velocity_rad_per_s;   // V_B's is its negative
+    const double volume_rate_a = v0_beta_ * velocity_rad_per_s;  // V_B's is its negative
     double flow_a = 0.0, flow_b = 0.0;
     if (open.inlet[0]) flow_a += port_flow_kg_per_s(supply_Pa, pa_Pa);
     if (open.outlet[0]) flow_a -= port_flow_kg_per_s(pa_Pa, ambient_Pa_);

@@ -21,7 +21,8 @@ Eigen::MatrixXd CoupledJointDynamics::static_gain_rad_per_bar() const {
 CoupledJointDynamics independent_dynamics(std::span<const ModelParameters> joints) {
   const int J = static_cast<int>(joints.size());
   if (!valid_joint_count(J)) {
-    throw InputError("coupled joint dynamics need 1 to " + std::to_string(kMaxJoints) + " joints, got " + std::to_string(J));
+    throw InputError("coupled joint dynamics need 1 to " + std::to_string(kMaxJoints) + " joints, got " +
+                     std::to_string(J));
   }
   CoupledJointDynamics d;
   d.per_angle.setZero(J, J);
@@ -57,7 +58,8 @@ CoupledJointDynamics identified_dynamics(const IdentifiedArmParameters& identifi
     }
   }
   if (Eigen::MatrixXd(d.per_angle).fullPivLu().rank() < joints) {
-    throw InputError("[identified_joint1.." + std::to_string(joints) + "] per_angle: a singular matrix is no arm (identify again)");
+    throw InputError("[identified_joint1.." + std::to_string(joints) +
+                     "] per_angle: a singular matrix is no arm (identify again)");
   }
   return d;
 }

@@ -8,7 +8,8 @@ namespace bellows {
 
 Eigen::MatrixXd MultiJointModel::lifted(int samples) const {
   const int J = joints();
-  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(samples) * J, static_cast<Eigen::Index>(samples) * J);
+  Eigen::MatrixXd P =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(samples) * J, static_cast<Eigen::Index>(samples) * J);
   Eigen::MatrixXd power_times_b = B;  // A^k B
   for (int lag = 0; lag < samples; ++lag) {
     const Eigen::MatrixXd markov = C * power_times_b;
@@ -21,7 +22,8 @@ Eigen::MatrixXd MultiJointModel::lifted(int samples) const {
 MultiJointModel block_diagonal_model(std::span<const DiscreteArmModel> joints) {
   const int J = static_cast<int>(joints.size());
   if (J < 1 || J > kMaxJoints) {
-    throw InputError("a multi-joint model needs 1 to " + std::to_string(kMaxJoints) + " joints, got " + std::to_string(J));
+    throw InputError("a multi-joint model needs 1 to " + std::to_string(kMaxJoints) + " joints, got " +
+                     std::to_string(J));
   }
   MultiJointModel model;
   model.A.setZero(2 * J, 2 * J);

@@ -18,10 +18,18 @@ constexpr double kBarPerPa = 1e-5;  // a product: a division here was the step's
 template <typename F>
 void with_joint_count(int joints, F&& f) {
   switch (joints) {
-    case 1: f(std::integral_constant<int, 1>{}); break;
-    case 2: f(std::integral_constant<int, 2>{}); break;
-    case 3: f(std::integral_constant<int, 3>{}); break;
-    default: f(std::integral_constant<int, kMaxJoints>{}); break;  // validate_chain allows 1..kMaxJoints
+    case 1:
+      f(std::integral_constant<int, 1>{});
+      break;
+    case 2:
+      f(std::integral_constant<int, 2>{});
+      break;
+    case 3:
+      f(std::integral_constant<int, 3>{});
+      break;
+    default:
+      f(std::integral_constant<int, kMaxJoints>{});
+      break;  // validate_chain allows 1..kMaxJoints
   }
 }
 
@@ -49,7 +57,8 @@ PneumaticArmChain::PneumaticArmChain(const PneumaticChainParameters& parameters,
       noise_(seed) {
   const int J = joints();
   for (int i = 0; i < J; ++i) {
-    bellows_[static_cast<std::size_t>(i)] = BellowsPneumatics(parameters_.bellows[static_cast<std::size_t>(i)], parameters_.gas);
+    bellows_[static_cast<std::size_t>(i)] =
+        BellowsPneumatics(parameters_.bellows[static_cast<std::size_t>(i)], parameters_.gas);
   }
   state_.angle_rad = JointVector::Zero(J);
   state_.velocity_rad_per_s = JointVector::Zero(J);
@@ -134,7 +143,7 @@ void PneumaticArmChain::advance_fixed(double dt_s) {
   using Vec = Eigen::Matrix<double, J, 1>;
   using Trig = arm_chain_kernel::Trig<J>;
   const arm_chain_kernel::Kernel<J> kernel(parameters_.chain, mechanics_.straight_inertia_kg_m2(),
-                                            mechanics_.damping_Nms_per_rad());
+                                           mechanics_.damping_Nms_per_rad());
   const double period = parameters_.pwm_period_s, supply_Pa = supply_Pa_;
   std::array<BellowsOpenings, J> open{};
 
@@ -149,7 +158,7 @@ void PneumaticArmChain::advance_fixed(double dt_s) {
 #pragma GCC unroll 4
     for (int i = 0; i < J; ++i) {
       bellows_[static_cast<std::size_t>(i)].pressure_rates(q(i), v(i), pa(i), pb(i), open[static_cast<std::size_t>(i)],
-                                                            supply_Pa, d(kChamberA * J + i), d(kChamberB * J + i));
+                                                           supply_Pa, d(kChamberA * J + i), d(kChamberB * J + i));
     }
     return d;
   };
@@ -200,7 +209,8 @@ void PneumaticArmChain::advance_fixed(double dt_s) {
   state_.angle_rad = segment<J>(x, kAngle);
   state_.velocity_rad_per_s = segment<J>(x, kRate);
   state_.creep_rad = segment<J>(x, kCreep);
-  for (int i = 0; i < J; ++i) state_.chamber_Pa[static_cast<std::size_t>(i)] = {x(kChamberA * J + i), x(kChamberB * J + i)};
+  for (int i = 0; i < J; ++i)
+    state_.chamber_Pa[static_cast<std::size_t>(i)] = {x(kChamberA * J + i), x(kChamberB * J + i)};
 }
 
 }  // namespace bellows

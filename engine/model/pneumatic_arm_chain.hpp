@@ -32,10 +32,10 @@ class PneumaticArmChain {
   /// Everything that evolves: physics, the PWM period in progress and the noise generator.
   struct State {
     double time_s = 0.0;
-    JointVector angle_rad, velocity_rad_per_s, creep_rad;  // q, q_dot, z
+    JointVector angle_rad, velocity_rad_per_s, creep_rad;   // q, q_dot, z
     std::array<ChamberPressures, kMaxJoints> chamber_Pa{};  // per joint
-    double pwm_phase_s = 0.0;                                // time since the current PWM period began
-    std::array<BellowsDuties, kMaxJoints> duties{};          // per joint, for the current period
+    double pwm_phase_s = 0.0;                               // time since the current PWM period began
+    std::array<BellowsDuties, kMaxJoints> duties{};         // per joint, for the current period
     GaussianNoise::State noise{};
   };
 

@@ -85,18 +85,21 @@ void validate_pneumatic_chain(const PneumaticChainParameters& parameters) {
     check(b.valve_critical_ratio >= 0.0 && b.valve_critical_ratio < 1.0, i, "valve_critical_ratio must be in [0, 1)",
           b.valve_critical_ratio);
     check(b.valves_per_port >= 1, i, "valves_per_port must be >= 1", b.valves_per_port);
-    const double reach_rad = 1.5 * parameters.chain.links[static_cast<std::size_t>(i)].hard_stop_deg * std::numbers::pi / 180.0;
+    const double reach_rad =
+        1.5 * parameters.chain.links[static_cast<std::size_t>(i)].hard_stop_deg * std::numbers::pi / 180.0;
     check(std::isfinite(b.volume_gain_per_rad) && std::abs(b.volume_gain_per_rad) * reach_rad < 1.0, i,
           "volume_gain_per_rad empties a chamber within 1.5 x the stops", b.volume_gain_per_rad);
   }
   const GasParameters& gas = parameters.gas;
-  const bool ok = parameters.supply_bar > 0.0 && std::isfinite(parameters.supply_bar) && parameters.pwm_period_s > 0.0 &&
-                  std::isfinite(parameters.pwm_period_s) && parameters.encoder_resolution_deg >= 0.0 &&
-                  parameters.pressure_noise_bar >= 0.0 && gas.gas_constant_J_per_kgK > 0.0 && gas.temperature_K > 0.0 &&
+  const bool ok = parameters.supply_bar > 0.0 && std::isfinite(parameters.supply_bar) &&
+                  parameters.pwm_period_s > 0.0 && std::isfinite(parameters.pwm_period_s) &&
+                  parameters.encoder_resolution_deg >= 0.0 && parameters.pressure_noise_bar >= 0.0 &&
+                  gas.gas_constant_J_per_kgK > 0.0 && gas.temperature_K > 0.0 &&
                   gas.reference_density_kg_per_m3 > 0.0 && gas.ambient_bar > 0.0;
   if (!ok) {
-    throw InputError("arm: supply_bar, pwm_period_s and the gas constants must be > 0, the encoder resolution and "
-                     "pressure noise >= 0");
+    throw InputError(
+        "arm: supply_bar, pwm_period_s and the gas constants must be > 0, the encoder resolution and "
+        "pressure noise >= 0");
   }
 }
 

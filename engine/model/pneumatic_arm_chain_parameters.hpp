@@ -15,10 +15,10 @@ namespace bellows {
 struct PneumaticChainParameters {
   ChainParameters chain;
   std::array<BellowsParameters, kMaxJoints> bellows{};  // per joint; the paper's bellows by default
-  double supply_bar = 3.0;               // absolute, one supply for every joint
-  double encoder_resolution_deg = 0.1;   // every joint's encoder
-  double pressure_noise_bar = 0.5e-3;    // sigma of every pressure sensor's Gaussian noise
-  double pwm_period_s = 1.0 / 200.0;     // every valve's PWM period
+  double supply_bar = 3.0;                              // absolute, one supply for every joint
+  double encoder_resolution_deg = 0.1;                  // every joint's encoder
+  double pressure_noise_bar = 0.5e-3;                   // sigma of every pressure sensor's Gaussian noise
+  double pwm_period_s = 1.0 / 200.0;                    // every valve's PWM period
   GasParameters gas{};
 };
 

@@ -24,8 +24,8 @@ inline double iso6358_mass_flow_kg_per_s(double from_Pa, double to_Pa, double co
   const double up = forward ? from_Pa : to_Pa;
   const double down = forward ? to_Pa : from_Pa;
   if (up <= 0.0) return 0.0;
-  const double magnitude = conductance_m3_per_sPa * up * reference_density_kg_per_m3 *
-                           iso6358_flow_function(down / up, critical_ratio);
+  const double magnitude =
+      conductance_m3_per_sPa * up * reference_density_kg_per_m3 * iso6358_flow_function(down / up, critical_ratio);
   return forward ? magnitude : -magnitude;
 }
 

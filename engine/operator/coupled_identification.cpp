@@ -42,8 +42,10 @@ CoupledJointDynamics from_parameters(const Eigen::VectorXd& p, int J) {
 Eigen::VectorXd difference_steps(const CoupledJointDynamics& d) {
   const Eigen::Index m = static_cast<Eigen::Index>(d.joints()) * d.joints();
   Eigen::VectorXd steps(3 * m);
-  const double scales[3] = {d.per_angle.cwiseAbs().maxCoeff(), d.per_velocity.cwiseAbs().maxCoeff(), d.per_bar.cwiseAbs().maxCoeff()};
-  for (int block = 0; block < 3; ++block) steps.segment(block * m, m).setConstant(kRelativeStep * std::max(scales[block], 1.0));
+  const double scales[3] = {d.per_angle.cwiseAbs().maxCoeff(), d.per_velocity.cwiseAbs().maxCoeff(),
+                            d.per_bar.cwiseAbs().maxCoeff()};
+  for (int block = 0; block < 3; ++block)
+    steps.segment(block * m, m).setConstant(kRelativeStep * std::max(scales[block], 1.0));
   return steps;
 }
 
@@ -57,10 +59,13 @@ void check_trials(std::span<const JointIdentificationData> trials) {
   if (!valid_joint_count(J)) throw InputError("identification: 1 to " + std::to_string(kMaxJoints) + " joints");
   JointVector largest_spread = JointVector::Zero(J);
   for (const JointIdentificationData& t : trials) {
-    if (t.joints() != J || t.pressure_difference_bar.cols() != J || t.pressure_difference_bar.rows() != t.angle_rad.rows()) {
-      throw InputError("identification: every trial of the coupled fit needs the same " + std::to_string(J) + " joints");
+    if (t.joints() != J || t.pressure_difference_bar.cols() != J ||
+        t.pressure_difference_bar.rows() != t.angle_rad.rows()) {
+      throw InputError("identification: every trial of the coupled fit needs the same " + std::to_string(J) +
+                       " joints");
     }
-    if (t.angle_rad.rows() < kMinimumSamples || !(t.sample_time_s > 0.0) || t.sample_time_s != trials.front().sample_time_s) {
+    if (t.angle_rad.rows() < kMinimumSamples || !(t.sample_time_s > 0.0) ||
+        t.sample_time_s != trials.front().sample_time_s) {
       throw InputError("identification: each trial needs at least 50 samples at one sample time, got " +
                        std::to_string(t.angle_rad.rows()));
     }
@@ -91,7 +96,8 @@ JointIdentificationData joint_identification_data(const TrialRecord& record, con
     const IdentificationData single = identification_data(record, controller, tick_s, j);
     if (n == 0) continue;
     data.angle_rad.col(j) = single.angle_rad.array() - single.angle_rad.head(rest).mean();
-    data.pressure_difference_bar.col(j) = single.pressure_difference_bar.array() - single.pressure_difference_bar.head(rest).mean();
+    data.pressure_difference_bar.col(j) =
+        single.pressure_difference_bar.array() - single.pressure_difference_bar.head(rest).mean();
   }
   return data;
 }
@@ -140,7 +146,8 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
                                   StopFlag stop) {
   check_trials(trials);
   const int J = trials.front().joints();
-  if (initial.joints() != J) throw InputError("identification: the starting model has another joint count than the trials");
+  if (initial.joints() != J)
+    throw InputError("identification: the starting model has another joint count than the trials");
   Eigen::Index total = 0;
   for (const JointIdentificationData& t : trials) total += t.angle_rad.size();
   // Every trial's simulated minus measured angles, stacked (an unstable candidate gives infinities).
@@ -163,7 +170,8 @@ CoupledModelFit fit_coupled_model(std::span<const JointIdentificationData> trial
   Eigen::VectorXd p = to_parameters(initial);
   const Eigen::VectorXd steps = difference_steps(initial);
   const Eigen::VectorXd start_residual = residual(p);
-  if (!std::isfinite(start_residual.squaredNorm())) throw InputError("identification: the coupled model's starting point is unstable on the data");
+  if (!std::isfinite(start_residual.squaredNorm()))
+    throw InputError("identification: the coupled model's starting point is unstable on the data");
   const LeastSquaresSolution<Eigen::VectorXd> solution = levenberg_marquardt(
       residual, p, start_residual, steps, kCoupledFitMaxIterations, kCoupledFitRelativeCostTolerance);
   fit.iterations = solution.iterations;

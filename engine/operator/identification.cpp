@@ -76,8 +76,8 @@ double standard_deviation(const Eigen::VectorXd& v) {
 
 }  // namespace
 
-IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller,
-                                       double tick_s, int joint) {
+IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller, double tick_s,
+                                       int joint) {
   IdentificationData data;
   data.sample_time_s = tick_s;
   const TrialTicks& t = record.joint_ticks(joint);
@@ -89,10 +89,9 @@ IdentificationData identification_data(const TrialRecord& record, const Controll
   // Pressure change per unit of mass, with the controller's nominal volume (bar per kg).
   const double bar_per_kg = gas.gas_constant_J_per_kgK * gas.temperature_K / (controller.volume_l * 1e-3) / kPaPerBar;
   auto capacity = [&](double from_bar, double to_bar) {
-    return controller.valves_per_port * iso6358_mass_flow_kg_per_s(from_bar * kPaPerBar, to_bar * kPaPerBar,
-                                                                    controller.valve_conductance_m3_per_sPa,
-                                                                    controller.valve_critical_ratio,
-                                                                    gas.reference_density_kg_per_m3);
+    return controller.valves_per_port *
+           iso6358_mass_flow_kg_per_s(from_bar * kPaPerBar, to_bar * kPaPerBar, controller.valve_conductance_m3_per_sPa,
+                                      controller.valve_critical_ratio, gas.reference_density_kg_per_m3);
   };
   // Mean pressure of one chamber over tick k: the valve pulse, open from the tick's start for the
   // fraction `open`, counts (1 - open/2) of its rise; the rest of the change (the bellows' volume
@@ -109,7 +108,8 @@ IdentificationData identification_data(const TrialRecord& record, const Controll
         tick_mean(t.pressure_b_bar(k), t.pressure_b_bar(k + 1), t.inlet_b(k), t.outlet_b(k), supply_bar(k));
   }
   if (n > 0) {
-    data.pressure_difference_bar(n - 1) = n > 1 ? data.pressure_difference_bar(n - 2) : t.pressure_a_bar(0) - t.pressure_b_bar(0);
+    data.pressure_difference_bar(n - 1) =
+        n > 1 ? data.pressure_difference_bar(n - 2) : t.pressure_a_bar(0) - t.pressure_b_bar(0);
   }
   return data;
 }

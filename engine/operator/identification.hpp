@@ -32,8 +32,8 @@ struct IdentificationData {
 /// The tick-rate record of a trial as identification data. The input of tick k is the mean pressure
 /// difference over the tick, reconstructed from the readings at its ends and the valve commands
 /// with the controller's nominal valve model (see identification.cpp). Of joint `joint` (0-based).
-IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller,
-                                       double tick_s, int joint = 0);
+IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller, double tick_s,
+                                       int joint = 0);
 
 /// The angle the model predicts for the data's pressure difference (held over each step), from the
 /// data's first angle with the arm at rest.
@@ -44,8 +44,8 @@ double normalized_fit_percent(const Eigen::VectorXd& measured, const Eigen::Vect
 
 struct ArmModelFit {
   ModelParameters model;
-  ModelParameters initial;     // the ARX estimate the refinement started from
-  double fit_percent = 0.0;    // on the fitted data
+  ModelParameters initial;   // the ARX estimate the refinement started from
+  double fit_percent = 0.0;  // on the fitted data
   double rms_residual_deg = 0.0;
   int iterations = 0;
   bool converged = false;

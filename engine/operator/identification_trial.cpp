@@ -41,7 +41,8 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
       const double time = k * sample_time_s;
       const double phase = p.chirp_start_hz * D / std::log(ratio) * (std::pow(ratio, time / D) - 1.0);
       const double edge = std::min(time, D - time);
-      const double fade = edge >= kFade_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * std::max(edge, 0.0) / kFade_s));
+      const double fade =
+          edge >= kFade_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * std::max(edge, 0.0) / kFade_s));
       t.joint(0)(k) = fade * p.amplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * phase);
     }
     return t;
@@ -61,7 +62,8 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
 
 Trajectory joint_excitation(const Trajectory& excitation, int joint, int joints) {
   if (!valid_joint_count(joints) || joint < 0 || joint >= joints || excitation.joints() != 1) {
-    throw InputError("identification: joint " + std::to_string(joint + 1) + " of " + std::to_string(joints) + " cannot be excited");
+    throw InputError("identification: joint " + std::to_string(joint + 1) + " of " + std::to_string(joints) +
+                     " cannot be excited");
   }
   const Eigen::VectorXd rest = Eigen::VectorXd::Zero(excitation.joint(0).size());
   Trajectory t{excitation.name + "-joint" + std::to_string(joint + 1), excitation.sample_time_s,
@@ -90,7 +92,8 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
       if (std::abs(angle_rad) <= bound_rad) continue;
       std::ostringstream message;
       message << "identification aborted, valves vented: "
-              << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string()) << "angle " << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
+              << (joints > 1 ? "joint " + std::to_string(j + 1) + "'s " : std::string()) << "angle "
+              << angle_rad / kRadPerDeg << " deg at t = " << tick.time_s << " s left +-" << max_abs_angle_deg
               << " deg; lower [identify] amplitude_deg";
       left_bound = message.str();
       runner.cancel();
@@ -98,7 +101,8 @@ void run_identification_trial(EngineDriver& driver, const Trajectory& excitation
     }
   });
   // The fault by its name too: "a fault is latched" alone does not say which.
-  const std::string named = status.fault != FaultCode::kNone ? std::string(" (") + fault_name(status.fault) + ")" : std::string();
+  const std::string named =
+      status.fault != FaultCode::kNone ? std::string(" (") + fault_name(status.fault) + ")" : std::string();
   switch (status.phase) {
     case TrialPhase::kDone:
       return;

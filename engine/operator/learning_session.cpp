@@ -15,14 +15,16 @@ namespace {
 // engine stopped taking commands, and the run cannot go on.
 void send_or_throw(EngineCore& core, const EngineCommand& command) {
   if (!core.send(command)) {
-    throw std::runtime_error(std::string("the engine's command queue is full: ") + to_string(command.kind) + " not sent");
+    throw std::runtime_error(std::string("the engine's command queue is full: ") + to_string(command.kind) +
+                             " not sent");
   }
 }
 
 }  // namespace
 
-IterationSummary summarize_trial(int iteration, const TrialRecord& record, const Eigen::Ref<const Eigen::MatrixXd>& correction_bar,
-                                 double ambient_bar, double p_max_bar) {
+IterationSummary summarize_trial(int iteration, const TrialRecord& record,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& correction_bar, double ambient_bar,
+                                 double p_max_bar) {
   IterationSummary s;
   s.iteration = iteration;
   s.held_samples = record.held_samples;
@@ -43,18 +45,20 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record, const
   const int n = record.learning_samples;
   for (int j = 0; j < joints; ++j) {
     const TrialSamples& joint = record.joint_samples(j);
-    if (n > 0) s.max_abs_error_deg = std::max(s.max_abs_error_deg, joint.error_rad.tail(n).cwiseAbs().maxCoeff() * kDegPerRad);
+    if (n > 0)
+      s.max_abs_error_deg = std::max(s.max_abs_error_deg, joint.error_rad.tail(n).cwiseAbs().maxCoeff() * kDegPerRad);
     s.saturated_samples += static_cast<int>((joint.u_total_bar.head(n).array().abs() > span).count());
   }
   return s;
 }
 
-LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Trajectory trajectory, const TimingParameters& timing,
-                                 const ControllerParameters& controller)
+LearningSession::LearningSession(EngineDriver& driver, LearningLaw& law, Trajectory trajectory,
+                                 const TimingParameters& timing, const ControllerParameters& controller)
     : LearningSession(driver, std::make_unique<SingleJointLearning>(law), std::move(trajectory), timing, controller) {}
 
-LearningSession::LearningSession(EngineDriver& driver, std::unique_ptr<SingleJointLearning> single, Trajectory trajectory,
-                                 const TimingParameters& timing, const ControllerParameters& controller)
+LearningSession::LearningSession(EngineDriver& driver, std::unique_ptr<SingleJointLearning> single,
+                                 Trajectory trajectory, const TimingParameters& timing,
+                                 const ControllerParameters& controller)
     : LearningSession(driver, *single, std::move(trajectory), timing, controller) {
   single_ = std::move(single);
 }
@@ -75,18 +79,20 @@ LearningSession::LearningSession(EngineDriver& driver, JointLearning& learning, 
                      std::to_string(trajectory_.learning_samples()));
   }
   if (learning.joints() != trajectory_.joints()) {
-    throw InputError("learning law built for " + std::to_string(learning.joints()) + " joints, trajectory '" + trajectory_.name +
-                     "' has " + std::to_string(trajectory_.joints()));
+    throw InputError("learning law built for " + std::to_string(learning.joints()) + " joints, trajectory '" +
+                     trajectory_.name + "' has " + std::to_string(trajectory_.joints()));
   }
-  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample, trajectory_.joints());  // last_record()'s size
+  record_.prepare(trajectory_.learning_samples(), timing_.ticks_per_sample,
+                  trajectory_.joints());  // last_record()'s size
   send_or_throw(driver_.core(), EngineCommand::select_trajectory(trajectory_));
 }
 
 void LearningSession::set_correction(const Eigen::Ref<const Eigen::MatrixXd>& correction_bar, int iteration) {
   if (correction_bar.rows() != corrections_.rows() || correction_bar.cols() != corrections_.cols()) {
-    throw InputError("correction of " + std::to_string(correction_bar.rows()) + " x " + std::to_string(correction_bar.cols()) +
-                     " does not match the trajectory's " + std::to_string(corrections_.rows()) + " samples x " +
-                     std::to_string(corrections_.cols()) + " joints");
+    throw InputError("correction of " + std::to_string(correction_bar.rows()) + " x " +
+                     std::to_string(correction_bar.cols()) + " does not match the trajectory's " +
+                     std::to_string(corrections_.rows()) + " samples x " + std::to_string(corrections_.cols()) +
+                     " joints");
   }
   corrections_ = correction_bar;
   iteration_ = iteration;

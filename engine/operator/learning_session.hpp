@@ -36,18 +36,19 @@ struct LearnedWith {
 /// every joint (and `joint_rms_deg` has each joint's); with one they are its own.
 struct IterationSummary {
   int iteration = 0;
-  double rms_deg = 0.0;                 // over every joint and sample 1..N
+  double rms_deg = 0.0;  // over every joint and sample 1..N
   double max_abs_error_deg = 0.0;
-  double max_abs_correction_bar = 0.0;  // of the correction applied in this trial
-  int saturated_samples = 0;            // samples (of any joint) whose total input was clamped
+  double max_abs_correction_bar = 0.0;               // of the correction applied in this trial
+  int saturated_samples = 0;                         // samples (of any joint) whose total input was clamped
   JointVector joint_rms_deg = JointVector::Zero(1);  // per joint, samples 1..N
-  int held_samples = 0;                 // samples without a fresh reading (TrialRecord::held): error 0, not learned from
-  LearnedWith learned_with = {};        // what learned the correction it applied (callers fill it in)
+  int held_samples = 0;           // samples without a fresh reading (TrialRecord::held): error 0, not learned from
+  LearnedWith learned_with = {};  // what learned the correction it applied (callers fill it in)
 };
 
 /// `correction_bar`: N values (one joint) or N x J, one column per joint.
-IterationSummary summarize_trial(int iteration, const TrialRecord& record, const Eigen::Ref<const Eigen::MatrixXd>& correction_bar,
-                                 double ambient_bar, double p_max_bar);
+IterationSummary summarize_trial(int iteration, const TrialRecord& record,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& correction_bar, double ambient_bar,
+                                 double p_max_bar);
 
 class LearningSession {
  public:
@@ -91,9 +92,9 @@ class LearningSession {
   Trajectory trajectory_;
   TimingParameters timing_;
   ControllerParameters controller_;
-  Eigen::MatrixXd corrections_;       // N x J
+  Eigen::MatrixXd corrections_;  // N x J
   Eigen::MatrixXd next_corrections_;
-  Eigen::MatrixXd feedback_bar_;      // N x J, the last trial's u_pid, for the law's input context
+  Eigen::MatrixXd feedback_bar_;  // N x J, the last trial's u_pid, for the law's input context
   TrialRecord record_;
   int iteration_ = 0;
   TrialRunner runner_;

@@ -23,8 +23,9 @@ struct LeastSquaresSolution {
 /// finite. `steps`: each parameter's difference step. A candidate with a non-finite cost is rejected
 /// like a worse one (damping grows).
 template <typename Vector, typename Residual>
-LeastSquaresSolution<Vector> levenberg_marquardt(const Residual& residual, const Vector& start, Eigen::VectorXd start_residual,
-                                                 const Vector& steps, int max_iterations, double relative_cost_tolerance) {
+LeastSquaresSolution<Vector> levenberg_marquardt(const Residual& residual, const Vector& start,
+                                                 Eigen::VectorXd start_residual, const Vector& steps,
+                                                 int max_iterations, double relative_cost_tolerance) {
   using Matrix = Eigen::Matrix<double, Vector::RowsAtCompileTime, Vector::RowsAtCompileTime>;
   LeastSquaresSolution<Vector> s{start, std::move(start_residual)};
   s.cost = s.residual.squaredNorm();

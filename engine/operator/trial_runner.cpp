@@ -7,16 +7,26 @@ namespace bellows {
 
 const char* to_string(TrialPhase phase) {
   switch (phase) {
-    case TrialPhase::kIdle: return "idle";
-    case TrialPhase::kArming: return "arming";
-    case TrialPhase::kWaiting: return "waiting";
-    case TrialPhase::kSettling: return "settling";
-    case TrialPhase::kRunning: return "running";
-    case TrialPhase::kDone: return "done";
-    case TrialPhase::kNotSent: return "not sent";
-    case TrialPhase::kRefused: return "refused";
-    case TrialPhase::kFaulted: return "faulted";
-    case TrialPhase::kCancelled: return "cancelled";
+    case TrialPhase::kIdle:
+      return "idle";
+    case TrialPhase::kArming:
+      return "arming";
+    case TrialPhase::kWaiting:
+      return "waiting";
+    case TrialPhase::kSettling:
+      return "settling";
+    case TrialPhase::kRunning:
+      return "running";
+    case TrialPhase::kDone:
+      return "done";
+    case TrialPhase::kNotSent:
+      return "not sent";
+    case TrialPhase::kRefused:
+      return "refused";
+    case TrialPhase::kFaulted:
+      return "faulted";
+    case TrialPhase::kCancelled:
+      return "cancelled";
   }
   return "?";
 }
@@ -106,7 +116,8 @@ bool TrialRunner::observe(const EngineEvent& event) {
     case EventKind::kTrialAborted:
       if (!held || event.trial_id != status_.trial_id) return false;
       status_.fault = core_.fault();
-      status_.message = event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(status_.fault));
+      status_.message =
+          event.detail[0] != '\0' ? std::string(event.detail.data()) : std::string(fault_message(status_.fault));
       finish(TrialPhase::kFaulted, event.time_s);
       return true;
     case EventKind::kFault:  // a held trial ends with its kTrialAborted; an arm is refused or not

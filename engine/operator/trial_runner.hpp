@@ -23,11 +23,11 @@
 namespace bellows {
 
 enum class TrialPhase : std::uint8_t {
-  kIdle,       // no trial started yet
-  kArming,     // the arm command is sent; the trial is sent once the engine is ARMED
-  kWaiting,    // the trial is sent; the engine has not taken it yet
-  kSettling,   // the engine took it (RUNNING): holding the trajectory's start
-  kRunning,    // tracking the trajectory, at `sample`
+  kIdle,      // no trial started yet
+  kArming,    // the arm command is sent; the trial is sent once the engine is ARMED
+  kWaiting,   // the trial is sent; the engine has not taken it yet
+  kSettling,  // the engine took it (RUNNING): holding the trajectory's start
+  kRunning,   // tracking the trajectory, at `sample`
   // Finished: the engine holds nothing of the caller's any more.
   kDone,       // the record is complete
   kNotSent,    // the command queue was full: `command` never reached the engine

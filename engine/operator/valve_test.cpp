@@ -22,16 +22,21 @@ std::string format(const char* pattern, Args... args) {
 
 const char* valve_name(ValveId valve) {
   switch (valve) {
-    case ValveId::kInletA: return "inlet A";
-    case ValveId::kInletB: return "inlet B";
-    case ValveId::kOutletA: return "outlet A";
-    case ValveId::kOutletB: return "outlet B";
+    case ValveId::kInletA:
+      return "inlet A";
+    case ValveId::kInletB:
+      return "inlet B";
+    case ValveId::kOutletA:
+      return "outlet A";
+    case ValveId::kOutletB:
+      return "outlet B";
   }
   return "?";
 }
 
 bool ValveTestReport::all_pass() const {
-  return finished && aborted.empty() && std::all_of(valves.begin(), valves.end(), [](const ValveVerdict& v) { return v.pass; });
+  return finished && aborted.empty() &&
+         std::all_of(valves.begin(), valves.end(), [](const ValveVerdict& v) { return v.pass; });
 }
 
 std::vector<std::string> ValveTestReport::failure_lines() const {
@@ -62,9 +67,10 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
   v.other_change_bar = air_bar(after, other, volume_gain_per_rad) - air_bar(before, other, volume_gain_per_rad);
   const double own_move = sign * v.own_change_bar, other_move = sign * v.other_change_bar;
   if (!(after.time_s > before.time_s)) {  // the same reading twice: nothing to judge the pulse by
-    v.problem = format("not judged: no reading taken after the pulse started (the newest is from %.3f s): the link to "
-                       "the rig delivers no fresh readings",
-                       after.time_s);
+    v.problem = format(
+        "not judged: no reading taken after the pulse started (the newest is from %.3f s): the link to "
+        "the rig delivers no fresh readings",
+        after.time_s);
   } else if (!std::isfinite(own_move) || !std::isfinite(other_move)) {
     v.problem = "a chamber pressure reads not-a-number: check the pressure sensors' inputs";
   } else if (!is_inlet(valve) && before.joint[0].chamber_bar[own] - ambient_bar < m) {
@@ -73,9 +79,10 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
   } else if (own_move >= m && own_move >= other_move + m) {
     v.pass = true;
   } else if (other_move >= m && other_move >= own_move + m) {
-    v.problem = format("chamber %s moved (%+.3f bar), not %s (%+.3f bar): the tubes, valve lines or pressure inputs of "
-                       "A and B are swapped",
-                       chamber_name(other), v.other_change_bar, chamber_name(own), v.own_change_bar);
+    v.problem = format(
+        "chamber %s moved (%+.3f bar), not %s (%+.3f bar): the tubes, valve lines or pressure inputs of "
+        "A and B are swapped",
+        chamber_name(other), v.other_change_bar, chamber_name(own), v.own_change_bar);
   } else if (own_move <= -m) {
     v.problem = format("chamber %s went the wrong way (%+.3f bar): the inlet and outlet of %s are swapped",
                        chamber_name(own), v.own_change_bar, chamber_name(own));
@@ -86,10 +93,11 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
     v.problem = format("no supply: the supply reads %.2f bar (below [safety] supply_min_bar %.2f)",
                        std::min(before.supply_bar, after.supply_bar), supply_min_bar);
   } else {
-    v.problem = format("dead valve: chamber %s did not %s (%+.3f bar in [rig_check] valve_pulse_s %.3f s): check the "
-                       "valve's line, its power and the valve%s",
-                       chamber_name(own), way, v.own_change_bar, check.valve_pulse_s,
-                       is_inlet(valve) ? ", and that air reaches it" : "");
+    v.problem = format(
+        "dead valve: chamber %s did not %s (%+.3f bar in [rig_check] valve_pulse_s %.3f s): check the "
+        "valve's line, its power and the valve%s",
+        chamber_name(own), way, v.own_change_bar, check.valve_pulse_s,
+        is_inlet(valve) ? ", and that air reaches it" : "");
   }
   return v;
 }
@@ -113,9 +121,10 @@ std::vector<EngineCommand> ValveTest::begin(EngineState state, const SensorReadi
   }
   if (!(latest.supply_bar >= safety_.supply_min_bar)) {  // arming would fault (supply-low) at once
     for (ValveVerdict& v : report_.valves) {
-      v.problem = is_inlet(v.valve) ? format("no supply: the supply reads %.2f bar (below [safety] supply_min_bar %.2f)",
-                                             latest.supply_bar, safety_.supply_min_bar)
-                                    : std::string("not tested: no supply to fill the chambers");
+      v.problem = is_inlet(v.valve)
+                      ? format("no supply: the supply reads %.2f bar (below [safety] supply_min_bar %.2f)",
+                               latest.supply_bar, safety_.supply_min_bar)
+                      : std::string("not tested: no supply to fill the chambers");
     }
     report_.finished = true;
     return {};
@@ -129,7 +138,9 @@ std::vector<EngineCommand> ValveTest::begin(EngineState state, const SensorReadi
 }
 
 EngineCommand ValveTest::command_for(Step step) {
-  const auto ticks_of = [this](double seconds) { return std::max(1, static_cast<int>(std::lround(seconds / tick_s_))); };
+  const auto ticks_of = [this](double seconds) {
+    return std::max(1, static_cast<int>(std::lround(seconds / tick_s_)));
+  };
   ValvePulse pulse;  // `after`: every valve closed, the chambers keep what the pulse left
   pulse.id = ++pulse_id_;
   pulse.settle_ticks = settle_ticks_;  // so that the reading shows all the step did
@@ -176,8 +187,8 @@ std::vector<EngineCommand> ValveTest::on_event(const EngineEvent& event) {
       if (event.trial_id != pulse_id_) return {};
       if (step_ == Step::kPulse) {
         const auto valve = static_cast<ValveId>(valve_);
-        report_.valves[valve_] = judge_valve(valve, before_, event.reading, ambient_bar_, check_, safety_.supply_min_bar,
-                                              volume_gain_per_rad_);
+        report_.valves[valve_] = judge_valve(valve, before_, event.reading, ambient_bar_, check_,
+                                             safety_.supply_min_bar, volume_gain_per_rad_);
       } else {
         before_ = event.reading;
       }
@@ -216,7 +227,9 @@ void ValveTest::finish_with(const std::string& why) {
 std::string ValveTest::progress() const {
   if (!started_) return "not started";
   if (report_.finished) return report_.aborted.empty() ? "done" : "stopped: " + report_.aborted;
-  const char* what = step_ == Step::kVent ? "venting both chambers" : step_ == Step::kFill ? "filling both chambers" : "pulsing";
+  const char* what = step_ == Step::kVent   ? "venting both chambers"
+                     : step_ == Step::kFill ? "filling both chambers"
+                                            : "pulsing";
   return format("%s: %s (%d of %d)", valve_name(static_cast<ValveId>(valve_)), what, valve_ + 1, kValveCount);
 }
 

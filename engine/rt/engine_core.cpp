@@ -80,15 +80,17 @@ const char* EngineCore::trial_refusal(const EngineCommand& command) const {
   const char* not_prepared = "the trial's trajectory, correction or record is missing or not prepared to its length";
   const Trajectory* trajectory = command.trajectory;
   const TrialRecord* record = command.record;
-  if (trajectory == nullptr || record == nullptr || (command.correction == nullptr) == (command.joint_correction == nullptr)) {
+  if (trajectory == nullptr || record == nullptr ||
+      (command.correction == nullptr) == (command.joint_correction == nullptr)) {
     return not_prepared;
   }
   if (const char* why = trajectory_refusal(*trajectory)) return why;
   const int joints = trajectory->joints();
   const int n = trajectory->learning_samples();
   if (command.correction != nullptr && command.correction->size() != n) return not_prepared;
-  if (command.correction != nullptr ? joints != 1
-                                    : command.joint_correction->rows() != n || command.joint_correction->cols() != joints) {
+  if (command.correction != nullptr
+          ? joints != 1
+          : command.joint_correction->rows() != n || command.joint_correction->cols() != joints) {
     return "the trial's correction is not one column of N values per joint of its trajectory";
   }
   if (record->joint_count() != joints) {
@@ -193,7 +195,8 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       hold_trajectory(command.trajectory, now_s);
       if (from == EngineState::kArmed && trajectory_ != nullptr) control_.hold(trajectory_->setpoint_rad(0));
       // Without a trajectory the engine drives one joint: holding several would vent them all.
-      if (from == EngineState::kArmed && trajectory_ == nullptr && control_.joints() != 1) control_.hold(last_angle_rad_);
+      if (from == EngineState::kArmed && trajectory_ == nullptr && control_.joints() != 1)
+        control_.hold(last_angle_rad_);
       return;
     case CommandKind::kSetGains: {
       ControllerParameters gains = controller_;
@@ -297,7 +300,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   // each is a tick without a reading, held like one (the trial's clock goes on, nothing learned).
   const int skipped = time_follows_ticks_ ? 0 : std::max(0, missed_deadlines);
   const int unattended = stale_count_ + skipped + (fresh ? 0 : 1);  // ticks the rig went uncontrolled
-  const int late_ticks = skipped_in_gap_ + skipped;                  // of them, the loop's
+  const int late_ticks = skipped_in_gap_ + skipped;                 // of them, the loop's
   // Only ticks with live valves count: a rig vented while the engine is safe is not uncontrolled,
   // and the tick that arms must not inherit the silence of a rig that was not serving yet.
   const bool counting = !fresh && valves_live(state());

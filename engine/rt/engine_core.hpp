@@ -143,10 +143,10 @@ class EngineCore {
   int settle_remaining_ = 0;
   double last_reading_time_s_ = -1.0;
   double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
-  int stale_count_ = 0;      // ticks in a row the rig went without a fresh reading (missed periods too)
-  int skipped_in_gap_ = 0;   // of them, the periods the loop missed (not the link's)
-  int fault_joint_ = -1;  // the joint the latched fault fired on (-1: none, or no joint's)
-  FaultDetail fault_detail_{};  // the latched fault's sentence, for its events
+  int stale_count_ = 0;          // ticks in a row the rig went without a fresh reading (missed periods too)
+  int skipped_in_gap_ = 0;       // of them, the periods the loop missed (not the link's)
+  int fault_joint_ = -1;         // the joint the latched fault fired on (-1: none, or no joint's)
+  FaultDetail fault_detail_{};   // the latched fault's sentence, for its events
   int missed_streak_ = 0;
   const bool time_follows_ticks_;  // the device's, read once: missed deadlines warn instead of fault
   double last_heartbeat_s_ = 0.0;

@@ -44,7 +44,8 @@ class SimulatedClock final : public EngineDriver {
 
   EngineCore& core() override { return core_; }
   void await() override {
-    while (pace_ != nullptr && pace_->write_available() == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    while (pace_ != nullptr && pace_->write_available() == 0)
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
     step(1);
   }
   bool simulated() const override { return true; }

@@ -25,28 +25,28 @@ struct PidGains {
 /// `after` until the next pulse, a disarm or a trial. The guards keep running; the PID does not.
 struct ValvePulse {
   ValveCommand valves{};
-  ValveCommand after{};      // default: every valve closed (the chambers keep their air)
+  ValveCommand after{};  // default: every valve closed (the chambers keep their air)
   int ticks = 0;
-  int settle_ticks = 0;      // of `after` before the end is reported: the link's lag, so that the
-                             // reported reading shows the whole pulse (a rig over LCM lags)
-  std::uint32_t id = 0;      // echoed in the kValvePulseDone event
+  int settle_ticks = 0;  // of `after` before the end is reported: the link's lag, so that the
+                         // reported reading shows the whole pulse (a rig over LCM lags)
+  std::uint32_t id = 0;  // echoed in the kValvePulseDone event
 };
 
 /// An operator command. Buffers named by pointer stay owned by the sender, who must keep them
 /// alive and unchanged until the engine hands them back (TrialComplete / TrialAborted event).
 struct EngineCommand {
   CommandKind kind = CommandKind::kHeartbeat;
-  const Trajectory* trajectory = nullptr;       // kSelectTrajectory, kStartTrial
-  const Eigen::VectorXd* correction = nullptr;  // kStartTrial: u_ilc(0..N-1), bar (one joint)
+  const Trajectory* trajectory = nullptr;             // kSelectTrajectory, kStartTrial
+  const Eigen::VectorXd* correction = nullptr;        // kStartTrial: u_ilc(0..N-1), bar (one joint)
   const Eigen::MatrixXd* joint_correction = nullptr;  // kStartTrial instead, for J joints: N x J, bar
-  TrialRecord* record = nullptr;                // kStartTrial: where the trial is written, prepared
-                                                // (TrialRecord::prepare) to the trajectory's length
-                                                // and joint count
-  int settle_ticks = 0;                         // kStartTrial: hold at the start before sample 0
-  std::uint32_t trial_id = 0;                   // kStartTrial: echoed in the trial's events
-  PidGains gains{};                             // kSetGains
-  ValvePulse pulse{};                           // kValvePulse
-  std::uint32_t stops_seen = 0;                 // set by EngineCore::send(): stops requested before it
+  TrialRecord* record = nullptr;                      // kStartTrial: where the trial is written, prepared
+                                                      // (TrialRecord::prepare) to the trajectory's length
+                                                      // and joint count
+  int settle_ticks = 0;                               // kStartTrial: hold at the start before sample 0
+  std::uint32_t trial_id = 0;                         // kStartTrial: echoed in the trial's events
+  PidGains gains{};                                   // kSetGains
+  ValvePulse pulse{};                                 // kValvePulse
+  std::uint32_t stops_seen = 0;                       // set by EngineCore::send(): stops requested before it
 
   /// A command that carries nothing but its kind (arm, disarm, reset, e-stop, heartbeat, ...).
   static EngineCommand of(CommandKind kind) {
@@ -80,7 +80,8 @@ struct EngineCommand {
 
  private:
   /// A trial's command before its correction (one vector, or one column per joint) is set.
-  static EngineCommand trial_of(const Trajectory& trajectory, TrialRecord& record, int settle_ticks, std::uint32_t trial_id) {
+  static EngineCommand trial_of(const Trajectory& trajectory, TrialRecord& record, int settle_ticks,
+                                std::uint32_t trial_id) {
     EngineCommand c = of(CommandKind::kStartTrial);
     c.trajectory = &trajectory;
     c.record = &record;
@@ -95,10 +96,10 @@ enum class EventKind : std::uint8_t {
   kCommandRefused,
   kFault,
   kTrialComplete,
-  kTrialAborted,  // the record is handed back incomplete (disarm, abort, fault)
-  kValvePulseDone,  // a valve pulse's `ticks` and `settle_ticks` are over; `reading`: the first fresh one
-                    // after them (taken after the pulse's last command); `trial_id`: its id
-  kWarning,       // something the operator should know that is not a fault (`fault` names it)
+  kTrialAborted,        // the record is handed back incomplete (disarm, abort, fault)
+  kValvePulseDone,      // a valve pulse's `ticks` and `settle_ticks` are over; `reading`: the first fresh one
+                        // after them (taken after the pulse's last command); `trial_id`: its id
+  kWarning,             // something the operator should know that is not a fault (`fault` names it)
   kTrajectorySelected,  // the engine holds `trajectory` now: earlier selections are handed back
 };
 
@@ -110,14 +111,14 @@ struct EngineEvent {
   CommandKind command = CommandKind::kHeartbeat;  // the command concerned, if any
   const char* refusal = "";                       // kCommandRefused: why (static text)
   FaultCode fault = FaultCode::kNone;
-  int fault_joint = -1;                           // kFault: the joint (0-based) the guard fired on; -1: no joint's
-  TrialRecord* record = nullptr;                  // kTrialComplete / kTrialAborted
-  const Trajectory* trajectory = nullptr;         // kTrajectorySelected
+  int fault_joint = -1;                    // kFault: the joint (0-based) the guard fired on; -1: no joint's
+  TrialRecord* record = nullptr;           // kTrialComplete / kTrialAborted
+  const Trajectory* trajectory = nullptr;  // kTrajectorySelected
   std::uint32_t trial_id = 0;
-  SensorReading reading{};                        // kValvePulseDone: read after the pulse's last tick
-  std::uint32_t count = 0;                        // kWarning: how many (e.g. deadlines missed in a row)
-  FaultDetail detail{};                           // kFault, kTrialAborted by a fault: the fault's own sentence
-                                                  // (the device's words: the rig's reason, the link's silence)
+  SensorReading reading{};  // kValvePulseDone: read after the pulse's last tick
+  std::uint32_t count = 0;  // kWarning: how many (e.g. deadlines missed in a row)
+  FaultDetail detail{};     // kFault, kTrialAborted by a fault: the fault's own sentence
+                            // (the device's words: the rig's reason, the link's silence)
 };
 
 /// One joint's controller outputs at a tick.
@@ -133,7 +134,7 @@ struct TickRecord {
   double time_s = 0.0;
   EngineState state = EngineState::kSafe;
   FaultCode fault = FaultCode::kNone;
-  int fault_joint = -1;            // the joint (0-based) the latched fault fired on; -1: none or no joint's
+  int fault_joint = -1;  // the joint (0-based) the latched fault fired on; -1: none or no joint's
   SensorReading reading{};
   std::array<TickJoint, kMaxJoints> joints{};  // [0, reading.joint_count): each joint's (the console's live strips)
   ValveCommand valves{};

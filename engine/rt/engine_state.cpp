@@ -50,28 +50,44 @@ Transition transition(EngineState state, CommandKind command) {
 
 const char* to_string(EngineState state) {
   switch (state) {
-    case EngineState::kSafe: return "SAFE";
-    case EngineState::kArmed: return "ARMED";
-    case EngineState::kRunning: return "RUNNING";
-    case EngineState::kFault: return "FAULT";
+    case EngineState::kSafe:
+      return "SAFE";
+    case EngineState::kArmed:
+      return "ARMED";
+    case EngineState::kRunning:
+      return "RUNNING";
+    case EngineState::kFault:
+      return "FAULT";
   }
   return "?";
 }
 
 const char* to_string(CommandKind command) {
   switch (command) {
-    case CommandKind::kArm: return "arm";
-    case CommandKind::kDisarm: return "disarm";
-    case CommandKind::kStartTrial: return "start trial";
-    case CommandKind::kAbortTrial: return "abort trial";
-    case CommandKind::kEmergencyStop: return "emergency stop";
-    case CommandKind::kReset: return "reset";
-    case CommandKind::kSelectTrajectory: return "select trajectory";
-    case CommandKind::kHeartbeat: return "heartbeat";
-    case CommandKind::kSetGains: return "set gains";
-    case CommandKind::kValvePulse: return "valve pulse";
-    case CommandKind::kGuard: return "safety guard";
-    case CommandKind::kTrialEnd: return "trial complete";
+    case CommandKind::kArm:
+      return "arm";
+    case CommandKind::kDisarm:
+      return "disarm";
+    case CommandKind::kStartTrial:
+      return "start trial";
+    case CommandKind::kAbortTrial:
+      return "abort trial";
+    case CommandKind::kEmergencyStop:
+      return "emergency stop";
+    case CommandKind::kReset:
+      return "reset";
+    case CommandKind::kSelectTrajectory:
+      return "select trajectory";
+    case CommandKind::kHeartbeat:
+      return "heartbeat";
+    case CommandKind::kSetGains:
+      return "set gains";
+    case CommandKind::kValvePulse:
+      return "valve pulse";
+    case CommandKind::kGuard:
+      return "safety guard";
+    case CommandKind::kTrialEnd:
+      return "trial complete";
   }
   return "?";
 }

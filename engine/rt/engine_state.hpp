@@ -14,18 +14,18 @@ namespace bellows {
 enum class EngineState : std::uint8_t { kSafe, kArmed, kRunning, kFault };
 
 enum class CommandKind : std::uint8_t {
-  kArm,             // SAFE -> ARMED
-  kDisarm,          // ARMED/RUNNING -> SAFE (a running trial is abandoned)
-  kStartTrial,      // ARMED -> RUNNING
-  kAbortTrial,      // RUNNING -> ARMED
-  kEmergencyStop,   // any -> FAULT, vents at once
-  kReset,           // FAULT -> SAFE
-  kSelectTrajectory,// SAFE/ARMED: the trajectory to hold and run next
-  kHeartbeat,       // the console is alive; no transition
-  kSetGains,        // SAFE/ARMED: PID gains between trials
-  kValvePulse,      // ARMED: the operator sets the valves for a while (the valve test); no transition
-  kGuard,           // not a command: the cause of a state change a safety guard made (FAULT)
-  kTrialEnd,        // not a command: the cause of RUNNING -> ARMED when a trial ran to its end
+  kArm,               // SAFE -> ARMED
+  kDisarm,            // ARMED/RUNNING -> SAFE (a running trial is abandoned)
+  kStartTrial,        // ARMED -> RUNNING
+  kAbortTrial,        // RUNNING -> ARMED
+  kEmergencyStop,     // any -> FAULT, vents at once
+  kReset,             // FAULT -> SAFE
+  kSelectTrajectory,  // SAFE/ARMED: the trajectory to hold and run next
+  kHeartbeat,         // the console is alive; no transition
+  kSetGains,          // SAFE/ARMED: PID gains between trials
+  kValvePulse,        // ARMED: the operator sets the valves for a while (the valve test); no transition
+  kGuard,             // not a command: the cause of a state change a safety guard made (FAULT)
+  kTrialEnd,          // not a command: the cause of RUNNING -> ARMED when a trial ran to its end
 };
 
 struct Transition {

@@ -15,7 +15,8 @@ class LatestValue {
   /// Writer side: publish a complete value.
   void write(const T& value) {
     buffers_[back_] = value;
-    const std::uint8_t previous = middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
+    const std::uint8_t previous =
+        middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
     back_ = previous & kIndexMask;
   }
 
@@ -36,9 +37,9 @@ class LatestValue {
   static constexpr std::uint8_t kFresh = 0x4;
   static constexpr std::uint8_t kIndexMask = 0x3;
   std::array<T, 3> buffers_{};
-  std::uint8_t back_ = 0;                 // writer's buffer
-  std::atomic<std::uint8_t> middle_{1};   // the hand-over buffer, with the fresh flag
-  std::uint8_t front_ = 2;                // reader's buffer
+  std::uint8_t back_ = 0;                // writer's buffer
+  std::atomic<std::uint8_t> middle_{1};  // the hand-over buffer, with the fresh flag
+  std::uint8_t front_ = 2;               // reader's buffer
 };
 
 }  // namespace bellows

@@ -73,7 +73,8 @@ void LatencyHistogram::clear() {
   max_ns_.store(0, std::memory_order_relaxed);
 }
 
-RealtimeLoop::RealtimeLoop(EngineCore& core, Device& device, double speed) : core_(core), device_(device), speed_(speed) {}
+RealtimeLoop::RealtimeLoop(EngineCore& core, Device& device, double speed)
+    : core_(core), device_(device), speed_(speed) {}
 
 RealtimeLoop::~RealtimeLoop() { stop(); }
 

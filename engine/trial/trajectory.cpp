@@ -24,7 +24,9 @@ void check_joint_count(const std::string& name, std::size_t joints) {
 }
 
 // "" for a single-joint trajectory (its messages stay as they always were), "joint 2: " otherwise.
-std::string joint_label(int joints, int joint) { return joints == 1 ? "" : "joint " + std::to_string(joint + 1) + ": "; }
+std::string joint_label(int joints, int joint) {
+  return joints == 1 ? "" : "joint " + std::to_string(joint + 1) + ": ";
+}
 }  // namespace
 
 double trapezoidal_move_angle_deg(const TrapezoidalMove& move, double time_s) {
@@ -63,8 +65,8 @@ Trajectory trajectory_from_moves(const std::string& name, double initial_deg, co
   return trajectory_from_joint_moves(name, {JointMoves{initial_deg, moves}}, duration_s, sample_time_s);
 }
 
-Trajectory trajectory_from_joint_moves(const std::string& name, const std::vector<JointMoves>& joints, double duration_s,
-                                       double sample_time_s) {
+Trajectory trajectory_from_joint_moves(const std::string& name, const std::vector<JointMoves>& joints,
+                                       double duration_s, double sample_time_s) {
   check_joint_count(name, joints.size());
   const int samples = static_cast<int>(std::lround(duration_s / sample_time_s));
   Trajectory trajectory{name, sample_time_s, std::vector<Eigen::VectorXd>(joints.size())};
@@ -92,8 +94,8 @@ JointVector Trajectory::setpoint_rad(Eigen::Index sample) const {
 void validate_trajectory(const Trajectory& trajectory, const TrajectoryLimits& limits) {
   check_joint_count(trajectory.name, static_cast<std::size_t>(trajectory.joints()));
   if (trajectory.learning_samples() < limits.min_learning_samples) {
-    throw InputError("trajectory '" + trajectory.name + "' is too short: " +
-                     std::to_string(trajectory.learning_samples() + 1) + " samples, at least " +
+    throw InputError("trajectory '" + trajectory.name +
+                     "' is too short: " + std::to_string(trajectory.learning_samples() + 1) + " samples, at least " +
                      std::to_string(limits.min_learning_samples + 1) + " needed");
   }
   for (int j = 0; j < trajectory.joints(); ++j) {
@@ -110,8 +112,8 @@ void validate_trajectory(const Trajectory& trajectory, const TrajectoryLimits& l
         throw InputError(where + "angle at sample " + std::to_string(k) + " is not a number");
       }
       if (std::abs(angle_deg) > limits.max_abs_angle_deg) {
-        throw InputError(where + "angle " + format_number(angle_deg) + " deg at t = " +
-                         format_number(static_cast<double>(k) * trajectory.sample_time_s) +
+        throw InputError(where + "angle " + format_number(angle_deg) +
+                         " deg at t = " + format_number(static_cast<double>(k) * trajectory.sample_time_s) +
                          " s is outside the joint range of +-" + format_number(limits.max_abs_angle_deg) + " deg");
       }
     }
@@ -139,8 +141,8 @@ Trajectory trajectory_from_joint_samples(const std::string& name, const std::vec
     const double expected = static_cast<double>(k) * sample_time_s;
     if (std::abs(time_s[k] - expected) > kTimeTolerance_s) {
       throw InputError("trajectory '" + name + "': sampling is not uniform at the ILC sample time " +
-                       format_number(sample_time_s) + " s: sample " + std::to_string(k) + " is at t = " +
-                       format_number(time_s[k]) + " s, expected " + format_number(expected) + " s");
+                       format_number(sample_time_s) + " s: sample " + std::to_string(k) +
+                       " is at t = " + format_number(time_s[k]) + " s, expected " + format_number(expected) + " s");
     }
   }
   Trajectory trajectory{name, sample_time_s, std::vector<Eigen::VectorXd>(joint_angle_deg.size())};

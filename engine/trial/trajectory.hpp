@@ -57,8 +57,8 @@ double trapezoidal_move_angle_deg(const TrapezoidalMove& move, double time_s);
 Trajectory trajectory_from_moves(const std::string& name, double initial_deg, const std::vector<TrapezoidalMove>& moves,
                                  double duration_s, double sample_time_s);
 /// The same for 1..kMaxJoints joints, one JointMoves per joint; throws InputError for another count.
-Trajectory trajectory_from_joint_moves(const std::string& name, const std::vector<JointMoves>& joints, double duration_s,
-                                       double sample_time_s);
+Trajectory trajectory_from_joint_moves(const std::string& name, const std::vector<JointMoves>& joints,
+                                       double duration_s, double sample_time_s);
 
 /// Builds a trajectory from (time, angle) samples, checking: finite values, time starting at 0 and
 /// uniformly spaced by `sample_time_s` (to 1e-6 s), angles within the limits. Throws InputError.

@@ -20,7 +20,8 @@ JointMoves moves_through(const std::vector<double>& angles_deg, const std::vecto
                          double peak_acceleration_deg_per_s2, double delay_s = 0.0) {
   JointMoves joint{angles_deg.front(), {}};
   for (std::size_t i = 0; i + 1 < angles_deg.size() && i < starts_s.size(); ++i) {
-    joint.moves.push_back({starts_s[i] + delay_s, angles_deg[i], angles_deg[i + 1], move_s, peak_acceleration_deg_per_s2});
+    joint.moves.push_back(
+        {starts_s[i] + delay_s, angles_deg[i], angles_deg[i + 1], move_s, peak_acceleration_deg_per_s2});
   }
   return joint;
 }
@@ -68,12 +69,15 @@ const LibraryEntry kLibrary[] = {
      [](double t) {
        constexpr double kSlow_s = 0.3, kSlowAcceleration_deg_per_s2 = 4000.0;
        return trajectory_from_joint_moves(
-           "steps", {moves_through({0, 20, 40, -20, -40, 0}, {0.5, 2.0, 3.5, 5.0, 6.5}, kSlow_s, kSlowAcceleration_deg_per_s2)},
+           "steps",
+           {moves_through({0, 20, 40, -20, -40, 0}, {0.5, 2.0, 3.5, 5.0, 6.5}, kSlow_s, kSlowAcceleration_deg_per_s2)},
            10.0, t);
      }},
     {"sine", 1, "8 s, 30 deg amplitude at 0.5 Hz with a 1 s raised-cosine fade in and out", sine},
     {"paper2", 2, "8 s, 2 joints: shoulder 0 -> 20 -> -20 -> 20 -> 0 deg (0.3 s moves), elbow the paper's",
-     [](double t) { return trajectory_from_joint_moves("paper2", {shoulder_moves(), paper_moves()}, kPaperDuration_s, t); }},
+     [](double t) {
+       return trajectory_from_joint_moves("paper2", {shoulder_moves(), paper_moves()}, kPaperDuration_s, t);
+     }},
     {"paper3", 3, "8 s, 3 joints: paper2, and the wrist does the paper's moves 0.3 s after the elbow",
      [](double t) {
        return trajectory_from_joint_moves("paper3", {shoulder_moves(), paper_moves(), paper_moves(kWristDelay_s)},

@@ -13,8 +13,8 @@ void TrialSamples::resize(Eigen::Index count) {
 }
 
 void TrialTicks::resize(Eigen::Index count) {
-  for (Eigen::VectorXd* v : {&angle_rad, &pressure_a_bar, &pressure_b_bar, &setpoint_a_bar, &setpoint_b_bar, &inlet_a, &outlet_a,
-                             &inlet_b, &outlet_b}) {
+  for (Eigen::VectorXd* v : {&angle_rad, &pressure_a_bar, &pressure_b_bar, &setpoint_a_bar, &setpoint_b_bar, &inlet_a,
+                             &outlet_a, &inlet_b, &outlet_b}) {
     v->setZero(count);
   }
 }
@@ -41,7 +41,8 @@ Eigen::VectorXd TrialRecord::normalized_error(int joint) const {
 
 Eigen::MatrixXd TrialRecord::normalized_joint_errors() const {
   Eigen::MatrixXd errors(learning_samples, joint_count());
-  for (int j = 0; j < joint_count(); ++j) errors.col(j) = joint_samples(j).error_rad.tail(learning_samples) / std::numbers::pi;
+  for (int j = 0; j < joint_count(); ++j)
+    errors.col(j) = joint_samples(j).error_rad.tail(learning_samples) / std::numbers::pi;
   return errors;
 }
 

@@ -34,11 +34,11 @@ struct TrialJoint {
 };
 
 struct TrialRecord {
-  Eigen::VectorXd sample_time_s;  // k T, k = 0..N: every joint's samples
-  Eigen::VectorXd tick_time_s;    // i tick_s: every joint's ticks
-  Eigen::VectorXd supply_bar;     // measured at each tick (one supply for every joint)
+  Eigen::VectorXd sample_time_s;        // k T, k = 0..N: every joint's samples
+  Eigen::VectorXd tick_time_s;          // i tick_s: every joint's ticks
+  Eigen::VectorXd supply_bar;           // measured at each tick (one supply for every joint)
   std::vector<TrialJoint> joints = {};  // J of them; joints[0] is joint 1
-  int learning_samples = 0;  // N
+  int learning_samples = 0;             // N
   bool complete = false;
   // Samples k = 0..N taken on a tick without a fresh reading (1: held; ControlCore::tick_held):
   // their error is 0 and nothing is learned from them. Shared by every joint (one reading for all).

@@ -5,8 +5,8 @@
 // unarmed, arms the shim (BELLOWS_FAULT_ARMED=1), runs one more trial (the console learns its
 // correction after saving it: two saves), waits for the saves, then quits like an operator (q,
 // and q again if asked); BELLOWS_DRIVER_SKIP_ARMED_TRIAL=1 quits without it (the session as it was
-// before the save under test, for the tests' reference). It prints what the operator would read, one `key: value` line each, and
-// exits as the console does: 4 when quitting leaves work the disk did not take, else 0.
+// before the save under test, for the tests' reference). It prints what the operator would read, one `key: value` line
+// each, and exits as the console does: 4 when quitting leaves work the disk did not take, else 0.
 //   console_save_driver DATA_DIR
 #include <cstdio>
 #include <cstdlib>
@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   ::setenv("BELLOWS_FAULT_ARMED", "0", 1);
   bellows::StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(), argv[1]);
   ConsoleFixture f(bellows::Configuration{}, 3, &gateway);
-  const auto settle = [&] { return f.pump_until([&] { return f.console->saves_settled() && !f.state().learner_busy; }); };
+  const auto settle = [&] {
+    return f.pump_until([&] { return f.console->saves_settled() && !f.state().learner_busy; });
+  };
   const char* trials_text = std::getenv("BELLOWS_DRIVER_TRIALS");
   const int before = trials_text != nullptr ? std::atoi(trials_text) : 2;
   if (!f.pump_until([&] { return f.state().law_ready; })) return 3;

@@ -1,8 +1,8 @@
 // Fault injection for the tests (issue 24): an LD_PRELOAD library that counts a process's
 // write(2), pwrite(2) and stdio fwrite(3) to regular files, rename(2)/renameat(2)/renameat2(2),
-// fsync(2)/fdatasync(2) of files and of directories, and at the k-th of them either kills the process (SIGKILL, before the call: a
-// power cut between two system calls) or fails that one call (ENOSPC or EIO) and lets the process
-// go on. Driven by the environment:
+// fsync(2)/fdatasync(2) of files and of directories, and at the k-th of them either kills the process (SIGKILL, before
+// the call: a power cut between two system calls) or fails that one call (ENOSPC or EIO) and lets the process go on.
+// Driven by the environment:
 //   BELLOWS_FAULT_AT=k           1-based; 0 or unset: never
 //   BELLOWS_FAULT_MODE=kill|enospc|eio
 //   BELLOWS_FAULT_COUNT=FILE     at exit, the number of calls counted (to know how many k to sweep)

@@ -21,7 +21,7 @@
 
 namespace {
 
-constexpr std::size_t kRigIdOffset = 32;    // after the fingerprint, session_id, seq and utime
+constexpr std::size_t kRigIdOffset = 32;  // after the fingerprint, session_id, seq and utime
 constexpr std::size_t kBindingOffset = 40;
 constexpr std::int64_t kRigId = 77;
 
@@ -99,7 +99,8 @@ void serve(Arm& arm, bellows::RigServer& rig, double ceiling_Pa, const bellows::
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   static const bellows::Configuration config;
-  static const bellows::PneumaticChainParameters arm2 = bellows::pneumatic_chain_of(config.plant, bellows::ArmParameters{"arm2"});
+  static const bellows::PneumaticChainParameters arm2 =
+      bellows::pneumatic_chain_of(config.plant, bellows::ArmParameters{"arm2"});
   std::array<std::uint8_t, bellows::kLcmKeyBytes> key_bytes{};
   key_bytes.fill(0x5a);
   const bellows::LcmKey key(key_bytes);
