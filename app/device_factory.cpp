@@ -114,6 +114,7 @@ class LcmRig final : public OpenedDevice {
         {"states", receive_counts_json(s.states)},
         {"rig_fault_states", s.rig_fault_states},
         {"last_fault_bits", s.last_fault_bits},
+        {"last_trip_bits", s.last_trip_bits},
         {"commands_sent", s.commands_sent},
         {"vent_commands_sent", s.vent_commands_sent},
         {"publish_errors", s.publish_errors},

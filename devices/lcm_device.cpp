@@ -235,6 +235,7 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
     fault.set(FaultCode::kRigFault, -1,
               "the LCM rig %llx ended this session without a reason (it shut down or restarted?)", rig);
   }
+  last_trip_bits_.store(s.fault_bits, std::memory_order_relaxed);
   trips_.write(fault);
 }
 
@@ -358,6 +359,7 @@ LcmDeviceStats LcmDevice::stats() const {
   s.states = counters_.snapshot();
   s.rig_fault_states = rig_fault_states_.load(relaxed);
   s.last_fault_bits = last_fault_bits_.load(relaxed);
+  s.last_trip_bits = last_trip_bits_.load(relaxed);
   s.last_foreign_session = last_foreign_session_.load(relaxed);
   s.joints = joints_;
   s.last_other_joints = last_other_joints_.load(relaxed);

@@ -47,10 +47,11 @@ namespace bellows {
 
 struct LcmDeviceStats {
   std::int64_t session_id = 0;
-  std::int64_t rig_id = 0;             // the rig served by, 0: none yet
-  ReceiveCounts states;                // io_state_t received, by outcome
-  std::uint64_t rig_fault_states = 0;  // states of this session carrying rig fault bits
-  std::int32_t last_fault_bits = 0;
+  std::int64_t rig_id = 0;                // the rig served by, 0: none yet
+  ReceiveCounts states;                   // io_state_t received, by outcome
+  std::uint64_t rig_fault_states = 0;     // states of this session carrying rig fault bits
+  std::int32_t last_fault_bits = 0;       // of the last state of this session (0 again once a new binding serves it)
+  std::int32_t last_trip_bits = 0;        // of the last state that reported a trip of the rig (its reasons)
   std::int64_t last_foreign_session = 0;  // the session a rig served when it was not this one
   int joints = 1;                         // this arm's
   int last_other_joints = 0;              // a rig's joint count when it was not this arm's, 0: none heard
@@ -221,6 +222,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};
   std::atomic<std::int32_t> last_fault_bits_{0};
+  std::atomic<std::int32_t> last_trip_bits_{0};
   std::atomic<std::int64_t> last_foreign_session_{0};
   std::atomic<int> last_other_joints_{0};
   std::atomic<std::uint64_t> commands_sent_{0};

@@ -3,6 +3,7 @@
 // learning on the paper scenario with the simulated arm.
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 #include "engine/rt/engine_core.hpp"
 #include "engine/operator/learning_session.hpp"
 #include "engine/learning/zero_phase_filter.hpp"
+#include "tests/learning_curve.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {
@@ -107,20 +109,7 @@ TEST(ZeroPhaseLowPass, PassesConstantsWithoutDelayAndAttenuatesAsItsGainSays) {
 
 // The paper scenario on the simulated arm, headless.
 std::vector<double> learn_on_paper_scenario(const std::string& law_name, int iterations, Configuration config = {}) {
-  config.ilc.law = law_name;
-  const Trajectory trajectory = library_trajectory("paper", config.timing.sample_s());
-  const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()),
-                                     trajectory.learning_samples());
-  SimulatedArm arm(config.plant, 1);
-  EngineCore core(arm, config.controller, config.timing, config.safety);
-  SimulatedClock clock(core, arm);
-  LearningSession session(clock, *law, trajectory, config.timing, config.controller);
-  std::vector<double> rms;
-  for (int i = 0; i <= iterations; ++i) {
-    rms.push_back(session.run_trial().rms_deg);
-    if (i < iterations) session.learn();
-  }
-  return rms;
+  return testing::learning_curve(std::move(config), law_name, "paper", iterations);
 }
 
 double floor_of(const std::vector<double>& rms, int last) {

@@ -17,6 +17,7 @@
 #include "engine/operator/learning_session.hpp"
 #include "engine/trial/trajectory.hpp"
 #include "engine/rt/engine_core.hpp"
+#include "tests/learning_curve.hpp"
 #include "tests/test_support.hpp"
 
 namespace bellows {
@@ -304,24 +305,7 @@ TEST(NoilcLearnedScenario, NeverDivergesOnTheShippedFaultsAndThePlantRanges) {
   }
 }
 
-// RMS (deg) of iterations 0..updates of `law` on `trajectory` with the simulated arm of `config`, seed 1.
-std::vector<double> learning_curve(Configuration config, const std::string& law_name,
-                                   const std::string& trajectory_name, int updates) {
-  config.ilc.law = law_name;
-  const Trajectory trajectory = library_trajectory(trajectory_name, config.timing.sample_s());
-  const auto law = make_learning_law(config, discretize_arm_model(config.model, config.timing.sample_s()),
-                                     trajectory.learning_samples());
-  SimulatedArm arm(config.plant, 1);
-  EngineCore core(arm, config.controller, config.timing, config.safety);
-  SimulatedClock clock(core, arm);
-  LearningSession session(clock, *law, trajectory, config.timing, config.controller);
-  std::vector<double> rms;
-  for (int i = 0; i <= updates; ++i) {
-    rms.push_back(session.run_trial().rms_deg);
-    if (i < updates) session.learn();
-  }
-  return rms;
-}
+using testing::learning_curve;
 
 // Arms the law was not tuned on (its defaults were chosen on the default arm only): the [plant] of a
 // heavier arm (twice the moving mass: omega0 / sqrt 2), a stiffer one (twice the stiffness: kappa / 2,

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The house style (.clang-format at the root) on every C++ file of the repository, tracked or new:
+#   scripts/house-style.sh            check: clang-format --dry-run --Werror, names each file out of style
+#   scripts/house-style.sh --fix      rewrite them in the style (what `scripts/dev format` runs)
+#   scripts/house-style.sh --planted  show that the check refuses a file out of style (a ctest)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+format="$(command -v clang-format || command -v clang-format-14 || true)"
+[ -n "$format" ] || { echo "house style: clang-format is not installed (scripts/setup.sh installs it)" >&2; exit 2; }
+files() { git ls-files --cached --others --exclude-standard -- '*.cpp' '*.hpp' '*.h' '*.cxx'; }
+case "${1:-}" in
+  "")
+    if ! files | xargs -r "$format" --dry-run --Werror; then
+      echo "house style: the files above are not in the style of .clang-format: scripts/dev format rewrites them" >&2
+      exit 1
+    fi
+    ;;
+  --fix)
+    files | xargs -r "$format" -i
+    ;;
+  --planted)
+    # A file of the tree in the style, then the same with one line indented by a stray space.
+    dir="$(mktemp -d)"
+    trap 'rm -rf "$dir"' EXIT
+    cp .clang-format "$dir/"
+    cp engine/base/errors.hpp "$dir/in_style.hpp"
+    "$format" --dry-run --Werror "$dir/in_style.hpp" || { echo "house style: engine/base/errors.hpp is not in the style" >&2; exit 1; }
+    sed '0,/^namespace/s/^namespace/ namespace/' "$dir/in_style.hpp" > "$dir/planted.hpp"
+    if "$format" --dry-run --Werror "$dir/planted.hpp" 2> /dev/null; then
+      echo "house style: the check passed a file out of style" >&2
+      exit 1
+    fi
+    echo "house style: the check refuses a file out of style"
+    ;;
+  *)
+    echo "usage: scripts/house-style.sh [--fix|--planted]" >&2
+    exit 2
+    ;;
+esac
