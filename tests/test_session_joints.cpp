@@ -128,25 +128,33 @@ Session simulate_joint_session(const char* preset, const std::string& trajectory
   return session;
 }
 
+/// Where `record` keeps `column` for joint `joint`: the joint's own, the record's shared one, or
+/// nothing (the correction learned, a column of IterationData).
+template <typename Joint>
+const Eigen::VectorXd* column_values(const TrialRecord& record, const Joint& of_joint,
+                                     const RecordColumn<Joint>& column) {
+  if (column.member != nullptr) return &(of_joint.*column.member);
+  if (column.shared != nullptr) return &(record.*column.shared);
+  return nullptr;
+}
+
 /// `a` and `b` agree as a file keeps them: angles through degrees (an ulp at most), the rest exactly.
+template <typename Joint>
+void expect_columns_equal(const TrialRecord& a, const Joint& a_joint, const TrialRecord& b, const Joint& b_joint,
+                          const std::vector<RecordColumn<Joint>>& columns, int joint) {
+  for (const RecordColumn<Joint>& column : columns) {
+    const Eigen::VectorXd* x = column_values(a, a_joint, column);
+    const Eigen::VectorXd* y = column_values(b, b_joint, column);
+    if (x == nullptr || y == nullptr) continue;
+    ASSERT_EQ(x->size(), y->size()) << column.name << " of joint " << joint + 1;
+    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
+    EXPECT_LE((*x - *y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
+  }
+}
+
 void expect_columns_equal(const TrialRecord& a, const TrialRecord& b, int joint) {
-  const TrialSamples& s = a.joint_samples(joint);
-  const TrialSamples& t = b.joint_samples(joint);
-  for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
-    if (column.member == nullptr) continue;
-    const Eigen::VectorXd& x = s.*column.member;
-    const Eigen::VectorXd& y = t.*column.member;
-    ASSERT_EQ(x.size(), y.size()) << column.name << " of joint " << joint + 1;
-    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
-    EXPECT_LE((x - y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
-  }
-  for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
-    const Eigen::VectorXd& x = a.joint_ticks(joint).*column.member;
-    const Eigen::VectorXd& y = b.joint_ticks(joint).*column.member;
-    ASSERT_EQ(x.size(), y.size()) << column.name << " of joint " << joint + 1;
-    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
-    EXPECT_LE((x - y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
-  }
+  expect_columns_equal(a, a.joint_samples(joint), b, b.joint_samples(joint), samples_record_columns(), joint);
+  expect_columns_equal(a, a.joint_ticks(joint), b, b.joint_ticks(joint), telemetry_record_columns(), joint);
 }
 
 /// The header line of `file`.

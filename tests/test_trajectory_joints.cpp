@@ -90,7 +90,8 @@ TEST(TrajectoryJoints, Paper3AddsTheWristDoingThePapersMovesLater) {
   EXPECT_EQ(paper3.joint(0), paper2.joint(0));
   EXPECT_EQ(paper3.joint(1), paper2.joint(1));
   // The wrist is the paper 0.3 s (15 samples) later, at +-30 deg.
-  const Eigen::VectorXd& paper = library_trajectory("paper", kSample_s).joint(0);
+  const Trajectory paper_trajectory = library_trajectory("paper", kSample_s);
+  const Eigen::VectorXd& paper = paper_trajectory.joint(0);  // (a reference into a temporary would dangle)
   const Eigen::VectorXd& wrist = paper3.joint(2);
   for (Eigen::Index k = 0; k < wrist.size(); ++k) {
     EXPECT_NEAR(wrist(k), k < 15 ? 0.0 : paper(k - 15), 1e-9) << "sample " << k;
