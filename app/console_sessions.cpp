@@ -23,9 +23,12 @@ constexpr const char* kConsoleLogKind = "console-log";
 
 /// What of the console's log belongs in a session: not a trial's routine state changes, nor the
 /// learner's lines (the iterations themselves are saved with their results).
-bool worth_saving(const ui::LogEntry& e) { return !e.routine && e.source != ui::LogSource::kLearner; }
+bool worth_saving(const ui::LogEntry& e) {
+  return !e.routine && (e.source != ui::LogSource::kLearner || !e.event_kind.empty());
+}
 
 std::string kind_of(const ui::LogEntry& e) {
+  if (!e.event_kind.empty()) return e.event_kind;
   if (e.important && e.text.rfind("FAULT", 0) == 0) return "fault";
   return ui::to_string(e.source);
 }
@@ -33,7 +36,8 @@ std::string kind_of(const ui::LogEntry& e) {
 ui::LogSource source_of(const std::string& name) {
   if (name == "operator") return ui::LogSource::kOperator;
   if (name == "engine" || name == "fault") return ui::LogSource::kEngine;
-  if (name == "learner") return ui::LogSource::kLearner;
+  if (name == "learner" || name == ui::kModelRefitEvent) return ui::LogSource::kLearner;
+  if (name == "device") return ui::LogSource::kDevice;
   return ui::LogSource::kSession;
 }
 
@@ -67,14 +71,28 @@ std::vector<ui::LogEntry> log_of(const SessionManifest& m) {
         const auto colon = line.find(": ", from);
         if (line.size() < 10 || colon == std::string::npos) continue;
         const std::string source = line.substr(from, colon - from);
-        out.push_back({line.substr(0, 8), engine_time_s, source_of(source), line.substr(colon + 2), source == "fault",
-                       false, e.time_utc, e.iteration});
+        out.push_back({line.substr(0, 8),
+                       engine_time_s,
+                       source_of(source),
+                       line.substr(colon + 2),
+                       source == "fault",
+                       false,
+                       e.time_utc,
+                       e.iteration,
+                       {}});
       }
       continue;
     }
     const bool known = e.kind == "operator" || e.kind == "engine" || e.kind == "session" || e.kind == "fault";
-    out.push_back({local_clock_of(e.time_utc), e.engine_time_s, source_of(e.kind),
-                   known ? e.message : e.kind + ": " + e.message, e.kind == "fault", false, e.time_utc, e.iteration});
+    out.push_back({local_clock_of(e.time_utc),
+                   e.engine_time_s,
+                   source_of(e.kind),
+                   known ? e.message : e.kind + ": " + e.message,
+                   e.kind == "fault",
+                   false,
+                   e.time_utc,
+                   e.iteration,
+                   {}});
   }
   return out;
 }
@@ -190,7 +208,11 @@ std::string StoreSessionGateway::save(const ui::SessionSnapshot& snapshot) {
     std::string lines;
     for (std::size_t i = first_new; i < held; ++i) {
       const ui::LogEntry& entry = snapshot.events[i];
-      if (worth_saving(entry)) {
+      if (worth_saving(entry) && !entry.event_kind.empty()) {  // an event of its own, in its place
+        if (!lines.empty()) writer_->record_event(kConsoleLogKind, lines);
+        lines.clear();
+        writer_->record_event(entry.event_kind, entry.text);
+      } else if (worth_saving(entry)) {
         lines += entry.clock + " ";
         if (entry.engine_time_s >= 0.0) {
           char stamp[40];
@@ -336,8 +358,15 @@ ui::SessionSnapshot StoreSessionGateway::open(const std::string& location) {
   snapshot.events = log_of(m);
   if (const std::string dropped = dropped_line(loaded); !dropped.empty()) {  // the writer removed it: say so once
     const std::string now = utc_now();
-    snapshot.events.push_back({local_clock_of(now), -1.0, ui::LogSource::kSession, dropped, true, false, now,
-                               static_cast<int>(loaded.iterations.size())});
+    snapshot.events.push_back({local_clock_of(now),
+                               -1.0,
+                               ui::LogSource::kSession,
+                               dropped,
+                               true,
+                               false,
+                               now,
+                               static_cast<int>(loaded.iterations.size()),
+                               {}});
   }
   snapshot.events_total = snapshot.events.size();
   writer_.reset();

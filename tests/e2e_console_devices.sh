@@ -50,7 +50,9 @@ device_setup() {
          "$BELLOWS" io-sim --rt off --config "$E2E_DIR/lcm-rig.toml" >"$E2E_DIR/io-sim.out" 2>&1 & RIG_PID=$!
          DEVICE_ARGS=(--device lcm --config "$E2E_DIR/lcm-rig.toml") ;;
     # Loopback only, on a free port: t7-sim says which one it got on its first line.
-    t7)  "$BELLOWS" t7-sim --listen 127.0.0.1:0 >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
+    # One answer 0.6 s late, 1 s after connecting: the link's lines (it stopped answering, it answers
+    # again) go to the console's log, not across the screen.
+    t7)  "$BELLOWS" t7-sim --listen 127.0.0.1:0 --stall-after 1 --stall-s 0.6 >"$E2E_DIR/t7-sim.out" 2>&1 & RIG_PID=$!
          local port="" tries=0
          while [ -z "$port" ]; do
            port="$(grep -oE 'on 127\.0\.0\.1:[0-9]+' "$E2E_DIR/t7-sim.out" | head -1 | cut -d: -f2 || true)"
@@ -78,6 +80,13 @@ for device in "${DEVICES[@]}"; do
   e2e_wait_for 'Bellows +SAFE '
   e2e_wait_for "(device )?$device: ok"
   e2e_wait_for 'law [a-z-]+  M'
+  if [ "$device" = t7 ]; then
+    e2e_keys l
+    e2e_wait_for 'device +t7 link 127\.0\.0\.1:[0-9]+ answers again'
+    ! e2e_screen | grep -qF 'bellows: t7 link' || e2e_fail "t7: the link's stderr lines were painted over the screen"
+    e2e_keys Escape
+    e2e_wait_for '─ Live ─'
+  fi
 
   # Arm, one iteration.
   e2e_keys a
@@ -140,7 +149,16 @@ for device in "${DEVICES[@]}"; do
   fi
 
   # The session reopens in the console, on the device it was made on.
-  e2e_start 120 40 -- console --session "$session" $([ "$device" = sim ] && echo --speed 2)
+  # With the device's loaded-machine settings again: a session brings back its device and its arm,
+  # not the link's timeouts nor the guards (the console's --config gives them).
+  reopen_args=()
+  case "$device" in
+    sim) reopen_args=(--speed 2) ;;
+    *) for ((i = 0; i < ${#DEVICE_ARGS[@]}; ++i)); do
+         [ "${DEVICE_ARGS[$i]}" = --config ] && reopen_args=(--config "${DEVICE_ARGS[$((i + 1))]}")
+       done ;;
+  esac
+  e2e_start 120 40 -- console --session "$session" "${reopen_args[@]}"
   e2e_wait_for 'it(eration)? 0  RMS'  # its one iteration, 0
   e2e_wait_for "(device )?$device: ok"
   e2e_quit

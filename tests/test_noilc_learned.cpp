@@ -10,6 +10,7 @@
 
 #include "devices/simulated_arm.hpp"
 #include "engine/base/errors.hpp"
+#include "engine/config/joint_learning_factory.hpp"
 #include "engine/config/learning_law_factory.hpp"
 #include "engine/learning/closed_loop_model.hpp"
 #include "engine/learning/noilc_learned.hpp"
@@ -127,6 +128,41 @@ TEST(NoilcLearned, RefitFindsTheCorrectionThatTheTrialsShow) {
   EXPECT_GT(law.last_report().prior_miss, 0.01);  // the prior alone mispredicts what the plant does
   EXPECT_NE(law.take_note().find("model refit from trial 4"), std::string::npos);
   EXPECT_TRUE(law.take_note().empty());  // said once
+}
+
+// What the console shows beside the RMS: each trial against the prediction of the model that planned
+// it, from the second update on (the first has no earlier trial), as the law's own report says.
+TEST(NoilcLearned, ModelCheckIsTheTrialAgainstItsModelsPredictionFromTheSecondUpdateOn) {
+  const ClosedLoopPrior prior = paper_prior();
+  const int n = 100;
+  NoilcLearnedLaw law(prior, {}, n);
+  const Eigen::VectorXd e0 = 0.1 * random_vector(n, 1.0, 5);
+  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(n), u1(n), u2(n);
+  law.update(u0, e0, u1);
+  EXPECT_FALSE(law.model_check().has_value());
+  law.update(u1, 0.5 * e0, u2);
+  const std::optional<ModelCheck> check = law.model_check();
+  ASSERT_TRUE(check.has_value());
+  const LearnedNoilcReport& report = law.core().last_report();
+  EXPECT_EQ(check->trial, 2);
+  EXPECT_EQ(check->predicted_change, report.predicted_change);
+  EXPECT_EQ(check->measured_change, report.measured_change);
+  EXPECT_DOUBLE_EQ(check->measured_change, (0.5 * e0).norm());
+  EXPECT_EQ(check->miss, report.prediction_miss);
+  EXPECT_EQ(check->refitted, report.refitted);
+  // A law without a model that learns has none; one joint's wrapper forwards the law's.
+  const auto plain = make_joint_learning(Configuration{}, paper_model(), 1, n);  // law = noilc
+  Eigen::MatrixXd p1(n, 1), p2(n, 1);
+  plain->update(Eigen::MatrixXd::Zero(n, 1), e0, p1);
+  plain->update(p1, 0.5 * e0, p2);
+  EXPECT_FALSE(plain->model_check().has_value());
+  Configuration learned;
+  learned.ilc.law = "noilc-learned";
+  const auto wrapped = make_joint_learning(learned, paper_model(), 1, n);
+  Eigen::MatrixXd w1(n, 1), w2(n, 1);
+  wrapped->update(Eigen::MatrixXd::Zero(n, 1), e0, w1);
+  wrapped->update(w1, 0.5 * e0, w2);
+  EXPECT_TRUE(wrapped->model_check().has_value());
 }
 
 TEST(NoilcLearned, ATrialThatGotWorseFallsBackToThePriorAndTheBestTrial) {

@@ -258,7 +258,8 @@ TEST(UiRender, TuningLogAndSessionScreens) {
   s.tuning.selected = 1;
   s.convergence = "may diverge: contraction 3.6 > 1 at 4.38 Hz";
   s.convergence_warning = true;
-  s.log.add({"12:01:00", 2.0, LogSource::kOperator, "k_p changed 0.3 -> 0.4 ([controller] k_p)", false, false, "", 0});
+  s.log.add(
+      {"12:01:00", 2.0, LogSource::kOperator, "k_p changed 0.3 -> 0.4 ([controller] k_p)", false, false, "", 0, {}});
   std::string text = all(render_lines(s));
   EXPECT_NE(text.find("> k_p            0.3"), std::string::npos) << text;
   EXPECT_NE(text.find("  W            2e-05"), std::string::npos) << text;

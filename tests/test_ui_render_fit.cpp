@@ -62,7 +62,7 @@ TEST(UiRenderFit, TheLogScreenWrapsLongEntries) {
   const std::string long_text =
       "learning law 'noilc' may diverge if the arm differs from the model by up to 30 %: contraction 3.606 > 1 "
       "at 4.38 Hz for kappa x1.30, omega0 x1.30 (11 of 25 grid points; nominal 0.750) END";
-  s.log.add({"12:00:03", 2.0, LogSource::kLearner, long_text, true, false, "", 0});
+  s.log.add({"12:00:03", 2.0, LogSource::kLearner, long_text, true, false, "", 0, {}});
   const std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("learning law 'noilc' may diverge"), std::string::npos) << screen;
   EXPECT_NE(screen.find("END"), std::string::npos) << screen;

@@ -50,8 +50,15 @@ TEST(UiRenderLayout, TheLogPanelUsesTheWidthAWideWindowHas) {
   ConsoleState s = sample_state(3, true);
   s.width = 200;
   s.height = 60;
-  s.log.add(
-      {"12:00:03", 2.0, LogSource::kOperator, "a log line that a 200 column window shows whole", false, false, "", 0});
+  s.log.add({"12:00:03",
+             2.0,
+             LogSource::kOperator,
+             "a log line that a 200 column window shows whole",
+             false,
+             false,
+             "",
+             0,
+             {}});
   const std::string screen = all(render_lines(s));
   EXPECT_TRUE(layout_has(screen, "a log line that a 200 column window shows whole"))
       << screen;  // cut at 29 columns before

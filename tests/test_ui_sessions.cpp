@@ -11,6 +11,8 @@
 #include "sessions/session_store.hpp"
 #include "tests/console_fixture.hpp"
 #include "tests/process_runner.hpp"
+#include "ui/canvas.hpp"
+#include "ui/render.hpp"
 
 namespace bellows {
 namespace {
@@ -328,6 +330,51 @@ TEST_F(UiSessions, ASessionStartedFromATransferRecordsWhereItsFirstCorrectionCam
   }
   // A session that started with feedback only records none.
   EXPECT_TRUE(load_manifest(taught).first_correction.is_null());
+}
+
+// A law that learns its model (noilc-learned, issue 27): each trial from the second on carries how far
+// it was from its model's prediction, the RMS list shows it, and each refit is a session event of its
+// own ("model-refit", as `bellows run` records it). The paper's law shows and records none.
+TEST_F(UiSessions, ALawThatLearnsItsModelShowsEachTrialAgainstItsPredictionAndSavesEachRefit) {
+  StoreSessionGateway gateway("sim");
+  Configuration config;
+  config.ilc.law = "noilc-learned";
+  ConsoleFixture f(config, 3, &gateway);
+  f.arm_valves();
+  f.run_batch(3);  // iterations 0..3: learned after 0, 1 and 2
+  save_and_wait(f);
+  const auto& trials = f.state().experiment.trials;
+  ASSERT_EQ(trials.size(), 4u);
+  EXPECT_FALSE(trials[0].model_check.has_value());  // the first update has nothing to compare with
+  for (int i = 1; i <= 2; ++i) {
+    const auto& check = trials[static_cast<std::size_t>(i)].model_check;
+    ASSERT_TRUE(check.has_value()) << "iteration " << i;
+    EXPECT_GT(check->measured_change, 0.0);
+    EXPECT_GT(check->predicted_change, 0.0);
+    EXPECT_GE(check->miss, 0.0);
+  }
+  ui::Canvas canvas(f.state().width, f.state().height);
+  ui::render(f.state(), canvas);
+  EXPECT_NE(canvas.text().find("  it       RMS   miss"), std::string::npos) << canvas.text();
+  const std::string location = f.state().experiment.session_location;
+  f.console.reset();
+  int refits = 0;
+  for (const SessionEvent& e : load_manifest(location).events) {
+    if (e.kind == "model-refit") {
+      ++refits;
+      EXPECT_EQ(e.message.rfind("noilc-learned: ", 0), 0u) << e.message;
+    }
+    EXPECT_EQ(e.message.find("model-refit"), std::string::npos) << "in a console-log line: " << e.message;
+  }
+  EXPECT_EQ(refits, 2);  // the updates after iterations 1 and 2 (the first refits nothing)
+
+  ConsoleFixture paper(Configuration{}, 3);
+  paper.arm_valves();
+  paper.run_batch(2);
+  for (const ui::Trial& t : paper.state().experiment.trials) EXPECT_FALSE(t.model_check.has_value());
+  ui::Canvas plain(paper.state().width, paper.state().height);
+  ui::render(paper.state(), plain);
+  EXPECT_EQ(plain.text().find("RMS   miss"), std::string::npos);
 }
 
 }  // namespace

@@ -72,9 +72,9 @@ inline ConsoleState sample_state(int trials, bool unicode) {
   s.live.reading.supply_bar = 3.0;
   s.live.valves.joint[0].inlet_duty = {0.5, 0.0};
   s.live.valves.joint[0].outlet_duty = {0.0, 0.25};
-  s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false, "", 0});
-  s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false, "", 0});
-  s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true, "", 0});
+  s.log.add({"12:00:00", 0.0, LogSource::kOperator, "console started", false, false, "", 0, {}});
+  s.log.add({"12:00:01", 0.5, LogSource::kEngine, "SAFE -> ARMED (arm)", false, false, "", 0, {}});
+  s.log.add({"12:00:02", 1.0, LogSource::kEngine, "ARMED -> RUNNING (start trial)", false, true, "", 0, {}});
   s.status = "hello operator";
   return s;
 }

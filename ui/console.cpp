@@ -7,6 +7,7 @@
 #include "ui/frame_pacer.hpp"
 #include "ui/keys.hpp"
 #include "ui/render.hpp"
+#include "ui/stderr_capture.hpp"
 #include "ui/terminal.hpp"
 
 namespace bellows::ui {
@@ -95,6 +96,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   // Declared before the loop stopper: the controller owns the buffers of a running trial, so it
   // must outlive the engine loop however this function ends.
   std::optional<ConsoleController> controller;
+  StderrCapture device_lines;  // declared before the terminal: given back after the screen is
   std::optional<Terminal> terminal;
   terminal.emplace(setup.allow_colors);  // throws InputError without a terminal, before the loop runs
   try {
@@ -131,6 +133,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
       key = terminal->read_key(0);
     }
     const double now = monotonic_s();
+    for (std::string& line : device_lines.drain()) controller->device_said(std::move(line));
     controller->update(now);
     if (simulated && simulated->advance(*controller, now)) controller->update(monotonic_s());
     if (setup.stop_flag != nullptr && setup.stop_flag->load(std::memory_order_relaxed)) {
@@ -169,6 +172,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   if (valves_live(setup.core->state())) setup.core->request_emergency_stop();  // never leave them live
   if (setup.simulated_clock != nullptr && !setup.core->emergency_stop_delivered()) setup.simulated_clock->step(1);
   // Vented; now what is not on disk yet (the last log lines, a black box) goes there.
+  for (std::string& line : device_lines.drain()) controller->device_said(std::move(line));
   while (!controller->saves_settled() && monotonic_s() - quit_s < kFinalSaveWaitS) {
     terminal->read_key(10);
     controller->update(monotonic_s());
@@ -183,6 +187,7 @@ ConsoleReport run_console(ConsoleSetup setup) {
   report.ui_cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID) - cpu_start_s;
   if (loop != nullptr) loop->stop();
   terminal.reset();
+  device_lines.restore();  // the device's last words (the link's final vent), on the normal screen
   if (loop != nullptr) report.loop = loop->latency();
   report.ticks = setup.core->ticks();
   report.dropped_events = setup.core->dropped_events();

@@ -73,9 +73,27 @@ void ConsoleController::log(LogSource source, std::string text, bool important, 
     // the last snapshot, and the log's times never run backwards.
     engine_time_s = state_.live_valid ? std::max(state_.live.time_s, newest_event_s_) : newest_event_s_;
   }
-  state_.log.add({env_.clock_text(), engine_time_s, source, std::move(text), important, routine, utc_timestamp(),
-                  state_.experiment.next_iteration()});
+  state_.log.add({env_.clock_text(),
+                  engine_time_s,
+                  source,
+                  std::move(text),
+                  important,
+                  routine,
+                  utc_timestamp(),
+                  state_.experiment.next_iteration(),
+                  {}});
   ++revision_;
+}
+
+void ConsoleController::log_event(const char* kind, LogSource source, std::string text) {
+  log(source, std::move(text));
+  state_.log.set_last_event_kind(kind);
+}
+
+void ConsoleController::device_said(std::string line) {
+  constexpr std::string_view kPrefix = "bellows: ";  // the program's name, which a log line needs not
+  if (line.rfind(kPrefix, 0) == 0) line.erase(0, kPrefix.size());
+  log(LogSource::kDevice, std::move(line));
 }
 
 void ConsoleController::set_status(std::string text, bool important) {

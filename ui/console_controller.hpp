@@ -100,6 +100,9 @@ class ConsoleController {
   void handle_key(int key, double now_s);
   /// Heartbeat, engine events, snapshot, telemetry, background tasks, loop statistics.
   void update(double now_s);
+  /// A line the device's I/O thread wrote to stderr (a rig link that stopped answering, and that
+  /// it answers again): into the log, as the device's, instead of across the screen.
+  void device_said(std::string line);
   void resize(int width, int height);
   /// Latches the engine's emergency stop (vents in its next tick, whatever its queue holds) and
   /// stops any trials. Never waits: the status says "vented" once the engine has acted.
@@ -161,6 +164,8 @@ class ConsoleController {
   void log(LogSource source, std::string text, bool important = false, double engine_time_s = -2.0,
            bool routine = false);
   void set_status(std::string text, bool important = false);
+  /// As log(), saved as a session event of `kind` (not a console-log line).
+  void log_event(const char* kind, LogSource source, std::string text);
 
   // Operator side (console_keys.cpp).
   bool handle_dialog_key(int key);
@@ -272,7 +277,12 @@ class ConsoleController {
     LearnedWith learned_with;  // the law and weights it was built with
   };
   BackgroundTask<BuiltLaw> law_build_;
-  BackgroundTask<Eigen::MatrixXd> law_update_;
+  struct LawUpdate {
+    Eigen::MatrixXd next;                   // the correction learned
+    std::string note;                       // what the law said (a model refit): a session event
+    std::optional<ModelCheck> model_check;  // the trial against its model's prediction
+  };
+  BackgroundTask<LawUpdate> law_update_;
   BackgroundTask<std::string> save_task_;
   BackgroundTask<std::string> rename_task_;
   BackgroundTask<std::vector<SessionListing>> list_task_;

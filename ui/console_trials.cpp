@@ -75,9 +75,11 @@ void ConsoleController::poll_tasks() {
   }
   if (law_update_.ready()) {
     try {
-      Eigen::MatrixXd next = law_update_.take();
+      LawUpdate done = law_update_.take();
       const int from = state_.experiment.trials.back().iteration;
-      state_.experiment.set_next(std::move(next), "learned from " + std::to_string(from), updating_learned_with_);
+      state_.experiment.trials.back().model_check = done.model_check;
+      if (!done.note.empty()) log_event(kModelRefitEvent, LogSource::kLearner, std::move(done.note));
+      state_.experiment.set_next(std::move(done.next), "learned from " + std::to_string(from), updating_learned_with_);
       log(LogSource::kLearner, format("new correction learned from iteration %d (max %.4f bar)", from,
                                       state_.experiment.next_correction_bar.cwiseAbs().maxCoeff()));
       state_.run.phase = RunProgress::Phase::kNone;
@@ -284,9 +286,11 @@ void ConsoleController::step() {
   law_update_.start([law = law_.get(), u = last.correction_bar, error = last.record.normalized_joint_errors(),
                      feedback = std::move(feedback), input_limit_bar] {
     law->set_input_context(feedback, input_limit_bar);  // laws that respect the pressure limits use it
-    Eigen::MatrixXd next(u.rows(), u.cols());
-    law->update(u, error, next);
-    return next;
+    LawUpdate done{Eigen::MatrixXd(u.rows(), u.cols()), {}, {}};
+    law->update(u, error, done.next);
+    done.note = law->take_note();
+    done.model_check = law->model_check();
+    return done;
   });
   ++revision_;
 }

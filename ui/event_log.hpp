@@ -11,7 +11,7 @@
 
 namespace bellows::ui {
 
-enum class LogSource { kOperator, kEngine, kLearner, kSession };
+enum class LogSource { kOperator, kEngine, kLearner, kSession, kDevice };
 
 const char* to_string(LogSource source);
 
@@ -24,7 +24,12 @@ struct LogEntry {
   bool routine = false;    // a trial's own state changes: only on the log screen
   std::string time_utc;    // ISO 8601 ("2024-05-01T12:00:00.123Z"), for saved sessions
   int iteration = 0;       // the iteration next to run when it happened
+  std::string event_kind;  // saved as a session event of its own kind ("model-refit"); empty: a
+                           // line of the console-log event (or not saved: LogSource::kLearner)
 };
+
+/// The kind of session event a law's note is saved as (what `bellows run` records too).
+inline constexpr const char* kModelRefitEvent = "model-refit";
 
 /// The current time as ISO 8601 UTC with milliseconds.
 std::string utc_timestamp();
@@ -38,6 +43,9 @@ class EventLog {
     ++total_;
   }
   const std::deque<LogEntry>& entries() const { return entries_; }
+  void set_last_event_kind(std::string kind) {
+    if (!entries_.empty()) entries_.back().event_kind = std::move(kind);
+  }
   std::size_t total() const { return total_; }  // ever added, for "new entries" checks
 
  private:
@@ -69,6 +77,8 @@ inline const char* to_string(LogSource source) {
       return "learner";
     case LogSource::kSession:
       return "session";
+    case LogSource::kDevice:
+      return "device";
   }
   return "?";
 }

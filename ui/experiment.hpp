@@ -6,6 +6,7 @@
 
 #include <any>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,13 +22,15 @@ namespace bellows::ui {
 
 struct Trial {
   int iteration = 0;
-  Eigen::MatrixXd correction_bar;  // u_ilc(0..N-1) the trial applied, one column per joint (N x J);
-                                   // empty once released
-  TrialRecord record;              // empty once released (saved, and older than the kept window)
-  IterationSummary summary;        // rms_deg over every joint and sample, joint_rms_deg per joint
-  std::string origin;              // "feedback only", "learned from 3", "correction of 2", "loaded"
-  std::any end_state;              // --clock sim: the engine's and arm's state at its end (saved for an
-                                   // exact resume; the app's type, opaque here); empty: none
+  Eigen::MatrixXd correction_bar;         // u_ilc(0..N-1) the trial applied, one column per joint (N x J);
+                                          // empty once released
+  TrialRecord record;                     // empty once released (saved, and older than the kept window)
+  IterationSummary summary;               // rms_deg over every joint and sample, joint_rms_deg per joint
+  std::string origin;                     // "feedback only", "learned from 3", "correction of 2", "loaded"
+  std::optional<ModelCheck> model_check;  // the law's model against this trial (laws that learn
+                                          // their model); the session's model-refit events hold it
+  std::any end_state;                     // --clock sim: the engine's and arm's state at its end (saved for an
+                                          // exact resume; the app's type, opaque here); empty: none
 
   /// False once its record and correction were released: they are in the session on disk only.
   bool in_memory() const { return record.learning_samples > 0; }

@@ -139,14 +139,18 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
   }
   // With several joints: the RMS over every joint and sample, then each joint's (docs/console.md).
   const int joints = s.experiment.joints();
-  const int list_width = joints > 1 ? 13 + 7 * joints : 15;  // "%4d %9.3f" and the best mark '*'
+  // A law that learns its model (noilc-learned): how far each trial's measured change of error was
+  // from what the model that planned it predicted, beside the RMS (docs/console.md).
+  const bool model_checks = std::any_of(trials.begin(), trials.end(), [](const Trial& t) { return t.model_check; });
+  const int check_width = model_checks ? 6 : 0;                              // " %4.0f%%"
+  const int list_width = (joints > 1 ? 13 + 7 * joints : 15) + check_width;  // "%4d %9.3f" and the best mark '*'
   const Rect list{in.right() - list_width, in.y, list_width, in.height};
   if (joints > 1) {
     std::string head = "  it     all ";
     for (int j = 0; j < joints; ++j) head += format("     j%d", j + 1);
-    c.put(list.x, list.y, head, Role::kDim);
+    c.put(list.x, list.y, head + (model_checks ? "  miss" : ""), Role::kDim);
   } else {
-    c.put(list.x, list.y, "  it       RMS ", Role::kDim);
+    c.put(list.x, list.y, model_checks ? "  it       RMS   miss" : "  it       RMS ", Role::kDim);
   }
   const int rows = list.height - 1;
   const int count = static_cast<int>(trials.size());
@@ -158,6 +162,10 @@ void render_rms(const ConsoleState& s, Canvas& c, const Rect& area, const Glyphs
                                   : format("%4d %9.3f%s", t.iteration, t.summary.rms_deg, is_best ? "*" : "");
     for (int j = 0; joints > 1 && j < joints; ++j) {
       line += j < t.summary.joint_rms_deg.size() ? format("%7.3f", t.summary.joint_rms_deg(j)) : std::string("      -");
+    }
+    if (model_checks) {
+      if (joints == 1 && !is_best) line += " ";
+      line += t.model_check ? format(" %4.0f%%", 100.0 * std::min(t.model_check->miss, 99.99)) : std::string("     -");
     }
     c.put(list.x, y, line, i == count - 1 ? Role::kNormal : Role::kDim, i == count - 1, list.right());
   }

@@ -93,6 +93,7 @@ class JointNormOptimalLearned final : public JointLearning {
   int samples() const override { return core_.samples(); }
   int joints() const override { return core_.joints(); }
   std::string take_note() override { return core_.take_note(); }
+  std::optional<ModelCheck> model_check() const override { return core_.model_check(); }
 
  private:
   LearnedModelNoilc core_;

@@ -35,6 +35,8 @@ class JointLearning {
   virtual const LearningLaw* single_joint_law() const { return nullptr; }
   /// As LearningLaw::take_note: a note for the session's events since the last call, then forgotten.
   virtual std::string take_note() { return {}; }
+  /// As LearningLaw::model_check, over every joint.
+  virtual std::optional<ModelCheck> model_check() const { return std::nullopt; }
 };
 
 /// One joint: `law` on the only column, exactly as the single-joint product has always learned.
@@ -52,6 +54,7 @@ class SingleJointLearning final : public JointLearning {
   void set_held_outputs(const std::vector<unsigned char>& held) override { law_.set_held_outputs(held); }
   const LearningLaw* single_joint_law() const override { return &law_; }
   std::string take_note() override { return law_.take_note(); }
+  std::optional<ModelCheck> model_check() const override { return law_.model_check(); }
 
  private:
   std::unique_ptr<LearningLaw> owned_;  // null when borrowed

@@ -19,6 +19,18 @@ struct LawFrequencyResponse {
   std::complex<double> from_error;
 };
 
+/// How well the model that planned a trial's correction predicted what the trial did: for laws that
+/// learn their model from the trials (noilc-learned), from their second update on. Norms over the
+/// trial's samples (and joints) of the normalized error e = (yD - y) / pi.
+struct ModelCheck {
+  int trial = 0;                  // the law's updates so far: the check is of the trial the last one read
+  double predicted_change = 0.0;  // ||P_model (u_j - u_{j-1})||: the change of output the model predicted
+  double measured_change = 0.0;   // ||e_{j-1} - e_j||: the change the trial showed
+  double miss = 0.0;              // ||measured - predicted|| / ||measured||
+  bool refitted = false;          // the model was refit from the trial
+  bool fell_back = false;         // the trial got worse: the model fell half way back to its prior
+};
+
 class LearningLaw {
  public:
   virtual ~LearningLaw() = default;
@@ -48,6 +60,10 @@ class LearningLaw {
   /// What the law has to say for the session's events since the last call (a model refit, a fall-back),
   /// then forgotten; empty for laws that never say anything.
   virtual std::string take_note() { return {}; }
+
+  /// After update(): the last trial against its model's prediction; empty for laws without a model
+  /// that learns (and before their second update).
+  virtual std::optional<ModelCheck> model_check() const { return std::nullopt; }
 };
 
 }  // namespace bellows

@@ -210,6 +210,12 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
   has_context_ = false;
 }
 
+std::optional<ModelCheck> LearnedModelNoilc::model_check() const {
+  if (report_.trial < 2) return std::nullopt;  // the first update has no earlier trial to compare with
+  return ModelCheck{report_.trial,           report_.predicted_change, report_.measured_change,
+                    report_.prediction_miss, report_.refitted,         report_.fell_back};
+}
+
 std::string LearnedModelNoilc::take_note() {
   std::string note;
   note.swap(note_);

@@ -81,6 +81,8 @@ class LearnedModelNoilc {
   const Eigen::MatrixXd& correction() const { return correction_; }
   /// The note for the session's events since the last call (empty if none), then cleared.
   std::string take_note();
+  /// As LearningLaw::model_check: from the last report, from the second update on.
+  std::optional<ModelCheck> model_check() const;
   /// As LearningLaw::set_input_context, N x J: before update(); marks the outputs the pressure limit
   /// shaped in this trial as not learnable.
   void set_input_context(const Eigen::Ref<const Eigen::MatrixXd>& feedback_bar, double input_limit_bar);
@@ -135,6 +137,7 @@ class NoilcLearnedLaw final : public LearningLaw {
   std::string name() const override { return "noilc-learned"; }
   int samples() const override { return core_.samples(); }
   std::string take_note() override { return core_.take_note(); }
+  std::optional<ModelCheck> model_check() const override { return core_.model_check(); }
   const LearnedModelNoilc& core() const { return core_; }
 
  private:
