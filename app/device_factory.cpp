@@ -157,6 +157,7 @@ class T7Rig final : public OpenedDevice {
     return {{"t7", device_->address()},
             {"product", t7::to_string(device_->product())},
             {"late_answers", device_->late_answers()},
+            {"late_readings", device_->late_readings()},
             {"reconnects", device_->reconnects()},
             {"link_error", device_->link_error()}};
   }

@@ -306,6 +306,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
     report["dropped_events"] = core.dropped_events();
     report["dropped_telemetry"] = core.dropped_telemetry();
     if (const nlohmann::json lcm = io.report(); !lcm.is_null()) report["lcm"] = lcm;
+    if (io.device_parameters().kind == "t7") report["t7"] = io.opened().report();  // late answers and readings
     if (loop != nullptr) {
       const LatencySummary l = loop->latency();
       report["loop"] = {
@@ -316,6 +317,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
           {"latency_us", {{"p50", l.p50_us}, {"p99", l.p99_us}, {"max", l.max_us}}},
           {"rt", loop->rt_description()},
           {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
+          {"cpu_idle_not_held", idle_hold.why_not()},
           {"speed", options.speed}};
       if (const DeviceHealth h = device.health(); h.has_link) {  // the link's figures, e.g. the T7's Modbus round trip
         report["loop"]["link"] = {

@@ -84,7 +84,8 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   const T7SimStatus s = server.status();
   out << "t7-sim: " << s.requests << " requests answered, " << s.exceptions << " with an exception (" << s.refusals
       << " refused by LabJack's rules), " << s.watchdog_actions << " watchdog actions, at most " << s.max_clients
-      << " connections at once, " << s.refused_connections << " refused" << std::endl;
+      << " connections at once, " << s.refused_connections << " refused; " << s.late_answers
+      << " answers more than 0.5 ms after LabJack's time (at most " << s.answer_late_max_s * 1e3 << " ms)" << std::endl;
   return 0;
 }
 

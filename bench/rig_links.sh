@@ -93,6 +93,7 @@ print(f"{'PASS' if within else 'FAIL'} {device} load {load} run {run:>2}: exit {
       f"rms {' / '.join('%.3f' % x for x in rms):<30} {'within 15%' if within else 'OUTSIDE 15%'}  "
       f"missed {loop.get('missed', '?')} held ticks {loop.get('held_ticks', '?')} "
       f"samples {held} stale {link.get('stale_readings', '?')} link errors {link.get('errors', '?')} "
+      f"{'late readings used %s ' % r['t7'].get('late_readings', '?') if 't7' in r else ''}"
       f"rt p50/p99/max {rt.get('p50', 0):.2f}/{rt.get('p99', 0):.2f}/{rt.get('max', 0):.2f} ms  "
       f"loop wake-up max {loop.get('latency_us', {}).get('max', 0) / 1e3:.1f} ms  loadavg {loadavg}")
 sys.exit(0 if within else 1)

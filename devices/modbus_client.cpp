@@ -26,6 +26,10 @@ constexpr std::size_t kHeader = 7;  // MBAP: transaction, protocol, length, unit
 constexpr int kUnit = 0xFF;         // Modbus TCP's "no unit" (a T7 answers any)
 // How often a wait looks at the stop flag.
 constexpr double kStopSlice_s = 0.02;
+// An answer whose transaction id no request carried (issue 24's words: it is no exception the device sent).
+constexpr const char* kNeverSent =
+    "a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no "
+    "exception";
 
 const char* exception_name(int code) {
   switch (code) {
@@ -201,6 +205,7 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
   last_exception_ = 0;
   timed_out_ = false;
   interrupted_ = false;
+  late_read_.pending = false;  // this request's answer will be newer than a late read's
   const double start = monotonic_seconds();
   const double deadline = std::min(start + response_timeout_s_, deadline_s_);
   if (fd_ < 0) {  // the connection was lost: a new one (the old one is closed)
@@ -228,6 +233,7 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     const int got = receive_frame(deadline);
     if (got == 0) {
       timed_out_ = !interrupted_;
+      if (timed_out_ && function == kReadHolding) late_read_ = {true, tid, count};  // take_late_read()
       return fail(interrupted_ ? "interrupted"
                                : "no answer within " + milliseconds(std::max(0.0, deadline - start)) +
                                      " (the exchange's deadline)");
@@ -261,9 +267,7 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     // cannot be trusted (issue 24's words: it is no exception the device sent).
     const auto behind = static_cast<std::uint16_t>(tid - frame_tid);
     if (!mine && (behind == 0 || behind > 0x7fff)) {
-      lose_connection(
-          "a framing or transaction-id mismatch: the response does not answer any request sent; the device sent no "
-          "exception");
+      lose_connection(kNeverSent);
       return false;
     }
     if (!mine) {
@@ -272,6 +276,55 @@ bool ModbusClient::request(int function, int address, int count, const std::uint
     }
     return ok;
   }
+}
+
+bool ModbusClient::take_late_read(std::uint16_t* registers) {
+  while (late_read_.pending && fd_ >= 0) {
+    if (rx_size_ >= kHeader) {
+      const std::size_t length = get16(&rx_[4]);
+      if (get16(&rx_[2]) != 0 || length < 2 || length > 254) {
+        lose_connection("the T7's answer is not Modbus TCP (the stream lost its framing)");
+        return false;
+      }
+      if (rx_size_ >= 6 + length) {
+        const std::size_t frame = 6 + length;
+        const unsigned frame_tid = get16(&rx_[0]);
+        const std::uint8_t* pdu = &rx_[8];
+        const int count = late_read_.count;
+        const bool answers = frame_tid == late_read_.tid && rx_[7] == kReadHolding &&
+                             frame - 8 == 1 + 2 * static_cast<std::size_t>(count) && pdu[0] == 2 * count;
+        if (answers)
+          for (int i = 0; i < count; ++i) registers[i] = static_cast<std::uint16_t>(get16(pdu + 1 + 2 * i));
+        std::memmove(rx_.data(), rx_.data() + frame, rx_size_ - frame);
+        rx_size_ -= frame;
+        if (static_cast<std::uint16_t>(transaction_ - frame_tid) > 0x7fff) {  // never sent
+          lose_connection(kNeverSent);
+          return false;
+        }
+        if (answers) {
+          late_read_.pending = false;
+          ++late_reads_taken_;
+          return true;
+        }
+        ++late_answers_;  // another timed-out request's answer (or the read's exception): dropped
+        continue;
+      }
+    }
+    const ssize_t n = ::recv(fd_, rx_.data() + rx_size_, rx_.size() - rx_size_, MSG_DONTWAIT);
+    if (n > 0) {
+      rx_size_ += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n == 0) {
+      lose_connection("the T7 closed the connection");
+      return false;
+    }
+    if (errno == EINTR) continue;
+    if (errno != EAGAIN && errno != EWOULDBLOCK)
+      lose_connection(std::string("receiving failed: ") + std::strerror(errno));
+    return false;
+  }
+  return false;
 }
 
 bool ModbusClient::read(int address, int count, std::uint16_t* registers) {

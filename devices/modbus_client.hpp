@@ -63,8 +63,17 @@ class ModbusClient {
   bool interrupted() const { return interrupted_; }
   /// "host:port".
   const std::string& address() const { return address_; }
+  /// After a read timed out and before the next request: its answer, if it has come meanwhile
+  /// (never waits), into `registers` (as many as the read asked for). A reading that missed its
+  /// exchange's deadline is still a reading of the inputs a moment ago, and a late answer usually
+  /// comes well before the next tick: handed over, it costs no tick. Answers to other timed-out
+  /// requests are dropped as a request drops them. False while nothing came, after a newer request
+  /// or when the connection failed (the next request reconnects).
+  bool take_late_read(std::uint16_t* registers);
   /// Answers to earlier, timed-out requests read and discarded since the start.
   std::uint64_t late_answers() const { return late_answers_; }
+  /// Answers to timed-out reads that take_late_read() handed over since the start.
+  std::uint64_t late_reads_taken() const { return late_reads_taken_; }
   /// Connections opened again after one was lost.
   std::uint64_t reconnects() const { return reconnects_; }
 
@@ -94,6 +103,13 @@ class ModbusClient {
   bool timed_out_ = false;
   bool interrupted_ = false;
   std::uint64_t late_answers_ = 0;
+  std::uint64_t late_reads_taken_ = 0;
+  struct LateRead {
+    bool pending = false;  // the last request was a read that timed out, its answer not yet seen
+    std::uint16_t tid = 0;
+    int count = 0;
+  };
+  LateRead late_read_;
   std::uint64_t reconnects_ = 0;
 };
 

@@ -12,10 +12,11 @@
 // One exchange has one deadline, [t7] response_timeout_s for the write and the read together, so a
 // vent never waits behind a stuck exchange for longer than that. A failed or timed-out exchange
 // hands nothing over: the engine sees stale readings and, after [safety] stale_ticks of them,
-// faults and vents. A late answer is read and dropped by its transaction id on the same
-// connection (devices/modbus_client.hpp); only a lost connection is opened again, the old one
-// closed first. A Modbus exception names the register and LabJack's error (link_error()).
-// Without commands (the engine not running) the I/O thread vents after [t7] command_timeout_s and
+// faults and vents. A late answer is matched by its transaction id on the same connection
+// (devices/modbus_client.hpp): the late read's, when it comes before the next command, is still
+// handed over (a reading of a moment ago, usually in time for the next tick); any other is dropped.
+// Only a lost connection is opened again, the old one closed first. A Modbus exception names the register and LabJack's
+// error (link_error()). Without commands (the engine not running) the I/O thread vents after [t7] command_timeout_s and
 // keeps reading every tick, which keeps the watchdog fed and raw_inputs() live.
 #pragma once
 
@@ -92,6 +93,8 @@ class T7Device final : public Device {
   /// Answers to timed-out requests dropped by transaction id, and connections opened again.
   std::uint64_t late_answers() const { return late_answers_.load(std::memory_order_relaxed); }
   std::uint64_t reconnects() const { return reconnects_.load(std::memory_order_relaxed); }
+  /// Readings of exchanges that missed their deadline, handed over when their answer came after all.
+  std::uint64_t late_readings() const { return late_readings_.load(std::memory_order_relaxed); }
   /// A request the T7 refused during the run (a Modbus exception): once per refusal, its sentence
   /// naming the register and LabJack's error ("t7 HOST:PORT: writing DIO2_EF_CONFIG_A (44304)
   /// refused: ..., LabJack error 2565 EF_VALUE_GREATER_THAN_PERIOD"), for the engine's
@@ -119,6 +122,8 @@ class T7Device final : public Device {
   void configure_lines();
   void serve();
   bool exchange(const ValveCommand& valves);
+  /// The reading in ain_buffer_, answered at `end` (steady clock), to the engine.
+  void publish_reading(double end);
   void encode_duties(const ValveCommand& valves);
   void record_round_trip(double ms);
   void fail_link(const std::string& why);
@@ -144,6 +149,7 @@ class T7Device final : public Device {
   std::size_t round_trip_count_ = 0;
   double origin_s_ = 0.0;
   double last_time_s_ = 0.0;
+  double exchange_start_s_ = 0.0;  // the latest exchange's (a late reading's round trip counts from it)
 
   std::thread thread_;
   std::atomic<bool> stop_{false};
@@ -154,7 +160,8 @@ class T7Device final : public Device {
   std::atomic<bool> refusal_pending_{false};
   std::array<std::atomic<double>, kSensorRoleCount> volts_{};
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
-  std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0};
+  std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0},
+      late_readings_{0};
 };
 
 }  // namespace bellows

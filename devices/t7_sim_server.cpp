@@ -17,6 +17,7 @@
 
 #include <modbus/modbus.h>
 
+#include "devices/request_arrival.hpp"
 #include "devices/t7_errors.hpp"
 #include "devices/t7_registers.hpp"
 #include "devices/t7_sim_rules.hpp"
@@ -33,6 +34,11 @@ constexpr double kStatusPeriod_s = 0.01;
 constexpr double kArmStep_s = 0.0005;
 // Simultaneous Modbus TCP connections a T7 serves (T-Series datasheet 6.0 "Ethernet").
 constexpr int kMaxConnections = 2;
+// The last stretch before an answer is due is spent polling the clock rather than asleep: a sleep
+// ends a wake-up of this host late (median ~0.1 ms on the 2-core VM, far more from an idle vCPU).
+constexpr double kAnswerSpin_s = 0.0002;
+// An answer sent later than this beyond its due time is counted as late (T7SimStatus).
+constexpr double kLateAnswer_s = 0.0005;
 
 bool inlets_closed_outlets_open(const std::array<double, kValveRoleCount>& duty) {
   return duty[0] == 0.0 && duty[1] == 0.0 && duty[2] == 1.0 && duty[3] == 1.0;
@@ -191,6 +197,8 @@ void T7SimServer::trickle_reply(int fd, int function, int address, int count) {
 }
 
 void T7SimServer::serve_client(int fd, double now, const std::function<void(const std::string&)>& events) {
+  // The request's arrival (the kernel's stamp), before this thread woke for it: a T7's answer time counts from there.
+  const double arrived_s = request_arrival_s(fd, now + start_s_) - start_s_;
   modbus_set_socket(context_, fd);
   const int length = modbus_receive(context_, query_.data());
   if (length == 0) return;  // not a request for this unit
@@ -206,7 +214,9 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
     status_.silent = true;  // the request is lost on the way: no answer, and the watchdog is not fed
     return;
   }
-  if (options_.stall_after_s >= 0.0 && status_.stalls == 0 && now - first_request_s_ >= options_.stall_after_s) {
+  const bool stalled =
+      options_.stall_after_s >= 0.0 && status_.stalls == 0 && now - first_request_s_ >= options_.stall_after_s;
+  if (stalled) {
     ++status_.stalls;
     char line[120];
     std::snprintf(line, sizeof line, "t7-sim: this answer comes %.3f s late (drill)", options_.stall_s);
@@ -229,9 +239,17 @@ void T7SimServer::serve_client(int fd, double now, const std::function<void(cons
   }
   if (options_.silent_reads && !writes && address < t7::kAin(t7::kAinCount)) return;  // lost on the way (drill)
   // As long as a T7 takes: the link, and each input the request reads at its resolution index.
-  const double answer_s = answer_time_s(function, address, count) + options_.answer_after_s;
-  if (answer_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(answer_s));
+  // Due that long after it arrived, or after the answer before it left when it queued behind that
+  // one (a T7 answers one request at a time); the stall drill may already have held it longer.
+  const double due_s =
+      std::max(arrived_s, busy_until_s_) + answer_time_s(function, address, count) + options_.answer_after_s;
+  wait_until_s(due_s + start_s_, kAnswerSpin_s);
   now = now_s();
+  busy_until_s_ = now;
+  if (!stalled) {  // how much later than a T7 (this host woke late), the stall drill aside
+    status_.answer_late_max_s = std::max(status_.answer_late_max_s, now - due_s);
+    if (now - due_s > kLateAnswer_s) ++status_.late_answers;
+  }
   const T7Refusal refusal =
       check_t7_request(registers_, options_.product, function, address, count, writes ? values : nullptr);
   if (refusal.exception != 0) {
@@ -311,6 +329,7 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
           ++status_.refused_connections;
           events("t7-sim: refused a connection: " + std::to_string(kMaxConnections) + " are open, a T7's limit");
         } else if (fd >= 0) {
+          enable_arrival_stamps(fd);  // refused: the answer is timed from when this thread saw the request
           if (!options_.nagle) {
             const int one = 1;
             setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);

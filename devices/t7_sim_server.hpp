@@ -71,13 +71,15 @@ struct T7SimStatus {
   std::uint32_t watchdog_timeout_s = 0;
   int watchdog_actions = 0;
   double last_watchdog_action_s = -1.0;
-  std::uint64_t requests = 0;    // answered
-  std::uint64_t exceptions = 0;  // answered with a Modbus exception
-  std::uint64_t refusals = 0;    // of which for a LabJack rule (t7_sim_rules.hpp), not an address
-  int last_refused_error = 0;    // LabJack's error number of the latest refusal (0: none)
-  int max_clients = 0;           // the most connections at once
-  int refused_connections = 0;   // connections beyond the T7's limit, closed at once
-  int clients = 0;               // connected now
+  std::uint64_t requests = 0;      // answered
+  std::uint64_t exceptions = 0;    // answered with a Modbus exception
+  std::uint64_t refusals = 0;      // of which for a LabJack rule (t7_sim_rules.hpp), not an address
+  int last_refused_error = 0;      // LabJack's error number of the latest refusal (0: none)
+  int max_clients = 0;             // the most connections at once
+  int refused_connections = 0;     // connections beyond the T7's limit, closed at once
+  int clients = 0;                 // connected now
+  std::uint64_t late_answers = 0;  // answers sent more than 0.5 ms after LabJack's time (this host woke late)
+  double answer_late_max_s = 0.0;  // the latest of them, beyond LabJack's time
   bool silent = false;
   int stalls = 0;                                    // answers held back by the stall drill
   bool trickling = false;                            // the trickle drill has begun
@@ -123,6 +125,7 @@ class T7SimServer {
   double start_s_ = 0.0;
   double arm_time_s_ = 0.0;  // wall time the arm has been advanced to (since start)
   double first_request_s_ = -1.0;
+  double busy_until_s_ = 0.0;  // when the last answer was due and left (the next queued one waits for it)
   bool roll_halved_ = false;
   double last_status_write_s_ = -1.0;
   T7SimStatus status_;  // the server thread's; published copies under the mutex

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <fstream>
 #include <optional>
+#include <string>
 
 #include "app/cpu_idle_hold.hpp"
 
@@ -23,12 +24,29 @@ TEST(CpuIdleHold, NotWantedHoldsNothing) {
   EXPECT_FALSE(hold.held_us().has_value());
 }
 
+// Writes `driver` as a cpuidle current_driver file and returns its path.
+std::string driver_file(const std::string& driver) {
+  const std::string path = testing::TempDir() + "cpuidle_current_driver";
+  std::ofstream(path) << driver << "\n";
+  return path;
+}
+
+TEST(CpuIdleHold, WithoutACpuidleDriverNothingIsClaimed) {
+  // No driver to act on a PM QoS limit (a VM's idle cores halt): the hold says so, and holds nothing.
+  const CpuIdleHold none(true, 0, driver_file("none"));
+  EXPECT_FALSE(none.held_us().has_value());
+  EXPECT_NE(none.why_not().find("no cpuidle driver"), std::string::npos) << none.why_not();
+  const CpuIdleHold missing(true, 0, testing::TempDir() + "no-such-cpuidle-file");
+  EXPECT_FALSE(missing.held_us().has_value());
+  EXPECT_NE(missing.why_not().find("missing"), std::string::npos) << missing.why_not();
+}
+
 TEST(CpuIdleHold, HoldsTheLimitWhileAliveAndReleasesIt) {
   const std::optional<std::int32_t> before = current_limit_us();
   if (!before) GTEST_SKIP() << "/dev/cpu_dma_latency is not readable here";
   if (*before <= 7) GTEST_SKIP() << "another process already holds a limit of " << *before << " us";
   {
-    const CpuIdleHold hold(true, 7);
+    const CpuIdleHold hold(true, 7, driver_file("intel_idle"));  // a driver that acts on it
     if (!hold.held_us()) GTEST_SKIP() << "no permission to write /dev/cpu_dma_latency";
     EXPECT_EQ(*hold.held_us(), 7);
     EXPECT_EQ(current_limit_us(), 7);

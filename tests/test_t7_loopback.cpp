@@ -312,9 +312,12 @@ TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
   EXPECT_TRUE(s.safe);
   EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kInletA)], 0.0);
   EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kOutletA)], 1.0);
-  // It acted after one timeout of silence, and the lines were safe within a PWM period of it.
+  // It acted after one timeout of silence, and the lines were safe within a PWM period of its action
+  // (of the action, not of the silence's start: when t7-sim's thread notices the timeout is its host's
+  // scheduling, which a loaded machine delays by tens of ms).
   EXPECT_GE(s.last_watchdog_action_s - s.last_request_s, 1.0);
-  EXPECT_LE(s.safe_since_s - s.last_request_s, 1.0 + 1.0 / 200.0);
+  EXPECT_GE(s.safe_since_s, s.last_watchdog_action_s);
+  EXPECT_LE(s.safe_since_s - s.last_watchdog_action_s, 1.0 / 200.0);
 }
 
 TEST(T7Loopback, ADeadLinkStopsTheReadingsAndSaysWhichLink) {
@@ -344,7 +347,12 @@ TEST(T7Loopback, ALateAnswerIsDroppedAndTheLinkAnswersAgain) {
   SimThread sim(options);
   T7Device device(device_options(sim.port()));
   ASSERT_TRUE(eventually([&] { return device.health().link_errors > 0; })) << "the late answer timed out";
-  ASSERT_TRUE(eventually([&] { return device.health().connected; })) << device.link_error();
+  // Answered in time again: the queue behind the stall is worked off (a late reading handed over
+  // while it drains says `connected` too, before its last timeouts).
+  const std::uint64_t exchanges_at_stall = device.health().exchanges;
+  ASSERT_TRUE(eventually([&] {
+    return device.health().connected && device.health().exchanges > exchanges_at_stall + 1;
+  })) << device.link_error();
   EXPECT_EQ(sim.status().stalls, 1);
   const DeviceHealth after_stall = device.health();
   const double time_s = device.read_sensors().time_s;
@@ -531,6 +539,31 @@ TEST(T7Timing, AProfileWhoseReadCannotFitTheTickIsRefusedBeforeConnecting) {
   }
   for (SensorRole role : kSensorRoles) options.profile.input(role).resolution_index = 0;  // the Pro's default, 9
   EXPECT_THROW(T7Device{options}, InputError);
+}
+
+// ---- a late answer costs no tick when it comes before the next command (issue 22) ----
+
+TEST(T7Loopback, AReadAnsweredAfterItsDeadlineIsStillHandedOver) {
+  T7SimOptions options;
+  options.answer_after_s = 0.02;  // every answer 20 ms late: the write fits a 30 ms deadline, write and read do not
+  SimThread sim(options);
+  T7DeviceOptions o = device_options(sim.port());
+  o.tick_s = 0.2;  // without commands, exchanges 0.4 s apart: each late answer comes long before the next
+  o.link.response_timeout_s = 0.03;
+  o.link.connect_timeout_s = 10.0;
+  T7Device device(o);
+  const std::atomic<bool> stop{false};
+  ASSERT_TRUE(device.wait_for_reading(10.0, stop)) << device.link_error();
+  ASSERT_TRUE(eventually([&] { return device.late_readings() >= 2; }));
+  const DeviceHealth h = device.health();
+  EXPECT_EQ(h.exchanges, 0u);  // no exchange was answered within its deadline...
+  EXPECT_GE(h.link_errors, 2u);
+  EXPECT_GE(device.late_readings(), 2u);  // ...and their readings came all the same
+  const SensorReading r = device.read_sensors();
+  EXPECT_GT(r.time_s, 0.0);
+  EXPECT_NEAR(r.supply_bar, PlantParameters{}.supply_bar, 0.05);
+  EXPECT_TRUE(device.link_answers());
+  EXPECT_EQ(sim.status().exceptions, 0u);
 }
 
 // ---- a bounded, interruptible connect ----

@@ -163,6 +163,8 @@ TEST_F(T7Processes, LearningThroughAT7MatchesTheInProcessArm) {
   EXPECT_EQ(sim->out().find("refused"), std::string::npos) << sim->out();
 }
 
+// The T7's watchdog is the device's own timing; what this shows is that bellows armed it so that a
+// killed bellows leaves the lines safe through it.
 TEST_F(T7Processes, AKilledBellowsLeavesSafeValvesWithinTheWatchdogTimeoutAndAPwmPeriod) {
   auto sim = start_sim();
   auto run = start_run(2, "run");
@@ -172,10 +174,15 @@ TEST_F(T7Processes, AKilledBellowsLeavesSafeValvesWithinTheWatchdogTimeoutAndAPw
   ASSERT_TRUE(wait_for([&] { return status().at("watchdog").at("actions").get<int>() > 0; })) << sim->out();
   const nlohmann::json s = status();
   EXPECT_TRUE(s.at("safe").get<bool>()) << s.dump();
-  const double silence_s = s.at("safe_since_s").get<double>() - s.at("last_request_s").get<double>();
-  const double limit_s = s.at("watchdog").at("timeout_s").get<double>() + s.at("pwm_period_s").get<double>();
-  EXPECT_GE(silence_s, s.at("watchdog").at("timeout_s").get<double>());  // it was the watchdog
-  EXPECT_LE(silence_s, limit_s) << s.dump();
+  // The watchdog acted after its timeout of silence (no earlier: it was the watchdog), and the lines
+  // were safe within a PWM period of its action. How soon after the timeout t7-sim's thread notices it
+  // is its host's scheduling (seconds on a loaded machine), not what a T7 or bellows does.
+  const double action_s = s.at("watchdog").at("last_action_s").get<double>();
+  const double safe_since_s = s.at("safe_since_s").get<double>();
+  EXPECT_GE(action_s - s.at("last_request_s").get<double>(), s.at("watchdog").at("timeout_s").get<double>())
+      << s.dump();
+  EXPECT_GE(safe_since_s, action_s) << s.dump();
+  EXPECT_LE(safe_since_s - action_s, s.at("pwm_period_s").get<double>()) << s.dump();
   EXPECT_NE(sim->out().find("watchdog"), std::string::npos);
 }
 
