@@ -27,6 +27,7 @@ class MemorySessions final : public ui::SessionGateway {
   bool available() const override { return true; }
   /// Like the store: a new session, or what was added to the session named by the snapshot.
   std::string save(const ui::SessionSnapshot& snapshot) override {
+    while (hold_saves) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a save still running
     const std::lock_guard<std::mutex> guard(mutex);
     const std::string location = snapshot.experiment.session_location.empty() ? "mem://" + std::to_string(saved.size())
                                                                               : snapshot.experiment.session_location;
@@ -73,6 +74,7 @@ class MemorySessions final : public ui::SessionGateway {
   std::map<std::string, ui::SessionSnapshot> saved;
   std::atomic<int> saves{0};  // the tests read and set these while workers save
   std::atomic<bool> fail_saves{false};
+  std::atomic<bool> hold_saves{false};
   std::mutex mutex;
 };
 
@@ -125,9 +127,11 @@ struct ConsoleFixture {
       if (std::chrono::steady_clock::now() - wall_start > std::chrono::seconds(120)) return false;
       // Engine time stands still while the learner works or a save runs, so that runs are
       // deterministic: a batch's next trial waits for the autosave, and on a loaded machine a save
-      // to disk can take longer than the engine time this loop would otherwise race through.
+      // to disk (or a transfer's offer) can take longer than the engine time this loop would
+      // otherwise race through.
       const bool waiting = console->state().run.phase == ui::RunProgress::Phase::kLearning ||
-                           console->state().learner_busy || !console->state().law_ready || !console->saves_settled();
+                           console->state().learner_busy || !console->state().law_ready || !console->saves_settled() ||
+                           console->transfer_offer_pending();
       if (waiting) std::this_thread::sleep_for(std::chrono::microseconds(200));
       else clock.step(5);
       console->update(clock.now_s());

@@ -9,7 +9,9 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 seed=7
 # arm_and_run_5 SPAN: arm, N 5, until "iterations SPAN done".
+# The law must be ready first (a reopened session's law is prepared again): N before it is refused.
 arm_and_run_5() {
+  e2e_wait_for 'law [a-z-]+  M'
   e2e_arm
   e2e_keys N
   e2e_wait_for 'Run K iterations'
@@ -19,7 +21,6 @@ arm_and_run_5() {
 e2e_start 120 40 -- console --clock sim --speed max --seed "$seed"
 e2e_wait_for 'Bellows +SAFE '
 e2e_wait_for 'sim clock'
-e2e_wait_for 'law [a-z-]+'  # the header names the law once it is ready
 e2e_wait_for 'a arms the valves'
 arm_and_run_5 '0\.\.5'
 e2e_keys d

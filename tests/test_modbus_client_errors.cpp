@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "devices/modbus_client.hpp"
+#include "tests/loopback_listener.hpp"
 
 namespace bellows {
 namespace {
@@ -21,14 +22,8 @@ class OneShotServer {
  public:
   template <typename Reply>
   explicit OneShotServer(Reply reply) {
-    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof address;
-    ::bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof address);
-    ::listen(listen_fd_, 1);
-    ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
+    listen_fd_ = testing::loopback_listener(address);
     port_ = ntohs(address.sin_port);
     thread_ = std::thread([this, reply] {
       const int fd = ::accept(listen_fd_, nullptr, nullptr);

@@ -32,7 +32,9 @@ TEST(ConsoleTransfer, OffersWhatTheLastTrajectoryTaughtAndTakesItWithOneKey) {
   ASSERT_EQ(f.state().experiment.trials.size(), 8u);
   // The first autosave's note ("saved as it goes") is a status too: let it land before the offer
   // it would otherwise replace on a loaded machine.
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().experiment.session_location.empty(); }));
+  // (The location is known when the save starts; its note comes when it ends: wait for the end.)
+  ASSERT_TRUE(
+      f.pump_until([&] { return !f.state().experiment.session_location.empty() && f.console->saves_settled(); }));
   choose_steps(f);
   ASSERT_TRUE(f.pump_until([&] { return f.state().status.find("T: start from what") != std::string::npos; }, 50.0))
       << f.state().status;

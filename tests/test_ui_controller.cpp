@@ -597,5 +597,39 @@ TEST(UiController, TheBrowserShowsEachSessionsDeviceAndRefusesAnotherOnesBeforeO
   EXPECT_EQ(f.sessions.saves, saves);
 }
 
+// A save still running when the operator moves on (a trajectory chosen, its unsaved trials
+// discarded) belongs to the experiment it saved: the new experiment keeps no location and no saved
+// count of it, and its own first save makes a session of its own (before, it took the old session's
+// location, and its trials would have gone into the old session, of another trajectory).
+TEST(UiController, ASaveThatEndsAfterATrajectorySwitchStaysWithTheExperimentItSaved) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');  // iteration 0, saved as it goes
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  const std::string paper_location = f.state().experiment.session_location;
+  ASSERT_FALSE(paper_location.empty());
+  f.sessions.hold_saves = true;
+  f.key('r');  // iteration 1: its save is held
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && !f.console->saves_settled(); }, 60.0));
+  f.key('t');
+  f.key(ui::key::kDown);  // steps
+  f.key(ui::key::kEnter);
+  if (f.state().dialog.kind == ui::DialogKind::kConfirmDiscard) f.key('y');
+  ASSERT_EQ(f.state().experiment.trajectory->name, "steps");
+  f.sessions.hold_saves = false;
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  EXPECT_TRUE(f.state().experiment.session_location.empty()) << f.state().experiment.session_location;
+  EXPECT_EQ(f.state().experiment.saved_trials, 0);
+  EXPECT_TRUE(f.logged("the last save of the experiment left behind finished: " + paper_location));
+  EXPECT_EQ(f.sessions.open(paper_location).experiment.trials.size(), 2u);  // both paper trials, on disk
+  f.key('r');                                                               // steps' iteration 0: a session of its own
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  const std::string steps_location = f.state().experiment.session_location;
+  EXPECT_FALSE(steps_location.empty());
+  EXPECT_NE(steps_location, paper_location);
+  EXPECT_EQ(f.sessions.open(paper_location).experiment.trials.size(), 2u);
+  EXPECT_EQ(f.sessions.open(steps_location).experiment.trajectory->name, "steps");
+}
+
 }  // namespace
 }  // namespace bellows::ui

@@ -55,6 +55,7 @@ ConsoleController::ConsoleController(ConsoleEnvironment env, Trajectory trajecto
       env_.sessions != nullptr ? env_.sessions->unavailable_reason() : "no session store in this build";
   auto shared = std::make_shared<const Trajectory>(std::move(trajectory));
   state_.experiment = Experiment::start(shared);
+  ++experiment_serial_;
   const auto strip_size = static_cast<std::size_t>(std::lround(kStripSeconds / env_.config.timing.sample_s()));
   strip_time_.assign(strip_size, 0.0);
   strip_angle_.assign(strip_size, {});

@@ -110,6 +110,8 @@ class ConsoleController {
   /// Nothing left to save and no save running (autosave caught up, or saving is not available or
   /// failed: then `state().status` says why).
   bool saves_settled() const;
+  /// A learning transfer's offer is being computed (in the background) for the chosen trajectory.
+  bool transfer_offer_pending() const { return transfer_task_.busy(); }
 
   const ConsoleState& state() const { return state_; }
   bool quit_requested() const { return quit_requested_; }
@@ -299,6 +301,10 @@ class ConsoleController {
   std::size_t saving_events_ = 0;
   bool saving_settings_changed_ = false;
   std::uint64_t saving_next_revision_ = 0;
+  // Bumped whenever state_.experiment is replaced (a trajectory chosen, a session opened): a save
+  // that finishes after it belongs to the experiment the operator left, never to the new one.
+  std::uint64_t experiment_serial_ = 0;
+  std::uint64_t saving_experiment_serial_ = 0;
 };
 
 }  // namespace bellows::ui

@@ -294,6 +294,7 @@ void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> traject
     select_trajectory(trajectory);
     remember_taught();
     state_.experiment = Experiment::start(trajectory);
+    ++experiment_serial_;
     state_.inspector = InspectorView{};
     if (trajectory->learning_samples() != old_samples || !law_) rebuild_law();
     log(LogSource::kOperator, format("trajectory %s (%.1f s, N = %d)", trajectory->name.c_str(),

@@ -66,6 +66,7 @@ void ConsoleController::start_save() {
   saving_events_ = state_.log.total();
   saving_settings_changed_ = e.settings_changed;
   saving_next_revision_ = e.next_revision;
+  saving_experiment_serial_ = experiment_serial_;
   save_task_.start([gateway = env_.sessions, snapshot = std::move(snapshot)] { return gateway->save(snapshot); });
 }
 
@@ -130,7 +131,19 @@ void ConsoleController::start_open(const std::string& location) {
 }
 
 void ConsoleController::poll_session_tasks() {
-  if (save_task_.ready()) {
+  if (save_task_.ready() && saving_experiment_serial_ != experiment_serial_) {
+    // The experiment the operator left (its trials discarded, or a session opened): its save is its
+    // own; the current experiment's location and counts stay as they are (else its trials would be
+    // appended to the old session, of another trajectory).
+    try {
+      log(LogSource::kSession, "the last save of the experiment left behind finished: " + save_task_.take());
+    } catch (const std::exception& error) {
+      log(LogSource::kSession, std::string("the last save of the experiment left behind failed: ") + error.what(),
+          true);
+    }
+    ++revision_;
+    autosave();
+  } else if (save_task_.ready()) {
     try {
       const std::string location = save_task_.take();
       Experiment& e = state_.experiment;
@@ -251,6 +264,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   state_.config = config;
   for (const LogEntry& entry : snapshot.events) state_.log.add(entry);
   state_.experiment = std::move(snapshot.experiment);
+  ++experiment_serial_;
   state_.experiment.saved_trials = static_cast<int>(state_.experiment.trials.size());
   state_.experiment.saved_faults = static_cast<int>(state_.experiment.faults.size());
   state_.experiment.settings_changed = false;
