@@ -195,6 +195,9 @@ TimeoutObservation provoke_command_timeout(EngineDriver& driver, LcmDevice& devi
     (void)core.send(EngineCommand::of(CommandKind::kDisarm));
     return seen;
   }
+  // The air held is what the rig reports with every valve closed: the fill's last reading came before
+  // its last open-inlet periods were applied, and the chambers rose a little after it.
+  seen.before = applied.reading;
   // Silence: the rig hears nothing, as from an engine that stalled.
   device.hold_commands(true);
   const bool held = wait_until([&] { return device.commands_held(); }, 1.0);

@@ -25,7 +25,7 @@ with open(sys.argv[1], "w") as f:
 EOF
 
 e2e_start "$width" "$height" -- console --speed max --rt off
-e2e_wait_for 'law [a-z-]+  M'  # a ready law (not "(preparing)"): N before it is refused
+e2e_wait_law_ready
 e2e_keys '?'
 e2e_wait_for 'Everywhere \(greyed'
 capture help-safe
@@ -110,7 +110,7 @@ e2e_history | grep -A3 '^bellows console:' | grep -v '^EXIT STATUS' > "$out/summ
 
 # Quit asks only when something would be lost: here nothing can be saved (no data directory).
 e2e_start "$width" "$height" XDG_DATA_HOME= HOME= -- console --speed max --rt off
-e2e_wait_for 'law [a-z-]+  M'  # the law ready, as in the first console
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y

@@ -15,7 +15,7 @@ printf '[arm]\npreset = "arm2"\n' >"$E2E_DIR/arm2.toml"
 e2e_start 120 40 -- console --speed max --config "$E2E_DIR/arm2.toml" --trajectory paper2
 e2e_wait_for 'Bellows +SAFE '
 e2e_wait_for 'trajectory paper2 \(8\.0 s\)  joint 1/2 shoulder'
-e2e_wait_for 'law [a-z-]+  M'  # the learning law is ready
+e2e_wait_law_ready
 
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'

@@ -17,7 +17,7 @@ has_reverse_video() {
 }
 
 e2e_start 100 30 LC_ALL=C LANG=C -- console --speed max --no-color
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y
@@ -38,7 +38,7 @@ has_reverse_video || e2e_fail "no reverse video for the keys and states"
 e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 e2e_start 100 30 TERM=vt100 -- console --speed max
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y
@@ -53,7 +53,7 @@ has_reverse_video || e2e_fail "no reverse video on a vt100"
 e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 e2e_start 100 30 -- console --speed max
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y

@@ -16,7 +16,7 @@ await_exit() {
 # Runs iterations 0..2 (N 2, docs/iterations.md) in a fresh console on its own data directory $1.
 three_iterations() {
   e2e_start 120 40 -- console --speed max --rt off --data-dir "$1"
-  e2e_wait_for 'law [a-z-]+  M'
+  e2e_wait_law_ready
   e2e_keys a
   e2e_wait_for 'Arm the valves\?'
   e2e_keys y

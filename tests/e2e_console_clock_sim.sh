@@ -9,9 +9,8 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 seed=7
 # arm_and_run_5 SPAN: arm, N 5, until "iterations SPAN done".
-# The law must be ready first (a reopened session's law is prepared again): N before it is refused.
 arm_and_run_5() {
-  e2e_wait_for 'law [a-z-]+  M'
+  e2e_wait_law_ready
   e2e_arm
   e2e_keys N
   e2e_wait_for 'Run K iterations'

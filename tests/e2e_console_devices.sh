@@ -79,7 +79,7 @@ for device in "${DEVICES[@]}"; do
   e2e_start 120 40 -- console "${DEVICE_ARGS[@]}" --trajectory steps
   e2e_wait_for 'Bellows +SAFE '
   e2e_wait_for "(device )?$device: ok"
-  e2e_wait_for 'law [a-z-]+  M'
+  e2e_wait_law_ready
   if [ "$device" = t7 ]; then
     e2e_keys l
     e2e_wait_for 'device +t7 link 127\.0\.0\.1:[0-9]+ answers again'

@@ -7,7 +7,7 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 120 40 -- console --speed max --trajectory steps
 e2e_wait_for 'Bellows +SAFE '
-e2e_wait_for 'law [a-z-]+  M'  # the learning law is ready
+e2e_wait_law_ready
 
 # Arm: asks first.
 e2e_keys a
@@ -22,7 +22,7 @@ e2e_keys Up
 e2e_wait_for 'paper: 8.0 s, 400 samples'
 e2e_keys Enter
 e2e_wait_for 'trajectory paper \(8.0 s\)'
-e2e_wait_for 'law [a-z-]+  M'  # rebuilt for 400 samples
+e2e_wait_law_ready  # rebuilt for 400 samples
 
 # Five learning iterations after the feedback-only one: 0..5, as `run --iterations 5` (docs/iterations.md).
 e2e_keys N
@@ -86,7 +86,7 @@ session="$(e2e_history | grep -oE '^session: /[^ ]+' | head -1 | cut -c10-)"
 # Relaunch on the saved session: the same RMS history, and learning goes on from it.
 e2e_start 120 40 -- console --speed max --session "$session"
 e2e_wait_for 'iteration 6  RMS'
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 [ "$(e2e_rms_list)" = "$history" ] || e2e_fail "RMS history after relaunch: $(e2e_rms_list | tr '\n' ' ') vs $(echo "$history" | tr '\n' ' ')"
 # The browser lists it: date, trajectory, iterations, best RMS.
 best="$(echo "$history" | awk 'NR == 1 || $2 < b { b = $2 } END { print b }')"

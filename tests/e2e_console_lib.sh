@@ -113,6 +113,12 @@ e2e_expect_falling() {
     e2e_fail "RMS not falling: $(echo "$1" | tr '\n' ' ')"
 }
 
+# e2e_wait_law_ready [LIMIT_S]: the header shows the learning law ready (its weights, not
+# "(preparing)"): `N` before that is refused (a reopened session's law is prepared again too).
+e2e_wait_law_ready() {
+  e2e_wait_for 'law [a-z-]+  M' "$@"
+}
+
 # e2e_arm: `a`, then `y` to the question: the valves ARMED.
 e2e_arm() {
   e2e_keys a

@@ -12,7 +12,7 @@ yes >/dev/null & loads+=($!)
 yes >/dev/null & loads+=($!)
 
 e2e_start 120 40 -- console --speed 1 --rt off --data-dir "$E2E_DIR/sessions"
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y

@@ -65,7 +65,7 @@ question() {
 }
 
 e2e_start 120 40 -- console --speed max --rt off
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 
 # Before arming: the arm question and the valve test's (Rig screen, v).
 e2e_keys a

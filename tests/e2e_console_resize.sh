@@ -4,7 +4,7 @@
 source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 120 40 -- console --speed 10
-e2e_wait_for 'law [a-z-]+  M'
+e2e_wait_law_ready
 e2e_keys a
 e2e_wait_for 'Arm the valves\?'
 e2e_keys y
