@@ -125,12 +125,13 @@ ui::SessionSnapshot snapshot_of(Session& loaded, const std::filesystem::path& di
     ui::Trial trial;
     trial.iteration = static_cast<int>(i);
     const TrialRecord& record = loaded.iterations[i].record;
-    trial.correction_bar.resize(n, record.joints());
-    for (int j = 0; j < record.joints(); ++j) trial.correction_bar.col(j) = record.joint_samples(j).u_ilc_bar.head(n);
+    trial.correction_bar.resize(n, record.joint_count());
+    for (int j = 0; j < record.joint_count(); ++j)
+      trial.correction_bar.col(j) = record.joint_samples(j).u_ilc_bar.head(n);
     trial.summary = loaded.manifest.iterations[i].summary;
-    if (trial.summary.joint_rms_deg.size() != record.joints()) {  // each joint's RMS, from its record
-      trial.summary.joint_rms_deg.resize(record.joints());
-      for (int j = 0; j < record.joints(); ++j) trial.summary.joint_rms_deg(j) = record.joint_rms_error_deg(j);
+    if (trial.summary.joint_rms_deg.size() != record.joint_count()) {  // each joint's RMS, from its record
+      trial.summary.joint_rms_deg.resize(record.joint_count());
+      for (int j = 0; j < record.joint_count(); ++j) trial.summary.joint_rms_deg(j) = record.joint_rms_error_deg(j);
     }
     trial.record = std::move(loaded.iterations[i].record);
     trial.origin = "saved";

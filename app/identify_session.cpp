@@ -58,7 +58,7 @@ void IdentifySession::begin(const Configuration& config, const std::string& devi
 void IdentifySession::save_estimation_trial(const Configuration& config, const std::string& signal,
                                             const TrialRecord& record) {
   if (!writer_) return;
-  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(record.learning_samples, record.joints());  // N x J
+  const Eigen::MatrixXd no_correction = Eigen::MatrixXd::Zero(record.learning_samples, record.joint_count());  // N x J
   const IterationSummary summary =
       summarize_trial(0, record, no_correction, config.controller.gas.ambient_bar, config.controller.p_max_bar);
   writer_->save_iteration(record, summary, no_correction, ResumeState{});
@@ -66,7 +66,7 @@ void IdentifySession::save_estimation_trial(const Configuration& config, const s
   std::snprintf(line, sizeof line,
                 "identification trial (%s): %d samples, tracking RMS %.3f deg; iteration 0 holds it%s", signal.c_str(),
                 record.learning_samples, summary.rms_deg,
-                record.joints() > 1 ? " (joint 1 excited; the other joints' trials are in the events)" : "");
+                record.joint_count() > 1 ? " (joint 1 excited; the other joints' trials are in the events)" : "");
   writer_->record_event("identify-trial", line);
 }
 

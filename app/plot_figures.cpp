@@ -147,8 +147,10 @@ struct IterationColumns {
 std::vector<IterationColumns> iteration_columns(const Session& session, const std::vector<int>& iterations) {
   std::vector<IterationColumns> out;
   for (int j : iterations) {
-    const TrialSamples& s = iteration_of(session, j, "iteration").record.samples;
-    out.push_back({j, rounded_times(s.time_s), degrees_of(s.angle_rad), s.u_ilc_bar, degrees_of(s.error_rad)});
+    const TrialRecord& record = iteration_of(session, j, "iteration").record;
+    const TrialSamples& s = record.joint_samples(0);
+    out.push_back(
+        {j, rounded_times(record.sample_time_s), degrees_of(s.angle_rad), s.u_ilc_bar, degrees_of(s.error_rad)});
   }
   return out;
 }
@@ -219,9 +221,9 @@ Figure rms_figure(const Session& session, const FigureRequest& request, const Fi
 
 Figure angle_figure(const Session& session, const std::vector<IterationColumns>& columns, const FigureStyle& style) {
   const Trajectory& trajectory = session.trajectory;
-  Eigen::VectorXd time_s(trajectory.angle_rad.size());
+  Eigen::VectorXd time_s(trajectory.learning_samples() + 1);
   for (Eigen::Index k = 0; k < time_s.size(); ++k) time_s(k) = static_cast<double>(k) * trajectory.sample_time_s;
-  const Eigen::VectorXd times = rounded_times(time_s), angle = degrees_of(trajectory.angle_rad);
+  const Eigen::VectorXd times = rounded_times(time_s), angle = degrees_of(trajectory.joint(0));
   FigureBuilder b{style,
                   "Joint angle and set point: " + session.manifest.name,
                   "time [s]",
@@ -287,10 +289,12 @@ Figure correction_figure(const Session& session, const std::vector<IterationColu
 }
 
 Figure pressure_figure(const Session& session, int trial, const FigureStyle& style) {
-  const TrialTicks& t = iteration_of(session, trial, "trial").record.ticks;
-  const Eigen::VectorXd time_s = rounded_times(t.time_s);
-  std::string data = data_block("pressures", {&time_s, &t.pressure_a_bar, &t.pressure_b_bar, &t.setpoint_a_bar,
-                                              &t.setpoint_b_bar, &t.supply_bar});
+  const TrialRecord& record = iteration_of(session, trial, "trial").record;
+  const TrialTicks& t = record.joint_ticks(0);
+  const Eigen::VectorXd& supply_bar = record.supply_bar;
+  const Eigen::VectorXd time_s = rounded_times(record.tick_time_s);
+  std::string data = data_block(
+      "pressures", {&time_s, &t.pressure_a_bar, &t.pressure_b_bar, &t.setpoint_a_bar, &t.setpoint_b_bar, &supply_bar});
   FigureBuilder b{style,
                   "Pressures, iteration " + std::to_string(trial) + ": " + session.manifest.name,
                   "time [s]",
@@ -321,11 +325,11 @@ Figure pressure_figure(const Session& session, int trial, const FigureStyle& sty
   const double low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
   const double high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(),
                                 t.setpoint_b_bar.maxCoeff()});
-  const double supply = t.supply_bar.size() > 0 ? t.supply_bar.mean() : 0.0;
+  const double supply = supply_bar.size() > 0 ? supply_bar.mean() : 0.0;
   if (supply <= high + 0.25 * (high - low)) {
     b.add({"$pressures using 1:6 with lines linewidth 1 linecolor rgb '#999999' dashtype 3",
            "supply",
-           {&time_s, &t.supply_bar}});
+           {&time_s, &supply_bar}});
     b.legend_heading = "chambers";
   } else {
     char heading[64];

@@ -163,7 +163,7 @@ void print_black_box(std::ostream& out, int index, const BlackBoxEntry& entry, c
     const TickRecord& t = ticks[i];
     std::snprintf(line, sizeof line, "    %9.3f  %-8s %9.2f %9.2f %8.3f %8.3f %8.3f  %.2f/%.2f, %.2f/%.2f%s", t.time_s,
                   to_string(t.state), t.reading.joint[0].angle_rad * 180.0 / std::numbers::pi,
-                  t.desired_angle_rad * 180.0 / std::numbers::pi, t.reading.joint[0].chamber_bar[0],
+                  t.joint(0).desired_rad * 180.0 / std::numbers::pi, t.reading.joint[0].chamber_bar[0],
                   t.reading.joint[0].chamber_bar[1], t.reading.supply_bar, t.valves.joint[0].inlet_duty[0],
                   t.valves.joint[0].outlet_duty[0], t.valves.joint[0].inlet_duty[1], t.valves.joint[0].outlet_duty[1],
                   t.fault != FaultCode::kNone ? (std::string("  <- ") + fault_name(t.fault)).c_str() : "");

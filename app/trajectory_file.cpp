@@ -146,12 +146,12 @@ std::string trajectory_csv(const Trajectory& trajectory) {
     }
   }
   text += "\n";
-  for (Eigen::Index k = 0; k < trajectory.angle_rad.size(); ++k) {
+  for (Eigen::Index k = 0; k <= trajectory.learning_samples(); ++k) {
     // Time to the nanosecond: the reader's tolerance is a microsecond, and 0.06 stays "0.06".
     text += shortest(std::round(static_cast<double>(k) * trajectory.sample_time_s * 1e9) / 1e9);
     for (int joint = 0; joint < trajectory.joints(); ++joint) {
       text += ',';
-      text += shortest(trajectory.joint_angle_rad(joint)(k) * kDegPerRad);
+      text += shortest(trajectory.joint(joint)(k) * kDegPerRad);
     }
     text += "\n";
   }

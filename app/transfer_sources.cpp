@@ -23,7 +23,7 @@ TransferSource transfer_source_from_session(const Session& session) {
   source.controller = session.manifest.configuration.controller;
   const Eigen::Index n = session.trajectory.learning_samples();
   for (const IterationData& iteration : session.iterations) {
-    const TrialSamples& s = iteration.record.samples;
+    const TrialSamples& s = iteration.record.joint_samples(0);
     if (s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1) continue;
     source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
   }

@@ -112,7 +112,7 @@ void BM_ConstrainedUpdatePaper(benchmark::State& state) {
   session.run_trial();
   const Eigen::VectorXd u_j = session.correction_bar();
   const Eigen::VectorXd e_j = session.last_record().normalized_error();
-  const Eigen::VectorXd feedback = session.last_record().samples.u_pid_bar.head(n);
+  const Eigen::VectorXd feedback = session.last_record().joint_samples(0).u_pid_bar.head(n);
   Eigen::VectorXd u_next(n);
   law.set_input_context(feedback, config.controller.p_max_bar - config.controller.gas.ambient_bar);
   for (auto _ : state) {

@@ -82,7 +82,7 @@ void BM_LoadPaperSession(benchmark::State& state) {
   if (!fs::exists(dir)) save_session(paper_session(), dir);
   for (auto _ : state) {
     const Session loaded = load_session(dir);
-    benchmark::DoNotOptimize(loaded.iterations.back().record.samples.angle_rad(10));
+    benchmark::DoNotOptimize(loaded.iterations.back().record.joint_samples(0).angle_rad(10));
   }
 }
 BENCHMARK(BM_LoadPaperSession)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -108,7 +108,7 @@ void BM_AutosavePaperIteration(benchmark::State& state) {
     const std::size_t source = static_cast<std::size_t>(index) % session.iterations.size();
     IterationSummary summary = session.manifest.iterations[source].summary;
     summary.iteration = index++;
-    writer.save_iteration(session.iterations[source].record, summary, session.iterations[source].next_correction_bar,
+    writer.save_iteration(session.iterations[source].record, summary, session.iterations[source].next_corrections_bar(),
                           *session.manifest.resume);
   }
 }
@@ -120,7 +120,7 @@ void BM_FormatPaperSession(benchmark::State& state) {
   for (auto _ : state) {
     std::size_t bytes = 0;
     for (const IterationData& data : session.iterations) {
-      bytes += format_samples_csv(data.record, data.next_correction_bar).size();
+      bytes += format_samples_csv(data.record, data.next_corrections_bar()).size();
       bytes += format_telemetry_csv(data.record).size();
     }
     benchmark::DoNotOptimize(bytes);

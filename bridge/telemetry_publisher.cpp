@@ -134,11 +134,11 @@ void TelemetryPublisher::publish_joints(lcm::LCM* bus, const TickRecord& tick, i
     const JointReading& r = tick.reading.joint[ji];
     const JointValves& v = tick.valves.joint[ji];
     t.angle_rad[j] = used ? r.angle_rad : 0.0;
-    t.desired_angle_rad[j] = used ? tick.joint_desired_rad(j) : 0.0;
-    t.u_total_bar[j] = used ? tick.joint_u_total_bar(j) : 0.0;
-    t.saturation[j] = static_cast<std::int8_t>(used ? tick.joint_setpoints(j).saturation_sign : 0);
-    t.setpoint_bar[j][0] = used ? tick.joint_setpoints(j).a_bar : 0.0;
-    t.setpoint_bar[j][1] = used ? tick.joint_setpoints(j).b_bar : 0.0;
+    t.desired_angle_rad[j] = used ? tick.joint(j).desired_rad : 0.0;
+    t.u_total_bar[j] = used ? tick.joint(j).u_total_bar : 0.0;
+    t.saturation[j] = static_cast<std::int8_t>(used ? tick.joint(j).setpoints.saturation_sign : 0);
+    t.setpoint_bar[j][0] = used ? tick.joint(j).setpoints.a_bar : 0.0;
+    t.setpoint_bar[j][1] = used ? tick.joint(j).setpoints.b_bar : 0.0;
     for (int i = 0; i < kActuatorCount; ++i) {
       t.chamber_bar[j][i] = used ? r.chamber_bar[static_cast<std::size_t>(i)] : 0.0;
       t.inlet_duty[j][i] = used ? v.inlet_duty[static_cast<std::size_t>(i)] : 0.0;
@@ -161,16 +161,16 @@ void TelemetryPublisher::on_tick(lcm::LCM* bus, const TickRecord& tick) {
     telemetry_t& t = telemetry_;
     copy_shared_fields(tick, t);
     t.angle_rad = tick.reading.joint[0].angle_rad;
-    t.desired_angle_rad = tick.desired_angle_rad;
+    t.desired_angle_rad = tick.joint(0).desired_rad;
     for (int i = 0; i < kActuatorCount; ++i) {
       t.chamber_bar[i] = tick.reading.joint[0].chamber_bar[i];
       t.inlet_duty[i] = tick.valves.joint[0].inlet_duty[i];
       t.outlet_duty[i] = tick.valves.joint[0].outlet_duty[i];
     }
-    t.u_total_bar = tick.u_total_bar;
-    t.setpoint_bar[0] = tick.setpoints.a_bar;
-    t.setpoint_bar[1] = tick.setpoints.b_bar;
-    t.saturation = static_cast<std::int8_t>(tick.setpoints.saturation_sign);
+    t.u_total_bar = tick.joint(0).u_total_bar;
+    t.setpoint_bar[0] = tick.joint(0).setpoints.a_bar;
+    t.setpoint_bar[1] = tick.joint(0).setpoints.b_bar;
+    t.saturation = static_cast<std::int8_t>(tick.joint(0).setpoints.saturation_sign);
     t.dropped_ticks = static_cast<std::int64_t>(dropped_ticks_.load(std::memory_order_relaxed));
     emit(bus, kTelemetryChannel, t, ticks_);
   }

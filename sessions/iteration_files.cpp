@@ -125,13 +125,13 @@ Trajectory parse_trajectory_csv_file(std::string_view text, const std::string& s
 
 std::string format_samples_csv(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar) {
   std::string out;
-  append_columns(out, samples_header(record.joints()), samples_file_values(record, next_corrections_bar));
+  append_columns(out, samples_header(record.joint_count()), samples_file_values(record, next_corrections_bar));
   return out;
 }
 
 std::string format_telemetry_csv(const TrialRecord& record) {
   std::string out;
-  append_columns(out, telemetry_header(record.joints()), telemetry_file_values(record));
+  append_columns(out, telemetry_header(record.joint_count()), telemetry_file_values(record));
   return out;
 }
 
@@ -150,7 +150,7 @@ void parse_samples_csv(std::string_view text, const std::string& source, int lea
 
 void parse_telemetry_csv(std::string_view text, const std::string& source, int learning_samples, int ticks_per_sample,
                          double tick_s, IterationData& data) {
-  const std::vector<std::string> header = telemetry_header(data.record.joints());
+  const std::vector<std::string> header = telemetry_header(data.record.joint_count());
   std::vector<Eigen::VectorXd> c = parse_csv(text, header_views(header), source);
   expect_rows(c[0], static_cast<Eigen::Index>(learning_samples) * ticks_per_sample, source,
               "learning samples times ticks per sample");

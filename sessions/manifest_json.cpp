@@ -223,8 +223,15 @@ Configuration configuration_from_json(const JsonReader& reader) {
 
 namespace {
 
+/// The key of "resume.controller" under which J-joint sessions of schema version 1 (the J-joint
+/// format of 410db9c, Nov 30, up to schema version 2) kept joints 2..J's controllers, one object
+/// each, beside joint 1's fields. Read, never written: version 2 keeps every joint's in kJointsKey.
+constexpr const char* kVersion1OtherJointsKey = "more_joints";
+/// Every joint's controllers, one object each, joint 1 first (schema version 2, J > 1).
+constexpr const char* kJointsKey = "joints";
+
 /// One joint's controllers: joint 1's fields of "controller" (as every session saved them), and
-/// each entry of its "more_joints".
+/// each entry of kJointsKey (or of kVersion1OtherJointsKey).
 Json joint_state_to_json(const ControlCore::JointState& s) {
   return {
       {"pid",
@@ -259,30 +266,44 @@ void joint_state_from_json(const JsonReader& r, const Configuration& config, Con
 }  // namespace
 
 Json controller_state_to_json(const ControlCore::State& s) {
-  Json out = joint_state_to_json(s);
-  out["tick_in_sample"] = s.tick_in_sample;
-  if (s.joints > 1) {  // absent: one joint (every session saved before joints were counted)
-    Json& more = out["more_joints"] = Json::array();
-    for (int joint = 1; joint < s.joints; ++joint)
-      more.push_back(joint_state_to_json(s.more_joints[static_cast<std::size_t>(joint - 1)]));
+  if (s.joint_count > 1) {
+    Json out = {{"tick_in_sample", s.tick_in_sample}, {kJointsKey, Json::array()}};
+    for (int joint = 0; joint < s.joint_count; ++joint) {
+      out[kJointsKey].push_back(joint_state_to_json(s.joints[static_cast<std::size_t>(joint)]));
+    }
+    return out;
   }
+  // One joint: its fields and the tick, exactly as every session saved them.
+  Json out = joint_state_to_json(s.joints[0]);
+  out["tick_in_sample"] = s.tick_in_sample;
   return out;
 }
 
 ControlCore::State controller_state_from_json(const JsonReader& r, const Configuration& config, int joints) {
   ControlCore::State s;
-  joint_state_from_json(r, config, s);
   s.tick_in_sample = r["tick_in_sample"].integer(0, config.timing.ticks_per_sample - 1);
-  s.joints = joints;
-  if (joints > 1 || r.has("more_joints")) {
-    const JsonReader more = r["more_joints"];
-    if (more.size() != static_cast<std::size_t>(joints - 1)) {
-      more.fail("expected " + std::to_string(joints - 1) + " entries (joints 2 to " + std::to_string(joints) +
-                " of the session's " + std::to_string(joints) + "), found " + std::to_string(more.size()));
+  s.joint_count = joints;
+  if (r.has(kJointsKey) || (joints > 1 && !r.has(kVersion1OtherJointsKey))) {
+    const JsonReader all = r[kJointsKey];
+    if (all.size() != static_cast<std::size_t>(joints)) {
+      all.fail("expected " + std::to_string(joints) + " entries (one per joint of the session's " +
+               std::to_string(joints) + "), found " + std::to_string(all.size()));
+    }
+    for (int joint = 0; joint < joints; ++joint) {
+      joint_state_from_json(all[static_cast<std::size_t>(joint)], config, s.joints[static_cast<std::size_t>(joint)]);
+    }
+    return s;
+  }
+  joint_state_from_json(r, config, s.joints[0]);
+  if (joints > 1 || r.has(kVersion1OtherJointsKey)) {
+    const JsonReader others = r[kVersion1OtherJointsKey];
+    if (others.size() != static_cast<std::size_t>(joints - 1)) {
+      others.fail("expected " + std::to_string(joints - 1) + " entries (joints 2 to " + std::to_string(joints) +
+                  " of the session's " + std::to_string(joints) + "), found " + std::to_string(others.size()));
     }
     for (int joint = 1; joint < joints; ++joint) {
-      joint_state_from_json(more[static_cast<std::size_t>(joint - 1)], config,
-                            s.more_joints[static_cast<std::size_t>(joint - 1)]);
+      joint_state_from_json(others[static_cast<std::size_t>(joint - 1)], config,
+                            s.joints[static_cast<std::size_t>(joint)]);
     }
   }
   return s;
@@ -324,7 +345,7 @@ Json manifest_head_to_json(const SessionManifest& m) {
   if (m.joints > 1) trajectory["joints"] = m.joints;  // absent: one joint (and the files as they always were)
   Json out = {
       {"format", kFormat},
-      {"schema_version", m.schema_version},
+      {"schema_version", session_schema_version_for(m.joints)},  // what is written here, whatever was read
       {"program_version", m.program_version},
       {"name", m.name},
       {"device", m.device},

@@ -45,8 +45,10 @@ nlohmann::ordered_json configuration_to_json(const Configuration& config);
 Configuration configuration_from_json(const JsonReader& reader);
 
 nlohmann::ordered_json controller_state_to_json(const ControlCore::State& state);
-/// Checks the ranges the configuration implies (filter length, ticks per sample) and that
-/// "more_joints" holds joints 2..`joints` (absent for one joint).
+/// One joint: joint 1's fields and "tick_in_sample" (every schema version). J > 1: "tick_in_sample"
+/// and "joints", one object per joint (schema version 2); version 1 kept joint 1's fields and
+/// joints 2..J under another key, still read (manifest_json.cpp). Checks the ranges the
+/// configuration implies (filter length, ticks per sample) and that every joint is there.
 ControlCore::State controller_state_from_json(const JsonReader& reader, const Configuration& config, int joints = 1);
 
 }  // namespace bellows

@@ -47,36 +47,37 @@ std::vector<std::string> header_of(const std::vector<Column>& table, int joints)
 
 const std::vector<RecordColumn<TrialSamples>>& samples_record_columns() {
   static const std::vector<RecordColumn<TrialSamples>> columns = {
-      {"time_s", "s", "k T", kTime, kShared, &S::time_s},
-      {"angle_setpoint_deg", "deg", "desired angle yD(k)", kDegrees, kJoint, &S::setpoint_rad},
-      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &S::angle_rad},
-      {"error_deg", "deg", "yD(k) - y(k); 0 at k = 0", kDegrees, kJoint, &S::error_rad},
-      {"u_pid_bar", "bar", "PID + feed-forward output", kAsIs, kJoint, &S::u_pid_bar},
-      {"u_ilc_bar", "bar", "learned correction applied at sample k (0 at k = N)", kAsIs, kJoint, &S::u_ilc_bar},
-      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, &S::u_total_bar},
-      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &S::pressure_a_bar},
-      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &S::pressure_b_bar},
-      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint, &S::setpoint_a_bar},
-      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint, &S::setpoint_b_bar},
+      {"time_s", "s", "k T", kTime, kShared, nullptr, &TrialRecord::sample_time_s},
+      {"angle_setpoint_deg", "deg", "desired angle yD(k)", kDegrees, kJoint, &S::setpoint_rad, nullptr},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &S::angle_rad, nullptr},
+      {"error_deg", "deg", "yD(k) - y(k); 0 at k = 0", kDegrees, kJoint, &S::error_rad, nullptr},
+      {"u_pid_bar", "bar", "PID + feed-forward output", kAsIs, kJoint, &S::u_pid_bar, nullptr},
+      {"u_ilc_bar", "bar", "learned correction applied at sample k (0 at k = N)", kAsIs, kJoint, &S::u_ilc_bar,
+       nullptr},
+      {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint, &S::u_total_bar, nullptr},
+      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &S::pressure_a_bar, nullptr},
+      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &S::pressure_b_bar, nullptr},
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint, &S::setpoint_a_bar, nullptr},
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint, &S::setpoint_b_bar, nullptr},
       {"u_ilc_next_bar", "bar", "correction learned from this iteration, applied in the next (0 at k = N)", kAsIs,
-       kJoint, nullptr},
+       kJoint, nullptr, nullptr},
   };
   return columns;
 }
 
 const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns() {
   static const std::vector<RecordColumn<TrialTicks>> columns = {
-      {"time_s", "s", "i tick_s", kTime, kShared, &T::time_s},
-      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &T::angle_rad},
-      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &T::pressure_a_bar},
-      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &T::pressure_b_bar},
-      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared, &T::supply_bar},
-      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A in force", kAsIs, kJoint, &T::setpoint_a_bar},
-      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B in force", kAsIs, kJoint, &T::setpoint_b_bar},
-      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint, &T::inlet_a},
-      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint, &T::outlet_a},
-      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint, &T::inlet_b},
-      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint, &T::outlet_b},
+      {"time_s", "s", "i tick_s", kTime, kShared, nullptr, &TrialRecord::tick_time_s},
+      {"angle_deg", "deg", "measured angle", kDegrees, kJoint, &T::angle_rad, nullptr},
+      {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint, &T::pressure_a_bar, nullptr},
+      {"pressure_b_bar", "bar (abs)", "measured pressure in actuator B", kAsIs, kJoint, &T::pressure_b_bar, nullptr},
+      {"supply_bar", "bar (abs)", "measured supply pressure", kAsIs, kShared, nullptr, &TrialRecord::supply_bar},
+      {"pressure_a_setpoint_bar", "bar (abs)", "set point of A in force", kAsIs, kJoint, &T::setpoint_a_bar, nullptr},
+      {"pressure_b_setpoint_bar", "bar (abs)", "set point of B in force", kAsIs, kJoint, &T::setpoint_b_bar, nullptr},
+      {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint, &T::inlet_a, nullptr},
+      {"outlet_a_duty", "0..1", "outlet valve A's PWM duty cycle", kAsIs, kJoint, &T::outlet_a, nullptr},
+      {"inlet_b_duty", "0..1", "inlet valve B's PWM duty cycle", kAsIs, kJoint, &T::inlet_b, nullptr},
+      {"outlet_b_duty", "0..1", "outlet valve B's PWM duty cycle", kAsIs, kJoint, &T::outlet_b, nullptr},
   };
   return columns;
 }
@@ -101,8 +102,8 @@ const std::vector<TickColumn>& black_box_record_columns() {
        [](const Tick& t, int j) { return t.reading.joint[at(j)].angle_rad; },
        [](Tick& t, int j, double v) { t.reading.joint[at(j)].angle_rad = v; }},
       {"angle_setpoint_deg", "deg", "desired angle", kDegrees, kJoint,
-       [](const Tick& t, int j) { return t.joint_desired_rad(j); },
-       [](Tick& t, int j, double v) { t.joint_desired_rad(j) = v; }},
+       [](const Tick& t, int j) { return t.joint(j).desired_rad; },
+       [](Tick& t, int j, double v) { t.joint(j).desired_rad = v; }},
       {"pressure_a_bar", "bar (abs)", "measured pressure in actuator A", kAsIs, kJoint,
        [](const Tick& t, int j) { return t.reading.joint[at(j)].chamber_bar[0]; },
        [](Tick& t, int j, double v) { t.reading.joint[at(j)].chamber_bar[0] = v; }},
@@ -113,14 +114,14 @@ const std::vector<TickColumn>& black_box_record_columns() {
        [](const Tick& t, int) { return t.reading.supply_bar; },
        [](Tick& t, int, double v) { t.reading.supply_bar = v; }},
       {"u_tot_bar", "bar", "u_pid + u_ilc, before the set-point clamp", kAsIs, kJoint,
-       [](const Tick& t, int j) { return t.joint_u_total_bar(j); },
-       [](Tick& t, int j, double v) { t.joint_u_total_bar(j) = v; }},
+       [](const Tick& t, int j) { return t.joint(j).u_total_bar; },
+       [](Tick& t, int j, double v) { t.joint(j).u_total_bar = v; }},
       {"pressure_a_setpoint_bar", "bar (abs)", "set point of A", kAsIs, kJoint,
-       [](const Tick& t, int j) { return t.joint_setpoints(j).a_bar; },
-       [](Tick& t, int j, double v) { t.joint_setpoints(j).a_bar = v; }},
+       [](const Tick& t, int j) { return t.joint(j).setpoints.a_bar; },
+       [](Tick& t, int j, double v) { t.joint(j).setpoints.a_bar = v; }},
       {"pressure_b_setpoint_bar", "bar (abs)", "set point of B", kAsIs, kJoint,
-       [](const Tick& t, int j) { return t.joint_setpoints(j).b_bar; },
-       [](Tick& t, int j, double v) { t.joint_setpoints(j).b_bar = v; }},
+       [](const Tick& t, int j) { return t.joint(j).setpoints.b_bar; },
+       [](Tick& t, int j, double v) { t.joint(j).setpoints.b_bar = v; }},
       {"inlet_a_duty", "0..1", "inlet valve A's PWM duty cycle", kAsIs, kJoint,
        [](const Tick& t, int j) { return t.valves.joint[at(j)].inlet_duty[0]; },
        [](Tick& t, int j, double v) { t.valves.joint[at(j)].inlet_duty[0] = v; }},
@@ -170,15 +171,18 @@ std::vector<std::string_view> header_views(const std::vector<std::string>& names
 std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record,
                                                  const Eigen::MatrixXd& next_corrections_bar) {
   std::vector<Eigen::VectorXd> values;
-  for (int joint = 0; joint < record.joints(); ++joint) {
+  for (int joint = 0; joint < record.joint_count(); ++joint) {
     const TrialSamples& samples = record.joint_samples(joint);
     for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
-      if (joint > 0 && column.scope == ColumnScope::kShared) continue;
+      if (column.scope == ColumnScope::kShared) {
+        if (joint == 0) values.push_back(written(record.*column.shared, column.scale));
+        continue;
+      }
       if (column.member != nullptr) {
         values.push_back(written(samples.*column.member, column.scale));
         continue;
       }
-      Eigen::VectorXd next = Eigen::VectorXd::Zero(samples.time_s.size());
+      Eigen::VectorXd next = Eigen::VectorXd::Zero(record.sample_time_s.size());
       const Eigen::Index learned = std::min(next.size(), next_corrections_bar.rows());
       if (joint < next_corrections_bar.cols()) next.head(learned) = next_corrections_bar.col(joint).head(learned);
       values.push_back(std::move(next));
@@ -189,9 +193,12 @@ std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record,
 
 std::vector<Eigen::VectorXd> telemetry_file_values(const TrialRecord& record) {
   std::vector<Eigen::VectorXd> values;
-  for (int joint = 0; joint < record.joints(); ++joint) {
+  for (int joint = 0; joint < record.joint_count(); ++joint) {
     for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
-      if (joint > 0 && column.scope == ColumnScope::kShared) continue;
+      if (column.scope == ColumnScope::kShared) {
+        if (joint == 0) values.push_back(written(record.*column.shared, column.scale));
+        continue;
+      }
       values.push_back(written(record.joint_ticks(joint).*column.member, column.scale));
     }
   }
@@ -216,28 +223,24 @@ std::vector<Eigen::VectorXd> black_box_file_values(const std::vector<TickRecord>
 }
 
 std::vector<Eigen::VectorXd> trajectory_file_values(const Trajectory& trajectory) {
-  const Eigen::Index rows = trajectory.angle_rad.size();
+  const Eigen::Index rows = trajectory.learning_samples() + 1;
   Eigen::VectorXd times(rows);
   for (Eigen::Index k = 0; k < rows; ++k) times(k) = static_cast<double>(k) * trajectory.sample_time_s;
   std::vector<Eigen::VectorXd> values = {rounded_times(times)};
-  for (int joint = 0; joint < trajectory.joints(); ++joint)
-    values.push_back(degrees_of(trajectory.joint_angle_rad(joint)));
+  for (int joint = 0; joint < trajectory.joints(); ++joint) values.push_back(degrees_of(trajectory.joint(joint)));
   return values;
 }
 
 Eigen::MatrixXd samples_from_file_values(std::vector<Eigen::VectorXd>& columns, int joints, TrialRecord& record) {
-  record.more_joint_samples.resize(static_cast<std::size_t>(joints - 1));
-  if (record.more_joint_ticks.size() != record.more_joint_samples.size()) {
-    record.more_joint_ticks.resize(record.more_joint_samples.size());
-  }
+  record.joints.resize(static_cast<std::size_t>(joints));
   const Eigen::Index rows = columns.empty() ? 0 : columns.front().size();
   Eigen::MatrixXd next(rows, joints);
   std::size_t at = 0;
   for (int joint = 0; joint < joints; ++joint) {
     TrialSamples& samples = record.joint_samples(joint);
     for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
-      if (joint > 0 && column.scope == ColumnScope::kShared) {
-        samples.*column.member = record.samples.*column.member;  // joint 1's, read first
+      if (column.scope == ColumnScope::kShared) {
+        if (joint == 0) record.*column.shared = read_back(std::move(columns[at++]), column.scale);
         continue;
       }
       Eigen::VectorXd& values = columns[at++];
@@ -250,11 +253,11 @@ Eigen::MatrixXd samples_from_file_values(std::vector<Eigen::VectorXd>& columns, 
 
 void telemetry_from_file_values(std::vector<Eigen::VectorXd>& columns, TrialRecord& record) {
   std::size_t at = 0;
-  for (int joint = 0; joint < record.joints(); ++joint) {
+  for (int joint = 0; joint < record.joint_count(); ++joint) {
     TrialTicks& ticks = record.joint_ticks(joint);
     for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
-      if (joint > 0 && column.scope == ColumnScope::kShared) {
-        ticks.*column.member = record.ticks.*column.member;  // joint 1's, read first
+      if (column.scope == ColumnScope::kShared) {
+        if (joint == 0) record.*column.shared = read_back(std::move(columns[at++]), column.scale);
         continue;
       }
       ticks.*column.member = read_back(std::move(columns[at++]), column.scale);

@@ -9,7 +9,7 @@
 // Several joints (issue 14): one file per iteration still, with one block of columns per joint.
 // Joint 1's columns keep their names (a one-joint file is exactly what it always was); joint j > 1
 // repeats the per-joint columns with the suffix `_j<j>` (`angle_deg_j2`) after joint 1's. Shared
-// columns (time, supply) are written once: the engine records the same values for every joint.
+// columns (time, supply) are written once, among joint 1's: the record keeps them once.
 #pragma once
 
 #include <string>
@@ -30,14 +30,17 @@ enum class ColumnScale { kAsIs, kDegrees, kTime };
 /// A column per joint, or one for the whole record (the same values in every joint's record).
 enum class ColumnScope { kPerJoint, kShared };
 
-template <typename Record>
+/// `Joint`: the per-joint part of the record (TrialSamples or TrialTicks).
+template <typename Joint>
 struct RecordColumn {
   std::string_view name;     // joint 1's; joint j > 1 adds "_j<j>"
   std::string_view unit;     // "s", "deg", "bar", "bar (abs)", "0..1"
   std::string_view meaning;  // one line for people (docs, exports)
   ColumnScale scale;
   ColumnScope scope;
-  Eigen::VectorXd Record::*member;  // where the record keeps it; null: the correction learned (samples)
+  Eigen::VectorXd Joint::*member;        // where each joint keeps it (kPerJoint)
+  Eigen::VectorXd TrialRecord::*shared;  // where the record keeps it (kShared)
+  // Both null: the correction learned (samples).
 };
 
 /// An iteration's ILC-rate samples, N + 1 rows, in file order.
@@ -46,7 +49,7 @@ const std::vector<RecordColumn<TrialSamples>>& samples_record_columns();
 const std::vector<RecordColumn<TrialTicks>>& telemetry_record_columns();
 
 /// A column of a fault's black box: one value per tick, read from and written into a TickRecord
-/// (which keeps joint 1's values apart from joints 2..J's: hence functions, not a member).
+/// (which keeps a joint's values in TickRecord::joints or in its reading or valves: hence functions).
 struct TickColumn {
   std::string_view name;
   std::string_view unit;
@@ -73,7 +76,7 @@ std::vector<std::string> trajectory_header(int joints);
 /// Views of `names` for the CSV reader.
 std::vector<std::string_view> header_views(const std::vector<std::string>& names);
 
-/// Every column's values as written, in the order of samples_header(record.joints()).
+/// Every column's values as written, in the order of samples_header(record.joint_count()).
 /// `next_corrections_bar` is N x J (a missing row or column is 0); the last row's is 0.
 std::vector<Eigen::VectorXd> samples_file_values(const TrialRecord& record,
                                                  const Eigen::MatrixXd& next_corrections_bar);
@@ -85,7 +88,7 @@ std::vector<Eigen::VectorXd> trajectory_file_values(const Trajectory& trajectory
 /// The record's samples (prepared for `joints` joints) from the columns of samples_header(joints)
 /// as read; returns the correction learned, (N + 1) x J as the file holds it.
 Eigen::MatrixXd samples_from_file_values(std::vector<Eigen::VectorXd>& columns, int joints, TrialRecord& record);
-/// The record's ticks from the columns of telemetry_header(record.joints()) as read.
+/// The record's ticks from the columns of telemetry_header(record.joint_count()) as read.
 void telemetry_from_file_values(std::vector<Eigen::VectorXd>& columns, TrialRecord& record);
 /// Ticks (one per row) of `joints` joints from the columns of black_box_header(joints) as read.
 std::vector<TickRecord> black_box_from_file_values(const std::vector<Eigen::VectorXd>& columns, int joints);

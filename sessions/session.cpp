@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <stdexcept>
 
 namespace bellows {
 
@@ -20,26 +19,6 @@ std::string utc_now() {
   char out[48];
   std::snprintf(out, sizeof out, "%s.%03dZ", stamp, static_cast<int>(millis));
   return out;
-}
-
-Eigen::MatrixXd IterationData::next_corrections_bar() const {
-  Eigen::MatrixXd out(next_correction_bar.size(), joints());
-  out.col(0) = next_correction_bar;
-  for (int joint = 1; joint < joints(); ++joint) {
-    const Eigen::VectorXd& column = more_joint_next_correction_bar[static_cast<std::size_t>(joint - 1)];
-    if (column.size() != out.rows())
-      throw std::invalid_argument("IterationData: the joints' corrections differ in length");
-    out.col(joint) = column;
-  }
-  return out;
-}
-
-void IterationData::set_next_corrections(const Eigen::MatrixXd& corrections_bar) {
-  next_correction_bar = corrections_bar.cols() > 0 ? Eigen::VectorXd(corrections_bar.col(0)) : Eigen::VectorXd();
-  more_joint_next_correction_bar.clear();
-  for (Eigen::Index joint = 1; joint < corrections_bar.cols(); ++joint) {
-    more_joint_next_correction_bar.emplace_back(corrections_bar.col(joint));
-  }
 }
 
 std::string rig_profile_of(const SessionManifest& manifest) {

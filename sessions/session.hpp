@@ -25,8 +25,12 @@ namespace bellows {
 /// (a field an older version lacks gets its documented default: docs/session-format.md,
 /// "Versions"); a newer version is refused. Bump it when what is written changes in a way an older
 /// reader would misread, and add a fixture of the new format (tests/fixtures/sessions/README.md).
-inline constexpr int kSessionSchemaVersion = 1;
+inline constexpr int kSessionSchemaVersion = 2;
 inline constexpr int kOldestSessionSchemaVersion = 1;
+/// The version a session of `joints` joints is written in: 1 for one joint (its files exactly as
+/// every earlier bellows wrote them), 2 for several (every joint's controllers alike in
+/// resume.controller.joints; manifest_json.hpp).
+constexpr int session_schema_version_for(int joints) { return joints > 1 ? 2 : 1; }
 
 /// The program's version, written into every manifest.
 std::string program_version();
@@ -59,7 +63,7 @@ struct IterationEntry {
 };
 
 /// What continuing the run exactly needs beyond the correction: the controllers' state (every
-/// joint's: ControlCore::State's more_joints are saved as "more_joints" when J > 1), the
+/// joint's: manifest_json.hpp says how), the
 /// device's own state (which only the device's owner understands, kept here as JSON) and the
 /// simulated clock. Only a run on a simulated clock can be captured exactly; after a wall-clock
 /// run `controller` is empty and a resume starts from freshly armed controllers.
@@ -73,7 +77,7 @@ struct ResumeState {
 };
 
 struct SessionManifest {
-  int schema_version = kSessionSchemaVersion;
+  int schema_version = session_schema_version_for(1);
   std::string program_version;
   std::string name;
   std::string device;  // Device::name(), e.g. "sim"
@@ -101,18 +105,16 @@ struct SessionManifest {
 };
 
 /// One iteration's signals: the trial record and the correction learned from it for the next trial.
-/// Joint 1's correction is `next_correction_bar` (the only one of a single-joint session), joints
-/// 2..J's are `more_joint_next_correction_bar`, as TrialRecord keeps its joints.
+/// Column j of the correction is joint j + 1's, as TrialRecord::joints[j] is its record.
 struct IterationData {
   TrialRecord record;
-  Eigen::VectorXd next_correction_bar;                               // N values, joint 1
-  std::vector<Eigen::VectorXd> more_joint_next_correction_bar = {};  // joints 2..J; empty: one joint
+  Eigen::MatrixXd next_corrections = {};  // N x J
 
-  int joints() const { return 1 + static_cast<int>(more_joint_next_correction_bar.size()); }
+  int joints() const { return record.joint_count(); }
   /// Every joint's correction, N x J (one column per joint): what a J-joint learning takes.
-  Eigen::MatrixXd next_corrections_bar() const;
+  const Eigen::MatrixXd& next_corrections_bar() const { return next_corrections; }
   /// Sets every joint's correction from N x J.
-  void set_next_corrections(const Eigen::MatrixXd& corrections_bar);
+  void set_next_corrections(const Eigen::MatrixXd& corrections_bar) { next_corrections = corrections_bar; }
 };
 
 /// How many of a loaded session's files the manifest's digests vouch for. A file whose digest does

@@ -109,8 +109,8 @@ std::string write_black_box_file(const DirectoryHandle& session, int index, cons
 
 IterationDigests write_iteration_files(const DirectoryHandle& iterations, int index, const TrialRecord& record,
                                        const Eigen::MatrixXd& next_corrections_bar) {
-  const std::vector<std::string> samples_names = samples_header(record.joints());
-  const std::vector<std::string> telemetry_names = telemetry_header(record.joints());
+  const std::vector<std::string> samples_names = samples_header(record.joint_count());
+  const std::vector<std::string> telemetry_names = telemetry_header(record.joint_count());
   const std::vector<Eigen::VectorXd> samples = samples_file_values(record, next_corrections_bar);
   const std::vector<Eigen::VectorXd> telemetry = telemetry_file_values(record);
   check_finite(samples, samples_names, index);

@@ -77,8 +77,7 @@ std::vector<fs::path> export_session_csv(const Session& session, const fs::path&
   }
   if (samples.empty()) {  // the header alone, of every joint
     TrialRecord empty;    // no rows: every joint's columns empty
-    empty.more_joint_samples.resize(static_cast<std::size_t>(session.manifest.joints - 1));
-    empty.more_joint_ticks.resize(empty.more_joint_samples.size());
+    empty.joints.resize(static_cast<std::size_t>(session.manifest.joints));
     samples.push_back(format_samples_csv(empty, Eigen::MatrixXd{}));
     telemetry.push_back(format_telemetry_csv(empty));
   }

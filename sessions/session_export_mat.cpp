@@ -81,12 +81,12 @@ MatVar columns_struct(const std::vector<std::string>& fields, const std::vector<
 }
 
 MatVar samples_struct(const IterationData& data) {
-  return columns_struct(samples_header(data.record.joints()),
+  return columns_struct(samples_header(data.record.joint_count()),
                         samples_file_values(data.record, data.next_corrections_bar()));
 }
 
 MatVar telemetry_struct(const TrialRecord& record) {
-  return columns_struct(telemetry_header(record.joints()), telemetry_file_values(record));
+  return columns_struct(telemetry_header(record.joint_count()), telemetry_file_values(record));
 }
 
 MatVar configuration_struct(const Configuration& config) {

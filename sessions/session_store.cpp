@@ -83,11 +83,11 @@ Session load_session_part(const DirectoryHandle& directory, const std::vector<in
 /// RMS error over every joint and learning sample (deg).
 double overall_rms_deg(const TrialRecord& record) {
   double sum_of_squares = 0.0;
-  for (int joint = 0; joint < record.joints(); ++joint) {
+  for (int joint = 0; joint < record.joint_count(); ++joint) {
     const double rms = record.joint_rms_error_deg(joint);
     sum_of_squares += rms * rms;
   }
-  return std::sqrt(sum_of_squares / record.joints());
+  return std::sqrt(sum_of_squares / record.joint_count());
 }
 
 }  // namespace

@@ -27,12 +27,12 @@ SessionWriter::SessionWriter(DirectoryHandle directory, SessionManifest manifest
 SessionWriter SessionWriter::create(const fs::path& data_dir, const std::string& name, SessionManifest header,
                                     const Trajectory& trajectory, const std::string& purpose) {
   if (!header.iterations.empty()) throw std::invalid_argument("SessionWriter::create: a new session has no iterations");
-  header.schema_version = kSessionSchemaVersion;
   if (header.program_version.empty()) header.program_version = program_version();
   if (header.started_utc.empty()) header.started_utc = utc_now();
   header.trajectory_name = trajectory.name;
   header.trajectory_samples = trajectory.learning_samples();
   header.joints = trajectory.joints();
+  header.schema_version = session_schema_version_for(header.joints);
   if (!name.empty()) {
     validate_session_name(name);
     header.name = name;
@@ -62,7 +62,7 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   remove_temporary_files(session);
   SessionManifest manifest = loaded.manifest;
   // What it writes is this bellows' format (what an older version lacked has its default now).
-  manifest.schema_version = kSessionSchemaVersion;
+  manifest.schema_version = session_schema_version_for(manifest.joints);
   SessionWriter writer(std::move(session), std::move(manifest), std::move(lock));
   // What an interrupted save wrote but never committed, and files a committed revision superseded:
   // not part of the session.
@@ -77,10 +77,10 @@ void SessionWriter::check_fits(const TrialRecord& record, const Eigen::MatrixXd&
     throw std::invalid_argument(std::string("SessionWriter::") + what +
                                 ": the record does not match the session's trajectory");
   }
-  if (record.joints() != manifest_.joints || next_corrections_bar.cols() != manifest_.joints) {
+  if (record.joint_count() != manifest_.joints || next_corrections_bar.cols() != manifest_.joints) {
     throw std::invalid_argument(std::string("SessionWriter::") + what + ": the session has " +
                                 std::to_string(manifest_.joints) + " joints, the record " +
-                                std::to_string(record.joints()) + " and the correction " +
+                                std::to_string(record.joint_count()) + " and the correction " +
                                 std::to_string(next_corrections_bar.cols()));
   }
 }

@@ -146,10 +146,10 @@ inline Trajectory short_trajectory(double sample_time_s) {
 inline void write_short_run_files(const std::filesystem::path& directory) {
   std::string csv = "time_s,angle_deg\n";
   const Trajectory trajectory = short_trajectory(0.02);
-  for (Eigen::Index k = 0; k < trajectory.angle_rad.size(); ++k) {
+  for (Eigen::Index k = 0; k <= trajectory.learning_samples(); ++k) {
     std::ostringstream row;
     row.precision(17);
-    row << static_cast<double>(k) * 0.02 << "," << trajectory.angle_rad(k) * 180.0 / 3.141592653589793 << "\n";
+    row << static_cast<double>(k) * 0.02 << "," << trajectory.joint(0)(k) * 180.0 / 3.141592653589793 << "\n";
     csv += row.str();
   }
   write_text(directory / "short.csv", csv);

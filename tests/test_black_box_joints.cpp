@@ -86,10 +86,10 @@ void expect_same_joint_ticks(const std::vector<TickRecord>& loaded, const std::v
       EXPECT_TRUE(within_an_ulp(a.reading.joint[ji].angle_rad, b.reading.joint[ji].angle_rad))
           << a.reading.joint[ji].angle_rad - b.reading.joint[ji].angle_rad;
       EXPECT_EQ(a.reading.joint[ji].chamber_bar, b.reading.joint[ji].chamber_bar);
-      EXPECT_EQ(a.joint_desired_rad(j), b.joint_desired_rad(j));
-      EXPECT_EQ(a.joint_u_total_bar(j), b.joint_u_total_bar(j));
-      EXPECT_EQ(a.joint_setpoints(j).a_bar, b.joint_setpoints(j).a_bar);
-      EXPECT_EQ(a.joint_setpoints(j).b_bar, b.joint_setpoints(j).b_bar);
+      EXPECT_EQ(a.joint(j).desired_rad, b.joint(j).desired_rad);
+      EXPECT_EQ(a.joint(j).u_total_bar, b.joint(j).u_total_bar);
+      EXPECT_EQ(a.joint(j).setpoints.a_bar, b.joint(j).setpoints.a_bar);
+      EXPECT_EQ(a.joint(j).setpoints.b_bar, b.joint(j).setpoints.b_bar);
       EXPECT_EQ(a.valves.joint[ji].inlet_duty, b.valves.joint[ji].inlet_duty);
       EXPECT_EQ(a.valves.joint[ji].outlet_duty, b.valves.joint[ji].outlet_duty);
     }
@@ -135,10 +135,10 @@ TEST_P(BlackBoxJointSessions, EveryJointIsRecordedSavedLoadedAndExported) {
   // joint's differ from joint 1's while the trial runs (its correction and PID are its own).
   const TickRecord& running = box[box.size() / 2];
   EXPECT_EQ(running.state, EngineState::kRunning);
-  EXPECT_NE(running.joint_u_total_bar(last), 0.0);
-  EXPECT_NE(running.joint_u_total_bar(last), running.joint_u_total_bar(0));
-  EXPECT_NE(running.joint_setpoints(last).a_bar, running.joint_setpoints(0).a_bar);
-  EXPECT_NE(running.joint_setpoints(last).a_bar, 0.0);
+  EXPECT_NE(running.joint(last).u_total_bar, 0.0);
+  EXPECT_NE(running.joint(last).u_total_bar, running.joint(0).u_total_bar);
+  EXPECT_NE(running.joint(last).setpoints.a_bar, running.joint(0).setpoints.a_bar);
+  EXPECT_NE(running.joint(last).setpoints.a_bar, 0.0);
 
   TempDir dir;
   save_session(saved, dir / "s");
@@ -177,8 +177,8 @@ print(t.__dict__["u_tot_bar_j" + j][-2], t.__dict__["pressure_b_setpoint_bar_j" 
   read >> u_total >> setpoint_b >> outlet_b;
   ASSERT_FALSE(read.fail()) << std::string(buffer, got);
   const TickRecord& before_stop = box[box.size() - 2];
-  EXPECT_EQ(u_total, before_stop.joint_u_total_bar(last));
-  EXPECT_EQ(setpoint_b, before_stop.joint_setpoints(last).b_bar);
+  EXPECT_EQ(u_total, before_stop.joint(last).u_total_bar);
+  EXPECT_EQ(setpoint_b, before_stop.joint(last).setpoints.b_bar);
   EXPECT_EQ(outlet_b, 1.0) << "the fault tick vents every joint";
 }
 

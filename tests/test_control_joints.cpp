@@ -41,7 +41,7 @@ SensorReading one_joint_of(const SensorReading& r, int joint) {
 }
 
 Trajectory one_joint_trajectory_of(const Trajectory& t, int joint) {
-  return Trajectory{t.name, t.sample_time_s, t.joint_angle_rad(joint)};
+  return Trajectory{t.name, t.sample_time_s, {t.joint(joint)}};
 }
 
 void expect_same_columns(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const char* what, int joint) {
@@ -62,8 +62,8 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
   ControlCore both(config.controller, timing), alone_1(config.controller, timing), alone_2(config.controller, timing);
   TrialRecord record, record_1, record_2;
   both.hold(paper2.setpoint_rad(0));
-  alone_1.hold(joint_1.angle_rad(0));
-  alone_2.hold(joint_2.angle_rad(0));
+  alone_1.hold(joint_1.joint(0)(0));
+  alone_2.hold(joint_2.joint(0)(0));
   EXPECT_EQ(both.joints(), 2);
   const int hold_ticks = 41, trial_ticks = n * timing.ticks_per_sample + 23;  // holding, the trial, holding
   int saw_inlet = 0;
@@ -89,11 +89,11 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
   }
   EXPECT_GT(saw_inlet, 100) << "the valves must have worked";
   ASSERT_TRUE(record.complete);
-  ASSERT_EQ(record.joints(), 2);
+  ASSERT_EQ(record.joint_count(), 2);
   EXPECT_FALSE(both.trial_running());
   for (int j = 0; j < 2; ++j) {
     const TrialRecord& single = j == 0 ? record_1 : record_2;
-    const TrialSamples &s = record.joint_samples(j), &t = single.samples;
+    const TrialSamples &s = record.joint_samples(j), &t = single.joint_samples(0);
     for (const auto& [a, b, what] : {std::tuple{&s.setpoint_rad, &t.setpoint_rad, "setpoint"},
                                      {&s.angle_rad, &t.angle_rad, "angle"},
                                      {&s.error_rad, &t.error_rad, "error"},
@@ -102,10 +102,10 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
                                      {&s.setpoint_b_bar, &t.setpoint_b_bar, "p_B set"}}) {
       expect_same_columns(*a, *b, what, j);
     }
-    const TrialTicks &u = record.joint_ticks(j), &v = single.ticks;
+    const TrialTicks &u = record.joint_ticks(j), &v = single.joint_ticks(0);
     expect_same_columns(u.inlet_a, v.inlet_a, "inlet A", j);
     expect_same_columns(u.outlet_b, v.outlet_b, "outlet B", j);
-    expect_same_columns(u.supply_bar, v.supply_bar, "supply", j);
+    expect_same_columns(record.supply_bar, single.supply_bar, "supply", j);
     EXPECT_EQ(record.joint_rms_error_deg(j), single.rms_error_deg());
     EXPECT_GT(record.joint_rms_error_deg(j), 1.0) << "open loop, the readings do not follow the trajectory";
   }
@@ -115,7 +115,7 @@ TEST(ControlJoints, EachJointOfTwoComputesExactlyAsASingleJointCoreOnItsOwnReadi
   ASSERT_EQ(errors.cols(), 2);
   EXPECT_EQ(errors.col(0), record.normalized_error());
   EXPECT_EQ(errors.col(1), record_2.normalized_error());
-  EXPECT_EQ(record.samples.u_ilc_bar.head(n), correction_1);
+  EXPECT_EQ(record.joint_samples(0).u_ilc_bar.head(n), correction_1);
   EXPECT_EQ(record.joint_samples(1).u_ilc_bar.head(n), correction_2);
 }
 
@@ -134,8 +134,8 @@ TEST(ControlJoints, AReadingOfAnotherJointCountDrivesNothingAndVentsEveryJoint) 
   }
   const ControlCore::State after = core.state();
   EXPECT_EQ(after.tick_in_sample, before.tick_in_sample) << "no controller ran";
-  EXPECT_EQ(after.more_joints[0].pid.integral_s, before.more_joints[0].pid.integral_s);
-  EXPECT_EQ(after.more_joints[0].pressure_a.count, before.more_joints[0].pressure_a.count);
+  EXPECT_EQ(after.joints[1].pid.integral_s, before.joints[1].pid.integral_s);
+  EXPECT_EQ(after.joints[1].pressure_a.count, before.joints[1].pressure_a.count);
 }
 
 TEST(ControlJoints, EveryJointsStateResumesExactlyAndJointOneKeepsItsFields) {
@@ -147,11 +147,11 @@ TEST(ControlJoints, EveryJointsStateResumesExactlyAndJointOneKeepsItsFields) {
   first.hold(hold);
   for (int tick = 0; tick < 37; ++tick) first.tick(moving_reading(3, tick, timing.tick_s));  // mid-sample
   const ControlCore::State saved = first.state();
-  EXPECT_EQ(saved.joints, 3);
-  EXPECT_EQ(saved.hold_rad, 0.2);
-  EXPECT_EQ(saved.more_joints[0].hold_rad, -0.1);
-  EXPECT_EQ(saved.more_joints[1].hold_rad, 0.3);
-  EXPECT_NE(saved.more_joints[1].pid.integral_s, 0.0);
+  EXPECT_EQ(saved.joint_count, 3);
+  EXPECT_EQ(saved.joints[0].hold_rad, 0.2);
+  EXPECT_EQ(saved.joints[1].hold_rad, -0.1);
+  EXPECT_EQ(saved.joints[2].hold_rad, 0.3);
+  EXPECT_NE(saved.joints[2].pid.integral_s, 0.0);
   ControlCore resumed(config.controller, timing);
   resumed.set_state(saved);
   EXPECT_EQ(resumed.joints(), 3);
@@ -167,10 +167,10 @@ TEST(ControlJoints, EveryJointsStateResumesExactlyAndJointOneKeepsItsFields) {
   }
   // A single-joint state (what every session saved so far holds) drives one joint.
   ControlCore::State single = saved;
-  single.joints = 1;
+  single.joint_count = 1;
   resumed.set_state(single);
   EXPECT_EQ(resumed.joints(), 1);
-  EXPECT_EQ(resumed.state().more_joints[0].pid.integral_s, 0.0) << "joints not driven start fresh";
+  EXPECT_EQ(resumed.state().joints[1].pid.integral_s, 0.0) << "joints not driven start fresh";
 }
 
 TEST(EngineJoints, ATwoJointTrajectoryOnAOneJointArmFaultsWhenArmedAndNeverDrivesIt) {
@@ -222,7 +222,7 @@ TEST(EngineJoints, RefusesATrialWhoseCorrectionOrRecordDoesNotFitItsTrajectorysJ
     EXPECT_EQ(f.core.joints(), 1) << "a refused trial selects nothing";
   }
   Trajectory uneven = paper2;
-  uneven.more_joints_rad[0].conservativeResize(n - 3);
+  uneven.joint(1).conservativeResize(n - 3);
   EXPECT_TRUE(f.core.send(EngineCommand::select_trajectory(uneven)));
   f.clock.step();
   const auto events = f.drain_events();

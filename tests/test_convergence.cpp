@@ -74,7 +74,7 @@ ConvergenceRun learn(const Configuration& config, int iterations, double kappa_s
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n), next(n);
   ConvergenceRun run;
   for (int j = 0; j < iterations; ++j) {
-    law->update(u, plant.trial(reference.angle_rad, u), next);
+    law->update(u, plant.trial(reference.joint(0), u), next);
     run.change_norm.push_back((next - u).norm());
     u.swap(next);
     run.correction_norm.push_back(u.norm());

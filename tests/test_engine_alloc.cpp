@@ -149,7 +149,7 @@ TEST(EngineAllocations, TicksOfThreeJointsAllocateNothing) {
     allocations = counter.allocations();
   }
   EXPECT_TRUE(record.complete);
-  EXPECT_EQ(record.joints(), 3);
+  EXPECT_EQ(record.joint_count(), 3);
   EXPECT_EQ(core.state(), EngineState::kArmed);
   EXPECT_GT(tap.read_available(), 1000u);
   EXPECT_EQ(allocations, 0);

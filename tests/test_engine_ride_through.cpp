@@ -99,13 +99,13 @@ TEST(EngineRideThrough, GapsShorterThanTheStaleLimitCostTheirTicksNotTheTrial) {
   for (int k = 0; k <= paper.learning_samples(); ++k) {
     if (record.held[static_cast<std::size_t>(k)] == 0) continue;
     ++held;
-    EXPECT_EQ(record.samples.error_rad(k), 0.0) << "held sample " << k << " must not be learned from";
+    EXPECT_EQ(record.joint_samples(0).error_rad(k), 0.0) << "held sample " << k << " must not be learned from";
     if (k < paper.learning_samples()) {  // its tick held every valve closed: nothing can inflate
       const int i = k * tps;
-      EXPECT_EQ(record.ticks.inlet_a(i), 0.0);
-      EXPECT_EQ(record.ticks.inlet_b(i), 0.0);
-      EXPECT_EQ(record.ticks.outlet_a(i), 0.0);
-      EXPECT_EQ(record.ticks.outlet_b(i), 0.0);
+      EXPECT_EQ(record.joint_ticks(0).inlet_a(i), 0.0);
+      EXPECT_EQ(record.joint_ticks(0).inlet_b(i), 0.0);
+      EXPECT_EQ(record.joint_ticks(0).outlet_a(i), 0.0);
+      EXPECT_EQ(record.joint_ticks(0).outlet_b(i), 0.0);
     }
   }
   EXPECT_EQ(held, record.held_samples);
@@ -249,7 +249,7 @@ TEST(EngineLateLoop, ALateWakeUpBelowTheLimitRidesThroughAsHeldTicksOnTheRigsClo
   EXPECT_GE(record.held_samples, missed / e.config.timing.ticks_per_sample);
   for (int k = 0; k <= paper.learning_samples(); ++k) {
     if (record.held[static_cast<std::size_t>(k)] != 0) {
-      EXPECT_EQ(record.samples.error_rad(k), 0.0) << k;
+      EXPECT_EQ(record.joint_samples(0).error_rad(k), 0.0) << k;
     }
   }
   // The trial's clock kept the rig's time: it ends when the clean one did, not `missed` ticks later.

@@ -123,10 +123,10 @@ TEST(Identification, ExcitationsStayWithinTheirAmplitudeAndUnknownSignalsAreReje
   const IdentificationParameters p;
   for (const std::string signal : {"chirp", "steps"}) {
     const Trajectory t = identification_trajectory(signal, p, 0.02);
-    EXPECT_LE(t.angle_rad.cwiseAbs().maxCoeff(), p.amplitude_deg * std::numbers::pi / 180.0 + 1e-12);
-    EXPECT_NEAR(t.angle_rad(0), 0.0, 1e-12);
-    EXPECT_NEAR(t.angle_rad(t.angle_rad.size() - 1), 0.0, 1e-9);
-    EXPECT_GT(t.angle_rad.cwiseAbs().maxCoeff(), 0.8 * p.amplitude_deg * std::numbers::pi / 180.0);
+    EXPECT_LE(t.joint(0).cwiseAbs().maxCoeff(), p.amplitude_deg * std::numbers::pi / 180.0 + 1e-12);
+    EXPECT_NEAR(t.joint(0)(0), 0.0, 1e-12);
+    EXPECT_NEAR(t.joint(0)(t.joint(0).size() - 1), 0.0, 1e-9);
+    EXPECT_GT(t.joint(0).cwiseAbs().maxCoeff(), 0.8 * p.amplitude_deg * std::numbers::pi / 180.0);
   }
   EXPECT_EQ(validation_signal("chirp"), "steps");
   EXPECT_THROW(identification_trajectory("noise", p, 0.02), InputError);

@@ -56,7 +56,7 @@ void select_and_arm(EngineDriver& driver, const Trajectory& trajectory) {
 
 std::vector<double> per_joint_rms_deg(const TrialRecord& record) {
   std::vector<double> rms;
-  for (int j = 0; j < record.joints(); ++j) rms.push_back(record.joint_rms_error_deg(j));
+  for (int j = 0; j < record.joint_count(); ++j) rms.push_back(record.joint_rms_error_deg(j));
   return rms;
 }
 
@@ -99,7 +99,7 @@ TEST(LcmJointClosedLoop, TheEngineDrivesArm2OverMemqAndEveryJointTracksAsInProce
   loop.stop();
   io.stop();
 
-  ASSERT_EQ(record.joints(), 2);
+  ASSERT_EQ(record.joint_count(), 2);
   const std::vector<double> over_lcm = per_joint_rms_deg(record);
   const std::vector<double> in_process = arm2_in_process(c, paper2);
   for (int j = 0; j < 2; ++j) {

@@ -103,11 +103,11 @@ TEST_P(JointTelemetry, EveryTickCarriesEveryJoint) {
         continue;
       }
       EXPECT_EQ(t.angle_rad[j], tick.reading.joint[ji].angle_rad);
-      EXPECT_EQ(t.desired_angle_rad[j], tick.joint_desired_rad(j));
+      EXPECT_EQ(t.desired_angle_rad[j], tick.joint(j).desired_rad);
       EXPECT_EQ(t.chamber_bar[j][1], tick.reading.joint[ji].chamber_bar[1]);
-      EXPECT_EQ(t.u_total_bar[j], tick.joint_u_total_bar(j));
-      EXPECT_EQ(t.setpoint_bar[j][0], tick.joint_setpoints(j).a_bar);
-      EXPECT_EQ(t.saturation[j], tick.joint_setpoints(j).saturation_sign);
+      EXPECT_EQ(t.u_total_bar[j], tick.joint(j).u_total_bar);
+      EXPECT_EQ(t.setpoint_bar[j][0], tick.joint(j).setpoints.a_bar);
+      EXPECT_EQ(t.saturation[j], tick.joint(j).setpoints.saturation_sign);
       EXPECT_EQ(t.inlet_duty[j][0], tick.valves.joint[ji].inlet_duty[0]);
       EXPECT_EQ(t.outlet_duty[j][1], tick.valves.joint[ji].outlet_duty[1]);
     }
@@ -166,7 +166,7 @@ TEST(JointTelemetryFault, OneJointStillSpeaksTelemetryT) {
   TickRecord tick;
   ASSERT_TRUE(bench.core.read_snapshot(tick));
   EXPECT_EQ(last.angle_rad, tick.reading.joint[0].angle_rad);
-  EXPECT_EQ(last.u_total_bar, tick.u_total_bar);
+  EXPECT_EQ(last.u_total_bar, tick.joint(0).u_total_bar);
   // And the joint message is refused as another type by a reader of telemetry_t.
   std::vector<std::uint8_t> bytes;
   const std::size_t size = encode_into(telemetry_joints_t{}, bytes);

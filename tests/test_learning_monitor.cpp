@@ -14,10 +14,10 @@ TrialRecord record(const Eigen::VectorXd& error_rad, const Eigen::VectorXd& u_pi
   TrialRecord r;
   const int n = static_cast<int>(u_ilc.size());
   r.prepare(n, 1);
-  r.samples.error_rad.tail(n) = error_rad;
-  r.samples.u_pid_bar.head(n) = u_pid;
-  r.samples.u_ilc_bar.head(n) = u_ilc;
-  r.samples.u_total_bar.head(n) = u_pid + u_ilc;
+  r.joint_samples(0).error_rad.tail(n) = error_rad;
+  r.joint_samples(0).u_pid_bar.head(n) = u_pid;
+  r.joint_samples(0).u_ilc_bar.head(n) = u_ilc;
+  r.joint_samples(0).u_total_bar.head(n) = u_pid + u_ilc;
   r.complete = true;
   return r;
 }

@@ -76,8 +76,8 @@ double single_joint_paper_rms_deg() {
 }
 
 Eigen::RowVectorXd joint_rms_deg(const TrialRecord& record) {
-  Eigen::RowVectorXd rms(record.joints());
-  for (int j = 0; j < record.joints(); ++j) rms(j) = record.joint_rms_error_deg(j);
+  Eigen::RowVectorXd rms(record.joint_count());
+  for (int j = 0; j < record.joint_count(); ++j) rms(j) = record.joint_rms_error_deg(j);
   return rms;
 }
 
@@ -140,7 +140,7 @@ TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEvery
   constexpr int kIterations = 5;
   for (int iteration = 0; iteration <= kIterations; ++iteration) {
     const TrialRecord record = e.trial(paper2, u, static_cast<std::uint32_t>(iteration + 1));
-    ASSERT_EQ(record.joints(), joints);
+    ASSERT_EQ(record.joint_count(), joints);
     rms.push_back(joint_rms_deg(record));
     const Eigen::MatrixXd errors = record.normalized_joint_errors();
     std::cout << "arm2/paper2 iteration " << iteration << ": RMS per joint (deg) " << rms.back() << ", overall "

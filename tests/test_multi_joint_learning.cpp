@@ -31,15 +31,15 @@ Eigen::MatrixXd paper_rad(int joints) {
       {0.6, 0.0, 20.0, 0.3}, {2.0, 20.0, -20.0, 0.3}, {3.4, -20.0, 20.0, 0.3}, {4.8, 20.0, 0.0, 0.3}};
   const Trajectory shoulder = trajectory_from_moves("shoulder", 0.0, shoulder_moves, 8.0, kSampleTime_s);
   const Trajectory elbow = library_trajectory("paper", kSampleTime_s);
-  Eigen::MatrixXd reference(shoulder.angle_rad.size(), joints);
-  reference.col(0) = shoulder.angle_rad;
-  reference.col(1) = elbow.angle_rad;
+  Eigen::MatrixXd reference(shoulder.joint(0).size(), joints);
+  reference.col(0) = shoulder.joint(0);
+  reference.col(1) = elbow.joint(0);
   if (joints == 3) {
     std::vector<TrapezoidalMove> wrist_moves;
     const double paper_moves[6][3] = {{0.6, 0, 30},   {1.6, 30, -30}, {2.6, -30, 30},
                                       {3.6, 30, -30}, {4.6, -30, 30}, {5.6, 30, 0}};
     for (const auto& m : paper_moves) wrist_moves.push_back({m[0] + 0.3, m[1], m[2]});
-    reference.col(2) = trajectory_from_moves("wrist", 0.0, wrist_moves, 8.0, kSampleTime_s).angle_rad;
+    reference.col(2) = trajectory_from_moves("wrist", 0.0, wrist_moves, 8.0, kSampleTime_s).joint(0);
   }
   return reference;
 }

@@ -257,7 +257,7 @@ PaperRun run_paper_scenario(const std::string& law_name, int iterations) {
     run.max_correction_bar.push_back(s.max_abs_correction_bar);
     run.largest_clamp_bar = std::max(run.largest_clamp_bar, d.clamped_excess_bar);
     if (j == iterations) break;
-    const Eigen::VectorXd feedback = session.last_record().samples.u_pid_bar.head(n);
+    const Eigen::VectorXd feedback = session.last_record().joint_samples(0).u_pid_bar.head(n);
     session.learn();
     run.worst_planned_total_bar =
         std::max(run.worst_planned_total_bar, (feedback + session.correction_bar()).cwiseAbs().maxCoeff());

@@ -231,7 +231,7 @@ TEST_F(Plot, RangesFitTheDataAndLegendsSitInsideTheAxes) {
   EXPECT_LT(rms_high, high * 2.0) << "not a decade above the data";
   EXPECT_NE(named(figures, "rms").plot.find("set ytics ("), std::string::npos);  // labelled ticks inside the range
   // Pressures: the axis spans the chambers, not the supply far above them.
-  const TrialTicks& t = session_.iterations.back().record.ticks;
+  const TrialTicks& t = session_.iterations.back().record.joint_ticks(0);
   const double p_low = std::min(t.pressure_a_bar.minCoeff(), t.pressure_b_bar.minCoeff());
   const double p_high = std::max({t.pressure_a_bar.maxCoeff(), t.pressure_b_bar.maxCoeff(), t.setpoint_a_bar.maxCoeff(),
                                   t.setpoint_b_bar.maxCoeff()});

@@ -46,12 +46,12 @@ void expect_same_ticks(const std::vector<TickRecord>& loaded, const std::vector<
     EXPECT_EQ(a.fault, b.fault);
     EXPECT_TRUE(same_number(a.reading.joint[0].angle_rad, b.reading.joint[0].angle_rad))
         << a.reading.joint[0].angle_rad << " " << b.reading.joint[0].angle_rad;
-    EXPECT_EQ(a.desired_angle_rad, b.desired_angle_rad);
+    EXPECT_EQ(a.joint(0).desired_rad, b.joint(0).desired_rad);
     EXPECT_EQ(a.reading.joint[0].chamber_bar, b.reading.joint[0].chamber_bar);
     EXPECT_EQ(a.reading.supply_bar, b.reading.supply_bar);
-    EXPECT_EQ(a.u_total_bar, b.u_total_bar);
-    EXPECT_EQ(a.setpoints.a_bar, b.setpoints.a_bar);
-    EXPECT_EQ(a.setpoints.b_bar, b.setpoints.b_bar);
+    EXPECT_EQ(a.joint(0).u_total_bar, b.joint(0).u_total_bar);
+    EXPECT_EQ(a.joint(0).setpoints.a_bar, b.joint(0).setpoints.a_bar);
+    EXPECT_EQ(a.joint(0).setpoints.b_bar, b.joint(0).setpoints.b_bar);
     EXPECT_EQ(a.valves.joint[0].inlet_duty, b.valves.joint[0].inlet_duty);
     EXPECT_EQ(a.valves.joint[0].outlet_duty, b.valves.joint[0].outlet_duty);
     EXPECT_EQ(a.sample, b.sample);

@@ -62,9 +62,12 @@ TEST(SessionResume, TenIterationsEqualFivePlusAResumeOfFive) {
   ASSERT_EQ(a.iterations.size(), 11u);
   ASSERT_EQ(b.iterations.size(), 11u);
   for (std::size_t i = 0; i < 11; ++i) {
-    EXPECT_EQ(a.iterations[i].record.samples.angle_rad, b.iterations[i].record.samples.angle_rad) << i;
-    EXPECT_EQ(a.iterations[i].record.ticks.pressure_a_bar, b.iterations[i].record.ticks.pressure_a_bar) << i;
-    EXPECT_EQ(a.iterations[i].next_correction_bar, b.iterations[i].next_correction_bar) << i;
+    EXPECT_EQ(a.iterations[i].record.joint_samples(0).angle_rad, b.iterations[i].record.joint_samples(0).angle_rad)
+        << i;
+    EXPECT_EQ(a.iterations[i].record.joint_ticks(0).pressure_a_bar,
+              b.iterations[i].record.joint_ticks(0).pressure_a_bar)
+        << i;
+    EXPECT_EQ(a.iterations[i].next_corrections_bar(), b.iterations[i].next_corrections_bar()) << i;
   }
   EXPECT_LT(split.back()["rms_deg"].get<double>(), 0.5 * split.front()["rms_deg"].get<double>());
   const auto& events = b.manifest.events;
@@ -260,7 +263,8 @@ TEST(SessionSaving, AWallClockRunSavesAndResumesWithItsCorrection) {
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   const Session continued = load_session(dir / "data" / "w");
   ASSERT_EQ(continued.iterations.size(), 3u);
-  EXPECT_EQ(continued.iterations[2].record.samples.u_ilc_bar.head(25), saved.iterations[1].next_correction_bar);
+  EXPECT_EQ(continued.iterations[2].record.joint_samples(0).u_ilc_bar.head(25),
+            saved.iterations[1].next_corrections_bar());
 }
 
 class SessionsCommand : public ::testing::Test {
@@ -364,7 +368,8 @@ TEST_F(SessionsCommand, ExportsCsvThatReadsBack) {
   for (int i = 0; i < 4; ++i) {
     for (int k = 0; k < 26; ++k) {
       EXPECT_EQ(samples[0](i * 26 + k), i);
-      EXPECT_EQ(radians_from_degrees(samples[3](i * 26 + k)), session.iterations[i].record.samples.angle_rad(k));
+      EXPECT_EQ(radians_from_degrees(samples[3](i * 26 + k)),
+                session.iterations[i].record.joint_samples(0).angle_rad(k));
     }
   }
   std::vector<std::string_view> telemetry_header = {"iteration"};
@@ -409,8 +414,8 @@ TEST_F(SessionsCommand, ExportsMatlabV73WithOneStructPerIteration) {
     ASSERT_EQ(angle.size(), 26u);
     ASSERT_EQ(u_tot.size(), 26u);
     for (int k = 0; k < 26; ++k) {
-      EXPECT_EQ(radians_from_degrees(angle[k]), session.iterations[i].record.samples.angle_rad(k));
-      EXPECT_EQ(u_tot[k], session.iterations[i].record.samples.u_total_bar(k));
+      EXPECT_EQ(radians_from_degrees(angle[k]), session.iterations[i].record.joint_samples(0).angle_rad(k));
+      EXPECT_EQ(u_tot[k], session.iterations[i].record.joint_samples(0).u_total_bar(k));
     }
     matvar_t* telemetry = Mat_VarGetStructFieldByName(iterations, "telemetry", i);
     ASSERT_NE(telemetry, nullptr);

@@ -69,7 +69,7 @@ void expect_mat_contents(const fs::path& path, const Session& session, mat_ft ve
               std::vector<double>{session.manifest.iterations[i].summary.rms_deg});
     matvar_t* samples = Mat_VarGetStructFieldByName(iterations, "samples", i);
     const std::vector<double> u_ilc = doubles(Mat_VarGetStructFieldByName(samples, "u_ilc_bar", 0));
-    const Eigen::VectorXd& saved = session.iterations[i].record.samples.u_ilc_bar;
+    const Eigen::VectorXd& saved = session.iterations[i].record.joint_samples(0).u_ilc_bar;
     EXPECT_EQ(u_ilc, std::vector<double>(saved.data(), saved.data() + saved.size()));
   }
   Mat_VarFree(iterations);
@@ -83,7 +83,7 @@ void expect_mat_contents(const fs::path& path, const Session& session, mat_ft ve
   const std::vector<double> angle = doubles(Mat_VarGetStructFieldByName(ticks, "angle_deg", 0));
   ASSERT_EQ(angle.size(), box.size());
   EXPECT_TRUE(std::isnan(angle.back()));  // the reading that caused the fault, as the engine saw it
-  EXPECT_EQ(doubles(Mat_VarGetStructFieldByName(ticks, "u_tot_bar", 0)).front(), box.front().u_total_bar);
+  EXPECT_EQ(doubles(Mat_VarGetStructFieldByName(ticks, "u_tot_bar", 0)).front(), box.front().joint(0).u_total_bar);
   matvar_t* faults = Mat_VarGetStructFieldByName(ticks, "fault", 0);
   ASSERT_NE(faults, nullptr);
   ASSERT_EQ(faults->class_type, MAT_C_CELL);
@@ -137,7 +137,7 @@ TEST_F(SessionExport, ReadsLegacyBlackBoxesWithNumericCodes) {
   ASSERT_EQ(read.size(), box.size());
   EXPECT_EQ(read.back().fault, FaultCode::kSensorNotANumber);
   EXPECT_EQ(read.back().state, EngineState::kFault);
-  EXPECT_EQ(read.front().u_total_bar, box.front().u_total_bar);
+  EXPECT_EQ(read.front().joint(0).u_total_bar, box.front().joint(0).u_total_bar);
   EXPECT_EQ(format_black_box_csv(read), format_black_box_csv(box));  // rewritten in today's vocabulary
   std::string bad = legacy;
   bad.replace(bad.find("\n") + 1, bad.size(), "x\n");

@@ -92,8 +92,8 @@ TEST(IterationFiles, TrajectoryRoundTripsExactly) {
                                                       0.02, TrajectoryLimits{});
   EXPECT_EQ(loaded.name, trajectory.name);
   EXPECT_EQ(loaded.sample_time_s, trajectory.sample_time_s);
-  ASSERT_EQ(loaded.angle_rad.size(), trajectory.angle_rad.size());
-  for (Eigen::Index k = 0; k < loaded.angle_rad.size(); ++k) EXPECT_EQ(loaded.angle_rad(k), trajectory.angle_rad(k));
+  ASSERT_EQ(loaded.joint(0).size(), trajectory.joint(0).size());
+  for (Eigen::Index k = 0; k < loaded.joint(0).size(); ++k) EXPECT_EQ(loaded.joint(0)(k), trajectory.joint(0)(k));
 }
 
 TEST(IterationFiles, TrajectoryChecksLengthSamplingAndLimits) {

@@ -142,7 +142,7 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
     for (int j = 0; j < joints; ++j) {
       const std::vector<double> angle_deg =
           fixture_csv_column(fixture / "trajectory.csv", trajectory_column(j, joints));
-      const Eigen::VectorXd& angle_rad = session.trajectory.joint_angle_rad(j);
+      const Eigen::VectorXd& angle_rad = session.trajectory.joint(j);
       ASSERT_EQ(static_cast<std::size_t>(angle_rad.size()), angle_deg.size());
       EXPECT_NEAR(angle_rad(angle_rad.size() - 1) * 180.0 / M_PI, angle_deg.back(), 1e-12) << "joint " << j + 1;
     }
@@ -168,6 +168,44 @@ TEST(SessionFixtures, EveryFixtureLoadsWithTheValuesOfItsOwnFiles) {
       EXPECT_TRUE(session.manifest.first_correction.is_null());
     }
   }
+}
+
+TEST(SessionFixtures, EveryJointsControllersAreReadFromEveryFormat) {
+  // Joint 1's controllers sit at the top of resume.controller in every version-1 session; a
+  // version-1 J-joint session keeps joints 2..J's in the one array there (its key is the reader's).
+  // A version-2 (J-joint) session keeps every joint's, joint 1's first, in the one array there.
+  int several = 0;
+  int version2 = 0;
+  for (const fs::path& fixture : saved_fixture_sessions()) {
+    SCOPED_TRACE(fixture.filename().string());
+    const nlohmann::json raw = nlohmann::json::parse(read_text(fixture / "manifest.json"));
+    if (!raw.contains("resume") || !raw["resume"].contains("controller")) continue;
+    const SessionManifest manifest = load_manifest(fixture);
+    ASSERT_TRUE(manifest.resume && manifest.resume->controller);
+    const ControlCore::State& state = *manifest.resume->controller;
+    const nlohmann::json& controller = raw["resume"]["controller"];
+    const int joints = raw["trajectory"].value("joints", 1);
+    ASSERT_EQ(state.joint_count, joints);
+    const bool every_joint_in_the_array = raw["schema_version"].get<int>() >= 2;
+    std::vector<const nlohmann::json*> saved;
+    if (!every_joint_in_the_array) saved.push_back(&controller);
+    for (const auto& item : controller.items()) {
+      if (item.value().is_array())
+        for (const nlohmann::json& joint : item.value()) saved.push_back(&joint);
+    }
+    ASSERT_EQ(saved.size(), static_cast<std::size_t>(joints));
+    for (int j = 0; j < joints; ++j) {
+      const nlohmann::json& expected = *saved[static_cast<std::size_t>(j)];
+      const ControlCore::JointState& read = state.joints[static_cast<std::size_t>(j)];
+      EXPECT_EQ(read.hold_rad, expected["hold_rad"].get<double>()) << "joint " << j + 1;
+      EXPECT_EQ(read.pid.integral_s, expected["pid"]["integral_s"].get<double>()) << "joint " << j + 1;
+      EXPECT_EQ(read.pressure_b.sum_bar, expected["pressure_b"]["sum_bar"].get<double>()) << "joint " << j + 1;
+    }
+    several += joints > 1 && !every_joint_in_the_array ? 1 : 0;
+    version2 += every_joint_in_the_array ? 1 : 0;
+  }
+  EXPECT_GT(several, 0) << "a J-joint fixture of schema version 1";
+  EXPECT_GT(version2, 0) << "a J-joint fixture of schema version 2";
 }
 
 TEST(SessionFixtures, EveryFixtureIsShownAndExported) {

@@ -75,8 +75,7 @@ Trajectory joint_trajectory(const std::string& name, double sample_time_s) {
   Trajectory trajectory = library_trajectory(name, sample_time_s);
   constexpr Eigen::Index kRows = 101;
   trajectory.name = name + "-head";
-  trajectory.angle_rad = trajectory.angle_rad.head(kRows).eval();
-  for (Eigen::VectorXd& joint : trajectory.more_joints_rad) joint = joint.head(kRows).eval();
+  for (Eigen::VectorXd& joint : trajectory.angles_rad) joint = joint.head(kRows).eval();
   return trajectory;
 }
 
@@ -129,25 +128,33 @@ Session simulate_joint_session(const char* preset, const std::string& trajectory
   return session;
 }
 
+/// Where `record` keeps `column` for joint `joint`: the joint's own, the record's shared one, or
+/// nothing (the correction learned, a column of IterationData).
+template <typename Joint>
+const Eigen::VectorXd* column_values(const TrialRecord& record, const Joint& of_joint,
+                                     const RecordColumn<Joint>& column) {
+  if (column.member != nullptr) return &(of_joint.*column.member);
+  if (column.shared != nullptr) return &(record.*column.shared);
+  return nullptr;
+}
+
 /// `a` and `b` agree as a file keeps them: angles through degrees (an ulp at most), the rest exactly.
+template <typename Joint>
+void expect_columns_equal(const TrialRecord& a, const Joint& a_joint, const TrialRecord& b, const Joint& b_joint,
+                          const std::vector<RecordColumn<Joint>>& columns, int joint) {
+  for (const RecordColumn<Joint>& column : columns) {
+    const Eigen::VectorXd* x = column_values(a, a_joint, column);
+    const Eigen::VectorXd* y = column_values(b, b_joint, column);
+    if (x == nullptr || y == nullptr) continue;
+    ASSERT_EQ(x->size(), y->size()) << column.name << " of joint " << joint + 1;
+    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
+    EXPECT_LE((*x - *y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
+  }
+}
+
 void expect_columns_equal(const TrialRecord& a, const TrialRecord& b, int joint) {
-  const TrialSamples& s = a.joint_samples(joint);
-  const TrialSamples& t = b.joint_samples(joint);
-  for (const RecordColumn<TrialSamples>& column : samples_record_columns()) {
-    if (column.member == nullptr) continue;
-    const Eigen::VectorXd& x = s.*column.member;
-    const Eigen::VectorXd& y = t.*column.member;
-    ASSERT_EQ(x.size(), y.size()) << column.name << " of joint " << joint + 1;
-    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
-    EXPECT_LE((x - y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
-  }
-  for (const RecordColumn<TrialTicks>& column : telemetry_record_columns()) {
-    const Eigen::VectorXd& x = a.joint_ticks(joint).*column.member;
-    const Eigen::VectorXd& y = b.joint_ticks(joint).*column.member;
-    ASSERT_EQ(x.size(), y.size()) << column.name << " of joint " << joint + 1;
-    const double tolerance = column.scale == ColumnScale::kAsIs ? 0.0 : 1e-12;
-    EXPECT_LE((x - y).cwiseAbs().maxCoeff(), tolerance) << column.name << " of joint " << joint + 1;
-  }
+  expect_columns_equal(a, a.joint_samples(joint), b, b.joint_samples(joint), samples_record_columns(), joint);
+  expect_columns_equal(a, a.joint_ticks(joint), b, b.joint_ticks(joint), telemetry_record_columns(), joint);
 }
 
 /// The header line of `file`.
@@ -163,7 +170,7 @@ TEST_P(JointSessions, RoundTripEveryJointAndExportIt) {
   TempDir dir;
   const Session saved = simulate_joint_session(preset, trajectory_name, 2);
   const int joints = saved.trajectory.joints();
-  ASSERT_EQ(saved.iterations[0].record.joints(), joints);
+  ASSERT_EQ(saved.iterations[0].record.joint_count(), joints);
   save_session(saved, dir / "s");
   const Session loaded = load_session(dir / "s");
 
@@ -177,7 +184,7 @@ TEST_P(JointSessions, RoundTripEveryJointAndExportIt) {
   EXPECT_EQ(header_of_file(dir / "s" / session_layout::kTrajectory), trajectory_header);
   ASSERT_EQ(loaded.trajectory.joints(), joints);
   for (int j = 0; j < joints; ++j) {
-    const Eigen::VectorXd difference = loaded.trajectory.joint_angle_rad(j) - saved.trajectory.joint_angle_rad(j);
+    const Eigen::VectorXd difference = loaded.trajectory.joint(j) - saved.trajectory.joint(j);
     EXPECT_LE(difference.cwiseAbs().maxCoeff(), 1e-12) << "joint " << j + 1;
   }
 
@@ -190,17 +197,21 @@ TEST_P(JointSessions, RoundTripEveryJointAndExportIt) {
       std::string::npos);
   ASSERT_EQ(loaded.iterations.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
-    ASSERT_EQ(loaded.iterations[i].record.joints(), joints);
+    ASSERT_EQ(loaded.iterations[i].record.joint_count(), joints);
     for (int j = 0; j < joints; ++j) expect_columns_equal(loaded.iterations[i].record, saved.iterations[i].record, j);
     EXPECT_EQ(loaded.iterations[i].next_corrections_bar(), saved.iterations[i].next_corrections_bar());
   }
-  // The resume state holds every joint's controllers.
+  // The resume state holds every joint's controllers, each alike (schema version 2).
+  const Json written = Json::parse(testing::read_text(dir / "s" / session_layout::kManifest));
+  EXPECT_EQ(written["schema_version"], 2);
+  EXPECT_EQ(written["resume"]["controller"]["joints"].size(), static_cast<std::size_t>(joints));
+  EXPECT_FALSE(written["resume"]["controller"].contains("pid")) << "no joint is kept apart";
   const ControlCore::State& state = *loaded.manifest.resume->controller;
   const ControlCore::State& recorded = *saved.manifest.resume->controller;
-  EXPECT_EQ(state.joints, joints);
-  for (int j = 1; j < joints; ++j) {
-    const auto& a = state.more_joints[static_cast<std::size_t>(j - 1)];
-    const auto& b = recorded.more_joints[static_cast<std::size_t>(j - 1)];
+  EXPECT_EQ(state.joint_count, joints);
+  for (int j = 0; j < joints; ++j) {
+    const auto& a = state.joints[static_cast<std::size_t>(j)];
+    const auto& b = recorded.joints[static_cast<std::size_t>(j)];
     EXPECT_EQ(a.pid.integral_s, b.pid.integral_s) << "joint " << j + 1;
     EXPECT_EQ(a.pressure_a.sum_bar, b.pressure_a.sum_bar) << "joint " << j + 1;
     EXPECT_EQ(a.setpoints.b_bar, b.setpoints.b_bar) << "joint " << j + 1;
@@ -233,7 +244,7 @@ print(len(m["iterations"]), it.samples.__dict__["angle_deg_j%d" % j][5], it.tele
   testing::write_text(dir / "read.py", script);
   const int last = joints - 1;
   Eigen::Index moved = 0;  // the sample where the last joint is farthest from 0
-  loaded.trajectory.joint_angle_rad(last).cwiseAbs().maxCoeff(&moved);
+  loaded.trajectory.joint(last).cwiseAbs().maxCoeff(&moved);
   FILE* pipe = ::popen(("/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "out.mat").string() + " " +
                         std::to_string(joints) + " " + std::to_string(moved) + " 2>&1")
                            .c_str(),
@@ -251,8 +262,8 @@ print(len(m["iterations"]), it.samples.__dict__["angle_deg_j%d" % j][5], it.tele
   EXPECT_EQ(count, 2);
   EXPECT_NEAR(angle, record.joint_samples(last).angle_rad(5) / kRadPerDeg, 1e-9);
   EXPECT_EQ(duty, record.joint_ticks(last).outlet_b(7));
-  EXPECT_EQ(next, loaded.iterations[1].more_joint_next_correction_bar[static_cast<std::size_t>(last - 1)](3));
-  EXPECT_NEAR(trajectory_deg, loaded.trajectory.joint_angle_rad(last)(moved) / kRadPerDeg, 1e-9);
+  EXPECT_EQ(next, loaded.iterations[1].next_corrections_bar()(3, last));
+  EXPECT_NEAR(trajectory_deg, loaded.trajectory.joint(last)(moved) / kRadPerDeg, 1e-9);
   EXPECT_NE(trajectory_deg, 0.0) << "the last joint moves by then";
 }
 
@@ -275,7 +286,8 @@ TEST(JointSessionFiles, OneJointIsWrittenAsAlways) {
   const Session one = testing::simulate_session(1);
   const Json manifest = manifest_to_json(one.manifest);
   EXPECT_FALSE(manifest["trajectory"].contains("joints"));
-  EXPECT_FALSE(manifest["resume"]["controller"].contains("more_joints"));
+  EXPECT_FALSE(manifest["resume"]["controller"].contains("joints"));
+  EXPECT_TRUE(manifest["resume"]["controller"].contains("pid")) << "joint 1's fields, as always";
   EXPECT_EQ(manifest["schema_version"], 1);
 }
 
@@ -419,24 +431,23 @@ TEST(JointSessionDamage, LiesAboutTheJointsAreRefusedInOneLine) {
                   "manifest.json: /trajectory/joints: expected a whole number in [1, 4], found 9");
   // A manifest claiming 3 joints of 2-joint files: the resume state lacks joint 3's controllers...
   expect_one_line(with_manifest([](Json& m) { m["trajectory"]["joints"] = 3; }),
-                  "/resume/controller/more_joints: expected 2 entries (joints 2 to 3 of the session's 3), found 1");
+                  "/resume/controller/joints: expected 3 entries (one per joint of the session's 3), found 2");
   // ...and given them, the trajectory file has two joints' columns.
   expect_one_line(with_manifest([](Json& m) {
                     m["trajectory"]["joints"] = 3;
-                    Json& more = m["resume"]["controller"]["more_joints"];
-                    more.push_back(more[0]);
+                    Json& all = m["resume"]["controller"]["joints"];
+                    all.push_back(all[0]);
                   }),
                   "trajectory.csv: line 1: the header must be 'time_s,q1_deg,q2_deg,q3_deg'");
   // The resume state without joint 2's controllers.
-  expect_one_line(with_manifest([](Json& m) { m["resume"]["controller"]["more_joints"] = Json::array(); }),
-                  "/resume/controller/more_joints: expected 1 entries (joints 2 to 2 of the session's 2)");
+  expect_one_line(with_manifest([](Json& m) { m["resume"]["controller"]["joints"].erase(1); }),
+                  "/resume/controller/joints: expected 2 entries (one per joint of the session's 2), found 1");
   // An iteration file without joint 2's columns (a joint's data missing), its digest updated.
   const fs::path samples = dir / "s" / session_layout::samples_file(0);
   const Session loaded = load_session(dir / "s");
   TrialRecord one_joint = loaded.iterations[0].record;
-  one_joint.more_joint_samples.clear();
-  one_joint.more_joint_ticks.clear();
-  testing::write_text(samples, format_samples_csv(one_joint, loaded.iterations[0].next_correction_bar));
+  one_joint.joints.resize(1);
+  testing::write_text(samples, format_samples_csv(one_joint, loaded.iterations[0].next_corrections_bar()));
   const std::string error = with_manifest([](Json& m) { m["iterations"][0].erase("samples_sha256"); });
   expect_one_line(error, "iterations/iteration_0000.csv: line 1: the header must be 'time_s,angle_setpoint_deg,");
   expect_one_line(error, "u_ilc_next_bar_j2'");

@@ -46,23 +46,28 @@ void expect_same_times(const Eigen::VectorXd& loaded, const Eigen::VectorXd& sav
   for (Eigen::Index k = 0; k < saved.size(); ++k) EXPECT_NEAR(loaded(k), saved(k), 1e-9) << what << " at " << k;
 }
 
-void expect_same_controller(const ControlCore::State& a, const ControlCore::State& b) {
-  EXPECT_EQ(a.pid.integral_s, b.pid.integral_s);
-  EXPECT_EQ(a.pid.previous_output, b.pid.previous_output);
-  EXPECT_EQ(a.pid.has_previous, b.pid.has_previous);
-  for (const auto& [x, y] : {std::pair{&a.pressure_a, &b.pressure_a}, std::pair{&a.pressure_b, &b.pressure_b}}) {
-    EXPECT_EQ(x->history_bar, y->history_bar);
-    EXPECT_EQ(x->count, y->count);
-    EXPECT_EQ(x->next, y->next);
-    EXPECT_EQ(x->sum_bar, y->sum_bar);
+void expect_same_controller(const ControlCore::State& state_a, const ControlCore::State& state_b) {
+  ASSERT_EQ(state_a.joint_count, state_b.joint_count);
+  for (int j = 0; j < state_a.joint_count; ++j) {
+    const ControlCore::JointState& a = state_a.joints[static_cast<std::size_t>(j)];
+    const ControlCore::JointState& b = state_b.joints[static_cast<std::size_t>(j)];
+    EXPECT_EQ(a.pid.integral_s, b.pid.integral_s);
+    EXPECT_EQ(a.pid.previous_output, b.pid.previous_output);
+    EXPECT_EQ(a.pid.has_previous, b.pid.has_previous);
+    for (const auto& [x, y] : {std::pair{&a.pressure_a, &b.pressure_a}, std::pair{&a.pressure_b, &b.pressure_b}}) {
+      EXPECT_EQ(x->history_bar, y->history_bar);
+      EXPECT_EQ(x->count, y->count);
+      EXPECT_EQ(x->next, y->next);
+      EXPECT_EQ(x->sum_bar, y->sum_bar);
+    }
+    EXPECT_EQ(a.setpoints.a_bar, b.setpoints.a_bar);
+    EXPECT_EQ(a.setpoints.b_bar, b.setpoints.b_bar);
+    EXPECT_EQ(a.setpoints.saturation_sign, b.setpoints.saturation_sign);
+    EXPECT_EQ(a.hold_rad, b.hold_rad);
+    EXPECT_EQ(a.desired_rad, b.desired_rad);
+    EXPECT_EQ(a.u_total_bar, b.u_total_bar);
   }
-  EXPECT_EQ(a.setpoints.a_bar, b.setpoints.a_bar);
-  EXPECT_EQ(a.setpoints.b_bar, b.setpoints.b_bar);
-  EXPECT_EQ(a.setpoints.saturation_sign, b.setpoints.saturation_sign);
-  EXPECT_EQ(a.hold_rad, b.hold_rad);
-  EXPECT_EQ(a.desired_rad, b.desired_rad);
-  EXPECT_EQ(a.u_total_bar, b.u_total_bar);
-  EXPECT_EQ(a.tick_in_sample, b.tick_in_sample);
+  EXPECT_EQ(state_a.tick_in_sample, state_b.tick_in_sample);
 }
 
 void expect_same_configuration(const Configuration& a, const Configuration& b) {
@@ -116,7 +121,7 @@ void expect_same_session(const Session& loaded, const Session& saved) {
   }
   EXPECT_EQ(loaded.trajectory.name, saved.trajectory.name);
   EXPECT_EQ(loaded.trajectory.sample_time_s, saved.trajectory.sample_time_s);
-  expect_same(loaded.trajectory.angle_rad, saved.trajectory.angle_rad, "trajectory");  // from degrees: exact
+  expect_same(loaded.trajectory.joint(0), saved.trajectory.joint(0), "trajectory");  // from degrees: exact
 
   ASSERT_EQ(loaded.iterations.size(), saved.iterations.size());
   for (std::size_t i = 0; i < loaded.iterations.size(); ++i) {
@@ -124,29 +129,30 @@ void expect_same_session(const Session& loaded, const Session& saved) {
     const TrialRecord& y = saved.iterations[i].record;
     EXPECT_EQ(x.learning_samples, y.learning_samples);
     EXPECT_TRUE(x.complete);
-    expect_same_times(x.samples.time_s, y.samples.time_s, "samples time");
-    expect_same_angles(x.samples.setpoint_rad, y.samples.setpoint_rad, "set point");
-    expect_same_angles(x.samples.angle_rad, y.samples.angle_rad, "angle");
-    expect_same_angles(x.samples.error_rad, y.samples.error_rad, "error");
-    expect_same(x.samples.u_pid_bar, y.samples.u_pid_bar, "u_pid");
-    expect_same(x.samples.u_ilc_bar, y.samples.u_ilc_bar, "u_ilc");
-    expect_same(x.samples.u_total_bar, y.samples.u_total_bar, "u_tot");
-    expect_same(x.samples.pressure_a_bar, y.samples.pressure_a_bar, "pressure A");
-    expect_same(x.samples.pressure_b_bar, y.samples.pressure_b_bar, "pressure B");
-    expect_same(x.samples.setpoint_a_bar, y.samples.setpoint_a_bar, "set point A");
-    expect_same(x.samples.setpoint_b_bar, y.samples.setpoint_b_bar, "set point B");
-    expect_same(loaded.iterations[i].next_correction_bar, saved.iterations[i].next_correction_bar, "next correction");
-    expect_same_times(x.ticks.time_s, y.ticks.time_s, "ticks time");
-    expect_same_angles(x.ticks.angle_rad, y.ticks.angle_rad, "ticks angle");
-    expect_same(x.ticks.pressure_a_bar, y.ticks.pressure_a_bar, "ticks pressure A");
-    expect_same(x.ticks.pressure_b_bar, y.ticks.pressure_b_bar, "ticks pressure B");
-    expect_same(x.ticks.supply_bar, y.ticks.supply_bar, "ticks supply");
-    expect_same(x.ticks.setpoint_a_bar, y.ticks.setpoint_a_bar, "ticks set point A");
-    expect_same(x.ticks.setpoint_b_bar, y.ticks.setpoint_b_bar, "ticks set point B");
-    expect_same(x.ticks.inlet_a, y.ticks.inlet_a, "inlet A");
-    expect_same(x.ticks.outlet_a, y.ticks.outlet_a, "outlet A");
-    expect_same(x.ticks.inlet_b, y.ticks.inlet_b, "inlet B");
-    expect_same(x.ticks.outlet_b, y.ticks.outlet_b, "outlet B");
+    expect_same_times(x.sample_time_s, y.sample_time_s, "samples time");
+    expect_same_angles(x.joint_samples(0).setpoint_rad, y.joint_samples(0).setpoint_rad, "set point");
+    expect_same_angles(x.joint_samples(0).angle_rad, y.joint_samples(0).angle_rad, "angle");
+    expect_same_angles(x.joint_samples(0).error_rad, y.joint_samples(0).error_rad, "error");
+    expect_same(x.joint_samples(0).u_pid_bar, y.joint_samples(0).u_pid_bar, "u_pid");
+    expect_same(x.joint_samples(0).u_ilc_bar, y.joint_samples(0).u_ilc_bar, "u_ilc");
+    expect_same(x.joint_samples(0).u_total_bar, y.joint_samples(0).u_total_bar, "u_tot");
+    expect_same(x.joint_samples(0).pressure_a_bar, y.joint_samples(0).pressure_a_bar, "pressure A");
+    expect_same(x.joint_samples(0).pressure_b_bar, y.joint_samples(0).pressure_b_bar, "pressure B");
+    expect_same(x.joint_samples(0).setpoint_a_bar, y.joint_samples(0).setpoint_a_bar, "set point A");
+    expect_same(x.joint_samples(0).setpoint_b_bar, y.joint_samples(0).setpoint_b_bar, "set point B");
+    expect_same(loaded.iterations[i].next_corrections_bar(), saved.iterations[i].next_corrections_bar(),
+                "next correction");
+    expect_same_times(x.tick_time_s, y.tick_time_s, "ticks time");
+    expect_same_angles(x.joint_ticks(0).angle_rad, y.joint_ticks(0).angle_rad, "ticks angle");
+    expect_same(x.joint_ticks(0).pressure_a_bar, y.joint_ticks(0).pressure_a_bar, "ticks pressure A");
+    expect_same(x.joint_ticks(0).pressure_b_bar, y.joint_ticks(0).pressure_b_bar, "ticks pressure B");
+    expect_same(x.supply_bar, y.supply_bar, "ticks supply");
+    expect_same(x.joint_ticks(0).setpoint_a_bar, y.joint_ticks(0).setpoint_a_bar, "ticks set point A");
+    expect_same(x.joint_ticks(0).setpoint_b_bar, y.joint_ticks(0).setpoint_b_bar, "ticks set point B");
+    expect_same(x.joint_ticks(0).inlet_a, y.joint_ticks(0).inlet_a, "inlet A");
+    expect_same(x.joint_ticks(0).outlet_a, y.joint_ticks(0).outlet_a, "outlet A");
+    expect_same(x.joint_ticks(0).inlet_b, y.joint_ticks(0).inlet_b, "inlet B");
+    expect_same(x.joint_ticks(0).outlet_b, y.joint_ticks(0).outlet_b, "outlet B");
     EXPECT_NEAR(x.rms_error_deg(), y.rms_error_deg(), 1e-12);
   }
 }
@@ -252,7 +258,7 @@ TEST(SessionWriter, AutosavesEveryIterationAndEvent) {
   EXPECT_TRUE(load_session(writer.directory()).iterations.empty());  // loadable from the start
   for (std::size_t i = 0; i < simulated.iterations.size(); ++i) {
     writer.save_iteration(simulated.iterations[i].record, simulated.manifest.iterations[i].summary,
-                          simulated.iterations[i].next_correction_bar, *simulated.manifest.resume);
+                          simulated.iterations[i].next_corrections_bar(), *simulated.manifest.resume);
     EXPECT_EQ(load_session(writer.directory()).iterations.size(), i + 1);
   }
   writer.record_event("fault", "supply pressure lost");
@@ -261,12 +267,13 @@ TEST(SessionWriter, AutosavesEveryIterationAndEvent) {
   EXPECT_EQ(loaded.manifest.events.back().kind, "fault");
   EXPECT_EQ(loaded.manifest.events.back().iteration, 3);
   for (std::size_t i = 0; i < 3; ++i) {
-    expect_same(loaded.iterations[i].next_correction_bar, simulated.iterations[i].next_correction_bar, "correction");
+    expect_same(loaded.iterations[i].next_corrections_bar(), simulated.iterations[i].next_corrections_bar(),
+                "correction");
     EXPECT_EQ(loaded.manifest.iterations[i].summary.rms_deg, simulated.manifest.iterations[i].summary.rms_deg);
   }
   // Out of order is a programming error, not bad input.
   EXPECT_THROW(writer.save_iteration(simulated.iterations[0].record, simulated.manifest.iterations[0].summary,
-                                     simulated.iterations[0].next_correction_bar, *simulated.manifest.resume),
+                                     simulated.iterations[0].next_corrections_bar(), *simulated.manifest.resume),
                std::invalid_argument);
 }
 
@@ -333,11 +340,11 @@ TEST(SessionWriter, RefusesNonFiniteValuesAndKeepsWhatWasSaved) {
   header.resume.reset();
   SessionWriter writer = SessionWriter::create(dir.path(), "n", header, simulated.trajectory, "test");
   writer.save_iteration(simulated.iterations[0].record, simulated.manifest.iterations[0].summary,
-                        simulated.iterations[0].next_correction_bar, *simulated.manifest.resume);
-  simulated.iterations[1].record.samples.angle_rad(3) = std::numeric_limits<double>::quiet_NaN();
+                        simulated.iterations[0].next_corrections_bar(), *simulated.manifest.resume);
+  simulated.iterations[1].record.joint_samples(0).angle_rad(3) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(error_of([&] {
               writer.save_iteration(simulated.iterations[1].record, simulated.manifest.iterations[1].summary,
-                                    simulated.iterations[1].next_correction_bar, *simulated.manifest.resume);
+                                    simulated.iterations[1].next_corrections_bar(), *simulated.manifest.resume);
             }).find("iteration 1: angle at index 3 is not a finite number"),
             std::string::npos);
   EXPECT_EQ(load_session(writer.directory()).iterations.size(), 1u);

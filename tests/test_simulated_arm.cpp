@@ -114,10 +114,11 @@ double largest_bounce_back_bar(const PlantParameters& plant) {
                        paper.learning_samples());
   LearningSession session(clock, law, paper, timing, controller);
   session.run_trial();
-  const TrialTicks& t = session.last_record().ticks;
+  const TrialRecord& record = session.last_record();
+  const TrialTicks& t = record.joint_ticks(0);
   double largest = 0.0;
-  for (Eigen::Index i = 0; i < t.time_s.size(); ++i) {
-    const bool moving_toward_b = t.time_s(i) > 1.6 && t.time_s(i) < 1.9;  // the +30 -> -30 move
+  for (Eigen::Index i = 0; i < record.tick_time_s.size(); ++i) {
+    const bool moving_toward_b = record.tick_time_s(i) > 1.6 && record.tick_time_s(i) < 1.9;  // the +30 -> -30 move
     if (moving_toward_b) largest = std::max(largest, t.pressure_a_bar(i) - t.setpoint_a_bar(i));
   }
   return largest;

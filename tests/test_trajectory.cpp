@@ -38,7 +38,7 @@ TEST(TrajectoryLibrary, PaperFollowsSection6) {
   const Trajectory paper = library_trajectory("paper", 0.02);
   EXPECT_EQ(paper.learning_samples(), 400);
   EXPECT_NEAR(paper.duration_s(), 8.0, 1e-12);
-  auto at = [&](double t) { return paper.angle_rad(std::lround(t / 0.02)) / kDeg; };
+  auto at = [&](double t) { return paper.joint(0)(std::lround(t / 0.02)) / kDeg; };
   EXPECT_DOUBLE_EQ(at(0.0), 0.0);
   EXPECT_NEAR(at(0.6), 0.0, 1e-9);
   EXPECT_NEAR(at(1.0), 30.0, 1e-9);
@@ -54,7 +54,7 @@ TEST(TrajectoryLibrary, EveryEntryIsValidAndUnknownNamesAreRejected) {
     const Trajectory t = library_trajectory(name, 0.02);
     EXPECT_NO_THROW(validate_trajectory(t, TrajectoryLimits{})) << name;
     EXPECT_FALSE(trajectory_library_description(name).empty());
-    EXPECT_GT(t.angle_rad.cwiseAbs().maxCoeff(), 10.0 * kDeg) << name;
+    EXPECT_GT(t.joint(0).cwiseAbs().maxCoeff(), 10.0 * kDeg) << name;
   }
   EXPECT_THROW(library_trajectory("nope", 0.02), InputError);
 }
@@ -70,7 +70,7 @@ TEST(TrajectoryCsv, ParsesAUniformFile) {
       parse_trajectory_csv(csv({{0.0, 0.0}, {0.02, 1.0}, {0.04, 2.5}, {0.06, 3.0}}), "dir/ramp.csv", 0.02, {});
   EXPECT_EQ(t.name, "ramp");
   EXPECT_EQ(t.learning_samples(), 3);
-  EXPECT_NEAR(t.angle_rad(2), 2.5 * kDeg, 1e-12);
+  EXPECT_NEAR(t.joint(0)(2), 2.5 * kDeg, 1e-12);
 }
 
 void expect_csv_rejected(const std::string& text, const std::string& fragment) {

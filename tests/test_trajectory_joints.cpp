@@ -19,7 +19,7 @@ constexpr double kJointDeg = std::numbers::pi / 180.0;
 constexpr double kSample_s = 0.02;
 
 double deg_at(const Trajectory& t, int joint, double time_s) {
-  return t.joint_angle_rad(joint)(std::lround(time_s / t.sample_time_s)) / kJointDeg;
+  return t.joint(joint)(std::lround(time_s / t.sample_time_s)) / kJointDeg;
 }
 
 TEST(TrajectoryJoints, SingleJointLibraryKeepsItsNumbers) {
@@ -34,8 +34,8 @@ TEST(TrajectoryJoints, SingleJointLibraryKeepsItsNumbers) {
                                                          {5.6, 30, 0, 0.2, 12000.0}},
                                                         8.0, kSample_s);
   EXPECT_EQ(paper.joints(), 1);
-  EXPECT_TRUE(paper.more_joints_rad.empty());
-  EXPECT_EQ(paper.angle_rad, paper_before.angle_rad);
+  EXPECT_TRUE(paper.angles_rad.size() == 1);
+  EXPECT_EQ(paper.joint(0), paper_before.joint(0));
   const Trajectory steps = library_trajectory("steps", kSample_s);
   const Trajectory steps_before = trajectory_from_moves("steps", 0.0,
                                                         {{0.5, 0, 20, 0.3, 4000.0},
@@ -44,7 +44,7 @@ TEST(TrajectoryJoints, SingleJointLibraryKeepsItsNumbers) {
                                                          {5.0, -20, -40, 0.3, 4000.0},
                                                          {6.5, -40, 0, 0.3, 4000.0}},
                                                         10.0, kSample_s);
-  EXPECT_EQ(steps.angle_rad, steps_before.angle_rad);
+  EXPECT_EQ(steps.joint(0), steps_before.joint(0));
   EXPECT_EQ(library_trajectory("sine", kSample_s).joints(), 1);
   EXPECT_EQ(trajectory_library_joints("paper"), 1);
 }
@@ -53,8 +53,8 @@ TEST(TrajectoryJoints, Paper2IsTheShouldersFourMovesAndThePapersElbow) {
   const Trajectory paper2 = library_trajectory("paper2", kSample_s);
   ASSERT_EQ(paper2.joints(), 2);
   EXPECT_EQ(trajectory_library_joints("paper2"), 2);
-  EXPECT_EQ(paper2.learning_samples(), 400);                                               // 8 s at 50 Hz
-  EXPECT_EQ(paper2.joint_angle_rad(1), library_trajectory("paper", kSample_s).angle_rad);  // the elbow: the paper's
+  EXPECT_EQ(paper2.learning_samples(), 400);                                    // 8 s at 50 Hz
+  EXPECT_EQ(paper2.joint(1), library_trajectory("paper", kSample_s).joint(0));  // the elbow: the paper's
   // Shoulder 0 -> 20 -> -20 -> 20 -> 0 deg, 0.3 s moves starting at 0.6, 2.0, 3.4 and 4.8 s.
   const double starts_s[] = {0.6, 2.0, 3.4, 4.8};
   const Trajectory fine = library_trajectory("paper2", 0.005);  // half a move, 0.15 s, on the grid
@@ -75,7 +75,7 @@ TEST(TrajectoryJoints, Paper2IsTheShouldersFourMovesAndThePapersElbow) {
                                                      {3.4, -20, 20, 0.3, 12000.0},
                                                      {4.8, 20, 0, 0.3, 12000.0}},
                                                     8.0, kSample_s);
-  EXPECT_EQ(paper2.angle_rad, shoulder.angle_rad);
+  EXPECT_EQ(paper2.joint(0), shoulder.joint(0));
   const JointVector at_one_second = paper2.setpoint_rad(50);
   ASSERT_EQ(at_one_second.size(), 2);
   EXPECT_NEAR(at_one_second(0) / kJointDeg, 20.0, 1e-9);
@@ -87,11 +87,12 @@ TEST(TrajectoryJoints, Paper3AddsTheWristDoingThePapersMovesLater) {
   const Trajectory paper3 = library_trajectory("paper3", kSample_s);
   ASSERT_EQ(paper3.joints(), 3);
   EXPECT_EQ(trajectory_library_joints("paper3"), 3);
-  EXPECT_EQ(paper3.angle_rad, paper2.angle_rad);
-  EXPECT_EQ(paper3.joint_angle_rad(1), paper2.joint_angle_rad(1));
+  EXPECT_EQ(paper3.joint(0), paper2.joint(0));
+  EXPECT_EQ(paper3.joint(1), paper2.joint(1));
   // The wrist is the paper 0.3 s (15 samples) later, at +-30 deg.
-  const Eigen::VectorXd& paper = library_trajectory("paper", kSample_s).angle_rad;
-  const Eigen::VectorXd& wrist = paper3.joint_angle_rad(2);
+  const Trajectory paper_trajectory = library_trajectory("paper", kSample_s);
+  const Eigen::VectorXd& paper = paper_trajectory.joint(0);  // (a reference into a temporary would dangle)
+  const Eigen::VectorXd& wrist = paper3.joint(2);
   for (Eigen::Index k = 0; k < wrist.size(); ++k) {
     EXPECT_NEAR(wrist(k), k < 15 ? 0.0 : paper(k - 15), 1e-9) << "sample " << k;
   }
@@ -117,7 +118,7 @@ TEST(TrajectoryJoints, JointCountsOutsideOneToFourAreRefused) {
             std::string::npos);
   EXPECT_THROW(trajectory_from_joint_moves("none", {}, 1.0, kSample_s), InputError);
   Trajectory ragged = library_trajectory("paper2", kSample_s);
-  ragged.more_joints_rad[0].conservativeResize(10);
+  ragged.joint(1).conservativeResize(10);
   EXPECT_NE(testing::error_of([&] { validate_trajectory(ragged, {}); }).find("joint 2: has 10 samples"),
             std::string::npos);
 }
@@ -151,9 +152,9 @@ TEST(TrajectoryJointsCsv, ReadsOneColumnPerJoint) {
   EXPECT_EQ(t.name, "arm3-wave");
   ASSERT_EQ(t.joints(), 3);
   EXPECT_EQ(t.learning_samples(), 2);
-  EXPECT_NEAR(t.angle_rad(2), 2.0 * kJointDeg, 1e-15);
-  EXPECT_NEAR(t.joint_angle_rad(1)(2), -4.0 * kJointDeg, 1e-15);
-  EXPECT_NEAR(t.joint_angle_rad(2)(1), 3.0 * kJointDeg, 1e-15);
+  EXPECT_NEAR(t.joint(0)(2), 2.0 * kJointDeg, 1e-15);
+  EXPECT_NEAR(t.joint(1)(2), -4.0 * kJointDeg, 1e-15);
+  EXPECT_NEAR(t.joint(2)(1), 3.0 * kJointDeg, 1e-15);
   // q1_deg alone is one joint, like time_s,angle_deg; CR LF and a byte order mark as for one joint.
   EXPECT_EQ(parse_trajectory_csv("\xef\xbb\xbftime_s,q1_deg\r\n0,0\r\n0.02,1\r\n0.04,2\r\n", "one.csv", kSample_s, {})
                 .joints(),
@@ -175,9 +176,8 @@ TEST(TrajectoryJointsCsv, WritesWhatItReadsBack) {
     EXPECT_EQ(loaded.name, name);
     ASSERT_EQ(loaded.joints(), original.joints()) << name;
     for (int j = 0; j < original.joints(); ++j) {
-      ASSERT_EQ(loaded.joint_angle_rad(j).size(), original.joint_angle_rad(j).size());
-      EXPECT_LT((loaded.joint_angle_rad(j) - original.joint_angle_rad(j)).cwiseAbs().maxCoeff(), 1e-15)
-          << name << " " << j;
+      ASSERT_EQ(loaded.joint(j).size(), original.joint(j).size());
+      EXPECT_LT((loaded.joint(j) - original.joint(j)).cwiseAbs().maxCoeff(), 1e-15) << name << " " << j;
     }
   }
   EXPECT_NE(trajectory_csv(library_trajectory("paper", kSample_s)).find("\n0.06,0\n"), std::string::npos)

@@ -102,7 +102,7 @@ TEST_F(TransferOnTheSimulatedArm, PlannedSetPointsRespectThePressureLimits) {
   const double reach = c.p_max_bar - c.gas.ambient_bar - TransferSettings{}.limit_margin_bar;
   const auto targets = unseen_trajectories(config.timing.sample_s());
   for (std::size_t i = 0; i < targets.size(); ++i) {
-    const Eigen::VectorXd r = targets[i].angle_rad / std::numbers::pi;
+    const Eigen::VectorXd r = targets[i].joint(0) / std::numbers::pi;
     const Eigen::VectorXd& u = (outcomes())[i].transfer.correction_bar;
     for (Eigen::Index t = 0; t < u.size(); ++t) {
       const double feedback = c.k_ff * r(t) - c.k_d_s * (t > 0 ? (r(t) - r(t - 1)) / config.timing.sample_s() : 0.0);

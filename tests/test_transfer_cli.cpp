@@ -31,8 +31,8 @@ class TransferCli : public ::testing::Test {
     const Trajectory triangle = testing::unseen_trajectories(Configuration{}.timing.sample_s())[3];
     std::ofstream csv(target_csv());
     csv << "time_s,angle_deg\n";
-    for (Eigen::Index k = 0; k < triangle.angle_rad.size(); ++k) {
-      csv << static_cast<double>(k) * triangle.sample_time_s << "," << triangle.angle_rad(k) * 180.0 / std::numbers::pi
+    for (Eigen::Index k = 0; k <= triangle.learning_samples(); ++k) {
+      csv << static_cast<double>(k) * triangle.sample_time_s << "," << triangle.joint(0)(k) * 180.0 / std::numbers::pi
           << "\n";
     }
   }
@@ -82,7 +82,7 @@ TEST_F(TransferCli, TheFirstTrialStartsFromWhatTheSessionsTaught) {
   ASSERT_TRUE(saved.manifest.first_correction.is_object());
   EXPECT_EQ(saved.manifest.first_correction["status"], "transferred");
   EXPECT_EQ(saved.manifest.first_correction["sources"].size(), 2u);
-  EXPECT_GT(saved.iterations[0].record.samples.u_ilc_bar.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(saved.iterations[0].record.joint_samples(0).u_ilc_bar.cwiseAbs().maxCoeff(), 0.0);
   // A session started without a transfer has no such field.
   EXPECT_TRUE(load_manifest(std::filesystem::path(data_dir()) / "trained-paper").first_correction.is_null());
 }

@@ -26,8 +26,8 @@ inline constexpr double kDegToRad = std::numbers::pi / 180.0;
 template <typename AngleOfTime>
 Trajectory trajectory_of(const std::string& name, double duration_s, double sample_time_s, AngleOfTime angle_deg) {
   const int n = static_cast<int>(std::lround(duration_s / sample_time_s));
-  Trajectory t{name, sample_time_s, Eigen::VectorXd(n + 1)};
-  for (int k = 0; k <= n; ++k) t.angle_rad(k) = angle_deg(k * sample_time_s) * kDegToRad;
+  Trajectory t{name, sample_time_s, {Eigen::VectorXd(n + 1)}};
+  for (int k = 0; k <= n; ++k) t.joint(0)(k) = angle_deg(k * sample_time_s) * kDegToRad;
   validate_trajectory(t, TrajectoryLimits{});
   return t;
 }
@@ -99,7 +99,7 @@ inline LearningRun run_learning(const Configuration& config, const Trajectory& t
   run.source.controller = config.controller;
   for (int j = 0; j <= iterations; ++j) {
     run.rms_deg.push_back(session.run_trial().rms_deg);
-    const TrialSamples& s = session.last_record().samples;
+    const TrialSamples& s = session.last_record().joint_samples(0);
     run.source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
     if (j < iterations) session.learn();
   }

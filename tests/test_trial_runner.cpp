@@ -114,9 +114,9 @@ TEST(TrialRunner, StepByStepAndRunToCompletionAndFedEventsGiveTheSameRecord) {
   for (const TrialRunner* r : {&a, &b, &c}) EXPECT_EQ(r->status().phase, TrialPhase::kDone);
   EXPECT_EQ(polled.clock.ticks(), run.clock.ticks());
   EXPECT_EQ(polled.clock.ticks(), fed.clock.ticks());
-  EXPECT_EQ(polled.record.samples.angle_rad, run.record.samples.angle_rad);
-  EXPECT_EQ(polled.record.samples.angle_rad, fed.record.samples.angle_rad);
-  EXPECT_EQ(polled.record.samples.u_total_bar, fed.record.samples.u_total_bar);
+  EXPECT_EQ(polled.record.joint_samples(0).angle_rad, run.record.joint_samples(0).angle_rad);
+  EXPECT_EQ(polled.record.joint_samples(0).angle_rad, fed.record.joint_samples(0).angle_rad);
+  EXPECT_EQ(polled.record.joint_samples(0).u_total_bar, fed.record.joint_samples(0).u_total_bar);
 }
 
 TEST(TrialRunner, AGuardFiringMidTrialEndsItFaultedWithTheFaultCode) {

@@ -561,7 +561,7 @@ TEST(UiController, AfterAnEmergencyStopTheLivePanelShowsTheRealState) {
   EXPECT_NE(screen.find(format("angle      %7.2f deg", live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi)),
             std::string::npos)
       << screen;
-  EXPECT_GT(std::abs(live.desired_angle_rad - live.reading.joint[0].angle_rad) * 180.0 / std::numbers::pi, 1.0)
+  EXPECT_GT(std::abs(live.joint(0).desired_rad - live.reading.joint[0].angle_rad) * 180.0 / std::numbers::pi, 1.0)
       << "the engine keeps its last set point: the panel must not show it as a tracking error";
 }
 

@@ -74,7 +74,7 @@ TEST(UiJoints, Arm2TrialsRecordPerJointAndOverallRmsAndLearnEveryJointsCorrectio
   ASSERT_EQ(e.trials.size(), 3u);
   for (const Trial& t : e.trials) {
     ASSERT_EQ(t.summary.joint_rms_deg.size(), 2);
-    ASSERT_EQ(t.record.joints(), 2);
+    ASSERT_EQ(t.record.joint_count(), 2);
     double squares = 0.0;
     for (int j = 0; j < 2; ++j) {
       EXPECT_DOUBLE_EQ(t.summary.joint_rms_deg(j), t.record.joint_rms_error_deg(j));
@@ -150,10 +150,10 @@ TEST(UiJoints, TheInspectorAndTheLiveStripShowTheSelectedJoint) {
   const TickRecord& live = f.state().live;
   ASSERT_FALSE(f.state().strip.angle_deg.empty());
   EXPECT_NEAR(f.state().strip.angle_deg.back(), live.reading.joint[1].angle_rad * 180.0 / std::numbers::pi, 1.0);
-  EXPECT_NEAR(f.state().strip.setpoint_deg.back(), live.more_desired_rad[0] * 180.0 / std::numbers::pi, 1e-9);
+  EXPECT_NEAR(f.state().strip.setpoint_deg.back(), live.joint(1).desired_rad * 180.0 / std::numbers::pi, 1e-9);
   f.key('j');
   EXPECT_NEAR(f.state().strip.angle_deg.back(), live.reading.joint[0].angle_rad * 180.0 / std::numbers::pi, 1.0);
-  EXPECT_NEAR(f.state().strip.setpoint_deg.back(), live.desired_angle_rad * 180.0 / std::numbers::pi, 1e-9);
+  EXPECT_NEAR(f.state().strip.setpoint_deg.back(), live.joint(0).desired_rad * 180.0 / std::numbers::pi, 1e-9);
 }
 
 TEST(UiJoints, AGuardNamesTheJointAndTheChamberItFiredOn) {

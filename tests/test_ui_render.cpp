@@ -203,7 +203,7 @@ TEST(UiRender, InspectorReadsTheValuesAtTheCursor) {
   const std::string text = all(render_lines(s));
   // Trial 1 at sample 35 (t = 0.7 s): the paper's first move is under way.
   const auto trajectory = library_trajectory("paper", 0.02);
-  const double setpoint_deg = trajectory.angle_rad(35) / kDeg;
+  const double setpoint_deg = trajectory.joint(0)(35) / kDeg;
   EXPECT_NE(text.find("Iteration 1 of 0..2"), std::string::npos) << text;
   EXPECT_NE(text.find("(learned from 0)"), std::string::npos);
   EXPECT_NE(text.find("sample     35 / 400"), std::string::npos);

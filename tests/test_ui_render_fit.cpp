@@ -145,7 +145,7 @@ TEST(UiRenderFit, NoNegativeZeroInTheReadouts) {
   s.width = 120;
   s.height = 40;
   s.live.reading.joint[0].angle_rad = -1e-9;
-  s.live.desired_angle_rad = 0.0;
+  s.live.joint(0).desired_rad = 0.0;
   const std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("angle         0.00 deg"), std::string::npos) << screen;
   EXPECT_EQ(screen.find("-0.00"), std::string::npos) << screen;
@@ -225,7 +225,7 @@ TEST(UiRenderFit, VentedTheLivePanelShowsNoSetPointAndNoTrackingError) {
   // (40 deg), the arm has sagged to 3 deg.
   ConsoleState s = small_state(EngineState::kFault);
   s.live.state = EngineState::kFault;
-  s.live.desired_angle_rad = 40.0 * testing::kDeg;
+  s.live.joint(0).desired_rad = 40.0 * testing::kDeg;
   s.live.reading.joint[0].angle_rad = 3.0 * testing::kDeg;
   std::string screen = all(render_lines(s));
   EXPECT_NE(screen.find("angle         3.00 deg"), std::string::npos) << screen;

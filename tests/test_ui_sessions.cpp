@@ -133,10 +133,10 @@ TEST_F(UiSessions, LaterSavesAppendIterationsSettingsAndLog) {
   // Each iteration's next correction is what the next one ran with: iteration 1 was saved with its
   // own, and rewritten with the learned one before iteration 2 started.
   const auto applied = [&](std::size_t i) {
-    return Eigen::VectorXd(loaded.iterations[i].record.samples.u_ilc_bar.head(400));
+    return Eigen::VectorXd(loaded.iterations[i].record.joint_samples(0).u_ilc_bar.head(400));
   };
-  EXPECT_TRUE(loaded.iterations[0].next_correction_bar.isApprox(applied(1)));
-  EXPECT_TRUE(loaded.iterations[1].next_correction_bar.isApprox(applied(2)));
+  EXPECT_TRUE(loaded.iterations[0].next_corrections_bar().isApprox(applied(1)));
+  EXPECT_TRUE(loaded.iterations[1].next_corrections_bar().isApprox(applied(2)));
   EXPECT_FALSE(applied(2).isApprox(applied(1)));
 }
 

@@ -23,7 +23,7 @@ TEST(UiStudy, ErrorPeaksAreTheLocalMaximaOfTheAbsoluteErrorLargestFirst) {
   record.prepare(8, 4);
   // Samples 0..8: sample 0 is before the trajectory and never a peak; |e| peaks at 2 (-3), 5 (2.5), 8 (4).
   const double e[] = {9.0, 1.0, -3.0, 1.0, 2.0, 2.5, 2.5, 1.0, 4.0};
-  for (int k = 0; k <= 8; ++k) record.samples.error_rad(k) = e[k] * kDeg;
+  for (int k = 0; k <= 8; ++k) record.joint_samples(0).error_rad(k) = e[k] * kDeg;
   EXPECT_EQ(error_peaks(record), (std::vector<int>{8, 2, 5}));
   EXPECT_NEAR(error_series_deg(record)[2], -3.0, 1e-12);
 }
@@ -36,7 +36,7 @@ TEST(UiStudy, TheDifferenceOfTwoIterationsAndItsRms) {
   EXPECT_EQ(d.other_iteration, 0);
   // Trial i applies 0.01 i bar everywhere and leaves the error set point * 0.5 / (i + 1).
   EXPECT_NEAR(d.rms_du_bar, 0.02, 1e-12);
-  const TrialSamples& r = s.experiment.trials[0].record.samples;
+  const TrialSamples& r = s.experiment.trials[0].record.joint_samples(0);
   double sum = 0.0;
   for (int k = 1; k <= r.error_rad.size() - 1; ++k) {
     const double de = r.setpoint_rad(k) * (0.5 / 3 - 0.5) / kDeg;

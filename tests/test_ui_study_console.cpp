@@ -34,7 +34,7 @@ TEST(UiStudyConsole, ETakesTheInspectorToTheLargestErrorThenTheNextOnesAndEBack)
   ASSERT_EQ(f.state().screen, Screen::kInspector);
   const Trial& newest = f.state().experiment.trials.back();
   EXPECT_EQ(f.state().inspector.trial, 1);
-  const TrialSamples& r = newest.record.samples;
+  const TrialSamples& r = newest.record.joint_samples(0);
   const int n = newest.record.learning_samples;
   int worst = 1;
   for (int k = 1; k <= n; ++k) {

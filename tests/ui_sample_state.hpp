@@ -48,11 +48,11 @@ inline ConsoleState sample_state(int trials, bool unicode) {
     Trial t;
     t.correction_bar = Eigen::VectorXd::Constant(n, 0.01 * i);
     t.record.prepare(n, 4);
-    TrialSamples& r = t.record.samples;
+    TrialSamples& r = t.record.joint_samples(0);
     for (int k = 0; k <= n; ++k) {
-      r.time_s(k) = k * 0.02;
-      r.setpoint_rad(k) = trajectory->angle_rad(k);
-      r.angle_rad(k) = trajectory->angle_rad(k) * (1.0 - 0.5 / (i + 1));
+      t.record.sample_time_s(k) = k * 0.02;
+      r.setpoint_rad(k) = trajectory->joint(0)(k);
+      r.angle_rad(k) = trajectory->joint(0)(k) * (1.0 - 0.5 / (i + 1));
       r.error_rad(k) = r.setpoint_rad(k) - r.angle_rad(k);
       r.u_pid_bar(k) = 0.001 * k;
       r.u_ilc_bar(k) = 0.01 * i;
@@ -67,7 +67,7 @@ inline ConsoleState sample_state(int trials, bool unicode) {
   s.live_valid = true;
   s.live.state = EngineState::kArmed;  // the latest tick, like the engine it came from
   s.live.reading.joint[0].angle_rad = 12.5 * kDeg;
-  s.live.desired_angle_rad = 12.0 * kDeg;
+  s.live.joint(0).desired_rad = 12.0 * kDeg;
   s.live.reading.joint[0].chamber_bar = {1.234, 1.1};
   s.live.reading.supply_bar = 3.0;
   s.live.valves.joint[0].inlet_duty = {0.5, 0.0};

@@ -284,7 +284,7 @@ void ConsoleController::perform(Action action) {
       const Trajectory& t = *state_.experiment.trajectory;
       open_dialog(DialogKind::kConfirmArm, "Arm the valves?",
                   {"The valves go live: the arm moves to the start of " + t.name,
-                   format("(%.1f deg) and holds it with the PID.", t.angle_rad(0) * 180.0 / std::numbers::pi)},
+                   format("(%.1f deg) and holds it with the PID.", t.joint(0)(0) * 180.0 / std::numbers::pi)},
                   "y arm   n or Esc cancel");
       return;
     }

@@ -33,7 +33,7 @@ void ConsoleController::jump_to_error_peak(int step) {
                true);
     return;
   }
-  const int joint = selected_joint(state_) < t.record.joints() ? selected_joint(state_) : 0;
+  const int joint = selected_joint(state_) < t.record.joint_count() ? selected_joint(state_) : 0;
   const std::vector<int> peaks = error_peaks(t.record, joint);
   if (peaks.empty()) {
     set_status(format("iteration %d has no error to jump to", t.iteration), true);
@@ -44,8 +44,8 @@ void ConsoleController::jump_to_error_peak(int step) {
   v.sample = peaks[static_cast<std::size_t>(v.peak)];
   const TrialSamples& samples = t.record.joint_samples(joint);
   set_status(format("iteration %d: |error| peak %d of %d, %.2f deg at %.2f s (sample %d); e next, E back", t.iteration,
-                    v.peak + 1, count, std::abs(samples.error_rad(v.sample)) * kDegPerRad, samples.time_s(v.sample),
-                    v.sample));
+                    v.peak + 1, count, std::abs(samples.error_rad(v.sample)) * kDegPerRad,
+                    t.record.sample_time_s(v.sample), v.sample));
 }
 
 bool ConsoleController::handle_screen_key(int k) {

@@ -22,7 +22,7 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
   source.controller = config.controller;
   const Eigen::Index n = experiment.samples();
   for (const Trial& trial : experiment.trials) {
-    const TrialSamples& s = trial.record.samples;
+    const TrialSamples& s = trial.record.joint_samples(0);
     if (!trial.record.complete || s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1)
       continue;
     source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});

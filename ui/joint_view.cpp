@@ -20,8 +20,7 @@ std::string joint_label(int joints, int joint) {
 }
 
 double tick_desired_rad(const TickRecord& tick, int joint) {
-  if (joint <= 0 || joint >= kMaxJoints) return tick.desired_angle_rad;
-  return tick.more_desired_rad[static_cast<std::size_t>(joint - 1)];
+  return tick.joint(joint >= 0 && joint < kMaxJoints ? joint : 0).desired_rad;
 }
 
 std::string fault_location(FaultCode code, int joint, const TickRecord& tick, const Configuration& config) {

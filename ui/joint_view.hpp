@@ -19,7 +19,7 @@ std::string joint_name(int joints, int joint);
 /// "joint 2/2 elbow" (joint is 0-based); "" for one joint.
 std::string joint_label(int joints, int joint);
 
-/// Joint `joint`'s set point in a tick (joint 1's is desired_angle_rad).
+/// Joint `joint`'s set point in a tick (joint 1's for a joint beyond kMaxJoints).
 double tick_desired_rad(const TickRecord& tick, int joint);
 
 /// Where a guard fired on a J-joint arm, in words ("joint 2 (elbow): angle 97.3 deg beyond its

@@ -17,9 +17,10 @@ std::vector<double> to_vector(const Eigen::Ref<const Eigen::VectorXd>& v, double
 }  // namespace
 
 TrialSeries trial_series(const TrialRecord& record, int joint) {
-  const TrialSamples& s = joint > 0 && joint < record.joints() ? record.joint_samples(joint) : record.samples;
-  const Eigen::Index n = s.time_s.size();
-  return {to_vector(s.time_s, 1.0, n), to_vector(s.angle_rad, kDegPerRad, n), to_vector(s.setpoint_rad, kDegPerRad, n)};
+  const TrialSamples& s = record.joint_samples(joint > 0 && joint < record.joint_count() ? joint : 0);
+  const Eigen::Index n = record.sample_time_s.size();
+  return {to_vector(record.sample_time_s, 1.0, n), to_vector(s.angle_rad, kDegPerRad, n),
+          to_vector(s.setpoint_rad, kDegPerRad, n)};
 }
 
 RmsSeries rms_series(const Experiment& experiment, int joint) {
@@ -33,7 +34,7 @@ RmsSeries rms_series(const Experiment& experiment, int joint) {
 }
 
 std::vector<double> error_series_deg(const TrialRecord& record, int joint) {
-  const TrialSamples& s = joint > 0 && joint < record.joints() ? record.joint_samples(joint) : record.samples;
+  const TrialSamples& s = record.joint_samples(joint > 0 && joint < record.joint_count() ? joint : 0);
   return to_vector(s.error_rad, kDegPerRad, s.error_rad.size());
 }
 
@@ -67,7 +68,7 @@ TrialDifference trial_difference(const Experiment& e, int trial, int other, int 
     d.why = format("iteration %d is on disk only", !a.in_memory() ? a.iteration : b.iteration);
     return d;
   }
-  if (joint >= a.record.joints() || joint >= b.record.joints() ||
+  if (joint >= a.record.joint_count() || joint >= b.record.joint_count() ||
       a.record.learning_samples != b.record.learning_samples) {
     d.why = "the two records differ in shape";
     return d;

@@ -49,19 +49,20 @@ void render_inspector(const ConsoleState& s, Canvas& c, const Rect& body) {
     return;
   }
   // The selected joint's signals (j selects; joint 1 of a record that has fewer joints).
-  const int joint = selected_joint(s) < t.record.joints() ? selected_joint(s) : 0;
+  const int joint = selected_joint(s) < t.record.joint_count() ? selected_joint(s) : 0;
   const TrialSamples& samples = t.record.joint_samples(joint);
-  const int k = std::clamp(s.inspector.sample, 0, static_cast<int>(samples.time_s.size()) - 1);
-  const double cursor_s = samples.time_s(k);
+  const int k = std::clamp(s.inspector.sample, 0, static_cast<int>(t.record.sample_time_s.size()) - 1);
+  const double cursor_s = t.record.sample_time_s(k);
   const int chosen = s.inspector.chosen;
   const TrialDifference diff = trial_difference(e, s.inspector.trial, chosen, joint);
 
   int x = c.put(body.x + 1, body.y, format("Iteration %d", t.iteration), Role::kTitle, true);
   x = c.put(x, body.y, format(" of 0..%d", e.trials.back().iteration), Role::kDim);
-  if (t.record.joints() > 1) x = c.put(x + 2, body.y, joint_label(t.record.joints(), joint), Role::kNormal, true);
+  if (t.record.joint_count() > 1)
+    x = c.put(x + 2, body.y, joint_label(t.record.joint_count(), joint), Role::kNormal, true);
   x = c.put(x + 2, body.y, "(" + t.origin + ")", Role::kDim);
   x = c.put(x + 2, body.y, format("RMS %.3f deg", t.summary.rms_deg), Role::kNormal, true);
-  if (joint < t.summary.joint_rms_deg.size() && t.record.joints() > 1) {
+  if (joint < t.summary.joint_rms_deg.size() && t.record.joint_count() > 1) {
     x = c.put(x + 1, body.y, format("(joint %d %.3f)", joint + 1, t.summary.joint_rms_deg(joint)), Role::kNormal);
   }
   if (chosen >= 0) c.put(x + 2, body.y, format("overlay: it %d", chosen), Role::kSeries3);

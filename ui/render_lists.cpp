@@ -101,14 +101,13 @@ void render_trajectory(const ConsoleState& s, Canvas& c, const Rect& body) {
     return;
   }
   const Trajectory& t = *ch.preview;
-  const int n = static_cast<int>(t.angle_rad.size());
+  const int n = static_cast<int>(t.joint(0).size());
   std::vector<double> time(static_cast<std::size_t>(n)), angle(static_cast<std::size_t>(n));
   double peak_speed = 0.0;
   for (int k = 0; k < n; ++k) {
     time[static_cast<std::size_t>(k)] = k * t.sample_time_s;
-    angle[static_cast<std::size_t>(k)] = to_deg(t.angle_rad(k));
-    if (k > 0)
-      peak_speed = std::max(peak_speed, std::abs(to_deg(t.angle_rad(k) - t.angle_rad(k - 1))) / t.sample_time_s);
+    angle[static_cast<std::size_t>(k)] = to_deg(t.joint(0)(k));
+    if (k > 0) peak_speed = std::max(peak_speed, std::abs(to_deg(t.joint(0)(k) - t.joint(0)(k - 1))) / t.sample_time_s);
   }
   const auto [lo, hi] = std::minmax_element(angle.begin(), angle.end());
   c.put(pin.x + 1, pin.y,

@@ -43,7 +43,7 @@ Eigen::VectorXd applied_total_bar(const TransferTrial& trial, const ControllerPa
 
 Eigen::VectorXd trial_error(const Trajectory& trajectory, const TransferTrial& trial) {
   const Eigen::Index n = trajectory.learning_samples();
-  return normalized(trajectory.angle_rad.tail(n) - trial.angle_rad.tail(n));
+  return normalized(trajectory.joint(0).tail(n) - trial.angle_rad.tail(n));
 }
 
 }  // namespace
@@ -171,7 +171,7 @@ void LearningTransfer::setup(std::vector<TransferSource> sources, const Controll
   for (int g = 0; g < groups; ++g) {
     const TransferSource& s = sources_[static_cast<std::size_t>(g)];
     const int n = s.trajectory.learning_samples();
-    const Eigen::VectorXd r = normalized(s.trajectory.angle_rad);
+    const Eigen::VectorXd r = normalized(s.trajectory.joint(0));
     if (closed_loop_theta_.size() > 0) {
       const Eigen::MatrixXd phi_r = build_regressors(r, reference_shape, 1, n, sample_time_s);
       for (const TransferTrial& trial : s.trials) {
@@ -211,7 +211,7 @@ Eigen::VectorXd LearningTransfer::predict_correction(TransferMethod method, cons
                                                      const Trajectory& target, const ControllerParameters& controller,
                                                      int* clamped) const {
   const int n = target.learning_samples();
-  const Eigen::VectorXd r = normalized(target.angle_rad);
+  const Eigen::VectorXd r = normalized(target.joint(0));
   // inverse-fir maps an angle to the input that produced it: fed the reference, it gives the input
   // that makes the arm follow it.
   const Eigen::VectorXd total = build_regressors(r, shape_of(method, settings_), 1, n, sample_time_s_) * theta;
@@ -237,7 +237,7 @@ Eigen::VectorXd LearningTransfer::predicted_error_change(const Eigen::VectorXd& 
 }
 
 Eigen::VectorXd LearningTransfer::predicted_feedback_error(const Trajectory& target) const {
-  const Eigen::VectorXd r = normalized(target.angle_rad);
+  const Eigen::VectorXd r = normalized(target.joint(0));
   return build_regressors(r, shape_of(TransferMethod::kReferenceFir, settings_), 1, target.learning_samples(),
                           sample_time_s_) *
          feedback_error_theta_;

@@ -100,33 +100,31 @@ void ControlCore::JointLoop::set_state(const JointState& state) {
 
 ControlCore::State ControlCore::state() const {
   State s;
-  static_cast<JointState&>(s) = loops_.front().state();
   s.tick_in_sample = tick_in_sample_;
-  s.joints = joints_;
-  for (int j = 1; j < joints_; ++j) s.more_joints[static_cast<std::size_t>(j - 1)] = loop(j).state();
+  s.joint_count = joints_;
+  for (int j = 0; j < joints_; ++j) s.joints[static_cast<std::size_t>(j)] = loop(j).state();
   return s;
 }
 
 void ControlCore::set_state(const State& state) {
   trajectory_ = nullptr;
-  use_joints(state.joints);
-  loops_.front().set_state(state);
-  for (int j = 1; j < joints_; ++j) loop(j).set_state(state.more_joints[static_cast<std::size_t>(j - 1)]);
+  use_joints(state.joint_count);
+  for (int j = 0; j < joints_; ++j) loop(j).set_state(state.joints[static_cast<std::size_t>(j)]);
   tick_in_sample_ = state.tick_in_sample;
 }
 
 void ControlCore::run_sample(const SensorReading& reading) {
   const bool recording = trajectory_ != nullptr;
   const int k = sample_;
+  if (recording) record_->sample_time_s(k) = k * trajectory_->sample_time_s;
   for (int j = 0; j < joints_; ++j) {
     JointLoop& c = loop(j);
     const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
     const double measured = r.angle_rad / std::numbers::pi;
     double u_ilc = 0.0;
     if (recording) {
-      c.desired_rad = trajectory_->joint_angle_rad(j)(k);
+      c.desired_rad = trajectory_->joint(j)(k);
       TrialSamples& s = record_->joint_samples(j);
-      s.time_s(k) = k * trajectory_->sample_time_s;
       s.setpoint_rad(k) = c.desired_rad;
       s.angle_rad(k) = r.angle_rad;
       s.error_rad(k) = k == 0 ? 0.0 : c.desired_rad - r.angle_rad;
@@ -162,12 +160,12 @@ void ControlCore::hold_sample(const SensorReading& last) {
   const int k = sample_;
   record_->held[static_cast<std::size_t>(k)] = 1;
   ++record_->held_samples;
+  record_->sample_time_s(k) = k * trajectory_->sample_time_s;
   for (int j = 0; j < joints_; ++j) {
     JointLoop& c = loop(j);
     const JointReading& r = last.joint[static_cast<std::size_t>(j)];
-    c.desired_rad = trajectory_->joint_angle_rad(j)(k);
+    c.desired_rad = trajectory_->joint(j)(k);
     TrialSamples& s = record_->joint_samples(j);
-    s.time_s(k) = k * trajectory_->sample_time_s;
     s.setpoint_rad(k) = c.desired_rad;
     s.angle_rad(k) = r.angle_rad;  // the last reading: no measurement of this sample
     s.error_rad(k) = 0.0;          // not learned from
@@ -197,6 +195,10 @@ ValveCommand ControlCore::step(const SensorReading& reading, bool fresh) {
   const bool recording = trajectory_ != nullptr;
   ValveCommand command;
   command.joint_count = joints_;
+  if (recording) {
+    record_->tick_time_s(tick_in_trial_) = tick_in_trial_ * timing_.tick_s;
+    record_->supply_bar(tick_in_trial_) = reading.supply_bar;
+  }
   for (int j = 0; j < joints_; ++j) {
     JointLoop& c = loop(j);
     const JointReading& r = reading.joint[static_cast<std::size_t>(j)];
@@ -211,11 +213,9 @@ ValveCommand ControlCore::step(const SensorReading& reading, bool fresh) {
     if (recording) {
       TrialTicks& t = record_->joint_ticks(j);
       const int i = tick_in_trial_;
-      t.time_s(i) = i * timing_.tick_s;
       t.angle_rad(i) = r.angle_rad;
       t.pressure_a_bar(i) = r.chamber_bar[0];
       t.pressure_b_bar(i) = r.chamber_bar[1];
-      t.supply_bar(i) = reading.supply_bar;
       t.setpoint_a_bar(i) = c.setpoints.a_bar;
       t.setpoint_b_bar(i) = c.setpoints.b_bar;
       t.inlet_a(i) = a.inlet;

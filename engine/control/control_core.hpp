@@ -34,7 +34,7 @@ namespace bellows {
 
 class ControlCore {
  public:
-  /// One joint's controllers between ticks, for joints 2..J (joint 1's are State's own fields).
+  /// One joint's controllers between ticks.
   struct JointState {
     PidController::State pid;
     PressureController::State pressure_a, pressure_b;
@@ -44,11 +44,11 @@ class ControlCore {
     double u_total_bar = 0.0;
   };
   /// Everything that evolves between ticks while holding: enough to continue a run exactly.
-  /// Its JointState fields are joint 1's (what single-joint session files store, unchanged).
-  struct State : JointState {
+  /// Fixed capacity: joints [0, joint_count) hold the J joints' controllers.
+  struct State {
     int tick_in_sample = 0;
-    int joints = 1;                                        // J
-    std::array<JointState, kMaxJoints - 1> more_joints{};  // joints 2..J
+    int joint_count = 1;                          // J
+    std::array<JointState, kMaxJoints> joints{};  // joints[0] is joint 1
   };
 
   ControlCore(const ControllerParameters& controller, const TimingParameters& timing);

@@ -19,9 +19,9 @@ const IterationDiagnostics& LearningMonitor::observe(int iteration, const TrialR
     throw InputError("learning monitor: trial has " + std::to_string(n) + " samples, expected " +
                      std::to_string(previous_correction_.size()));
   }
-  const auto correction = record.samples.u_ilc_bar.head(n);
-  const auto total = record.samples.u_total_bar.head(n);
-  const double error_norm = record.samples.error_rad.tail(n).norm();
+  const auto correction = record.joint_samples(0).u_ilc_bar.head(n);
+  const auto total = record.joint_samples(0).u_total_bar.head(n);
+  const double error_norm = record.joint_samples(0).error_rad.tail(n).norm();
 
   IterationDiagnostics d;
   d.iteration = iteration;

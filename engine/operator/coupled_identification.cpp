@@ -85,17 +85,15 @@ void check_trials(std::span<const JointIdentificationData> trials) {
 
 JointIdentificationData joint_identification_data(const TrialRecord& record, const ControllerParameters& controller,
                                                   double tick_s, double rest_s) {
-  const int J = record.joints();
+  const int J = record.joint_count();
   JointIdentificationData data;
   data.sample_time_s = tick_s;
-  const Eigen::Index n = record.ticks.angle_rad.size();
+  const Eigen::Index n = record.tick_time_s.size();
   data.angle_rad.resize(n, J);
   data.pressure_difference_bar.resize(n, J);
   const Eigen::Index rest = std::clamp<Eigen::Index>(std::lround(rest_s / tick_s), 1, std::max<Eigen::Index>(n, 1));
   for (int j = 0; j < J; ++j) {
-    TrialRecord one;  // joint j's columns as a single-joint record: identification_data reconstructs its tick means
-    one.ticks = record.joint_ticks(j);
-    const IdentificationData single = identification_data(one, controller, tick_s);
+    const IdentificationData single = identification_data(record, controller, tick_s, j);
     if (n == 0) continue;
     data.angle_rad.col(j) = single.angle_rad.array() - single.angle_rad.head(rest).mean();
     data.pressure_difference_bar.col(j) =

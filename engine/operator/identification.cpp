@@ -76,12 +76,13 @@ double standard_deviation(const Eigen::VectorXd& v) {
 
 }  // namespace
 
-IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller,
-                                       double tick_s) {
+IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller, double tick_s,
+                                       int joint) {
   IdentificationData data;
   data.sample_time_s = tick_s;
-  data.angle_rad = record.ticks.angle_rad;
-  const TrialTicks& t = record.ticks;
+  const TrialTicks& t = record.joint_ticks(joint);
+  const Eigen::VectorXd& supply_bar = record.supply_bar;
+  data.angle_rad = t.angle_rad;
   const Eigen::Index n = t.angle_rad.size();
   data.pressure_difference_bar.resize(n);
   const GasParameters& gas = controller.gas;
@@ -103,8 +104,8 @@ IdentificationData identification_data(const TrialRecord& record, const Controll
   };
   for (Eigen::Index k = 0; k + 1 < n; ++k) {
     data.pressure_difference_bar(k) =
-        tick_mean(t.pressure_a_bar(k), t.pressure_a_bar(k + 1), t.inlet_a(k), t.outlet_a(k), t.supply_bar(k)) -
-        tick_mean(t.pressure_b_bar(k), t.pressure_b_bar(k + 1), t.inlet_b(k), t.outlet_b(k), t.supply_bar(k));
+        tick_mean(t.pressure_a_bar(k), t.pressure_a_bar(k + 1), t.inlet_a(k), t.outlet_a(k), supply_bar(k)) -
+        tick_mean(t.pressure_b_bar(k), t.pressure_b_bar(k + 1), t.inlet_b(k), t.outlet_b(k), supply_bar(k));
   }
   if (n > 0) {
     data.pressure_difference_bar(n - 1) =

@@ -31,9 +31,9 @@ struct IdentificationData {
 
 /// The tick-rate record of a trial as identification data. The input of tick k is the mean pressure
 /// difference over the tick, reconstructed from the readings at its ends and the valve commands
-/// with the controller's nominal valve model (see identification.cpp).
-IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller,
-                                       double tick_s);
+/// with the controller's nominal valve model (see identification.cpp). Of joint `joint` (0-based).
+IdentificationData identification_data(const TrialRecord& record, const ControllerParameters& controller, double tick_s,
+                                       int joint = 0);
 
 /// The angle the model predicts for the data's pressure difference (held over each step), from the
 /// data's first angle with the arm at rest.

@@ -34,7 +34,7 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
     if (!(p.chirp_end_hz > p.chirp_start_hz) || p.chirp_end_hz >= 0.5 / sample_time_s) {
       throw InputError("[identify] chirp_end_hz must lie above chirp_start_hz and below the Nyquist frequency");
     }
-    Trajectory t{"identify-chirp", sample_time_s, Eigen::VectorXd(samples + 1)};
+    Trajectory t{"identify-chirp", sample_time_s, {Eigen::VectorXd(samples + 1)}};
     const double ratio = p.chirp_end_hz / p.chirp_start_hz;
     const double D = p.duration_s;
     for (int k = 0; k <= samples; ++k) {
@@ -43,7 +43,7 @@ Trajectory identification_trajectory(const std::string& signal, const Identifica
       const double edge = std::min(time, D - time);
       const double fade =
           edge >= kFade_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * std::max(edge, 0.0) / kFade_s));
-      t.angle_rad(k) = fade * p.amplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * phase);
+      t.joint(0)(k) = fade * p.amplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * phase);
     }
     return t;
   }
@@ -65,10 +65,10 @@ Trajectory joint_excitation(const Trajectory& excitation, int joint, int joints)
     throw InputError("identification: joint " + std::to_string(joint + 1) + " of " + std::to_string(joints) +
                      " cannot be excited");
   }
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(excitation.joint(0).size());
   Trajectory t{excitation.name + "-joint" + std::to_string(joint + 1), excitation.sample_time_s,
-               Eigen::VectorXd::Zero(excitation.angle_rad.size())};
-  t.more_joints_rad.assign(static_cast<std::size_t>(joints - 1), Eigen::VectorXd::Zero(excitation.angle_rad.size()));
-  (joint == 0 ? t.angle_rad : t.more_joints_rad[static_cast<std::size_t>(joint - 1)]) = excitation.angle_rad;
+               std::vector<Eigen::VectorXd>(static_cast<std::size_t>(joints), rest)};
+  t.joint(joint) = excitation.joint(0);
   return t;
 }
 

@@ -28,7 +28,7 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record,
   IterationSummary s;
   s.iteration = iteration;
   s.held_samples = record.held_samples;
-  const int joints = record.joints();
+  const int joints = record.joint_count();
   s.joint_rms_deg.resize(joints);
   for (int j = 0; j < joints; ++j) s.joint_rms_deg(j) = record.joint_rms_error_deg(j);
   s.max_abs_correction_bar = correction_bar.size() > 0 ? correction_bar.cwiseAbs().maxCoeff() : 0.0;
@@ -36,7 +36,7 @@ IterationSummary summarize_trial(int iteration, const TrialRecord& record,
   if (joints == 1) {  // exactly as before joints were counted
     s.rms_deg = record.rms_error_deg();
     s.max_abs_error_deg = record.max_abs_error_deg();
-    const Eigen::VectorXd inputs = record.samples.u_total_bar.head(record.learning_samples);
+    const Eigen::VectorXd inputs = record.joint_samples(0).u_total_bar.head(record.learning_samples);
     s.saturated_samples = static_cast<int>((inputs.array().abs() > span).count());
     return s;
   }
@@ -125,7 +125,7 @@ IterationSummary LearningSession::run_trial() {
 
 void LearningSession::learn() {
   const int n = record_.learning_samples;
-  for (int j = 0; j < record_.joints(); ++j) feedback_bar_.col(j) = record_.joint_samples(j).u_pid_bar.head(n);
+  for (int j = 0; j < record_.joint_count(); ++j) feedback_bar_.col(j) = record_.joint_samples(j).u_pid_bar.head(n);
   learning_.set_input_context(feedback_bar_, controller_.p_max_bar - controller_.gas.ambient_bar);
   learning_.set_held_outputs(record_.held);
   learning_.update(corrections_, record_.normalized_joint_errors(), next_corrections_);

@@ -93,12 +93,16 @@ const char* EngineCore::trial_refusal(const EngineCommand& command) const {
           : command.joint_correction->rows() != n || command.joint_correction->cols() != joints) {
     return "the trial's correction is not one column of N values per joint of its trajectory";
   }
-  if (record->joints() != joints || static_cast<int>(record->more_joint_ticks.size()) != joints - 1) {
+  if (record->joint_count() != joints) {
     return "the trial's record is not prepared for the joints of its trajectory";
   }
+  const Eigen::Index tick_count = static_cast<Eigen::Index>(n) * timing_.ticks_per_sample;
+  if (record->sample_time_s.size() != n + 1 || record->tick_time_s.size() != tick_count ||
+      record->supply_bar.size() != tick_count) {
+    return not_prepared;
+  }
   for (int j = 0; j < joints; ++j) {
-    if (record->joint_samples(j).time_s.size() != n + 1 ||
-        record->joint_ticks(j).time_s.size() != static_cast<Eigen::Index>(n) * timing_.ticks_per_sample) {
+    if (record->joint_samples(j).error_rad.size() != n + 1 || record->joint_ticks(j).angle_rad.size() != tick_count) {
       return not_prepared;
     }
   }
@@ -108,7 +112,7 @@ const char* EngineCore::trial_refusal(const EngineCommand& command) const {
 const char* EngineCore::trajectory_refusal(const Trajectory& trajectory) {
   if (!valid_joint_count(trajectory.joints())) return "the trajectory has more joints than bellows drives";
   for (int j = 0; j < trajectory.joints(); ++j) {
-    if (trajectory.joint_angle_rad(j).size() != trajectory.angle_rad.size() || trajectory.angle_rad.size() == 0) {
+    if (trajectory.joint(j).size() != trajectory.joint(0).size() || trajectory.joint(0).size() == 0) {
       return "the trajectory's joints do not all have the same number of samples";
     }
   }
@@ -409,9 +413,7 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   tick.fault_joint = fault_joint_;
   tick.reading = reading;
   for (int j = 0; j < control_.joints(); ++j) {  // every joint's, for the black box and the telemetry
-    tick.joint_desired_rad(j) = control_.desired_angle_rad(j);
-    tick.joint_u_total_bar(j) = control_.last_u_total_bar(j);
-    tick.joint_setpoints(j) = control_.setpoints(j);
+    tick.joint(j) = {control_.desired_angle_rad(j), control_.last_u_total_bar(j), control_.setpoints(j)};
   }
   tick.valves = valves;
   tick.sample = control_.sample_index();
@@ -430,7 +432,7 @@ void EngineCore::restore_armed(const ControlCore::State& state, double now_s) {
     throw std::logic_error("EngineCore::restore_armed: only before the first tick, in SAFE");
   }
   control_.set_state(state);
-  last_angle_rad_ = state.hold_rad;
+  last_angle_rad_ = state.joints[0].hold_rad;
   change_state(EngineState::kArmed, now_s, CommandKind::kArm);
 }
 

@@ -121,6 +121,13 @@ struct EngineEvent {
                             // (the device's words: the rig's reason, the link's silence)
 };
 
+/// One joint's controller outputs at a tick.
+struct TickJoint {
+  double desired_rad = 0.0;
+  double u_total_bar = 0.0;
+  ChamberSetpoints setpoints{};
+};
+
 /// One tick as the loop saw it: for the telemetry ring, the black box and the live snapshot.
 struct TickRecord {
   std::uint64_t tick = 0;
@@ -129,28 +136,14 @@ struct TickRecord {
   FaultCode fault = FaultCode::kNone;
   int fault_joint = -1;  // the joint (0-based) the latched fault fired on; -1: none or no joint's
   SensorReading reading{};
-  double desired_angle_rad = 0.0;                         // joint 1's (the reading and the valves carry every joint)
-  std::array<double, kMaxJoints - 1> more_desired_rad{};  // joints 2..J's (the console's live strip per joint)
-  double u_total_bar = 0.0;                               // joint 1's
-  std::array<double, kMaxJoints - 1> more_u_total_bar{};  // joints 2..J's
-  ChamberSetpoints setpoints{};                           // joint 1's
-  std::array<ChamberSetpoints, kMaxJoints - 1> more_setpoints{};  // joints 2..J's
+  std::array<TickJoint, kMaxJoints> joints{};  // [0, reading.joint_count): each joint's (the console's live strips)
   ValveCommand valves{};
   int sample = -1;  // ILC sample of the running trial, -1 otherwise
   std::uint32_t trial_id = 0;
 
-  /// Joint `joint`'s (0-based, within kMaxJoints) desired angle, total input and chamber set points.
-  double& joint_desired_rad(int joint) { return joint == 0 ? desired_angle_rad : more_desired_rad[more(joint)]; }
-  double joint_desired_rad(int joint) const { return joint == 0 ? desired_angle_rad : more_desired_rad[more(joint)]; }
-  double& joint_u_total_bar(int joint) { return joint == 0 ? u_total_bar : more_u_total_bar[more(joint)]; }
-  double joint_u_total_bar(int joint) const { return joint == 0 ? u_total_bar : more_u_total_bar[more(joint)]; }
-  ChamberSetpoints& joint_setpoints(int joint) { return joint == 0 ? setpoints : more_setpoints[more(joint)]; }
-  const ChamberSetpoints& joint_setpoints(int joint) const {
-    return joint == 0 ? setpoints : more_setpoints[more(joint)];
-  }
-
- private:
-  static std::size_t more(int joint) { return static_cast<std::size_t>(joint - 1); }
+  /// Joint `joint`'s (0-based, within kMaxJoints) outputs.
+  TickJoint& joint(int joint) { return joints[static_cast<std::size_t>(joint)]; }
+  const TickJoint& joint(int joint) const { return joints[static_cast<std::size_t>(joint)]; }
 };
 
 }  // namespace bellows

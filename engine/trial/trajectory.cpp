@@ -69,10 +69,9 @@ Trajectory trajectory_from_joint_moves(const std::string& name, const std::vecto
                                        double duration_s, double sample_time_s) {
   check_joint_count(name, joints.size());
   const int samples = static_cast<int>(std::lround(duration_s / sample_time_s));
-  Trajectory trajectory{name, sample_time_s, Eigen::VectorXd(samples + 1)};
-  trajectory.more_joints_rad.resize(joints.size() - 1);
+  Trajectory trajectory{name, sample_time_s, std::vector<Eigen::VectorXd>(joints.size())};
   for (std::size_t j = 0; j < joints.size(); ++j) {
-    Eigen::VectorXd& angle_rad = j == 0 ? trajectory.angle_rad : trajectory.more_joints_rad[j - 1];
+    Eigen::VectorXd& angle_rad = trajectory.angles_rad[j];
     angle_rad.resize(samples + 1);
     for (int k = 0; k <= samples; ++k) {
       const double t = k * sample_time_s;
@@ -88,7 +87,7 @@ Trajectory trajectory_from_joint_moves(const std::string& name, const std::vecto
 
 JointVector Trajectory::setpoint_rad(Eigen::Index sample) const {
   JointVector setpoint(joints());
-  for (int j = 0; j < joints(); ++j) setpoint(j) = joint_angle_rad(j)(sample);
+  for (int j = 0; j < joints(); ++j) setpoint(j) = joint(j)(sample);
   return setpoint;
 }
 
@@ -96,16 +95,16 @@ void validate_trajectory(const Trajectory& trajectory, const TrajectoryLimits& l
   check_joint_count(trajectory.name, static_cast<std::size_t>(trajectory.joints()));
   if (trajectory.learning_samples() < limits.min_learning_samples) {
     throw InputError("trajectory '" + trajectory.name +
-                     "' is too short: " + std::to_string(trajectory.angle_rad.size()) + " samples, at least " +
+                     "' is too short: " + std::to_string(trajectory.learning_samples() + 1) + " samples, at least " +
                      std::to_string(limits.min_learning_samples + 1) + " needed");
   }
   for (int j = 0; j < trajectory.joints(); ++j) {
-    const Eigen::VectorXd& angle_rad = trajectory.joint_angle_rad(j);
+    const Eigen::VectorXd& angle_rad = trajectory.joint(j);
     // One joint keeps today's messages; with several, each names its joint.
     const std::string where = "trajectory '" + trajectory.name + "': " + joint_label(trajectory.joints(), j);
-    if (angle_rad.size() != trajectory.angle_rad.size()) {
+    if (angle_rad.size() != trajectory.joint(0).size()) {
       throw InputError(where + "has " + std::to_string(angle_rad.size()) + " samples, joint 1 has " +
-                       std::to_string(trajectory.angle_rad.size()));
+                       std::to_string(trajectory.joint(0).size()));
     }
     for (Eigen::Index k = 0; k < angle_rad.size(); ++k) {
       const double angle_deg = angle_rad(k) / kRadPerDeg;
@@ -146,12 +145,10 @@ Trajectory trajectory_from_joint_samples(const std::string& name, const std::vec
                        " is at t = " + format_number(time_s[k]) + " s, expected " + format_number(expected) + " s");
     }
   }
-  Trajectory trajectory{name, sample_time_s, {}};
-  trajectory.more_joints_rad.resize(joint_angle_deg.size() - 1);
+  Trajectory trajectory{name, sample_time_s, std::vector<Eigen::VectorXd>(joint_angle_deg.size())};
   for (std::size_t j = 0; j < joint_angle_deg.size(); ++j) {
-    Eigen::VectorXd& angle_rad = j == 0 ? trajectory.angle_rad : trajectory.more_joints_rad[j - 1];
-    angle_rad = Eigen::Map<const Eigen::VectorXd>(joint_angle_deg[j].data(), static_cast<Eigen::Index>(time_s.size())) *
-                kRadPerDeg;
+    const auto count = static_cast<Eigen::Index>(time_s.size());
+    trajectory.angles_rad[j] = Eigen::Map<const Eigen::VectorXd>(joint_angle_deg[j].data(), count) * kRadPerDeg;
   }
   validate_trajectory(trajectory, limits);
   return trajectory;

@@ -1,8 +1,7 @@
 // Reference trajectories: the desired joint angles sampled at the ILC sample time.
 // A trajectory of N learning samples holds N + 1 angles per joint, at t = 0, T, ..., N T; sample 0
-// is where the arm waits before the trial (the lifted error is e(1..N)). One joint is the default:
-// `angle_rad` is joint 1 (the only joint of a single-joint trajectory), `more_joints_rad` joints 2..J
-// (../shared/spec/multi-joint.md section 3).
+// is where the arm waits before the trial (the lifted error is e(1..N)). J joints of equal rank:
+// joint(j) is joint j + 1's angles (../shared/spec/multi-joint.md section 3).
 #pragma once
 
 #include <string>
@@ -32,16 +31,14 @@ struct JointMoves {
 struct Trajectory {
   std::string name;
   double sample_time_s = 0.0;
-  Eigen::VectorXd angle_rad;                          // joint 1: N + 1 samples
-  std::vector<Eigen::VectorXd> more_joints_rad = {};  // joints 2..J, N + 1 samples each; empty: one joint
+  std::vector<Eigen::VectorXd> angles_rad = {};  // one per joint (J), N + 1 samples each
 
-  int learning_samples() const { return static_cast<int>(angle_rad.size()) - 1; }
+  int learning_samples() const { return angles_rad.empty() ? -1 : static_cast<int>(angles_rad.front().size()) - 1; }
   double duration_s() const { return learning_samples() * sample_time_s; }
-  int joints() const { return 1 + static_cast<int>(more_joints_rad.size()); }
-  /// Joint `joint` (0 = joint 1 = angle_rad) over time; the joint must exist.
-  const Eigen::VectorXd& joint_angle_rad(int joint) const {
-    return joint == 0 ? angle_rad : more_joints_rad[static_cast<std::size_t>(joint - 1)];
-  }
+  int joints() const { return static_cast<int>(angles_rad.size()); }
+  /// Joint `joint`'s (0-based) angles over time; the joint must exist.
+  const Eigen::VectorXd& joint(int joint) const { return angles_rad[static_cast<std::size_t>(joint)]; }
+  Eigen::VectorXd& joint(int joint) { return angles_rad[static_cast<std::size_t>(joint)]; }
   /// Every joint's desired angle at `sample` (allocation-free: JointVector has a fixed capacity).
   JointVector setpoint_rad(Eigen::Index sample) const;
 };

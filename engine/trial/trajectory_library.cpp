@@ -44,12 +44,12 @@ constexpr double kWristDelay_s = 0.3;  // paper3's wrist follows the elbow this 
 Trajectory sine(double sample_time_s) {
   constexpr double kDuration_s = 8.0, kAmplitude_deg = 30.0, kFrequency_Hz = 0.5, kFade_s = 1.0;
   const int samples = static_cast<int>(std::lround(kDuration_s / sample_time_s));
-  Trajectory trajectory{"sine", sample_time_s, Eigen::VectorXd(samples + 1)};
+  Trajectory trajectory{"sine", sample_time_s, {Eigen::VectorXd(samples + 1)}};
   for (int k = 0; k <= samples; ++k) {
     const double t = k * sample_time_s;
     const double edge = std::min(t, kDuration_s - t);
     const double fade = edge >= kFade_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * edge / kFade_s));
-    trajectory.angle_rad(k) = fade * kAmplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * kFrequency_Hz * t);
+    trajectory.joint(0)(k) = fade * kAmplitude_deg * kRadPerDeg * std::sin(2.0 * std::numbers::pi * kFrequency_Hz * t);
   }
   return trajectory;
 }
