@@ -49,6 +49,7 @@ struct LearnedNoilcSettings {
   bool refit = true;               // false: the prior only (what the closed loop alone does)
   double limit_margin_bar = 0.0;   // a set point within this of the pressure limit is on the limit
   double limit_recovery_s = 0.08;  // outputs this long after an input on the limit are not learned from
+  bool cross_joint = true;         // several joints: each output's correction from every joint's input
 };
 
 /// What the last update did, for the session and the console.
@@ -78,7 +79,13 @@ class LearnedModelNoilc {
   int samples() const { return samples_; }
   int joints() const { return prior_.joints(); }
   const LearnedNoilcReport& last_report() const { return report_; }
+  /// The learned coefficients as closed_loop_model takes them: per_joint() x J, or per_joint() J x J
+  /// with cross_joint (several joints).
   const Eigen::MatrixXd& correction() const { return correction_; }
+  /// The coefficients of one output's correction: per_joint(), times J with cross_joint.
+  int coefficients_per_output() const {
+    return settings_.shape.per_joint() * (settings_.cross_joint ? prior_.joints() : 1);
+  }
   /// The note for the session's events since the last call (empty if none), then cleared.
   std::string take_note();
   /// As LearningLaw::model_check: from the last report, from the second update on.
@@ -101,10 +108,12 @@ class LearnedModelNoilc {
   int samples_;
   StateSpaceModel prior_model_, model_;
   StateSpaceNoilc solver_;
-  Eigen::MatrixXd correction_;           // per_joint x J
-  std::vector<Eigen::MatrixXd> gram_;    // per joint
-  std::vector<Eigen::VectorXd> moment_;  // per joint
-  Eigen::VectorXd data_scale_;           // per joint: the largest mean square regressor of one trial
+  Eigen::MatrixXd correction_;                       // coefficients_per_output() x J
+  std::vector<Eigen::MatrixXd> gram_;                // per output joint
+  std::vector<Eigen::VectorXd> moment_;              // per output joint
+  Eigen::VectorXd data_scale_;                       // per output joint: the largest mean square regressor of one trial
+  Eigen::MatrixXd regressors_, masked_, increment_;  // the refit's workspace: N x q, N x q, q x q
+  double increment_scale_ = 0.0;
   Eigen::MatrixXd u_previous_, e_previous_, u_best_, e_best_, planned_;
   Eigen::MatrixXd feedback_;  // N x J: this trial's feedback (bar), with has_context_
   double reach_bar_ = 0.0;
