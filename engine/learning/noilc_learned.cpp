@@ -41,6 +41,7 @@ LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const Learned
   // refit model has them, and a refit rewrites its outputs only.
   prior_model_ = closed_loop_model(prior_, CorrectionShape{0, {}}, {});
   model_ = closed_loop_model(prior_, settings_.shape, correction_);
+  prior_solver_.setup(prior_model_, settings_.weights, samples_);
   rebuild();
 }
 
@@ -144,9 +145,16 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
     };
     const Eigen::MatrixXd predicted = model_.simulate(du), prior_predicted = prior_model_.simulate(du);
     report_.measured_change = measured;
-    report_.predicted_change = predicted.norm();
-    report_.prediction_miss = miss(predicted);
     report_.prior_miss = miss(prior_predicted);
+    // The model that planned u_j is judged on it; the refit model is judged on it too (out of sample:
+    // fitted on the trials before), and the next update is planned by whichever of the refit model and
+    // the prior predicted this trial better. A refit that has learned what the trials' large changes
+    // showed but mispredicts the fine ones near convergence (a coupled arm's pose-dependent terms no
+    // linear correction holds) then leaves the planning to the prior instead of steering it wrong.
+    const double refit_model_miss = miss(predicted);
+    report_.predicted_change = planned_with_prior_ ? prior_predicted.norm() : predicted.norm();
+    report_.prediction_miss = planned_with_prior_ ? report_.prior_miss : refit_model_miss;
+    plan_with_prior_ = refit_model_miss > report_.prior_miss;
     if (cost > (1.0 + settings_.guard) * best_cost_) {
       report_.fell_back = true;
       from_best = true;
@@ -188,10 +196,11 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
       std::snprintf(
           text, sizeof text,
           "noilc-learned: model %s from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
-          "the prior alone %.0f %%, the refit %.0f %%)%s",
+          "the prior alone %.0f %%, the refit %.0f %%)%s%s",
           report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured,
           100.0 * report_.prediction_miss, 100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
-          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step");
+          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step",
+          plan_with_prior_ ? "; the prior plans the next update (it predicted this trial better)" : "");
       note_ = text;
     }
   }
@@ -202,14 +211,17 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
     best_cost_ = cost;
   }
   report_.step = step_;
+  report_.prior_plans = plan_with_prior_;
   // The update, like the refit, does not act on the outputs the pressure limit shaped: their errors
   // are zeroed (as noilc-constrained does; docs/learning-laws.md), so the correction does not wind up
   // against a limit the linear model cannot see.
+  StateSpaceNoilc& planner = plan_with_prior_ ? prior_solver_ : solver_;
+  planned_with_prior_ = plan_with_prior_;
   if (from_best) {
-    solver_.solve(u_best_, e_best_.cwiseProduct(learnable_best_), u_next);
+    planner.solve(u_best_, e_best_.cwiseProduct(learnable_best_), u_next);
     if (step_ < 1.0) u_next = u_best_ + step_ * (u_next - u_best_);
   } else {
-    solver_.solve(u_j, e_j.cwiseProduct(learnable_), u_next);
+    planner.solve(u_j, e_j.cwiseProduct(learnable_), u_next);
     if (step_ < 1.0) u_next = u_j + step_ * (u_next - u_j);
   }
   // The next trial's change is measured against the trial its correction was planned from.

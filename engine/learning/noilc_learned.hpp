@@ -25,6 +25,12 @@
 // trial with half the step (halved again for every further failure, down to 1/8; doubled back
 // towards 1 by every trial that did not get worse).
 //
+// Several joints: each output's correction reads every joint's input (cross-joint, the coupling the
+// prior has wrong), unless `cross_joint` is false (diagonal).
+//
+// The planner: each trial judges the refit model (fitted on the trials before) and the prior on how
+// well they predicted its change of error; the better one plans the next update (the refit on a tie).
+//
 // Every refit and fall-back is reported as a note (take_note), which the session records as an event.
 #pragma once
 
@@ -62,6 +68,7 @@ struct LearnedNoilcReport {
   double measured_change = 0.0;   // ||e_j - e_{j-1}|| (normalized units)
   double predicted_change = 0.0;  // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
   double prediction_miss = 0.0;   // ||-(e_j - e_{j-1}) - P_model du|| / ||e_j - e_{j-1}||, same model
+  bool prior_plans = false;       // the next update is planned by the prior (it predicted this trial better)
   double prior_miss = 0.0;        // the same with the prior alone
   double refit_miss = 0.0;        // the same with the model refit from this trial
   int left_out = 0;               // output entries the refit did not learn from (limit-shaped, held)
@@ -107,7 +114,9 @@ class LearnedModelNoilc {
   LearnedNoilcSettings settings_;
   int samples_;
   StateSpaceModel prior_model_, model_;
-  StateSpaceNoilc solver_;
+  StateSpaceNoilc solver_, prior_solver_;            // on the refit model, on the prior
+  bool plan_with_prior_ = false;                     // the prior predicted the last trial better than the refit model
+  bool planned_with_prior_ = false;                  // ... and planned the trial being measured
   Eigen::MatrixXd correction_;                       // coefficients_per_output() x J
   std::vector<Eigen::MatrixXd> gram_;                // per output joint
   std::vector<Eigen::VectorXd> moment_;              // per output joint
