@@ -3,6 +3,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <string>
 
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -86,9 +87,24 @@ StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const Correction
       m.A(state, state) = a;
       m.B(state, i) = 1.0 - a;
     }
-    if (correction.size() > 0) m.C.block(i, first, 1, per_joint) = correction.col(i).transpose();
   }
+  set_correction(shape, correction, m);
   return m;
+}
+
+void set_correction(const CorrectionShape& shape, const Eigen::MatrixXd& correction, StateSpaceModel& model) {
+  const int J = model.inputs(), per_joint = shape.per_joint(), learned = model.states() - per_joint * J;
+  model.C.rightCols(per_joint * J).setZero();
+  if (correction.size() == 0) return;
+  if (correction.cols() != J || (correction.rows() != per_joint && correction.rows() != per_joint * J)) {
+    throw InputError("the learned correction is not " + std::to_string(per_joint) + " (or " +
+                     std::to_string(per_joint * J) + ") x " + std::to_string(J));
+  }
+  const bool cross_joint = correction.rows() == per_joint * J;
+  for (int i = 0; i < J; ++i) {
+    if (cross_joint) model.C.block(i, learned, 1, per_joint * J) = correction.col(i).transpose();
+    else model.C.block(i, learned + i * per_joint, 1, per_joint) = correction.col(i).transpose();
+  }
 }
 
 Eigen::MatrixXd correction_regressors(const Eigen::Ref<const Eigen::VectorXd>& du, const CorrectionShape& shape,

@@ -2,8 +2,10 @@
 // behind the pressure controllers' designed first-order response (tau_p, with the bellows'
 // bounce-back the pressure loop leaves uncompensated), inside the PID of the reference system's
 // section 3 (the same closed loop z G / (1 + G C_pid) that engine/config/convergence writes down per
-// frequency), plus a learned correction per joint in parallel: an FIR of the last `taps` inputs and
-// first-order low-passes (the slow modes the nominal model lacks: creep, the valves' flow limits).
+// frequency), plus a learned correction in parallel: per input, an FIR of its last `taps` values and
+// first-order low-passes of it (the slow modes the nominal model lacks: creep, the valves' flow
+// limits), read by each joint's output either from its own input only (diagonal) or from every
+// joint's (cross-joint: the coupling the prior's model has wrong).
 // States: [arm 2J | pressure J | PID integral J | previous output J | correction (taps + low-passes) J].
 #pragma once
 
@@ -41,9 +43,15 @@ struct CorrectionShape {
   int per_joint() const { return taps + static_cast<int>(lowpass_time_constants_s.size()); }
 };
 
-/// The model with the correction's coefficients `correction` (per_joint() x J, column per joint).
+/// The model with the correction's coefficients `correction`, column i joint i's output: per_joint() x J
+/// (diagonal: from joint i's input only) or per_joint() J x J (cross-joint: rows k per_joint() ... from
+/// joint k's input), or empty (none).
 StateSpaceModel closed_loop_model(const ClosedLoopPrior& prior, const CorrectionShape& shape,
                                   const Eigen::MatrixXd& correction);
+
+/// Writes the coefficients `correction` (as closed_loop_model's) into the outputs of `model`, a
+/// closed_loop_model of the same prior and shape: a refit changes C only, not A and B.
+void set_correction(const CorrectionShape& shape, const Eigen::MatrixXd& correction, StateSpaceModel& model);
 
 /// Regressors of the correction for one joint's input change du(0..N-1): row t-1 holds what the
 /// correction states hold at sample t (N x per_joint()), so that y_correction = Phi * coefficients.

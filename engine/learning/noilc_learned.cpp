@@ -25,10 +25,11 @@ LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const Learned
   for (const double tau : settings.shape.lowpass_time_constants_s) {
     if (!(tau > 0.0) || !std::isfinite(tau)) throw InputError("[ilc] the correction's time constants must be positive");
   }
-  const int J = prior.joints(), p = settings.shape.per_joint();
-  correction_ = Eigen::MatrixXd::Zero(p, J);
-  gram_.assign(static_cast<std::size_t>(J), Eigen::MatrixXd::Zero(p, p));
-  moment_.assign(static_cast<std::size_t>(J), Eigen::VectorXd::Zero(p));
+  const int J = prior.joints(), q = coefficients_per_output();
+  correction_ = Eigen::MatrixXd::Zero(q, J);
+  gram_.assign(static_cast<std::size_t>(J), Eigen::MatrixXd::Zero(q, q));
+  moment_.assign(static_cast<std::size_t>(J), Eigen::VectorXd::Zero(q));
+  regressors_.resize(samples, q);
   data_scale_ = Eigen::VectorXd::Zero(J);
   if (!(settings.limit_margin_bar >= 0.0) || !std::isfinite(settings.limit_margin_bar))
     throw InputError("[ilc] limit_margin_bar must be a finite, non-negative pressure");
@@ -36,12 +37,16 @@ LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const Learned
     throw InputError("[ilc] limit_recovery_s must be a finite, non-negative time");
   learnable_ = Eigen::MatrixXd::Ones(samples, J);
   feedback_ = Eigen::MatrixXd::Zero(samples, J);
-  prior_model_ = closed_loop_model(prior_, settings_.shape, correction_);
+  // The prior alone has no correction states (they would only add zeros to its predictions); the
+  // refit model has them, and a refit rewrites its outputs only.
+  prior_model_ = closed_loop_model(prior_, CorrectionShape{0, {}}, {});
+  model_ = closed_loop_model(prior_, settings_.shape, correction_);
+  prior_solver_.setup(prior_model_, settings_.weights, samples_);
   rebuild();
 }
 
 void LearnedModelNoilc::rebuild() {
-  model_ = closed_loop_model(prior_, settings_.shape, correction_);
+  set_correction(settings_.shape, correction_, model_);
   solver_.setup(model_, settings_.weights, samples_);
 }
 
@@ -67,22 +72,35 @@ void LearnedModelNoilc::set_held_outputs(const std::vector<unsigned char>& held)
 void LearnedModelNoilc::refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual,
                               const Eigen::MatrixXd& learnable) {
   const double T = prior_.sample_time_s;
-  const int p = settings_.shape.per_joint();
+  const int p = settings_.shape.per_joint(), q = coefficients_per_output();
+  const bool cross_joint = q != p;
+  // Cross-joint: every output is fitted on the regressors of every joint's input (the coupling the
+  // prior has wrong), [Phi(du_1) | ... | Phi(du_J)]; diagonal: on its own input's.
+  if (cross_joint) {
+    for (int k = 0; k < joints(); ++k)
+      regressors_.middleCols(k * p, p) = correction_regressors(du.col(k), settings_.shape, T);
+  }
   for (int i = 0; i < joints(); ++i) {
     const auto k = static_cast<std::size_t>(i);
-    // Rows the refit may not learn from (limit-shaped, held) are left out of the fit altogether.
-    const Eigen::MatrixXd phi = learnable.col(i).asDiagonal() * correction_regressors(du.col(i), settings_.shape, T);
+    if (!cross_joint) regressors_ = correction_regressors(du.col(i), settings_.shape, T);
+    // Rows the refit may not learn from (limit-shaped, held) are left out of the fit altogether. The
+    // outputs of several joints usually share them: their product is then made once.
+    if (!cross_joint || i == 0 || learnable.col(i) != learnable.col(i - 1)) {
+      masked_ = learnable.col(i).asDiagonal() * regressors_;
+      increment_.noalias() = masked_.transpose() * masked_;
+      increment_scale_ = masked_.squaredNorm() / q;
+    }
     const Eigen::VectorXd r = learnable.col(i).cwiseProduct(residual.col(i));
     gram_[k] *= settings_.forgetting;
     moment_[k] *= settings_.forgetting;
-    gram_[k].noalias() += phi.transpose() * phi;
-    moment_[k].noalias() += phi.transpose() * r;
+    gram_[k] += increment_;
+    moment_[k].noalias() += masked_.transpose() * r;
     // The ridge pulls towards the prior (a zero correction) with a weight relative to the largest
     // change of correction seen: a trial whose correction barely changed (near convergence, the change
     // is below the noise) then adds almost nothing to the fit, and the model stays what the
     // informative trials made it instead of walking away with the noise.
-    data_scale_(i) = std::max(data_scale_(i), phi.squaredNorm() / p);
-    if (!(data_scale_(i) > 0.0)) continue;  // this joint's correction never changed: nothing to learn from
+    data_scale_(i) = std::max(data_scale_(i), increment_scale_);
+    if (!(data_scale_(i) > 0.0)) continue;  // the correction never changed: nothing to learn from
     const double ridge = settings_.relative_ridge * data_scale_(i);
     Eigen::MatrixXd a = gram_[k];
     a.diagonal().array() += ridge;
@@ -127,9 +145,16 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
     };
     const Eigen::MatrixXd predicted = model_.simulate(du), prior_predicted = prior_model_.simulate(du);
     report_.measured_change = measured;
-    report_.predicted_change = predicted.norm();
-    report_.prediction_miss = miss(predicted);
     report_.prior_miss = miss(prior_predicted);
+    // The model that planned u_j is judged on it; the refit model is judged on it too (out of sample:
+    // fitted on the trials before), and the next update is planned by whichever of the refit model and
+    // the prior predicted this trial better. A refit that has learned what the trials' large changes
+    // showed but mispredicts the fine ones near convergence (a coupled arm's pose-dependent terms no
+    // linear correction holds) then leaves the planning to the prior instead of steering it wrong.
+    const double refit_model_miss = miss(predicted);
+    report_.predicted_change = planned_with_prior_ ? prior_predicted.norm() : predicted.norm();
+    report_.prediction_miss = planned_with_prior_ ? report_.prior_miss : refit_model_miss;
+    plan_with_prior_ = refit_model_miss > report_.prior_miss;
     if (cost > (1.0 + settings_.guard) * best_cost_) {
       report_.fell_back = true;
       from_best = true;
@@ -171,10 +196,11 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
       std::snprintf(
           text, sizeof text,
           "noilc-learned: model %s from trial %d: predicted change of error %.4g, measured %.4g (miss %.0f %%; "
-          "the prior alone %.0f %%, the refit %.0f %%)%s",
+          "the prior alone %.0f %%, the refit %.0f %%)%s%s",
           report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured,
           100.0 * report_.prediction_miss, 100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
-          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step");
+          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step",
+          plan_with_prior_ ? "; the prior plans the next update (it predicted this trial better)" : "");
       note_ = text;
     }
   }
@@ -185,14 +211,17 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
     best_cost_ = cost;
   }
   report_.step = step_;
+  report_.prior_plans = plan_with_prior_;
   // The update, like the refit, does not act on the outputs the pressure limit shaped: their errors
   // are zeroed (as noilc-constrained does; docs/learning-laws.md), so the correction does not wind up
   // against a limit the linear model cannot see.
+  StateSpaceNoilc& planner = plan_with_prior_ ? prior_solver_ : solver_;
+  planned_with_prior_ = plan_with_prior_;
   if (from_best) {
-    solver_.solve(u_best_, e_best_.cwiseProduct(learnable_best_), u_next);
+    planner.solve(u_best_, e_best_.cwiseProduct(learnable_best_), u_next);
     if (step_ < 1.0) u_next = u_best_ + step_ * (u_next - u_best_);
   } else {
-    solver_.solve(u_j, e_j.cwiseProduct(learnable_), u_next);
+    planner.solve(u_j, e_j.cwiseProduct(learnable_), u_next);
     if (step_ < 1.0) u_next = u_j + step_ * (u_next - u_j);
   }
   // The next trial's change is measured against the trial its correction was planned from.

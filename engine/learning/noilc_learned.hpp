@@ -25,6 +25,12 @@
 // trial with half the step (halved again for every further failure, down to 1/8; doubled back
 // towards 1 by every trial that did not get worse).
 //
+// Several joints: each output's correction reads every joint's input (cross-joint, the coupling the
+// prior has wrong), unless `cross_joint` is false (diagonal).
+//
+// The planner: each trial judges the refit model (fitted on the trials before) and the prior on how
+// well they predicted its change of error; the better one plans the next update (the refit on a tie).
+//
 // Every refit and fall-back is reported as a note (take_note), which the session records as an event.
 #pragma once
 
@@ -49,6 +55,7 @@ struct LearnedNoilcSettings {
   bool refit = true;               // false: the prior only (what the closed loop alone does)
   double limit_margin_bar = 0.0;   // a set point within this of the pressure limit is on the limit
   double limit_recovery_s = 0.08;  // outputs this long after an input on the limit are not learned from
+  bool cross_joint = true;         // several joints: each output's correction from every joint's input
 };
 
 /// What the last update did, for the session and the console.
@@ -61,6 +68,7 @@ struct LearnedNoilcReport {
   double measured_change = 0.0;   // ||e_j - e_{j-1}|| (normalized units)
   double predicted_change = 0.0;  // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
   double prediction_miss = 0.0;   // ||-(e_j - e_{j-1}) - P_model du|| / ||e_j - e_{j-1}||, same model
+  bool prior_plans = false;       // the next update is planned by the prior (it predicted this trial better)
   double prior_miss = 0.0;        // the same with the prior alone
   double refit_miss = 0.0;        // the same with the model refit from this trial
   int left_out = 0;               // output entries the refit did not learn from (limit-shaped, held)
@@ -78,7 +86,13 @@ class LearnedModelNoilc {
   int samples() const { return samples_; }
   int joints() const { return prior_.joints(); }
   const LearnedNoilcReport& last_report() const { return report_; }
+  /// The learned coefficients as closed_loop_model takes them: per_joint() x J, or per_joint() J x J
+  /// with cross_joint (several joints).
   const Eigen::MatrixXd& correction() const { return correction_; }
+  /// The coefficients of one output's correction: per_joint(), times J with cross_joint.
+  int coefficients_per_output() const {
+    return settings_.shape.per_joint() * (settings_.cross_joint ? prior_.joints() : 1);
+  }
   /// The note for the session's events since the last call (empty if none), then cleared.
   std::string take_note();
   /// As LearningLaw::model_check: from the last report, from the second update on.
@@ -100,11 +114,15 @@ class LearnedModelNoilc {
   LearnedNoilcSettings settings_;
   int samples_;
   StateSpaceModel prior_model_, model_;
-  StateSpaceNoilc solver_;
-  Eigen::MatrixXd correction_;           // per_joint x J
-  std::vector<Eigen::MatrixXd> gram_;    // per joint
-  std::vector<Eigen::VectorXd> moment_;  // per joint
-  Eigen::VectorXd data_scale_;           // per joint: the largest mean square regressor of one trial
+  StateSpaceNoilc solver_, prior_solver_;            // on the refit model, on the prior
+  bool plan_with_prior_ = false;                     // the prior predicted the last trial better than the refit model
+  bool planned_with_prior_ = false;                  // ... and planned the trial being measured
+  Eigen::MatrixXd correction_;                       // coefficients_per_output() x J
+  std::vector<Eigen::MatrixXd> gram_;                // per output joint
+  std::vector<Eigen::VectorXd> moment_;              // per output joint
+  Eigen::VectorXd data_scale_;                       // per output joint: the largest mean square regressor of one trial
+  Eigen::MatrixXd regressors_, masked_, increment_;  // the refit's workspace: N x q, N x q, q x q
+  double increment_scale_ = 0.0;
   Eigen::MatrixXd u_previous_, e_previous_, u_best_, e_best_, planned_;
   Eigen::MatrixXd feedback_;  // N x J: this trial's feedback (bar), with has_context_
   double reach_bar_ = 0.0;

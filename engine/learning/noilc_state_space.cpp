@@ -2,9 +2,6 @@
 
 #include <cmath>
 #include <string>
-#include <utility>
-
-#include <Eigen/SparseCore>
 
 #include "engine/base/errors.hpp"
 
@@ -13,13 +10,65 @@ namespace {
 // Gains that change by less than this (relative to their size) from one stage to the next have
 // settled: the remaining stages of a time-invariant problem repeat them to rounding.
 constexpr double kSettledGain = 1e-13;
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+// The sweep's products, on the raw storage of column-major matrices (rows x cols, leading dimension
+// ld) and of compressed-column sparse ones: each a loop the compiler vectorizes, none of Eigen's
+// general product machinery (packing, blocking) that costs more than the arithmetic at these sizes.
+
+/// out = X S: column j of out is the combination of X's columns that S's column j names.
+void times_sparse(const double* X, Eigen::Index rows, Eigen::Index ldx, const Sparse& S, double* out,
+                  Eigen::Index ldo) {
+  const int* outer = S.outerIndexPtr();
+  const int* inner = S.innerIndexPtr();
+  const double* values = S.valuePtr();
+  for (Eigen::Index j = 0; j < S.outerSize(); ++j) {
+    double* o = out + j * ldo;
+    for (Eigen::Index r = 0; r < rows; ++r) o[r] = 0.0;
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      const double a = values[k];
+      const double* x = X + static_cast<Eigen::Index>(inner[k]) * ldx;
+      for (Eigen::Index r = 0; r < rows; ++r) o[r] += a * x[r];
+    }
+  }
+}
+
+/// Column j of S dotted with x (S' x, one entry).
+double column_dot(const Sparse& S, Eigen::Index j, const double* x) {
+  const int* inner = S.innerIndexPtr();
+  const double* values = S.valuePtr();
+  double sum = 0.0;
+  for (int k = S.outerIndexPtr()[j]; k < S.outerIndexPtr()[j + 1]; ++k) sum += values[k] * x[inner[k]];
+  return sum;
+}
+
+/// out = S' x.
+void transpose_times(const Sparse& S, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> out) {
+  for (Eigen::Index j = 0; j < S.outerSize(); ++j) out(j) = column_dot(S, j, x.data());
+}
+
+/// out = S x.
+void times(const Sparse& S, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> out) {
+  out.setZero();
+  const int* inner = S.innerIndexPtr();
+  const double* values = S.valuePtr();
+  for (Eigen::Index j = 0; j < S.outerSize(); ++j) {
+    const double xj = x(j);
+    for (int k = S.outerIndexPtr()[j]; k < S.outerIndexPtr()[j + 1]; ++k) out(inner[k]) += values[k] * xj;
+  }
+}
+
+/// The upper triangle from the lower: exactly symmetric.
+void mirror_lower(Eigen::MatrixXd& M) { M.triangularView<Eigen::StrictlyUpper>() = M.transpose(); }
 }  // namespace
 
 Eigen::MatrixXd StateSpaceModel::simulate(const Eigen::Ref<const Eigen::MatrixXd>& u) const {
+  const Sparse A_sparse = A.sparseView();
   Eigen::MatrixXd y(u.rows(), u.cols());
   Eigen::VectorXd x = Eigen::VectorXd::Zero(A.rows()), next(A.rows());
   for (Eigen::Index t = 0; t < u.rows(); ++t) {
-    next.noalias() = A * x;
+    times(A_sparse, x, next);
     next.noalias() += B * u.row(t).transpose();
     x.swap(next);
     y.row(t).noalias() = (C * x).transpose();
@@ -42,6 +91,8 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
   A_ = model.A;
   B_ = model.B;
   C_ = model.C;
+  A_sparse_ = A_.sparseView();
+  B_sparse_ = B_.sparseView();
   m_ = weights.m;
   s_ = weights.s;
   rate_weight_ = weights.w / (model.sample_time_s * model.sample_time_s);
@@ -49,60 +100,36 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
   output_to_state_ = m_ * C_.transpose();
   // Augmented model z = [dx; v(t-1)]: Ab = [[A, 0], [0, 0]], Bb = [B; I], Cb = [C, 0] (noilc_mimo).
   const Eigen::Index augmented = n + J;
-  Eigen::MatrixXd Bb(augmented, J);
-  Bb << B_, Eigen::MatrixXd::Identity(J, J);
-  Eigen::MatrixXd Cb = Eigen::MatrixXd::Zero(J, augmented);
-  Cb.leftCols(n) = C_;
-  const Eigen::MatrixXd output_weight = m_ * Cb.transpose() * Cb;
-  // A is sparse (the closed loop's blocks, the correction's shift register and low-passes): the
-  // sweep's products with it cost O(nonzeros x n) instead of O(n^3), which is what keeps a refit's
-  // set-up within the time between trials for J joints.
-  const Eigen::SparseMatrix<double> A_sparse = A_.sparseView();
-  Eigen::MatrixXd P = output_weight;  // P_N
-  tail_.clear();
+  output_weight_.setZero(augmented, augmented);
+  output_weight_.topLeftCorner(n, n).noalias() = output_to_state_ * C_;  // m Cb' Cb
+  P_ = output_weight_;                                                   // P_N
+  next_P_.resize(augmented, augmented);
+  PB_.resize(augmented, J);
+  curvature_.resize(J, J);
+  cross_.resize(augmented, J);
+  scaled_cross_.resize(augmented, J);
+  PA_.resize(n, n);
+  tail_stages_ = 0;
   bool settled = false;
-  auto sweep = [&](int t) {
-    const double W = rate_weight(t);
-    Eigen::MatrixXd Q = t >= 1 ? output_weight : Eigen::MatrixXd::Zero(augmented, augmented);
-    Q.bottomRightCorner(J, J).diagonal().array() += W;
-    const Eigen::MatrixXd PB = P * Bb;
-    Eigen::MatrixXd curvature = Bb.transpose() * PB;
-    curvature.diagonal().array() += s_ + W;
-    curvature = (0.5 * (curvature + curvature.transpose())).eval();
-    // Ab = [[A, 0], [0, 0]]: cross = PB' Ab = [PB_x' A, 0] and Ab' P Ab = [[A' P_xx A, 0], [0, 0]].
-    Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(J, augmented);
-    cross.leftCols(n) = PB.topRows(n).transpose() * A_sparse;
-    cross.rightCols(J).diagonal().array() -= W;
-    const Eigen::LLT<Eigen::MatrixXd> factor(curvature);
-    if (factor.info() != Eigen::Success || !curvature.allFinite()) {
-      throw InputError("norm-optimal ILC: the weights do not give a positive definite cost (need s + w > 0 or m > 0)");
-    }
-    Stage stage;
-    stage.inverse = factor.solve(Eigen::MatrixXd::Identity(J, J));
-    stage.gain = -stage.inverse * cross;
-    const Eigen::MatrixXd PA = P.topLeftCorner(n, n) * A_sparse;
-    Eigen::MatrixXd next = Q - cross.transpose() * stage.inverse * cross;
-    next.topLeftCorner(n, n) += A_sparse.transpose() * PA;
-    P = std::move(next);
-    P = (0.5 * (P + P.transpose())).eval();
-    return stage;
-  };
   for (int t = samples - 1; t >= 1; --t) {
-    Stage stage = sweep(t);
-    if (t < samples - 1 && !tail_.empty()) {
+    if (static_cast<std::size_t>(tail_stages_) == tail_.size()) tail_.emplace_back();
+    Stage& stage = tail_[static_cast<std::size_t>(tail_stages_)];
+    sweep(t, stage);
+    if (tail_stages_ > 0) {
+      const Stage& last = tail_[static_cast<std::size_t>(tail_stages_) - 1];
       const double size = 1.0 + stage.gain.cwiseAbs().maxCoeff();
-      if ((stage.gain - tail_.back().gain).cwiseAbs().maxCoeff() <= kSettledGain * size &&
-          (stage.inverse - tail_.back().inverse).cwiseAbs().maxCoeff() <=
+      if ((stage.gain - last.gain).cwiseAbs().maxCoeff() <= kSettledGain * size &&
+          (stage.inverse - last.inverse).cwiseAbs().maxCoeff() <=
               kSettledGain * (1.0 + stage.inverse.cwiseAbs().maxCoeff())) {
-        settled_ = std::move(stage);
+        settled_ = stage;
         settled = true;
         break;
       }
     }
-    tail_.push_back(std::move(stage));
+    ++tail_stages_;
   }
-  if (!settled) settled_ = tail_.back();
-  first_ = sweep(0);  // from the settled P: every stage between repeats the settled one
+  if (!settled) settled_ = tail_[static_cast<std::size_t>(tail_stages_) - 1];
+  sweep(0, first_);  // from the settled P: every stage between repeats the settled one
   feedforward_.resize(J, samples);
   p_x_.resize(n);
   next_x_.resize(n);
@@ -115,6 +142,63 @@ void StateSpaceNoilc::setup(const StateSpaceModel& model, const StateSpaceNoilcW
   previous_change_.resize(J);
 }
 
+void StateSpaceNoilc::sweep(int t, Stage& out) {
+  const Eigen::Index n = A_.rows(), J = B_.cols(), augmented = n + J;
+  const double W = rate_weight(t);
+  // PB = P Bb = P_{:,x} B + P_{:,v}; the curvature Bb' P Bb + S + W (symmetric, J x J).
+  times_sparse(P_.data(), augmented, augmented, B_sparse_, PB_.data(), augmented);
+  PB_ += P_.rightCols(J);
+  for (Eigen::Index k = 0; k < J; ++k) {
+    for (Eigen::Index l = 0; l < J; ++l) curvature_(k, l) = column_dot(B_sparse_, k, PB_.col(l).data()) + PB_(n + k, l);
+  }
+  curvature_.diagonal().array() += s_ + W;
+  for (Eigen::Index i = 0; i < J; ++i) {
+    for (Eigen::Index k = 0; k < i; ++k)
+      curvature_(i, k) = curvature_(k, i) = 0.5 * (curvature_(i, k) + curvature_(k, i));
+  }
+  // Ab = [[A, 0], [0, 0]]: cross = PB' Ab - [0, W I] = [PB_x' A, -W I] (held transposed, (n + J) x J)
+  // and Ab' P Ab = [[A' P_xx A, 0], [0, 0]].
+  for (Eigen::Index k = 0; k < J; ++k) {
+    for (Eigen::Index j = 0; j < n; ++j) cross_(j, k) = column_dot(A_sparse_, j, PB_.col(k).data());
+  }
+  cross_.bottomRows(J).setZero();
+  cross_.bottomRows(J).diagonal().array() -= W;
+  factor_.compute(curvature_);
+  if (factor_.info() != Eigen::Success || !curvature_.allFinite()) {
+    throw InputError("norm-optimal ILC: the weights do not give a positive definite cost (need s + w > 0 or m > 0)");
+  }
+  out.inverse.setIdentity(J, J);
+  factor_.solveInPlace(out.inverse);
+  // scaled_cross = cross' H^-1 ((n + J) x J): the gain is its transpose, negated, and P's downdate
+  // cross' H^-1 cross its product with cross.
+  scaled_cross_.setZero();
+  for (Eigen::Index k = 0; k < J; ++k) {
+    for (Eigen::Index l = 0; l < J; ++l) scaled_cross_.col(k) += out.inverse(l, k) * cross_.col(l);
+  }
+  out.gain = -scaled_cross_.transpose();
+  // P_t = Q + Ab' P Ab - cross' H^-1 cross, Q = m Cb' Cb (none at t = 0) plus W on v(t-1); the lower
+  // triangle, then mirrored.
+  if (t >= 1) next_P_ = output_weight_;
+  else next_P_.setZero();
+  next_P_.bottomRightCorner(J, J).diagonal().array() += W;
+  times_sparse(P_.data(), n, augmented, A_sparse_, PA_.data(), n);  // P_xx A
+  for (Eigen::Index j = 0; j < n; ++j) {                            // (A' P_xx A)(r, j) = A(:, r)' (P_xx A)(:, j)
+    const double* pa = PA_.col(j).data();
+    double* column = next_P_.col(j).data();
+    for (Eigen::Index r = j; r < n; ++r) column[r] += column_dot(A_sparse_, r, pa);
+  }
+  for (Eigen::Index j = 0; j < augmented; ++j) {
+    double* column = next_P_.col(j).data();
+    for (Eigen::Index k = 0; k < J; ++k) {
+      const double c = scaled_cross_(j, k);
+      const double* x = cross_.col(k).data();
+      for (Eigen::Index r = j; r < augmented; ++r) column[r] -= c * x[r];
+    }
+  }
+  mirror_lower(next_P_);
+  P_.swap(next_P_);
+}
+
 double StateSpaceNoilc::rate_weight(int t) const {
   if (t == 0) return 0.0;  // D's rows as noilc_riccati: u(0) has no change of its own, the last one counts twice
   return t == samples_ - 1 ? 2.0 * rate_weight_ : rate_weight_;
@@ -123,7 +207,7 @@ double StateSpaceNoilc::rate_weight(int t) const {
 const StateSpaceNoilc::Stage& StateSpaceNoilc::stage(int t) const {
   if (t == 0) return first_;
   const auto from_end = static_cast<std::size_t>(samples_ - 1 - t);
-  return from_end < tail_.size() ? tail_[from_end] : settled_;
+  return from_end < static_cast<std::size_t>(tail_stages_) ? tail_[from_end] : settled_;
 }
 
 void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const Eigen::Ref<const Eigen::MatrixXd>& e_j,
@@ -150,7 +234,7 @@ void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const 
     const Stage& K = stage(t);
     feedforward_.col(t).noalias() = K.inverse * h_;
     feedforward_.col(t) = -feedforward_.col(t);
-    next_x_.noalias() = A_.transpose() * p_x_;
+    transpose_times(A_sparse_, p_x_, next_x_);
     next_x_.noalias() += K.gain.leftCols(n).transpose() * h_;
     if (t >= 1) next_x_.noalias() -= output_to_state_ * e_j.row(t - 1).transpose();
     p_x_.swap(next_x_);
@@ -166,7 +250,7 @@ void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const 
     change_.noalias() += K.gain.leftCols(n) * dx_;
     change_.noalias() += K.gain.rightCols(J) * previous_change_;
     u_next.row(t) = u_j.row(t) + change_.transpose();
-    next_dx_.noalias() = A_ * dx_;
+    times(A_sparse_, dx_, next_dx_);
     next_dx_.noalias() += B_ * change_;
     dx_.swap(next_dx_);
     previous_change_ = change_;
@@ -175,8 +259,8 @@ void StateSpaceNoilc::solve(const Eigen::Ref<const Eigen::MatrixXd>& u_j, const 
 
 std::size_t StateSpaceNoilc::memory_bytes() const {
   const auto per_stage = static_cast<std::size_t>(first_.gain.size() + first_.inverse.size());
-  return sizeof(double) *
-         (per_stage * static_cast<std::size_t>(stored_stages()) + static_cast<std::size_t>(feedforward_.size()));
+  // The tail's storage beyond tail_stages_ (kept from an earlier, longer sweep) is held too.
+  return sizeof(double) * (per_stage * (tail_.size() + 2) + static_cast<std::size_t>(feedforward_.size()));
 }
 
 }  // namespace bellows

@@ -5,16 +5,19 @@
 // corrections to it (engine/learning/closed_loop_model, noilc_learned).
 //
 // Set-up is a backward Riccati sweep that stops once the gains have settled (the stages between the
-// first and the last few are time-invariant), so it costs O(n^3) per stage for the settling stages
-// only, and the gains are O(settling) in memory: the law refits its model between trials at the cost
-// of one such sweep. solve() is one backward and one forward pass, O(N (n + J) J + N n^2), and
-// allocates nothing.
+// first and the last few are time-invariant), so it runs for the settling stages only, and the gains
+// are O(settling) in memory: the law refits its model between trials at the cost of one such sweep.
+// A (the closed loop's blocks, the correction's shift register and low-passes) and B are sparse: a
+// stage costs O(nnz(A) n + (n + J)^2 J), every product a column operation on dense storage, and the
+// sweep's workspace is kept between set-ups of a model of the same size. solve() is one backward and
+// one forward pass, O(N (nnz(A) + (n + J) J)), and allocates nothing.
 #pragma once
 
 #include <cstddef>
 #include <vector>
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 
 namespace bellows {
 
@@ -23,7 +26,7 @@ struct StateSpaceModel {
   double sample_time_s = 0.0;
   int states() const { return static_cast<int>(A.rows()); }
   int inputs() const { return static_cast<int>(B.cols()); }
-  /// y(1..N) from u(0..N-1) from rest, N x J (column per input): O(N n^2).
+  /// y(1..N) from u(0..N-1) from rest, N x J (column per input): O(N (nnz(A) + n J)).
   Eigen::MatrixXd simulate(const Eigen::Ref<const Eigen::MatrixXd>& u) const;
 };
 
@@ -42,7 +45,7 @@ class StateSpaceNoilc {
   int samples() const { return samples_; }
   int inputs() const { return static_cast<int>(B_.cols()); }
   /// Stages with gains of their own (the rest share the settled gain).
-  int stored_stages() const { return static_cast<int>(tail_.size()) + 2; }
+  int stored_stages() const { return tail_stages_ + 2; }
   std::size_t memory_bytes() const;
 
  private:
@@ -52,12 +55,19 @@ class StateSpaceNoilc {
   };
   const Stage& stage(int t) const;
   double rate_weight(int t) const;  // 0 at t = 0, doubled at t = N-1
+  /// One stage of the backward sweep: the gains of stage t from P = P_{t+1}, then P becomes P_t.
+  void sweep(int t, Stage& out);
 
   Eigen::MatrixXd A_, B_, C_, output_to_state_;  // output_to_state_ = m C'
+  Eigen::SparseMatrix<double> A_sparse_, B_sparse_;
   double m_ = 0.0, s_ = 0.0, rate_weight_ = 0.0;
   int samples_ = 0;
   Stage first_, settled_;
-  std::vector<Stage> tail_;      // stages N-1, N-2, ... until the gains settled (tail_[k] is stage N-1-k)
+  std::vector<Stage> tail_;  // stages N-1, N-2, ... until the gains settled (tail_[k] is stage N-1-k)
+  int tail_stages_ = 0;      // how many of tail_ this set-up filled (the rest is kept storage)
+  // The sweep's workspace: P_{t+1} and P_t over z = [dx; v(t-1)], and the products of a stage.
+  Eigen::MatrixXd output_weight_, P_, next_P_, PB_, curvature_, cross_, scaled_cross_, PA_;
+  Eigen::LLT<Eigen::MatrixXd> factor_;
   Eigen::MatrixXd feedforward_;  // J x N, rewritten each solve
   Eigen::VectorXd p_x_, next_x_, dx_, next_dx_;
   Eigen::VectorXd p_v_, h_, rate_, change_, previous_change_;
