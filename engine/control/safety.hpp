@@ -26,9 +26,10 @@
 // own, the missed periods are held ticks (the trial's clock keeps the rig's time) and count towards
 // the stale limit; when the late loop made at least half of a stale run the fault is
 // missed-deadlines. `missed_deadline_streak` (8 = 40 ms, for the same reasons) bounds a run of late
-// wake-ups even with fresh readings. Meanwhile the rig's own bound holds: io-sim and an LCM rig vent
-// after `[lcm] rig_timeout_s`, the T7 link's I/O thread after `[t7] command_timeout_s`, the T7's
-// watchdog after `[t7] watchdog_timeout_s`.
+// wake-ups even with fresh readings; a rig's own timeout reported in such a stall is named
+// missed-deadlines too (the rig vented because the loop stopped). Meanwhile the rig's own bound
+// holds: io-sim and an LCM rig vent after `[lcm] rig_timeout_s`, the T7 link's I/O thread after
+// `[t7] command_timeout_s`, the T7's watchdog after `[t7] watchdog_timeout_s`.
 #pragma once
 
 #include <array>
