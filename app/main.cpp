@@ -1,4 +1,9 @@
-// bellows: the lab console and its headless commands.
+// bellows: the lab console and its headless commands. The command line is wired here; each
+// command's work is in its own file. Every error ends in one line `bellows: ...` on stderr, its text
+// passed through printable() (engine/base/printable_text.hpp), and the exit status its type carries
+// (engine/base/errors.hpp): 0 done, 1 an internal error (untyped: a bug), 2 bad input, 3 an engine
+// fault, 4 the environment refused, 5 `rig check` found a failing valve or rig limit, 128 + N
+// stopped by signal N after venting and saving what finished (app/signals.hpp).
 #include <unistd.h>
 
 #include <csignal>

@@ -68,7 +68,7 @@ std::vector<fs::path> csv_export_paths(const Session& session, const fs::path& s
 }
 
 std::vector<fs::path> export_session_csv(const Session& session, const fs::path& samples_path, bool force) {
-  const std::vector<fs::path> paths = csv_export_paths(session, samples_path);
+  std::vector<fs::path> paths = csv_export_paths(session, samples_path);  // not const: returned by move
   check_export_targets(session, paths, ".csv", force);
   std::vector<std::string> samples, telemetry;
   for (const IterationData& data : session.iterations) {

@@ -62,6 +62,7 @@ MatVar text(const std::string& value) {
 /// A struct (array) with the given fields; set them with set_field().
 MatVar structure(const std::vector<std::string>& fields, size_t count = 1) {
   std::vector<const char*> names;
+  names.reserve(fields.size() + 1);
   for (const std::string& field : fields) names.push_back(field.c_str());
   names.push_back(nullptr);
   size_t dims[2] = {1, count};

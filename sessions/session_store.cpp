@@ -103,7 +103,7 @@ fs::path default_data_dir() {
 
 fs::path given_data_dir(const std::string& option_value) {
   if (option_value.empty()) return default_data_dir();
-  const fs::path dir(option_value);
+  fs::path dir(option_value);  // not const: returned by move
   std::error_code error;
   const fs::file_status status = fs::status(dir, error);
   if (status.type() == fs::file_type::not_found)
@@ -156,7 +156,8 @@ fs::path rename_session(const fs::path& directory, const std::string& new_name) 
   const fs::path parent = directory.parent_path();
   if (const std::string why = session_name_refusal(new_name, parent); !why.empty()) throw InputError(why);
   SessionManifest manifest = load_manifest(directory);
-  const fs::path target = parent / new_name;
+  // Not const: returned, so moved out.
+  fs::path target = parent / new_name;
   const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
   std::error_code error;
   fs::rename(directory, target, error);

@@ -164,17 +164,17 @@ void SessionWriter::update_next_correction(const TrialRecord& record, const Eige
   update_next_correction(record, Eigen::MatrixXd(next_correction_bar));
 }
 
-void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::MatrixXd& next_correction_bar) {
+void SessionWriter::update_next_correction(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar) {
   if (manifest_.iterations.empty()) {
     throw std::invalid_argument("SessionWriter::update_next_correction: no iteration saved yet");
   }
-  check_fits(record, next_correction_bar, "update_next_correction");
+  check_fits(record, next_corrections_bar, "update_next_correction");
   // The committed samples file is never rewritten: the new correction goes into the next revision
   // of it, and the manifest naming that revision (with its digest) is the commit. The old file is
   // removed once the manifest no longer names it.
   const int iteration = next_iteration() - 1;
   IterationEntry& entry = manifest_.iterations.back();
-  const std::string contents = format_samples_csv(record, next_correction_bar);
+  const std::string contents = format_samples_csv(record, next_corrections_bar);
   const int revision = entry.samples_revision + 1;
   const auto name_of = [&](int r) {
     return session_layout::folder_and_name(session_layout::samples_file(iteration, r)).second;

@@ -226,7 +226,7 @@ TEST(EngineLateLoop, ARigTimeoutReportedAfterTheLoopStalledPastItsStreakIsTheLoo
   }
 }
 
-// Missed deadlines on a rig whose time is its own (docs/architecture.md): the periods the loop
+// Missed deadlines on a rig whose time is its own (engine/control/safety.hpp): the periods the loop
 // missed passed on the rig without a command; below the limits they are held like missing readings.
 TEST(EngineLateLoop, ALateWakeUpBelowTheLimitRidesThroughAsHeldTicksOnTheRigsClock) {
   const Trajectory paper = library_trajectory("paper", 0.02);

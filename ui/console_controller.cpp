@@ -148,7 +148,7 @@ void ConsoleController::start(double now_s) {
 }
 
 void ConsoleController::select_trajectory(std::shared_ptr<const Trajectory> trajectory) {
-  selected_trajectories_.push_back(trajectory);
+  selected_trajectories_.push_back(std::move(trajectory));
   if (!send(EngineCommand::select_trajectory(*selected_trajectories_.back()), "select trajectory")) {
     selected_trajectories_.pop_back();  // the engine never saw it
     log(LogSource::kOperator, "the engine holds the previous trajectory until the next trial", true);

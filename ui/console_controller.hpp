@@ -186,12 +186,12 @@ class ConsoleController {
   void jump_to_error_peak(int step);
   void open_trajectory_chooser();
   void preview_selected_trajectory();
-  void use_trajectory(std::shared_ptr<const Trajectory> trajectory);
+  void use_trajectory(const std::shared_ptr<const Trajectory>& trajectory);
   /// Empty when applied; otherwise why not (nothing changed).
   std::string apply_tuning(int field, const std::string& text);
   /// The next (+1) or previous (-1) learning law; the law is rebuilt and the change logged.
   void choose_law_step(int step);
-  void confirm_discard(std::string what, std::function<void()> action);
+  void confirm_discard(const std::string& what, std::function<void()> action);
   void quit_when_saved();  // quits once the save in progress is done (it asks again if that save fails)
   void quit_now();
 

@@ -262,7 +262,7 @@ void ConsoleController::preview_selected_trajectory() {
   }
 }
 
-void ConsoleController::confirm_discard(std::string what, std::function<void()> action) {
+void ConsoleController::confirm_discard(const std::string& what, std::function<void()> action) {
   const Experiment& e = state_.experiment;
   if (!e.unsaved() || e.trials.empty()) {
     action();
@@ -276,7 +276,7 @@ void ConsoleController::confirm_discard(std::string what, std::function<void()> 
       "y discard   n or Esc cancel");
 }
 
-void ConsoleController::use_trajectory(std::shared_ptr<const Trajectory> trajectory) {
+void ConsoleController::use_trajectory(const std::shared_ptr<const Trajectory>& trajectory) {
   if (state_.engine_state == EngineState::kFault) {
     set_status("a fault is latched: reset it (R) before choosing a trajectory", true);
     return;

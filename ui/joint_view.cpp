@@ -29,7 +29,7 @@ std::string fault_location(FaultCode code, int joint, const TickRecord& tick, co
   const SafetyParameters& limits = config.safety;
   const double p_limit_bar = config.controller.p_max_bar + limits.pressure_margin_bar;
   const std::string name = joint_name(joints, joint);
-  const std::string where = format("joint %d", joint + 1) + (name.empty() ? "" : " (" + name + ")");
+  std::string where = format("joint %d", joint + 1) + (name.empty() ? "" : " (" + name + ")");
   const JointReading& r = tick.reading.joint[static_cast<std::size_t>(joint)];
   constexpr double kDegPerRad = 180.0 / std::numbers::pi;
   const double angle_deg = r.angle_rad * kDegPerRad;

@@ -1,6 +1,10 @@
 // What crosses thread boundaries around the engine: operator commands in, events and tick records
 // out. All plain values (pointers to buffers the sender owns), so queues can copy them without
-// allocating.
+// allocating. Commands travel in an SPSC queue: a full one refuses the command (EngineCore::send()
+// returns false, [[nodiscard]]). Events travel in another: a full one drops the event, counted
+// (EngineCore::dropped_events(): the console's header and log, the run's JSON, a session event).
+// The engine writes a trial's record and hands it back with kTrialComplete or kTrialAborted, and
+// says with kTrajectorySelected when the sender may free the trajectories it selected before.
 #pragma once
 
 #include <array>

@@ -1,10 +1,16 @@
 // The engine's safety state machine. Pure: a table of which operator command is allowed in which
 // state and where it leads, so every transition can be tested without a loop or a device.
 //
-//   SAFE     disarmed: inlets closed, outlets open
-//   ARMED    valves live, holding the trajectory's start
-//   RUNNING  a trial in progress (settle at the start, then the trajectory)
-//   FAULT    latched and vented; only Reset leaves it, and it leads to SAFE (re-arm explicitly)
+//   SAFE     disarmed: inlets closed, outlets open (vented)       arm -> ARMED
+//   ARMED    valves live, holding the trajectory's start with      start trial -> RUNNING,
+//            the PID; a valve pulse (the valve test) hands the     disarm -> SAFE
+//            valves to the operator for its ticks, guards running
+//   RUNNING  a trial in progress (settle at the start, then the    its end or abort trial -> ARMED,
+//            trajectory with the current correction)               disarm -> SAFE (trial handed back)
+//   FAULT    latched, vented in the tick the fault was seen        reset -> SAFE only (re-arm explicitly)
+// An emergency stop from any state, or a guard while the valves are live, leads to FAULT. Any other
+// (state, command) is refused with a reason the operator sees (tests/test_engine_state.cpp checks
+// every pair).
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,8 @@
 // The engine thread on wall time: ticks on absolute deadlines (CLOCK_MONOTONIC, TIMER_ABSTIME),
-// with SCHED_FIFO and locked memory when the system allows it. On an overrun it counts the missed
-// periods and skips ahead rather than bursting. It keeps a histogram of wake-up latency.
+// with SCHED_FIFO (priority 80 by default, above the rig links' I/O threads at 70) and locked memory
+// when the system allows it (`--rt try`, the default, or `enforce`). Every signal is blocked on
+// it, so that no handler runs inside a tick. On an overrun it counts the missed periods and skips
+// ahead rather than bursting. It keeps a histogram of wake-up latency.
 //
 // `speed` warps time for a simulated device: each tick advances the device by tick_s but waits only
 // tick_s / speed of wall time (speed 0 means as fast as possible).
