@@ -171,7 +171,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
   setup.allow_colors = !options.no_color;
 
   // The loop wakes 200 times a second: keep the cores out of deep idle while it runs.
-  const CpuIdleHold idle_hold(!simulated_time && speed > 0.0 && options.rt != RealtimeMode::kOff);
+  const CpuIdleHold idle_hold(!simulated_time && speed > 0.0 && options.rt != RealtimeMode::kOff, 0,
+                              CpuIdleHold::kCpuidleDriverPath, config.device.kind != "sim");
   const ui::ConsoleReport report = ui::run_console(std::move(setup));
   char line[320];
   std::snprintf(line, sizeof line,
@@ -185,7 +186,8 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
                 static_cast<unsigned long long>(report.ticks), static_cast<unsigned long long>(report.loop.missed),
                 report.loop.p50_us, report.loop.p99_us, report.loop.max_us,
                 simulated_time ? "simulated clock" : loop.rt_description().c_str(),
-                idle_hold.held_us() ? ", cores out of deep idle" : "", static_cast<unsigned long long>(report.frames),
+                idle_hold.held_us() || idle_hold.spinning_cores() > 0 ? ", cores out of deep idle" : "",
+                static_cast<unsigned long long>(report.frames),
                 report.seconds > 0 ? static_cast<double>(report.frames) / report.seconds : 0.0,
                 report.seconds > 0 ? 100.0 * report.ui_cpu_s / report.seconds : 0.0);
   out << line;

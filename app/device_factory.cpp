@@ -59,9 +59,11 @@ class SimulatedChainDevice final : public OpenedDevice {
 
 class LcmRig final : public OpenedDevice {
  public:
-  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s, int joints)
+  LcmRig(const std::string& url, RealtimeMode rt, std::int64_t session_id, LcmKey key, double rig_silence_s, int joints,
+         const TickPhaseLock::Parameters& phase_lock)
       : device_(session_id, key, rig_silence_s, joints),
         io_(url.empty() ? kDefaultLcmUrl : url, std::vector<LcmEndpoint*>{&device_}) {
+    device_.set_tick_phase_lock(phase_lock);
     io_.start(rt, kDeviceIoPriority);
   }
   ~LcmRig() override { io_.stop(); }
@@ -120,7 +122,8 @@ class LcmRig final : public OpenedDevice {
         {"publish_errors", s.publish_errors},
         {"authenticated", s.keyed},
         {"commands_not_ours", s.commands_not_ours},
-        {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}}};
+        {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}},
+        {"tick_phase", {{"lead_ms", device_.tick_phase_lead_ms()}, {"shifted_ms", device_.tick_phase_shifted_ms()}}}};
   }
 
  private:
@@ -231,9 +234,10 @@ std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const 
   if (device.kind == "sim" && config.arm.has_chain()) return std::make_unique<SimulatedChainDevice>(config, seed);
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
-    return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
-                                    load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s,
-                                    arm_joint_count(config.arm));
+    return std::make_unique<LcmRig>(
+        device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
+        load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s, arm_joint_count(config.arm),
+        TickPhaseLock::Parameters{config.timing.tick_s, config.lcm.tick_phase_lead, config.lcm.tick_phase_step_s});
   }
   if (device.kind == "t7") return open_t7(device, config, rt);
   throw InputError("--device '" + device.kind + "': unknown device (known: sim, lcm, t7)");

@@ -214,8 +214,10 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
       monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
     }
   }
-  // Paced wall-clock ticks wake from idle 200 times a second: keep the cores out of deep idle.
-  const CpuIdleHold idle_hold(loop != nullptr && speed > 0.0 && options.rt != RealtimeMode::kOff);
+  // Paced wall-clock ticks wake from idle 200 times a second: keep the cores out of deep idle (for a
+  // rig, where no cpuidle driver would act on it, by spinning: app/cpu_idle_hold.hpp).
+  const CpuIdleHold idle_hold(loop != nullptr && speed > 0.0 && options.rt != RealtimeMode::kOff, 0,
+                              CpuIdleHold::kCpuidleDriverPath, io.device_parameters().kind != "sim");
   if (loop != nullptr) loop->start(options.rt);
 
   nlohmann::json iterations = nlohmann::json::array();
@@ -327,6 +329,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
           {"rt", loop->rt_description()},
           {"cpu_wakeup_limit_us", idle_hold.held_us() ? nlohmann::json(*idle_hold.held_us()) : nlohmann::json(nullptr)},
           {"cpu_idle_not_held", idle_hold.why_not()},
+          {"cpu_idle_spinning_cores", idle_hold.spinning_cores()},
           {"speed", options.speed}};
       if (const DeviceHealth h = device.health(); h.has_link) {  // the link's figures, e.g. the T7's Modbus round trip
         report["loop"]["link"] = {

@@ -5,7 +5,8 @@
 # it. Everything runs in a private network namespace (`unshare -n`: loopback up, multicast on lo),
 # so no traffic leaves it. Per run it prints the exit status and fault, the RMS of each iteration
 # against the in-process simulated arm's (same seed), and the link's figures: missed deadlines,
-# held ticks and samples (ride-through), stale readings, link errors, round trip p50/p99/max, and a
+# held ticks and samples (ride-through), stale readings, link errors, (LCM) where the engine's reads
+# sit after the rig's states and how far its ticks were moved to get there, round trip p50/p99/max, and a
 # verdict (PASS: every iteration's RMS within 15 % of the in-process arm's); after each load a
 # summary "N of M within 15 %", and the machine's load average (uptime) before and after.
 # Usage: bench/rig_links.sh [--device lcm|t7|both] [--runs 10] [--iterations 3] [--bellows PATH]
@@ -88,12 +89,16 @@ rms = [i["rms_deg"] for i in r.get("iterations", [])]
 within = len(rms) == len(ref) and all(abs(a - b) <= 0.15 * b for a, b in zip(rms, ref))
 loop = r.get("loop", {}); link = loop.get("link", {}); rt = link.get("round_trip_ms", {})
 held = sum(i.get("held_samples", 0) for i in r.get("iterations", []))
+def phase(p):  # LCM: where the engine's reads sit after the rig's states (docs/lcm-protocol.md "Timing")
+    return "" if not p else f"phase lead {p['lead_ms']:.2f} ms (shifted {p['shifted_ms']:+.1f}) "
+
 fault = r.get("fault", {}).get("name", "-")
 print(f"{'PASS' if within else 'FAIL'} {device} load {load} run {run:>2}: exit {status} fault {fault:<14} "
       f"rms {' / '.join('%.3f' % x for x in rms):<30} {'within 15%' if within else 'OUTSIDE 15%'}  "
       f"missed {loop.get('missed', '?')} held ticks {loop.get('held_ticks', '?')} "
       f"samples {held} stale {link.get('stale_readings', '?')} link errors {link.get('errors', '?')} "
       f"{'late readings used %s ' % r['t7'].get('late_readings', '?') if 't7' in r else ''}"
+      f"{phase(r.get('lcm', {}).get('rig', {}).get('tick_phase'))}"
       f"rt p50/p99/max {rt.get('p50', 0):.2f}/{rt.get('p99', 0):.2f}/{rt.get('max', 0):.2f} ms  "
       f"loop wake-up max {loop.get('latency_us', {}).get('max', 0) / 1e3:.1f} ms  loadavg {loadavg}")
 sys.exit(0 if within else 1)

@@ -42,8 +42,20 @@ LcmDevice::LcmDevice(std::int64_t session_id, LcmKey key, double rig_silence_s, 
 // ---- engine thread ----
 
 SensorReading LcmDevice::read_sensors() {
-  if (!inbox_.read(reading_)) bump(stale_reads_);
-  return reading_;
+  if (inbox_.read(reading_)) {
+    if (!lockstep_) phase_lock_.observe(monotonic_s() - reading_.handed_over_s);
+  } else {
+    bump(stale_reads_);
+  }
+  return reading_.reading;
+}
+
+double LcmDevice::tick_shift_s() {
+  if (lockstep_) return 0.0;  // the rig's answers pace the ticks
+  const double shift_s = phase_lock_.take_shift_s();
+  phase_lead_ms_.store(1e3 * phase_lock_.lead_s(), std::memory_order_relaxed);
+  phase_shifted_ms_.store(1e3 * phase_lock_.shifted_s(), std::memory_order_relaxed);
+  return shift_s;
 }
 
 void LcmDevice::write_valves(const ValveCommand& command) {
@@ -297,7 +309,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.
     pending_.time_s = std::max(now_s - origin_s_, std::nextafter(last_reading_time_s_, INFINITY));
     last_reading_time_s_ = pending_.time_s;
-    inbox_.write(pending_);
+    inbox_.write(Handover{pending_, monotonic_s()});
     answered_.store(answer_generation_, std::memory_order_release);  // after the reading it answers with
     pending_fresh_ = false;
     last_state_s_.store(now_s, std::memory_order_relaxed);

@@ -40,6 +40,7 @@
 #include "devices/lcm_io_messages.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/round_trip_stats.hpp"
+#include "devices/tick_phase_lock.hpp"
 #include "engine/control/device.hpp"
 #include "engine/rt/latest_value.hpp"
 
@@ -112,6 +113,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// offers. No real rig waits for its commands: a real rig runs on the wall clock.
   /// Before the engine is made (it reads time_follows_ticks() once); engine thread.
   void set_lockstep(double answer_timeout_s);
+  /// On the wall clock, the engine's ticks lock to the phase of the rig's states (devices/
+  /// tick_phase_lock; not in lockstep, where the answers pace the ticks). Before the engine ticks.
+  void set_tick_phase_lock(const TickPhaseLock::Parameters& parameters) { phase_lock_ = TickPhaseLock(parameters); }
+  double tick_shift_s() override;
 
   // ---- LcmEndpoint: I/O thread only ----
   void attach(lcm::LCM& bus) override;
@@ -127,6 +132,10 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// When (the I/O thread's clock, monotonic_s()) the last valid state was handed to the engine.
   double last_state_s() const { return last_state_s_.load(std::memory_order_relaxed); }
   LcmDeviceStats stats() const;
+  /// The phase lock's average lead (ms from a state's handover to the engine's read; -1: none yet)
+  /// and the sum of its shifts (ms); any thread.
+  double tick_phase_lead_ms() const { return phase_lead_ms_.load(std::memory_order_relaxed); }
+  double tick_phase_shifted_ms() const { return phase_shifted_ms_.load(std::memory_order_relaxed); }
   /// The link: round trip from a command to the first state echoing it, rejected messages and
   /// rig fault states as errors, engine reads without a new state as stale; connected while a
   /// valid state arrived within the last kLinkAlive_s.
@@ -171,12 +180,17 @@ class LcmDevice final : public Device, public LcmEndpoint {
   const LcmKey key_;
   const double rig_silence_s_;
   const int joints_;
-  LatestValue<Outgoing> outbox_;      // engine -> I/O
-  LatestValue<SensorReading> inbox_;  // I/O -> engine
-  LatestValue<DeviceFault> trips_;    // I/O -> engine: the rig's own trips
-  SensorReading reading_{};           // engine thread's copy
-  std::uint64_t written_ = 0;         // engine thread: valve states written to the outbox
-  bool lockstep_ = false;             // set_lockstep(), before the engine ticks
+  LatestValue<Outgoing> outbox_;  // engine -> I/O
+  struct Handover {
+    SensorReading reading{};
+    double handed_over_s = 0.0;  // monotonic_s() when the I/O thread put it in the inbox
+  };
+  LatestValue<Handover> inbox_;     // I/O -> engine
+  LatestValue<DeviceFault> trips_;  // I/O -> engine: the rig's own trips
+  Handover reading_{};              // engine thread's copy
+  TickPhaseLock phase_lock_;        // engine thread; step 0 (no lock) until set_tick_phase_lock()
+  std::uint64_t written_ = 0;       // engine thread: valve states written to the outbox
+  bool lockstep_ = false;           // set_lockstep(), before the engine ticks
   double answer_timeout_s_ = 0.0;
 
   // I/O thread state.
@@ -232,6 +246,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::array<double, 64> sent_s_{};
   RoundTripStats round_trips_;
   std::atomic<std::uint64_t> stale_reads_{0};
+  std::atomic<double> phase_lead_ms_{-1.0}, phase_shifted_ms_{0.0};
   std::atomic<std::uint64_t> commands_not_ours_{0};
   std::atomic<std::int64_t> rig_foreign_commands_{0}, rig_unauthenticated_commands_{0};
 };

@@ -1,5 +1,8 @@
 // The CPU idle hold: a PM QoS request that lives exactly as long as the object.
 #include <gtest/gtest.h>
+#include <sched.h>
+
+#include <filesystem>
 
 #include <cstdint>
 #include <fstream>
@@ -39,6 +42,31 @@ TEST(CpuIdleHold, WithoutACpuidleDriverNothingIsClaimed) {
   const CpuIdleHold missing(true, 0, testing::TempDir() + "no-such-cpuidle-file");
   EXPECT_FALSE(missing.held_us().has_value());
   EXPECT_NE(missing.why_not().find("missing"), std::string::npos) << missing.why_not();
+}
+
+TEST(CpuIdleHold, ForARigWithoutACpuidleDriverEveryCoreSpinsInTheIdleClassWhileItLives) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ASSERT_EQ(sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  const int cores = CPU_COUNT(&allowed);
+  {
+    const CpuIdleHold hold(true, 0, driver_file("none"), true);
+    if (hold.spinning_cores() == 0) GTEST_SKIP() << "SCHED_IDLE refused here: " << hold.why_not();
+    EXPECT_EQ(hold.spinning_cores(), cores);
+    EXPECT_EQ(hold.why_not(), "") << "held, by spinning";
+    EXPECT_FALSE(hold.held_us().has_value()) << "no PM QoS limit was asked for";
+    // The spinners are in the idle class (a thread with work takes their core at once): this
+    // process's threads in SCHED_IDLE, one per core.
+    int idle_class = 0;
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+      const int policy = sched_getscheduler(static_cast<pid_t>(std::stoi(task.path().filename().string())));
+      if (policy == SCHED_IDLE) ++idle_class;
+    }
+    EXPECT_EQ(idle_class, cores);
+  }
+  // Not for the simulated arm (no spinners), and with a driver that acts, never.
+  EXPECT_EQ(CpuIdleHold(true, 0, driver_file("none"), false).spinning_cores(), 0);
+  EXPECT_EQ(CpuIdleHold(false, 0, driver_file("none"), true).spinning_cores(), 0);
 }
 
 TEST(CpuIdleHold, HoldsTheLimitWhileAliveAndReleasesIt) {

@@ -204,6 +204,28 @@ TEST(EngineRideThrough, ADeviceFaultWhileVentedIsTakenButNotLatched) {
   EXPECT_EQ(e.core.state(), EngineState::kArmed);  // the old report does not fire on arming
 }
 
+TEST(EngineLateLoop, ARigTimeoutReportedAfterTheLoopStalledPastItsStreakIsTheLoopsFault) {
+  // The rig vented itself because this loop stalled (a stopped process, a host that did not run it):
+  // after the stall the rig's report and the loop's lateness arrive in one tick, in either order.
+  // What happened is the stall; the rig's report is its consequence.
+  for (const bool stalled : {true, false}) {
+    GappyEngine e(Configuration{}, true);
+    EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+    e.clock.step(10);
+    DeviceFault timeout;
+    timeout.set(FaultCode::kRigTimeout, -1, "the rig heard no command for its timeout and vented itself");
+    e.device.report(timeout);
+    if (stalled) {
+      e.step_late(e.config.safety.missed_deadline_streak);
+    } else {
+      e.clock.step();
+    }
+    EXPECT_EQ(e.core.state(), EngineState::kFault);
+    EXPECT_EQ(e.core.fault(), stalled ? FaultCode::kMissedDeadlines : FaultCode::kRigTimeout)
+        << (stalled ? "after a stall" : "on time") << ": " << fault_name(e.core.fault());
+  }
+}
+
 // Missed deadlines on a rig whose time is its own (docs/architecture.md): the periods the loop
 // missed passed on the rig without a command; below the limits they are held like missing readings.
 TEST(EngineLateLoop, ALateWakeUpBelowTheLimitRidesThroughAsHeldTicksOnTheRigsClock) {

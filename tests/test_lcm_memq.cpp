@@ -412,6 +412,40 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   EXPECT_TRUE(vented(arm.state().command)) << "stopping left the rig vented";
 }
 
+TEST(LcmClosedLoop, TheEnginesTicksLockToThePhaseOfTheRigsStates) {
+  // The rig publishes on its own 5 ms clock, the engine ticks on its own: whatever phase they start
+  // with, the lock moves the engine's reads to the share of a period after each state it is asked
+  // for. Two targets a half period apart: a lead that was not moved meets both only by chance.
+  for (const double lead_fraction : {0.25, 0.75}) {
+    Configuration c;
+    c.lcm.rig_timeout_s = 1.0;  // a stalled I/O thread on a loaded machine is not what this is about
+    SimulatedArm arm(c.plant, 3);
+    std::vector<std::string> rig_log;
+    RigServer rig(arm, RigBench::parameters(c, LcmKey{}, rig_log), 77);
+    LcmDevice device(LcmDevice::random_session_id());
+    device.set_tick_phase_lock({c.timing.tick_s, lead_fraction, c.lcm.tick_phase_step_s});
+    LcmIoThread io("memq://", {&device, &rig});
+    io.start(RealtimeMode::kTry, 70);
+    EngineCore core(device, c.controller, c.timing, c.safety);
+    RealtimeLoop loop(core, device, 1.0);
+    loop.start(RealtimeMode::kTry);  // SAFE: a vent every tick, which binds the rig; its states follow
+    ASSERT_TRUE(testing::eventually([&] { return device.connected(); }, 10.0)) << "the rig never answered";
+    const double target_ms = 1e3 * lead_fraction * c.timing.tick_s;
+    // 2.5 ms at 0.1 ms a tick: 25 ticks; the average lead within 0.6 ms of the target for 10 reads in a row.
+    int on_target = 0;
+    const bool locked = testing::eventually(
+        [&] {
+          on_target = std::abs(device.tick_phase_lead_ms() - target_ms) < 0.6 ? on_target + 1 : 0;
+          return on_target >= 10;
+        },
+        20.0);
+    loop.stop();
+    io.stop();
+    EXPECT_TRUE(locked) << "target " << target_ms << " ms, the average lead " << device.tick_phase_lead_ms()
+                        << " ms after shifting " << device.tick_phase_shifted_ms() << " ms";
+  }
+}
+
 // ---- telemetry ----
 
 struct TelemetryRun {

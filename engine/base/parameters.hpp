@@ -147,6 +147,8 @@ struct LcmParameters {
   int seq_window = 100;                   // largest step a rig accepts between a session's sequence numbers
   double rig_pressure_margin_bar = 0.35;  // a rig vents a chamber above [controller] p_max_bar + this
   double rig_angle_limit_deg = 100.0;     // a rig vents and drops its session beyond this angle
+  double tick_phase_lead = 0.5;     // wall clock: the engine reads each rig state this share of a tick after it arrives
+  double tick_phase_step_s = 1e-4;  // largest shift of one tick's deadline towards that phase; 0: no lock
 };
 
 /// Which rig the commands drive (`[device]`; `--device`, `--lcm`, `--t7`, `--rig-profile` override

@@ -235,6 +235,13 @@ std::vector<ParameterBinding> make_bindings() {
       number("lcm", "rig_angle_limit_deg", "deg",
              "a rig vents and drops its session beyond this angle, in [[safety] angle_limit_deg, 180]", pos(180.0),
              [](C& c) { return &c.lcm.rig_angle_limit_deg; }),
+      number("lcm", "tick_phase_lead", "",
+             "on the wall clock the engine's ticks lock to the phase of the rig's states: each is read this share of "
+             "a tick after it arrives (in (0, 1); half a tick leaves the most room for jitter)",
+             Range{0.0, 1.0, true, true}, [](C& c) { return &c.lcm.tick_phase_lead; }),
+      number("lcm", "tick_phase_step_s", "s",
+             "largest shift of one tick's deadline towards that phase, at most a tenth of [timing] tick_s; 0: no lock",
+             upto(0.01), [](C& c) { return &c.lcm.tick_phase_step_s; }),
       name("lcm", "key_file",
            "shared key (32 bytes, not world-readable; relative to the config file) authenticating rig commands and "
            "states; empty: none",

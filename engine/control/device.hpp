@@ -110,6 +110,11 @@ class Device {
   /// simulation): then a late tick harms nothing physical and a missed deadline is a warning.
   /// A real or remote rig keeps the default: its time passes on its own, a missed deadline faults.
   virtual bool time_follows_ticks() const { return false; }
+  /// How much later (s; negative: earlier) the engine's next tick should start than one period
+  /// after this one. A rig that publishes its states on a clock of its own asks for the ticks to
+  /// read each state a safe margin after it arrives (LcmDevice; docs/lcm-protocol.md "Timing");
+  /// the loop takes at most a tenth of a period. Engine thread, once after every tick. Default 0.
+  virtual double tick_shift_s() { return 0.0; }
   /// A short human name, e.g. "sim" or "lcm".
   virtual const char* name() const = 0;
   /// The link's figures; any thread. In-process devices report nothing.

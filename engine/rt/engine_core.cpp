@@ -313,7 +313,13 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   // What the device found itself is taken every tick (and acted on only while the valves are live).
   DeviceFault device_fault;
   const bool device_faulted = device_.take_fault(device_fault);
-  if (valves_live(state()) && device_faulted) enter_fault(device_fault, now_s);
+  // A rig that timed out while this loop was stalled past its limits timed out because of the stall:
+  // the loop's guards below name it (missed-deadlines), not the rig's report that raced them here.
+  const bool loop_stalled =
+      !time_follows_ticks_ && (missed_streak_ >= safety_.missed_deadline_streak ||
+                               (unattended >= safety_.stale_ticks && 2 * late_ticks >= unattended));
+  const bool stall_explains_it = device_fault.code == FaultCode::kRigTimeout && loop_stalled;
+  if (valves_live(state()) && device_faulted && !stall_explains_it) enter_fault(device_fault, now_s);
   if (valves_live(state()) && unattended >= safety_.stale_ticks) {
     // The stale limit, on the time the rig went without a command from a fresh reading: the
     // device names why (a lost link, or frozen sensors), unless the late loop made most of it.

@@ -5,7 +5,9 @@
 #include <sys/mman.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 
@@ -169,7 +171,12 @@ void RealtimeLoop::run(int priority, RealtimeMode mode) {
     device_.advance(tick_s);
     missed_since_last = 0;
     ++tick;
-    if (period_ns > 0) deadline = add_ns(deadline, period_ns);
+    if (period_ns > 0) {
+      // The device may move the phase of the ticks (never their pace) by a little at a time.
+      const double shift_ns = std::clamp(device_.tick_shift_s() * 1e9 / speed_, -0.1 * static_cast<double>(period_ns),
+                                         0.1 * static_cast<double>(period_ns));
+      deadline = add_ns(deadline, period_ns + std::llround(shift_ns));
+    }
   }
 }
 
