@@ -23,6 +23,7 @@
 #include "engine/model/arm_chain_parameters.hpp"
 #include "engine/model/arm_model.hpp"
 #include "engine/config/convergence.hpp"
+#include "engine/config/joint_convergence.hpp"
 #include "engine/rt/engine_core.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
@@ -30,6 +31,7 @@
 #include "engine/learning/learning_monitor.hpp"
 #include "engine/operator/learning_session.hpp"
 #include "sessions/session_store.hpp"
+#include "ui/learning_text.hpp"
 
 namespace bellows {
 namespace {
@@ -65,9 +67,6 @@ std::optional<TransferReport> transfer_for(const RunOptions& options, const Conf
                                            const Trajectory& trajectory, bool resuming) {
   if (options.transfer_from.empty()) return std::nullopt;
   if (resuming) throw InputError("--transfer-from gives a new session its first correction; a resumed session has one");
-  if (trajectory.joints() > 1)
-    throw InputError("--transfer-from learns one joint's correction; trajectory '" + trajectory.name + "' has " +
-                     std::to_string(trajectory.joints()));
   const TransferMethod method = parse_transfer_method(options.transfer_method);
   std::filesystem::path data_dir;
   try {
@@ -193,18 +192,23 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   if (const std::string line = learning_model_line(learning_model); !line.empty()) said.note(line);
   if (transfer) said.note(transfer_line(*transfer));
   if (!recording.directory().empty()) said.note("session " + recording.directory().string());
-  io.start_telemetry(recording.directory());  // its LCM log goes into the session
-  ConvergencePrediction prediction;
+  io.start_telemetry(recording.directory());     // its LCM log goes into the session
+  ConvergencePrediction prediction;              // one joint
+  JointConvergencePrediction joints_prediction;  // several: the arm's and each joint's
   try {
     if (const LearningLaw* single = law->single_joint_law(); single != nullptr) {
       prediction = predict_convergence(*single, config, trajectory.learning_samples(), &stop_requested());
-    }  // several joints: no frequency-domain prediction (prediction.available stays false)
+    } else {
+      joints_prediction =
+          predict_joint_convergence(config, trajectory.joints(), trajectory.learning_samples(), &stop_requested());
+      for (const std::string& line : ui::joint_prediction_lines(joints_prediction, config.ilc.law)) said.note(line);
+    }
   } catch (const Cancelled&) {
     // Stopped by a signal: the first trial sees the flag too, vents and records why.
   }
   if (!prediction.warning.empty()) said.note("warning: " + prediction.warning);
   LearningMonitor monitor(config.controller.p_max_bar - config.controller.gas.ambient_bar,
-                          trajectory.learning_samples());
+                          trajectory.learning_samples(), trajectory.joints());
   if (resumed != nullptr) {  // the saved iterations too: wind-up may span a resume
     for (std::size_t i = 0; i < resumed->iterations.size(); ++i) {
       monitor.observe(static_cast<int>(i), resumed->iterations[i].record);
@@ -266,11 +270,15 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   said.finish();
   if (!log_error.empty()) said.error("bellows: " + log_error);
   if (const std::string warning = io.warning(); !warning.empty()) said.error("bellows: " + warning);  // a loss
-  if (monitor.windup().detected) {
+  if (trajectory.joints() > 1) {  // every joint's, wound up or not
+    for (const std::string& line :
+         ui::windup_monitor_lines(monitor.windup(), static_cast<int>(monitor.history().size())))
+      said.note(line);
+  } else if (monitor.windup().detected) {
     std::ostringstream warning;
     warning << "warning: correction wind-up since iteration " << *monitor.windup().first_iteration
             << ": the correction keeps growing where the set points saturate (largest clamped excess "
-            << monitor.windup().max_clamped_excess_bar << " bar); law noilc-constrained avoids it";
+            << monitor.windup().max_clamped_excess_bar << " bar); law " << ui::kWindupRemedyLaw << " avoids it";
     said.note(warning.str());
   }
   if (core.dropped_events() > 0) {  // a loss like any other: said, and kept with the session
@@ -297,7 +305,8 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
         {"seed", seed},
         {"clock", options.clock},
         {"samples", trajectory.learning_samples()},
-        {"prediction", prediction_json(prediction)},
+        {"prediction",
+         trajectory.joints() > 1 ? joint_prediction_json(joints_prediction) : prediction_json(prediction)},
         {"windup", windup_json(monitor.windup())},
         {"session",
          recording.directory().empty() ? nlohmann::json(nullptr) : nlohmann::json(recording.directory().string())},

@@ -1,6 +1,7 @@
 #include "app/transfer_sources.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "engine/base/errors.hpp"
 #include "sessions/session_store.hpp"
@@ -16,18 +17,12 @@ std::string describe(const Session& session) {
 
 }  // namespace
 
-TransferSource transfer_source_from_session(const Session& session) {
-  TransferSource source;
-  source.name = session.manifest.name.empty() ? session.directory.filename().string() : session.manifest.name;
-  source.trajectory = session.trajectory;
-  source.controller = session.manifest.configuration.controller;
-  const Eigen::Index n = session.trajectory.learning_samples();
-  for (const IterationData& iteration : session.iterations) {
-    const TrialSamples& s = iteration.record.joint_samples(0);
-    if (s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1) continue;
-    source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
-  }
-  return source;
+JointTransferSource transfer_source_from_session(const Session& session) {
+  std::vector<const TrialRecord*> records;
+  for (const IterationData& iteration : session.iterations) records.push_back(&iteration.record);
+  return joint_transfer_source(
+      session.manifest.name.empty() ? session.directory.filename().string() : session.manifest.name, session.trajectory,
+      session.manifest.configuration.controller, records);
 }
 
 void check_transfer_source(const Session& session, const Configuration& target, const std::string& device,
@@ -59,38 +54,28 @@ std::vector<Session> load_transfer_sessions(const std::vector<std::string>& name
 TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config,
                                 const Trajectory& target, TransferMethod method) {
   TransferReport report;
-  std::vector<TransferSource> sources;
+  std::vector<JointTransferSource> sources;
   for (const Session& session : sessions) {
     sources.push_back(transfer_source_from_session(session));
     const IterationEntry* last = session.manifest.iterations.empty() ? nullptr : &session.manifest.iterations.back();
     report.sources.push_back({sources.back().name, session.directory.string(), session.trajectory.name,
-                              static_cast<int>(sources.back().trials.size()),
-                              last != nullptr ? last->summary.rms_deg : 0.0});
+                              sources.back().trials(), last != nullptr ? last->summary.rms_deg : 0.0});
   }
   TransferSettings settings;
   settings.method = method;
-  LearningTransfer transfer(settings);
-  transfer.setup(std::move(sources), config.controller, config.timing.sample_s());
-  report.result = transfer.solve(target);
+  report.result = transfer_every_joint(sources, config.controller, config.timing.sample_s(), target, settings);
   return report;
 }
 
-nlohmann::json transfer_json(const TransferReport& report) {
-  const TransferResult& r = report.result;
-  nlohmann::json sources = nlohmann::json::array();
-  for (const TransferSourceInfo& s : report.sources) {
-    sources.push_back({{"session", s.name},
-                       {"directory", s.directory},
-                       {"trajectory", s.trajectory},
-                       {"trials", s.trials},
-                       {"last_rms_deg", s.last_rms_deg}});
-  }
+namespace {
+
+/// One joint's transfer: method, status, why it fell back, its prediction and validation.
+nlohmann::json joint_transfer_json(const TransferResult& r) {
   nlohmann::json methods = nlohmann::json::object();
   for (const auto& [name, ratio] : r.method_ratios)
     methods[name] = std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr);
   const bool applied = r.status == TransferStatus::kTransferred;
-  return {{"sources", sources},
-          {"method", r.method},
+  return {{"method", r.method},
           {"status", applied ? "transferred" : "fallback"},
           {"reason", applied ? nlohmann::json(nullptr) : nlohmann::json(r.reason)},
           {"prediction",
@@ -105,17 +90,62 @@ nlohmann::json transfer_json(const TransferReport& report) {
           {"max_abs_correction_bar", r.correction_bar.size() > 0 ? r.correction_bar.cwiseAbs().maxCoeff() : 0.0}};
 }
 
+/// "inverse-fir, predicted first trial 1.90 deg RMS (feedback only 8.60 deg)" or "none: <why>".
+std::string joint_transfer_words(const TransferResult& r) {
+  char words[256];
+  if (r.status == TransferStatus::kTransferred) {
+    std::snprintf(words, sizeof words, "%s, predicted first trial %.2f deg RMS (feedback only %.2f deg)",
+                  r.method.c_str(), r.predicted_rms_deg, r.predicted_feedback_only_rms_deg);
+    return words;
+  }
+  return "none, the first trial runs with feedback only: " + r.reason;
+}
+
+}  // namespace
+
+nlohmann::json transfer_json(const TransferReport& report) {
+  const JointTransferResult& r = report.result;
+  nlohmann::json sources = nlohmann::json::array();
+  for (const TransferSourceInfo& s : report.sources) {
+    sources.push_back({{"session", s.name},
+                       {"directory", s.directory},
+                       {"trajectory", s.trajectory},
+                       {"trials", s.trials},
+                       {"last_rms_deg", s.last_rms_deg}});
+  }
+  if (r.joints.size() == 1) {  // one joint: its transfer's fields beside the sources
+    nlohmann::json out = joint_transfer_json(r.joints.front());
+    out["sources"] = sources;
+    return out;
+  }
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::size_t j = 0; j < r.joints.size(); ++j) {
+    joints.push_back(joint_transfer_json(r.joints[j]));
+    joints.back()["joint"] = j + 1;
+  }
+  const double feedback_only = r.predicted_feedback_only_rms_deg();
+  return {{"sources", sources},
+          {"status", r.transferred() ? "transferred" : "fallback"},
+          {"prediction",
+           {{"feedback_only_rms_deg", feedback_only},
+            {"rms_deg", r.predicted_rms_deg()},
+            {"ratio", feedback_only > 0.0 ? r.predicted_rms_deg() / feedback_only : 1.0}}},
+          {"max_abs_correction_bar", r.correction_bar.size() > 0 ? r.correction_bar.cwiseAbs().maxCoeff() : 0.0},
+          {"joints", joints}};
+}
+
 std::string transfer_line(const TransferReport& report) {
   std::string names;
   for (const TransferSourceInfo& s : report.sources) names += (names.empty() ? "" : ", ") + s.name;
-  const TransferResult& r = report.result;
-  char line[256];
-  if (r.status == TransferStatus::kTransferred) {
-    std::snprintf(line, sizeof line, ": %s, predicted first trial %.2f deg RMS (feedback only %.2f deg)",
-                  r.method.c_str(), r.predicted_rms_deg, r.predicted_feedback_only_rms_deg);
-    return "transfer from " + names + line;
-  }
-  return "transfer from " + names + ": none, the first trial runs with feedback only: " + r.reason;
+  const JointTransferResult& r = report.result;
+  if (r.joints.size() == 1) return "transfer from " + names + ": " + joint_transfer_words(r.joints.front());
+  std::string line = "transfer from " + names + ":";
+  for (std::size_t j = 0; j < r.joints.size(); ++j)
+    line += (j == 0 ? " joint " : "; joint ") + std::to_string(j + 1) + " " + joint_transfer_words(r.joints[j]);
+  char total[160];
+  std::snprintf(total, sizeof total, "; the arm's first trial predicted %.2f deg RMS (feedback only %.2f deg)",
+                r.predicted_rms_deg(), r.predicted_feedback_only_rms_deg());
+  return line + total;
 }
 
 }  // namespace bellows

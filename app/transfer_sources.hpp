@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/config/configuration.hpp"
-#include "engine/config/learning_transfer.hpp"
+#include "engine/config/joint_transfer.hpp"
 #include "sessions/session.hpp"
 
 namespace bellows {
@@ -24,8 +24,8 @@ struct TransferSourceInfo {
   double last_rms_deg = 0.0;
 };
 
-/// The trials of `session` as a transfer source.
-TransferSource transfer_source_from_session(const Session& session);
+/// The trials of `session` as a transfer source, every joint's.
+JointTransferSource transfer_source_from_session(const Session& session);
 
 /// Checks that `session` can teach a run of `target` on `device`: same sample time, same device, the
 /// same simulated plant ([plant]: the same arm) and, on a rig, the same rig profile (`rig_profile`:
@@ -41,17 +41,20 @@ std::vector<Session> load_transfer_sessions(const std::vector<std::string>& name
 
 struct TransferReport {
   std::vector<TransferSourceInfo> sources;
-  TransferResult result;
+  JointTransferResult result;  // every joint's
 };
 
-/// Sets up the transfer from `sessions` and solves it for `target`.
+/// Sets up the transfer of every joint from `sessions` and solves it for `target`.
 TransferReport compute_transfer(const std::vector<Session>& sessions, const Configuration& config,
                                 const Trajectory& target, TransferMethod method = TransferMethod::kAuto);
 
-/// {"sources": [...], "method", "status", "reason", "prediction": {...}, ...}
+/// One joint: {"sources": [...], "method", "status", "reason", "prediction": {...}, ...}. Several:
+/// {"sources", "status" (transferred when any joint was), "prediction" (over every joint),
+/// "max_abs_correction_bar", "joints": [{"joint", "method", "status", "reason", "prediction", ...}]}.
 nlohmann::json transfer_json(const TransferReport& report);
 /// One line for the progress stream, e.g. "transfer from a, b: inverse-fir, predicted first trial 1.9 deg RMS
-/// (feedback only 8.6 deg)" or "transfer from a: none, the first trial runs with feedback only: <why>".
+/// (feedback only 8.6 deg)" or "transfer from a: none, the first trial runs with feedback only: <why>";
+/// several joints: each joint's after "joint j", then the arm's predicted first trial.
 std::string transfer_line(const TransferReport& report);
 
 }  // namespace bellows

@@ -27,7 +27,24 @@ std::string arm_config(const std::string& name, const std::string& toml) {
 
 TEST(CliJoints, Arm2ReportsEveryJointsRmsAndLearns) {
   const std::string arm2 = arm_config("arm2", "[arm]\npreset = \"arm2\"\n");
-  const nlohmann::json report = joints_run_json("--config " + arm2 + " --iterations 3");
+  const auto run =
+      testing::run_process(testing::kBellows + " run --json --no-save --config " + arm2 + " --iterations 3");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(run.out);
+  // The prediction and the wind-up monitor, the arm's and each joint's (issue 26).
+  const nlohmann::json& prediction = report.at("prediction");
+  ASSERT_TRUE(prediction.at("available").get<bool>()) << prediction.dump();
+  EXPECT_EQ(prediction.at("joints_learned"), "together");
+  EXPECT_LT(prediction.at("nominal").at("contraction").get<double>(), 1.0);
+  ASSERT_EQ(prediction.at("joints").size(), 2u);
+  for (const nlohmann::json& joint : prediction.at("joints"))
+    EXPECT_LE(joint.at("contraction").get<double>(), prediction.at("nominal").at("contraction").get<double>() + 1e-9);
+  ASSERT_EQ(report.at("windup").at("joints").size(), 2u);
+  EXPECT_EQ(report.at("iterations")[1].at("joint_diagnostics").size(), 2u);
+  EXPECT_NE(run.err.find("convergence prediction (noilc, 2 joints learned together"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("  joint 2/2 elbow: keeps at most "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("wind-up monitor, joint 1/2 shoulder: "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("joint 2/2 elbow: "), std::string::npos) << run.err;
   EXPECT_EQ(report.at("trajectory"), "paper2") << "the arm's paper trajectory when --trajectory is left out";
   EXPECT_EQ(report.at("joints"), 2);
   EXPECT_EQ(report.at("arm").at("name"), "arm2");
@@ -124,8 +141,8 @@ TEST(CliJoints, WhatCannotDriveTheArmIsRefusedInOneLine) {
       "run --no-save --config " + arm_config("bad", "[arm]\npreset = \"arm2\"\n[ilc]\njoint_model = \"rigid\"\n"),
       "[ilc] joint_model = 'rigid': unknown (known: coupled, independent, identified)");
   expect_refused_in_one_line("rig check --config " + arm2, "`bellows rig check` tests the valves of one joint's rig");
-  expect_refused_in_one_line("run --no-save --config " + arm2 + " --transfer-from nowhere",
-                             "--transfer-from learns one joint's correction; trajectory 'paper2' has 2");
+  // --transfer-from learns every joint's correction (tests/test_transfer_cli.cpp): a missing session is refused.
+  expect_refused_in_one_line("run --no-save --config " + arm2 + " --transfer-from nowhere", "nowhere");
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 // `bellows run --transfer-from SESSION...`: the first trial of a new trajectory runs with what saved
 // sessions taught; --json reports the transfer, the session records where its first correction came
 // from, and sessions that cannot teach this run are refused with one line naming them (exit 2).
+#include <cmath>
 #include <fstream>
+#include <numbers>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -115,6 +118,75 @@ TEST_F(TransferCli, SessionsThatDoNotFitAreRefusedByNameWithNothingCreated) {
   EXPECT_EQ(method.exit_code, 2) << method.err;
   EXPECT_NE(method.err.find("transfer method must be"), std::string::npos) << method.err;
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(data_dir()) / "refused"));
+}
+
+/// A two-joint trajectory as the CSV `time_s,q1_deg,q2_deg`: the shoulder `a` deg and the elbow `b`
+/// deg of a raised-cosine pulse of `period_s`, over 8 s.
+std::string two_joint_csv(double a_deg, double b_deg, double period_s) {
+  std::ostringstream csv;
+  csv << "time_s,q1_deg,q2_deg\n";
+  const double T = Configuration{}.timing.sample_s();
+  for (int k = 0; k * T <= 8.0 + 1e-9; ++k) {
+    const double t = k * T;
+    const double phase = std::fmod(t, period_s) / period_s;
+    const double shape = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * phase);
+    csv << t << "," << a_deg * shape << "," << b_deg * shape * (t < 4.0 ? 1.0 : -1.0) << "\n";
+  }
+  return csv.str();
+}
+
+TEST_F(TransferCli, AnArmOfTwoJointsFitsEveryJointsFirstCorrectionOnItsOwn) {
+  const std::string arm2 = write("arm2.toml", "[arm]\npreset = \"arm2\"\n");
+  const std::string taught = write("arm2-pulses.csv", two_joint_csv(15.0, 25.0, 2.0));
+  const std::string target = write("arm2-target.csv", two_joint_csv(10.0, 30.0, 1.6));
+  for (const auto& [name, trajectory] :
+       {std::pair{"arm2-paper2", std::string("paper2")}, std::pair{"arm2-pulses", taught}}) {
+    const ProcessResult r = run_bellows({"run", "--config", arm2, "--trajectory", trajectory, "--iterations", "8",
+                                         "--data-dir", data_dir(), "--name", name, "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const ProcessResult plain =
+      run_bellows({"run", "--config", arm2, "--trajectory", target, "--iterations", "0", "--no-save", "--json"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const nlohmann::json alone = nlohmann::json::parse(plain.out)["iterations"][0];
+  const ProcessResult r = run_bellows({"run", "--config", arm2, "--trajectory", target, "--iterations", "0", "--json",
+                                       "--data-dir", data_dir(), "--name", "arm2-transferred", "--transfer-from",
+                                       "arm2-paper2", "--transfer-from", "arm2-pulses"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(r.out);
+  const nlohmann::json& transfer = report["transfer"];
+  ASSERT_EQ(transfer["joints"].size(), 2u) << transfer.dump();
+  ASSERT_EQ(transfer["sources"].size(), 2u);
+  const nlohmann::json first = report["iterations"][0];
+  bool any = false;
+  for (int j = 0; j < 2; ++j) {
+    const nlohmann::json& joint = transfer["joints"][j];
+    EXPECT_EQ(joint["joint"], j + 1);
+    EXPECT_EQ(joint["method_validation_ratios"].size(), 3u) << "every method fitted and validated for this joint";
+    if (joint["status"] == "transferred") {
+      any = true;
+      EXPECT_LT(first["joint_rms_deg"][j].get<double>(), alone["joint_rms_deg"][j].get<double>()) << "joint " << j + 1;
+    } else {  // a joint whose fit would not help keeps feedback only, and says why
+      EXPECT_EQ(joint["status"], "fallback");
+      EXPECT_FALSE(joint["reason"].get<std::string>().empty());
+      EXPECT_EQ(joint["max_abs_correction_bar"].get<double>(), 0.0);
+    }
+  }
+  EXPECT_EQ(transfer["status"], any ? "transferred" : "fallback");
+  // Nothing transferred: iteration 0 runs with feedback only, as without --transfer-from, bit for bit.
+  if (!any) {
+    EXPECT_EQ(first["joint_rms_deg"], alone["joint_rms_deg"]);
+  }
+  const Session saved = load_session(std::filesystem::path(data_dir()) / "arm2-transferred");
+  EXPECT_EQ(saved.manifest.first_correction["joints"].size(), 2u) << "the session records every joint's transfer";
+  EXPECT_NE(r.err.find("transfer from arm2-paper2, arm2-pulses: joint 1 "), std::string::npos) << r.err;
+  // A session of one joint cannot teach the arm: refused by name in one line.
+  const ProcessResult other = run_bellows({"run", "--config", arm2, "--trajectory", target, "--data-dir", data_dir(),
+                                           "--name", "arm2-refused", "--transfer-from", "trained-paper"});
+  EXPECT_EQ(other.exit_code, 2) << other.err;
+  EXPECT_NE(other.err.find("'trained-paper': it was recorded on another arm (one joint there, 'arm2' here)"),
+            std::string::npos)
+      << other.err;
 }
 
 }  // namespace

@@ -303,7 +303,7 @@ TEST_F(UiSessions, ASessionStartedFromATransferRecordsWhereItsFirstCorrectionCam
       << f.state().status;
   f.key('T');
   ASSERT_NE(f.state().experiment.first_correction, nullptr);
-  const double predicted = f.state().experiment.first_correction->result.predicted_rms_deg;
+  const double predicted = f.state().experiment.first_correction->result.predicted_rms_deg();
   f.key('r');
   ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
   save_and_wait(f);

@@ -291,7 +291,7 @@ class ConsoleController {
   BackgroundTask<SessionSnapshot> open_task_;
   BackgroundTask<std::string> figure_task_;
   BackgroundTask<TransferOffer> transfer_task_;
-  std::vector<TransferSource> taught_;            // earlier experiments of this console
+  std::vector<JointTransferSource> taught_;       // earlier experiments of this console
   std::vector<TransferSourceNote> taught_notes_;  // one per taught_ source, for the session's first_correction
   std::vector<std::string> taught_locations_;     // where they are saved (not read back as "saved" sources)
   TransferOffer transfer_offer_;

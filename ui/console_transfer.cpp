@@ -14,20 +14,13 @@ std::string TransferOffer::offer_line() const {
                 feedback_only_rms_deg);
 }
 
-TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config) {
-  TransferSource source;
-  if (!experiment.trajectory) return source;
-  source.name = experiment.trajectory->name;
-  source.trajectory = *experiment.trajectory;
-  source.controller = config.controller;
-  const Eigen::Index n = experiment.samples();
+JointTransferSource transfer_source_of(const Experiment& experiment, const Configuration& config) {
+  if (!experiment.trajectory) return {};
+  std::vector<const TrialRecord*> records;
   for (const Trial& trial : experiment.trials) {
-    const TrialSamples& s = trial.record.joint_samples(0);
-    if (!trial.record.complete || s.u_ilc_bar.size() < n || s.u_pid_bar.size() < n || s.angle_rad.size() < n + 1)
-      continue;
-    source.trials.push_back({s.u_ilc_bar.head(n), s.u_pid_bar.head(n), s.angle_rad.head(n + 1)});
+    if (trial.record.complete) records.push_back(&trial.record);
   }
-  return source;
+  return joint_transfer_source(experiment.trajectory->name, *experiment.trajectory, config.controller, records);
 }
 
 TransferSourceNote transfer_note_of(const Experiment& experiment, std::string name) {
@@ -40,7 +33,7 @@ TransferSourceNote transfer_note_of(const Experiment& experiment, std::string na
   return note;
 }
 
-TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions,
+TransferOffer compute_transfer_offer(std::vector<JointTransferSource> taught, SessionGateway* sessions,
                                      const Configuration& config, const std::string& device,
                                      const std::string& rig_profile, const std::shared_ptr<const Trajectory>& target,
                                      int max_saved, const std::vector<std::string>& taught_locations,
@@ -48,14 +41,14 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
   TransferOffer offer;
   offer.trajectory = target;
   try {
-    std::vector<TransferSource> sources;
+    std::vector<JointTransferSource> sources;
     auto record = std::make_shared<FirstCorrection>();
     for (std::size_t i = 0; i < taught.size(); ++i) {
-      TransferSource& s = taught[i];
-      if (s.trials.empty()) continue;
+      JointTransferSource& s = taught[i];
+      if (s.trials() == 0 || static_cast<int>(s.joints.size()) != target->joints()) continue;
       record->sources.push_back(i < taught_notes.size() ? taught_notes[i]
                                                         : TransferSourceNote{s.name, "", s.name, 0, 0.0});
-      record->sources.back().trials = static_cast<int>(s.trials.size());
+      record->sources.back().trials = s.trials();
       sources.push_back(std::move(s));
     }
     if (sessions != nullptr && sessions->available()) {
@@ -72,8 +65,8 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
           if (!transfer_mismatch(snapshot.config, snapshot.device_name, config, device).empty()) continue;
           if (!rig_profile_mismatch(snapshot.rig_profile, rig_profile).empty())
             continue;  // another arm, or wired otherwise
-          TransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
-          if (source.trials.empty()) continue;
+          JointTransferSource source = transfer_source_of(snapshot.experiment, snapshot.config);
+          if (source.trials() == 0 || static_cast<int>(source.joints.size()) != target->joints()) continue;
           source.name = listing.name + " (saved)";
           TransferSourceNote note = transfer_note_of(snapshot.experiment, listing.name);
           note.directory = listing.location;
@@ -89,21 +82,25 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
       offer.why_not = "no earlier trials of this arm to learn from";
       return offer;
     }
-    for (const TransferSource& s : sources) offer.sources += (offer.sources.empty() ? "" : ", ") + s.name;
+    for (const JointTransferSource& s : sources) offer.sources += (offer.sources.empty() ? "" : ", ") + s.name;
     offer.source_count = static_cast<int>(sources.size());
-    LearningTransfer transfer;
-    transfer.setup(std::move(sources), config.controller, config.timing.sample_s());
-    const TransferResult result = transfer.solve(*target);
-    offer.method = result.method;
-    offer.predicted_rms_deg = result.predicted_rms_deg;
-    offer.feedback_only_rms_deg = result.predicted_feedback_only_rms_deg;
-    if (result.status != TransferStatus::kTransferred) {
-      offer.why_not = result.reason;
+    JointTransferResult result =
+        transfer_every_joint(sources, config.controller, config.timing.sample_s(), *target, TransferSettings{});
+    for (const TransferResult& joint : result.joints) {
+      const bool applied = joint.status == TransferStatus::kTransferred;
+      offer.method +=
+          (offer.method.empty() ? "" : " / ") + (applied || result.joints.size() == 1 ? joint.method : "none");
+    }
+    offer.predicted_rms_deg = result.predicted_rms_deg();
+    offer.feedback_only_rms_deg = result.predicted_feedback_only_rms_deg();
+    if (!result.transferred()) {
+      for (const TransferResult& joint : result.joints)
+        offer.why_not += (offer.why_not.empty() ? "" : "; ") + joint.reason;
       return offer;
     }
     offer.correction_bar = result.correction_bar;
     offer.useful = true;
-    record->result = result;
+    record->result = std::move(result);
     offer.record = std::move(record);
   } catch (const std::exception& error) {
     offer.why_not = error.what();
@@ -114,9 +111,8 @@ TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, Session
 // The controller's side: remembering what was taught, offering, taking the offer.
 
 void ConsoleController::remember_taught() {
-  if (state_.experiment.joints() > 1) return;  // transfers learn one joint's dynamics
-  TransferSource source = transfer_source_of(state_.experiment, env_.config);
-  if (source.trials.empty()) return;
+  JointTransferSource source = transfer_source_of(state_.experiment, env_.config);
+  if (source.trials() == 0) return;
   taught_.push_back(std::move(source));
   taught_notes_.push_back(transfer_note_of(state_.experiment, state_.experiment.trajectory->name + " (this console)"));
   if (!state_.experiment.session_location.empty()) taught_locations_.push_back(state_.experiment.session_location);
@@ -125,8 +121,7 @@ void ConsoleController::remember_taught() {
 void ConsoleController::offer_transfer() {
   transfer_offer_ = TransferOffer{};
   if (!state_.experiment.trials.empty() || state_.experiment.next_correction_bar.cwiseAbs().maxCoeff() > 0.0) return;
-  if (state_.experiment.joints() > 1) return;  // transfers learn one joint's dynamics
-  if (transfer_task_.busy()) {                 // one at a time: ask again when the running one is done
+  if (transfer_task_.busy()) {  // one at a time: ask again when the running one is done
     transfer_wanted_ = true;
     return;
   }

@@ -1,6 +1,6 @@
 // Learning transfer in the console (issue 13): when the operator selects a trajectory that has no
 // correction yet, what the earlier experiments of this console and the saved sessions taught is
-// turned into a first correction on a worker thread (engine/config/learning_transfer); the console offers
+// turned into a first correction on a worker thread (engine/config/joint_transfer, every joint's); the console offers
 // it with its prediction, and `T` takes it. The taught experiments are kept when the operator moves
 // on to another trajectory.
 #pragma once
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "engine/config/configuration.hpp"
-#include "engine/config/learning_transfer.hpp"
+#include "engine/config/joint_transfer.hpp"
 #include "ui/experiment.hpp"
 #include "ui/key_map.hpp"
 #include "ui/session_gateway.hpp"
@@ -20,9 +20,9 @@ namespace bellows::ui {
 struct TransferOffer {
   bool useful = false;
   std::shared_ptr<const Trajectory> trajectory;  // what it was computed for
-  Eigen::VectorXd correction_bar;
-  std::string method;
-  std::string sources;  // "paper, steps (saved)"
+  Eigen::MatrixXd correction_bar;                // N x J
+  std::string method;                            // several joints: each joint's, "inverse-fir / none"
+  std::string sources;                           // "paper, steps (saved)"
   int source_count = 0;
   double predicted_rms_deg = 0.0;
   double feedback_only_rms_deg = 0.0;
@@ -32,8 +32,9 @@ struct TransferOffer {
   std::string offer_line() const;
 };
 
-/// An experiment's trials as a transfer source; no trials when it has none with a record.
-TransferSource transfer_source_of(const Experiment& experiment, const Configuration& config);
+/// An experiment's complete trials as a transfer source, every joint's; no trials when it has none
+/// with a record.
+JointTransferSource transfer_source_of(const Experiment& experiment, const Configuration& config);
 
 /// Worker thread: the transfer from `taught` (this console's earlier experiments) and the `max_saved`
 /// newest saved sessions that fit this run (transfer_mismatch; on a rig, the same rig profile:
@@ -41,7 +42,7 @@ TransferSource transfer_source_of(const Experiment& experiment, const Configurat
 /// transfer that cannot be computed or would not help comes back with `why_not`. `taught_locations`:
 /// where `taught` is saved; `taught_notes`: one per `taught` source, for the record (the console saves as it goes), so
 /// the same trials are not used twice.
-TransferOffer compute_transfer_offer(std::vector<TransferSource> taught, SessionGateway* sessions,
+TransferOffer compute_transfer_offer(std::vector<JointTransferSource> taught, SessionGateway* sessions,
                                      const Configuration& config, const std::string& device,
                                      const std::string& rig_profile, const std::shared_ptr<const Trajectory>& target,
                                      int max_saved = 4, const std::vector<std::string>& taught_locations = {},

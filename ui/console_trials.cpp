@@ -2,6 +2,7 @@
 // trial runner, fed by the UI loop's events and snapshot: never waiting), finishing it (summary,
 // diagnostics, log), and the run modes (one trial, a step, K iterations).
 #include "engine/config/convergence.hpp"
+#include "engine/config/joint_convergence.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/config/joint_learning_factory.hpp"
 #include "engine/config/learning_law_factory.hpp"
@@ -9,6 +10,7 @@
 #include "ui/canvas.hpp"
 #include "ui/console_controller.hpp"
 #include "ui/joint_view.hpp"
+#include "ui/learning_text.hpp"
 
 namespace bellows::ui {
 
@@ -26,10 +28,15 @@ void ConsoleController::rebuild_law() {
         BuiltLaw built;
         built.law = make_joint_learning(config, model, joints, samples);
         built.learned_with = learned_with(config);
-        // Predicted for one joint's law (the single-joint model); several joints learn without one.
+        // One joint: its law's frequency response; several: the arm's lifted prediction and each joint's.
         const LearningLaw* single = built.law->single_joint_law();
-        const ConvergencePrediction p =
-            single != nullptr ? predict_convergence(*single, config, samples) : ConvergencePrediction{};
+        if (single == nullptr) {
+          const JointConvergencePrediction p = predict_joint_convergence(config, joints, samples);
+          built.convergence = joint_prediction_summary(p, config.ilc.law);
+          built.warning = !p.arm.warning.empty();
+          return built;
+        }
+        const ConvergencePrediction p = predict_convergence(*single, config, samples);
         if (p.available) {
           built.convergence = format(
               "predicted contraction per trial %.3f (nominal model); %.3f at worst for a model "
@@ -38,8 +45,7 @@ void ConsoleController::rebuild_law() {
           built.warning = !p.warning.empty();
           if (built.warning) built.convergence = p.warning;
         } else {
-          built.convergence = single != nullptr ? "no convergence prediction for this law"
-                                                : "no convergence prediction for several joints";
+          built.convergence = "no convergence prediction for this law";
         }
         return built;
       });
@@ -203,13 +209,17 @@ void ConsoleController::finish_trial(double time_s) {
                  : "",
              s.saturated_samples > 0 ? format(", %d samples saturated", s.saturated_samples).c_str() : ""),
       false, time_s);
-  if (diagnostics_.windup_just_detected()) {
+  if (diagnostics_.windup().joints.empty() && diagnostics_.windup_just_detected()) {
     log(LogSource::kLearner,
         format("wind-up since iteration %d: the correction keeps growing where the set points saturate (%.3f bar "
                "clamped away); the law noilc-constrained avoids it",
                diagnostics_.windup().first_iteration.value_or(s.iteration),
                diagnostics_.windup().max_clamped_excess_bar),
         true, time_s);
+  }
+  for (const int joint : diagnostics_.windup_just_detected_joints()) {  // several joints: each its own
+    log(LogSource::kLearner,
+        windup_warning(diagnostics_.windup().joints[static_cast<std::size_t>(joint)], e.joints(), joint), true, time_s);
   }
   if (s.joint_rms_deg.size() > 1) {
     std::string per_joint;

@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 
 #include "engine/operator/learning_session.hpp"
-#include "engine/config/learning_transfer.hpp"
+#include "engine/config/joint_transfer.hpp"
 #include "engine/trial/trajectory.hpp"
 #include "engine/rt/engine_messages.hpp"
 #include "engine/trial/trial_record.hpp"
@@ -56,7 +56,7 @@ struct TransferSourceNote {
 /// records it as its manifest's `first_correction`, like `bellows run --transfer-from`.
 struct FirstCorrection {
   std::vector<TransferSourceNote> sources;
-  TransferResult result;
+  JointTransferResult result;  // every joint's
 };
 
 struct Experiment {

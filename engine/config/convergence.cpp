@@ -76,11 +76,27 @@ ContractionEstimate estimate(const LearningLaw& law, const Configuration& config
 }
 
 constexpr int kFrequencyPoints = 600;
-// |lambda| up to 1 + 1e-3 counts as "not diverging": such a mode needs ~700 trials to double, and
-// laws that barely learn near Nyquist (gradient) sit at |lambda| = 1 within rounding there.
-constexpr double kDivergenceTolerance = 1e-3;
 
 }  // namespace
+
+std::string convergence_warning(const ConvergencePrediction& p, const std::string& law_name) {
+  const bool nominal_diverges = p.nominal.contraction > 1.0 + kDivergenceTolerance;
+  if (!nominal_diverges && p.diverging_points == 0) return {};
+  const ContractionEstimate& w = nominal_diverges ? p.nominal : p.worst;
+  char text[320];
+  if (nominal_diverges) {
+    std::snprintf(text, sizeof text,
+                  "learning law '%s' is predicted to diverge on the nominal model: contraction %.3f > 1 at %.2f Hz",
+                  law_name.c_str(), w.contraction, w.worst_frequency_hz);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "learning law '%s' may diverge if the arm differs from the model by up to %.0f %%: contraction "
+                  "%.3f > 1 at %.2f Hz for kappa x%.2f, omega0 x%.2f (%d of %zu grid points; nominal %.3f)",
+                  law_name.c_str(), 100.0 * p.model_error, w.contraction, w.worst_frequency_hz, w.kappa_scale,
+                  w.omega0_scale, p.diverging_points, p.grid.size(), p.nominal.contraction);
+  }
+  return text;
+}
 
 ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples,
                                           StopFlag stop) {
@@ -107,23 +123,7 @@ ConvergencePrediction predict_convergence(const LearningLaw& law, const Configur
       if (e.contraction > p.worst.contraction) p.worst = e;
     }
   }
-  const bool nominal_diverges = p.nominal.contraction > 1.0 + kDivergenceTolerance;
-  if (nominal_diverges || p.diverging_points > 0) {
-    const ContractionEstimate& w = nominal_diverges ? p.nominal : p.worst;
-    char text[320];
-    if (nominal_diverges) {
-      std::snprintf(text, sizeof text,
-                    "learning law '%s' is predicted to diverge on the nominal model: contraction %.3f > 1 at %.2f Hz",
-                    law.name().c_str(), w.contraction, w.worst_frequency_hz);
-    } else {
-      std::snprintf(text, sizeof text,
-                    "learning law '%s' may diverge if the arm differs from the model by up to %.0f %%: contraction "
-                    "%.3f > 1 at %.2f Hz for kappa x%.2f, omega0 x%.2f (%d of %zu grid points; nominal %.3f)",
-                    law.name().c_str(), 100.0 * p.model_error, w.contraction, w.worst_frequency_hz, w.kappa_scale,
-                    w.omega0_scale, p.diverging_points, p.grid.size(), p.nominal.contraction);
-    }
-    p.warning = text;
-  }
+  p.warning = convergence_warning(p, law.name());
   return p;
 }
 

@@ -39,6 +39,14 @@ struct ConvergencePrediction {
   std::string warning;       // empty when every grid point contracts
 };
 
+/// |lambda| up to 1 + this counts as "not diverging": such a mode needs ~700 trials to double, and
+/// laws that barely learn near Nyquist (gradient) sit at |lambda| = 1 within rounding there.
+inline constexpr double kDivergenceTolerance = 1e-3;
+
+/// The warning of a prediction whose nominal contraction, or a grid point's, exceeds 1 (law
+/// `law_name` named in it); empty when every point contracts.
+std::string convergence_warning(const ConvergencePrediction& prediction, const std::string& law_name);
+
 /// The prediction for `law` on trials of `samples` samples, with the grid of [ilc] prediction_*.
 /// Throws Cancelled when `stop` is set (looked at between grid points).
 ConvergencePrediction predict_convergence(const LearningLaw& law, const Configuration& config, int samples,

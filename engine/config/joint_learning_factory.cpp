@@ -125,16 +125,23 @@ class PerJointLearning final : public JointLearning {
 
 }  // namespace
 
-std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s) {
-  std::vector<DiscreteArmModel> models;
+std::vector<ModelParameters> independent_joint_parameters(const ChainParameters& chain) {
+  std::vector<ModelParameters> joints;
   for (int i = 0; i < chain.joints; ++i) {
     const ChainLink& link = chain.links[static_cast<std::size_t>(i)];
     ModelParameters joint;
     joint.kappa_rad_per_bar = link.kappa_rad_per_bar;
     joint.omega0_rad_per_s = link.omega0_straight_rad_per_s;
     joint.damping = link.damping_ratio;
-    models.push_back(discretize_arm_model(joint, sample_time_s));
+    joints.push_back(joint);
   }
+  return joints;
+}
+
+std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s) {
+  std::vector<DiscreteArmModel> models;
+  for (const ModelParameters& joint : independent_joint_parameters(chain))
+    models.push_back(discretize_arm_model(joint, sample_time_s));
   return models;
 }
 
@@ -150,6 +157,10 @@ MultiJointModel joint_learning_model(const ChainParameters& chain, const std::st
     }
   }
   throw InputError("[ilc] joint_model = '" + joint_model + "': unknown (known: coupled, independent, identified)");
+}
+
+bool learns_joints_together(const std::string& law) {
+  return law == "noilc" || law == "noilc-constrained" || law == "noilc-learned";
 }
 
 std::unique_ptr<JointLearning> make_joint_learning(const Configuration& config, const DiscreteArmModel& model,

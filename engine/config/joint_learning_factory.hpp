@@ -18,6 +18,10 @@
 
 namespace bellows {
 
+/// Each joint of `chain` as a single-joint arm's [model] (its row of the spec's table: kappa, w0 with
+/// the arm straight, delta; the other keys their defaults), the rest of the chain held still.
+std::vector<ModelParameters> independent_joint_parameters(const ChainParameters& chain);
+
 /// Each joint of `chain` as a single-joint arm (its row of the spec's table: kappa, w0 with the arm
 /// straight, delta), the rest of the chain held still.
 std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& chain, double sample_time_s);
@@ -27,6 +31,10 @@ std::vector<DiscreteArmModel> independent_joint_models(const ChainParameters& ch
 /// identify` fitted (identified: `identified`'s first J rows, InputError when they hold none).
 MultiJointModel joint_learning_model(const ChainParameters& chain, const std::string& joint_model, double sample_time_s,
                                      const IdentifiedArmParameters& identified = {});
+
+/// True for the laws whose J-joint form learns every joint in one update (noilc, noilc-constrained,
+/// noilc-learned); the others learn each joint on its own, with that joint's model.
+bool learns_joints_together(const std::string& law);
 
 /// The learning for `joints` joints of `samples` samples. `model` is the single-joint model (one
 /// joint only). Throws InputError for a law, model or weights that cannot be used, or a joint count

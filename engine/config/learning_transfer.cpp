@@ -46,6 +46,15 @@ Eigen::VectorXd trial_error(const Trajectory& trajectory, const TransferTrial& t
   return normalized(trajectory.joint(0).tail(n) - trial.angle_rad.tail(n));
 }
 
+/// "'arm2'" (the arm's name), or "one joint".
+std::string arm_words(const ArmParameters& arm) {
+  if (!arm.has_chain()) return "one joint";
+  std::string words = "'";
+  words += arm.name();
+  words += "'";
+  return words;
+}
+
 }  // namespace
 
 std::string rig_profile_mismatch(const std::string& source_profile, const std::string& target_profile) {
@@ -65,20 +74,31 @@ std::string transfer_mismatch(const Configuration& source, const std::string& so
   if (source_device != target_device) {
     return "it was recorded on the device '" + source_device + "', this run drives '" + target_device + "'";
   }
+  if (source.arm.name() != target.arm.name()) {
+    std::string why = "it was recorded on another arm (";
+    why += arm_words(source.arm);
+    why += " there, ";
+    why += arm_words(target.arm);
+    why += " here)";
+    return why;
+  }
   if (target_device != "sim") return {};
   Configuration a = source, b = target;  // the bindings hand out pointers into a mutable configuration
   for (const ParameterBinding& binding : parameter_bindings()) {
-    if (binding.section != "plant" || binding.key.rfind("fault", 0) == 0 || binding.key.rfind("spike", 0) == 0)
+    const bool arm_key = binding.section.rfind("arm", 0) == 0;  // [arm], [arm_jointK]: the chain's links
+    if ((binding.section != "plant" && !arm_key) || binding.key.rfind("fault", 0) == 0 ||
+        binding.key.rfind("spike", 0) == 0)
       continue;
     const bool differs = binding.real ? std::abs(*binding.real(a) - *binding.real(b)) >
                                             1e-9 * std::max(std::abs(*binding.real(a)), std::abs(*binding.real(b)))
                                       : binding.integer && *binding.integer(a) != *binding.integer(b);
     if (differs && binding.real) {
-      std::snprintf(line, sizeof line, "it was recorded on another simulated arm ([plant] %s is %g there, %g here)",
-                    binding.key.c_str(), *binding.real(a), *binding.real(b));
+      std::snprintf(line, sizeof line, "it was recorded on another simulated arm ([%s] %s is %g there, %g here)",
+                    binding.section.c_str(), binding.key.c_str(), *binding.real(a), *binding.real(b));
       return line;
     }
-    if (differs) return "it was recorded on another simulated arm ([plant] " + binding.key + " differs)";
+    if (differs)
+      return "it was recorded on another simulated arm ([" + binding.section + "] " + binding.key + " differs)";
   }
   return {};
 }
