@@ -349,6 +349,9 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
     advance_arm(now);
     if (registers_.run_watchdog(now)) {
       ++status_.watchdog_actions;
+      if (status_.first_watchdog_action_s < 0.0 || status_.last_request_s > status_.last_watchdog_action_s) {
+        status_.first_watchdog_action_s = now;
+      }
       status_.last_watchdog_action_s = now;
       apply_lines(now);
       char line[200];
@@ -384,7 +387,8 @@ void T7SimServer::write_status(double now, bool force) {
       text, sizeof text,
       "{\"time_s\": %.6f, \"valves\": {\"inlet_a\": %.6f, \"inlet_b\": %.6f, \"outlet_a\": %.6f, \"outlet_b\": %.6f}, "
       "\"safe\": %s, \"safe_since_s\": %.6f, \"last_request_s\": %.6f, \"watchdog\": {\"enabled\": %s, "
-      "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f}, \"requests\": %llu, \"exceptions\": %llu, "
+      "\"timeout_s\": %u, \"actions\": %d, \"last_action_s\": %.6f, \"first_action_s\": %.6f}, \"requests\": %llu, "
+      "\"exceptions\": %llu, "
       "\"refusals\": %llu, \"last_refused_error\": %d, "
       "\"max_clients\": %d, \"refused_connections\": %d, "
       "\"clients\": %d, \"silent\": %s, \"stalls\": %d, \"pwm_period_s\": %.6f, \"chamber_bar\": [%.6f, %.6f], "
@@ -393,11 +397,12 @@ void T7SimServer::write_status(double now, bool force) {
       "\"angle_trips\": %d}}\n",
       s.time_s, s.duty[0], s.duty[1], s.duty[2], s.duty[3], s.safe ? "true" : "false", s.safe_since_s, s.last_request_s,
       s.watchdog_enabled ? "true" : "false", s.watchdog_timeout_s, s.watchdog_actions, s.last_watchdog_action_s,
-      static_cast<unsigned long long>(s.requests), static_cast<unsigned long long>(s.exceptions),
-      static_cast<unsigned long long>(s.refusals), s.last_refused_error, s.max_clients, s.refused_connections,
-      s.clients, s.silent ? "true" : "false", s.stalls, 1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0],
-      s.chamber_bar[1], s.angle_rad, options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad,
-      s.pressure_limit_trips, s.angle_limit_trips);
+      s.first_watchdog_action_s, static_cast<unsigned long long>(s.requests),
+      static_cast<unsigned long long>(s.exceptions), static_cast<unsigned long long>(s.refusals), s.last_refused_error,
+      s.max_clients, s.refused_connections, s.clients, s.silent ? "true" : "false", s.stalls,
+      1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1], s.angle_rad,
+      options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
+      s.angle_limit_trips);
   const std::string temporary = options_.status_path + ".tmp";
   {
     std::ofstream out(temporary, std::ios::trunc);

@@ -186,7 +186,9 @@ TEST_F(T7Processes, AKilledBellowsLeavesSafeValvesWithinTheWatchdogTimeoutAndAPw
   // The watchdog acted after its timeout of silence (no earlier: it was the watchdog), and the lines
   // were safe within a PWM period of its action. How soon after the timeout t7-sim's thread notices it
   // is its host's scheduling (seconds on a loaded machine), not what a T7 or bellows does.
-  const double action_s = s.at("watchdog").at("last_action_s").get<double>();
+  // The first action of this silence: while it lasts the watchdog acts again every timeout, and
+  // on a loaded machine the test may read the status only after several.
+  const double action_s = s.at("watchdog").at("first_action_s").get<double>();
   const double safe_since_s = s.at("safe_since_s").get<double>();
   EXPECT_GE(action_s - s.at("last_request_s").get<double>(), s.at("watchdog").at("timeout_s").get<double>())
       << s.dump();
