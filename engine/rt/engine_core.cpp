@@ -315,16 +315,17 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   const bool device_faulted = device_.take_fault(device_fault);
   // A rig that timed out while this loop was stalled past its limits timed out because of the stall:
   // the loop's guards below name it (missed-deadlines), not the rig's report that raced them here.
+  const bool stale_limit = unattended >= safety_.stale_ticks;
+  const bool mostly_late = 2 * late_ticks >= unattended;  // the late loop made most of the silence
   const bool loop_stalled =
-      !time_follows_ticks_ && (missed_streak_ >= safety_.missed_deadline_streak ||
-                               (unattended >= safety_.stale_ticks && 2 * late_ticks >= unattended));
+      !time_follows_ticks_ && (missed_streak_ >= safety_.missed_deadline_streak || (stale_limit && mostly_late));
   const bool stall_explains_it = device_fault.code == FaultCode::kRigTimeout && loop_stalled;
   if (valves_live(state()) && device_faulted && !stall_explains_it) enter_fault(device_fault, now_s);
-  if (valves_live(state()) && unattended >= safety_.stale_ticks) {
+  if (valves_live(state()) && stale_limit) {
     // The stale limit, on the time the rig went without a command from a fresh reading: the
     // device names why (a lost link, or frozen sensors), unless the late loop made most of it.
     DeviceFault silence;
-    if (2 * late_ticks >= unattended) {
+    if (mostly_late) {
       silence.set(FaultCode::kMissedDeadlines, -1,
                   "the rig went %.0f ms without the loop's commands, %.0f ms of it because the loop was late "
                   "([safety] stale_ticks): lighten the machine's load, or use --rt enforce",
