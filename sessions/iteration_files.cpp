@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include "engine/base/errors.hpp"
 #include "engine/base/units.hpp"
@@ -150,6 +151,9 @@ void parse_samples_csv(std::string_view text, const std::string& source, int lea
 
 void parse_telemetry_csv(std::string_view text, const std::string& source, int learning_samples, int ticks_per_sample,
                          double tick_s, IterationData& data) {
+  if (data.record.joint_count() < 1) {  // a caller's mistake, not the file's: there is nothing to fill
+    throw std::logic_error("parse_telemetry_csv: the record has no joints (read its samples first)");
+  }
   const std::vector<std::string> header = telemetry_header(data.record.joint_count());
   std::vector<Eigen::VectorXd> c = parse_csv(text, header_views(header), source);
   expect_rows(c[0], static_cast<Eigen::Index>(learning_samples) * ticks_per_sample, source,

@@ -38,7 +38,8 @@ std::string format_telemetry_csv(const TrialRecord& record);
 void parse_samples_csv(std::string_view text, const std::string& source, int learning_samples, double sample_time_s,
                        IterationData& data, int joints = 1);
 /// Fills `data.record`'s ticks of the joints its samples have (parse_samples_csv first); checks
-/// N * ticks_per_sample rows and the time column.
+/// N * ticks_per_sample rows and the time column. A record with no joints is the caller's mistake
+/// (std::logic_error), never an out-of-bounds read.
 void parse_telemetry_csv(std::string_view text, const std::string& source, int learning_samples, int ticks_per_sample,
                          double tick_s, IterationData& data);
 

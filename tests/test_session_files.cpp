@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -106,6 +107,16 @@ TEST(IterationFiles, TrajectoryChecksLengthSamplingAndLimits) {
   TrajectoryLimits narrow;
   narrow.max_abs_angle_deg = 10.0;
   EXPECT_NE(error_of([&] { parse_trajectory_csv_file(text, "t.csv", "x", 25, 0.02, narrow); }).find("joint range"),
+            std::string::npos);
+}
+
+// The fuzzer's find (fuzz_session_readers, 2026-12-01): telemetry read into a record that had no
+// joints yet built an empty header and read its first column out of bounds.
+TEST(IterationFiles, TelemetryRefusesAnEmptyFileAndARecordWithoutJoints) {
+  IterationData data;
+  EXPECT_THROW(parse_telemetry_csv("\r\n", "t.csv", 25, 4, 0.005, data), std::logic_error);
+  data.record.prepare(25, 4);
+  EXPECT_NE(error_of([&] { parse_telemetry_csv("\r\n", "t.csv", 25, 4, 0.005, data); }).find("t.csv"),
             std::string::npos);
 }
 

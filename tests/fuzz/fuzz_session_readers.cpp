@@ -50,6 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         bellows::parse_samples_csv(text, "fuzz", kSamples, kSampleTime_s, iteration);
         break;
       case 2:
+        iteration.record.prepare(kSamples, kTicksPerSample);  // one joint, as the samples file gives
         bellows::parse_telemetry_csv(text, "fuzz", kSamples, kTicksPerSample, kTick_s, iteration);
         break;
       case 3:
