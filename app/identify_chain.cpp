@@ -146,10 +146,6 @@ nlohmann::json dynamics_json(const CoupledJointDynamics& d) {
           {"static_gain_rad_per_bar", matrix_json(d.static_gain_rad_per_bar())}};
 }
 
-nlohmann::json model_json(const ModelParameters& m) {
-  return {{"kappa", m.kappa_rad_per_bar}, {"omega0", m.omega0_rad_per_s}, {"damping", m.damping}};
-}
-
 std::string percents(const JointVector& v) {
   std::string text;
   char one[32];

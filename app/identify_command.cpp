@@ -93,10 +93,6 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
   return {std::move(estimation), std::move(validation)};
 }
 
-nlohmann::json model_json(const ModelParameters& m) {
-  return {{"kappa", m.kappa_rad_per_bar}, {"omega0", m.omega0_rad_per_s}, {"damping", m.damping}};
-}
-
 }  // namespace
 
 std::string model_held_in(const std::string& toml_text, bool rig_profile, bool several_joints) {

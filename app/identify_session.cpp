@@ -79,6 +79,10 @@ void IdentifySession::note_validation_trial(const std::string& signal, const Ide
   record("identify-trial", line);
 }
 
+nlohmann::json model_json(const ModelParameters& m) {
+  return {{"kappa", m.kappa_rad_per_bar}, {"omega0", m.omega0_rad_per_s}, {"damping", m.damping}};
+}
+
 void IdentifySession::note_fit(const ModelParameters& model, const ModelParameters& configured, double fit_percent,
                                double validation_fit_percent, double rms_residual_deg, int iterations, bool converged) {
   char line[400];

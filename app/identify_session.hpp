@@ -20,6 +20,9 @@
 
 namespace bellows {
 
+/// A model's three parameters as the JSON reports of `identify` (one joint and a chain) write them.
+nlohmann::json model_json(const ModelParameters& m);
+
 class IdentifySession {
  public:
   /// Nothing is recorded with `no_save`; otherwise the session is created by begin().

@@ -56,7 +56,9 @@ std::string held_samples_line(const IterationSummary& s, const TrialRecord& reco
   for (std::size_t k = 0; k < record.held.size(); ++k) {
     if (record.held[k] == 0) continue;
     if (++listed > 50) return line + " ...";
-    line += " " + std::to_string(k);
+    // Not `" " + std::to_string(k)`: GCC 12 warns falsely on it in some unity batches (its bugs 105329, 105651).
+    line += ' ';
+    line += std::to_string(k);
   }
   return line;
 }
