@@ -131,7 +131,7 @@ TEST(NoilcLearnedPlanner, SeveralJointsTheUpdateActsOnTheLimitShapedErrors) {
     return u_next;
   };
   const int n = 200;
-  LearnedNoilcSettings settings;
+  const LearnedNoilcSettings settings;
   for (const ClosedLoopPrior& prior : {paper_prior(), arm2_prior()}) {
     const int J = prior.joints();
     const int recovery = static_cast<int>(std::lround(settings.limit_recovery_s / prior.sample_time_s));
@@ -141,10 +141,10 @@ TEST(NoilcLearnedPlanner, SeveralJointsTheUpdateActsOnTheLimitShapedErrors) {
     const Eigen::MatrixXd u = Eigen::MatrixXd::Zero(n, J);
     const Eigen::MatrixXd acts_on = prior_plan(prior, settings, u, e), ignores = prior_plan(prior, settings, u, zeroed);
     ASSERT_GT((acts_on - ignores).norm(), 1e-3 * acts_on.norm());
-    settings.joints_zero_limited_errors = false;
-    const Eigen::MatrixXd by_default = first_update(prior, settings, e);
-    settings.joints_zero_limited_errors = true;
-    const Eigen::MatrixXd zeroing = first_update(prior, settings, e);
+    const Eigen::MatrixXd by_default = first_update(prior, LearnedNoilcSettings{}, e);
+    LearnedNoilcSettings zero_limited;
+    zero_limited.joints_zero_limited_errors = true;
+    const Eigen::MatrixXd zeroing = first_update(prior, zero_limited, e);
     EXPECT_LT((zeroing - ignores).norm(), 1e-9 * ignores.norm()) << J << " joints";
     EXPECT_LT((by_default - (J == 1 ? ignores : acts_on)).norm(), 1e-9 * acts_on.norm()) << J << " joints";
   }
