@@ -316,7 +316,7 @@ namespace {
 /// The session named by `options`, checked to be a bellows session (its manifest loads, or at
 /// least is there when it is damaged), so that rm never removes a directory that is not one.
 fs::path existing_session(const SessionsOptions& options) {
-  const fs::path directory = session_dir_of(options);
+  fs::path directory = session_dir_of(options);  // not const: returned, so moved
   std::error_code error;
   if (!fs::is_regular_file(directory / session_layout::kManifest, error)) {
     throw InputError(directory.string() + " is not a bellows session (no " + session_layout::kManifest + ")");

@@ -118,20 +118,20 @@ io_joints_command_t widen(const io_command_t& c) {
   return w;
 }
 
-io_state_t narrow(const io_joints_state_t& w) {
+io_state_t narrow(const io_joints_state_t& state) {
   io_state_t s{};
-  copy_state_header(w, s);
-  s.angle_rad = w.angle_rad[0];
-  for (int i = 0; i < kActuatorCount; ++i) s.chamber_bar[i] = w.chamber_bar[0][i];
+  copy_state_header(state, s);
+  s.angle_rad = state.angle_rad[0];
+  for (int i = 0; i < kActuatorCount; ++i) s.chamber_bar[i] = state.chamber_bar[0][i];
   return s;
 }
 
-io_command_t narrow(const io_joints_command_t& w) {
+io_command_t narrow(const io_joints_command_t& command) {
   io_command_t c{};
-  copy_command_header(w, c);
+  copy_command_header(command, c);
   for (int i = 0; i < kActuatorCount; ++i) {
-    c.inlet_duty[i] = w.inlet_duty[0][i];
-    c.outlet_duty[i] = w.outlet_duty[0][i];
+    c.inlet_duty[i] = command.inlet_duty[0][i];
+    c.outlet_duty[i] = command.outlet_duty[0][i];
   }
   return c;
 }

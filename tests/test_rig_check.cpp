@@ -79,6 +79,8 @@ TEST(ValveTest, ADeadInletIsNamedAndTheOthersPass) {
   const ValveVerdict& outlet = verdict(r, ValveId::kOutletA);
   EXPECT_FALSE(outlet.pass);
   EXPECT_NE(outlet.problem.find("see inlet A"), std::string::npos) << outlet.problem;
+  // ... and names the fill it had, the other cause when inlet A passed (a fill too short for the link).
+  EXPECT_NE(outlet.problem.find("fill_s 0.030 s"), std::string::npos) << outlet.problem;
 }
 
 TEST(ValveTest, NoSupplyIsNamedAndNothingIsArmed) {

@@ -292,14 +292,15 @@ TEST_F(T7Processes, RigCheckWithoutAReadingSaysSoAndFails) {
 // stale ticks fault a check on a 2-core machine running the suite (the ride-through is the
 // engine's, issue 22); what is checked here is that the strict T7-Pro accepts every request. The
 // pulses are 0.1 s, not 30 ms: a stalled tick of a loaded host can eat most of a 30 ms pulse, and
-// then a good valve reads as dead (about 1 run in 7 under the suite's load).
+// then a good valve reads as dead (about 1 run in 7 under the suite's load); the fill before an outlet's
+// test likewise (CI, 2026-12-02: a 30 ms fill left chamber B 0.01 bar above ambient: outlet B untested).
 TEST_F(T7Processes, RigCheckPassesEveryValveOnTheStrictT7Pro) {
   auto sim = start_sim();
   const std::filesystem::path config =
       testing::write_file(dir_, "loaded.toml",
                           "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = "
                           "400\nmissed_deadline_streak = 100000\n"
-                          "[rig_check]\nvalve_pulse_s = 0.1\n");
+                          "[rig_check]\nvalve_pulse_s = 0.1\nfill_s = 0.1\n");
   const testing::ProcessResult r =
       run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", config.string(), "--no-save", "--yes"});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;

@@ -84,6 +84,7 @@ JointTransferResult transfer_every_joint(const std::vector<JointTransferSource>&
   result.correction_bar = Eigen::MatrixXd::Zero(std::max(0, target.learning_samples()), joints);
   for (int j = 0; j < joints; ++j) {
     std::vector<TransferSource> joint_sources;
+    joint_sources.reserve(sources.size());
     for (const JointTransferSource& source : sources)
       joint_sources.push_back(source.joints[static_cast<std::size_t>(j)]);
     LearningTransfer transfer(settings);

@@ -74,8 +74,11 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
   } else if (!std::isfinite(own_move) || !std::isfinite(other_move)) {
     v.problem = "a chamber pressure reads not-a-number: check the pressure sensors' inputs";
   } else if (!is_inlet(valve) && before.joint[0].chamber_bar[own] - ambient_bar < m) {
-    v.problem = format("not tested: chamber %s held no air to let out (%.3f bar; see inlet %s)", chamber_name(own),
-                       before.joint[0].chamber_bar[own], chamber_name(own));
+    // Either inlet's own test failed, or the fill was too short for this link (a late tick eats it).
+    v.problem = format(
+        "not tested: chamber %s held no air to let out (%.3f bar after [rig_check] fill_s %.3f s of both "
+        "inlets; see inlet %s: if it passed, a longer fill_s)",
+        chamber_name(own), before.joint[0].chamber_bar[own], check.fill_s, chamber_name(own));
   } else if (own_move >= m && own_move >= other_move + m) {
     v.pass = true;
   } else if (other_move >= m && other_move >= own_move + m) {
