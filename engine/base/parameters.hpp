@@ -116,6 +116,12 @@ struct IlcParameters {
   double learned_ridge = 1e-3;      // ridge of the refit, relative to the data's scale
   double learned_guard = 0.25;      // a trial whose ||e||^2 rose by more than this over the best falls back
   int learned_taps = 8;             // FIR taps of the learned correction per joint
+  // Several joints only (one joint ignores both): 1 lets the refit model plan an update when it predicted the last
+  // trial better than the prior (0: the prior plans every update; the refit still learns and reports), and 1 zeroes
+  // the limit-shaped errors in the update as one joint does (0: only the refit leaves them out). 0 measured better on
+  // arm2/paper2 and arm3/paper3 (docs/learning-laws.md).
+  int learned_joints_refit_plans = 0;
+  int learned_joints_zero_limited = 0;
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's

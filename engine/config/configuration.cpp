@@ -169,6 +169,13 @@ std::vector<ParameterBinding> make_bindings() {
              upto(100.0), [](C& c) { return &c.ilc.learned_guard; }),
       whole("ilc", "learned_taps", "noilc-learned: FIR taps of the model's learned correction per joint", count(32),
             [](C& c) { return &c.ilc.learned_taps; }),
+      whole("ilc", "learned_joints_refit_plans",
+            "noilc-learned, several joints: 1 lets the refit model plan when it predicted better; 0 the prior plans",
+            between(0.0, 1.0), [](C& c) { return &c.ilc.learned_joints_refit_plans; }),
+      whole(
+          "ilc", "learned_joints_zero_limited",
+          "noilc-learned, several joints: 1 zeroes the limit-shaped errors in the update; 0 only the refit omits them",
+          between(0.0, 1.0), [](C& c) { return &c.ilc.learned_joints_zero_limited; }),
       whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", count(21),
             [](C& c) { return &c.ilc.prediction_grid_points; }),
       // [identify]

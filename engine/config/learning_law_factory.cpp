@@ -42,6 +42,8 @@ std::vector<std::string> learning_law_weight_keys(const std::string& name) {
             "learned_ridge",
             "learned_guard",
             "learned_taps",
+            "learned_joints_refit_plans",
+            "learned_joints_zero_limited",
             "limit_margin_bar",
             "limit_recovery_s"};
   }

@@ -30,6 +30,8 @@
 //
 // The planner: each trial judges the refit model (fitted on the trials before) and the prior on how
 // well they predicted its change of error; the better one plans the next update (the refit on a tie).
+// Several joints: the prior plans every update unless `joints_refit_plans` (the refit still learns and
+// is judged); the update zeroes the limit-shaped errors only with `joints_zero_limited_errors`.
 //
 // Every refit and fall-back is reported as a note (take_note), which the session records as an event.
 #pragma once
@@ -56,6 +58,12 @@ struct LearnedNoilcSettings {
   double limit_margin_bar = 0.0;   // a set point within this of the pressure limit is on the limit
   double limit_recovery_s = 0.08;  // outputs this long after an input on the limit are not learned from
   bool cross_joint = true;         // several joints: each output's correction from every joint's input
+  // Several joints only: the refit model may plan (when it predicted the last trial better than the prior); false:
+  // the prior plans every update. On arm2/arm3 the refit's early steps were the wrong ones (docs/learning-laws.md).
+  bool joints_refit_plans = false;
+  // Several joints only: the update zeroes the errors the pressure limit shaped (false: only the refit leaves them
+  // out). Zeroed, a wrist that touches its limit every trial never has those errors corrected.
+  bool joints_zero_limited_errors = false;
 };
 
 /// What the last update did, for the session and the console.
@@ -109,6 +117,8 @@ class LearnedModelNoilc {
   void refit(const Eigen::MatrixXd& du, const Eigen::MatrixXd& residual, const Eigen::MatrixXd& learnable);
   void rebuild();
   void leave_out_limited_outputs(const Eigen::Ref<const Eigen::MatrixXd>& u_j);
+  bool prior_plans_always() const { return joints() > 1 && !settings_.joints_refit_plans; }
+  bool zeroes_limited_errors() const { return joints() == 1 || settings_.joints_zero_limited_errors; }
 
   ClosedLoopPrior prior_;
   LearnedNoilcSettings settings_;
