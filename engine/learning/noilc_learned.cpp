@@ -223,15 +223,14 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
   // Several joints (unless joints_zero_limited_errors): the refit leaves them out, the update does not:
   // arm3's wrist touches its limit every trial, and zeroed there its error was never corrected (1.29 deg
   // at iteration 10 against 0.975).
-  if (from_best) {
-    if (zeroes_limited_errors()) planner.solve(u_best_, e_best_.cwiseProduct(learnable_best_), u_next);
-    else planner.solve(u_best_, e_best_, u_next);
-    if (step_ < 1.0) u_next = u_best_ + step_ * (u_next - u_best_);
-  } else {
-    if (zeroes_limited_errors()) planner.solve(u_j, e_j.cwiseProduct(learnable_), u_next);
-    else planner.solve(u_j, e_j, u_next);
-    if (step_ < 1.0) u_next = u_j + step_ * (u_next - u_j);
-  }
+  const auto plan_from = [&](const Eigen::Ref<const Eigen::MatrixXd>& u, const Eigen::Ref<const Eigen::MatrixXd>& e,
+                             const Eigen::MatrixXd& learnable) {
+    if (zeroes_limited_errors()) planner.solve(u, e.cwiseProduct(learnable), u_next);
+    else planner.solve(u, e, u_next);
+    if (step_ < 1.0) u_next = u + step_ * (u_next - u);
+  };
+  if (from_best) plan_from(u_best_, e_best_, learnable_best_);
+  else plan_from(u_j, e_j, learnable_);
   // The next trial's change is measured against the trial its correction was planned from.
   if (from_best) {
     u_previous_ = u_best_;
