@@ -201,13 +201,17 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
 
   // A stale limit of 120 ms (24 ticks), not the default 40 ms: the limit acting after the kill is
   // this test's subject, and a loaded machine's stalls of 20-80 ms before it must not end the trial
-  // first (the default's exact tick count has in-process tests: EngineRideThrough).
+  // first (the default's exact tick count has in-process tests: EngineRideThrough). The rig's own
+  // command timeout gets the same 120 ms, for the same stalls: with the default 50 ms a stalled
+  // engine host made the rig vent and drop the session before the kill (CI: `rig-timeout` at a
+  // load of two; the rig's timeout has tests of its own: RigCheckLimits*, LcmRigFaults).
   const int stale_ticks = 24;
   const std::string config = testing::write_file(dir, "loaded.toml",
                                                  "[safety]\nstale_ticks = " + std::to_string(stale_ticks) +
-                                                     "\nmissed_deadline_streak = 1000\n")
+                                                     "\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = " +
+                                                     std::to_string(stale_ticks * Configuration{}.timing.tick_s) + "\n")
                                  .string();
-  Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
+  Child rig({kBellows, "io-sim", "--config", config}, dir / "rig.out", dir / "rig.err");
   Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
              kDefaultLcmUrl, "--lcm-log", "--name", "killed", "--config", config},
             dir / "run.out", dir / "run.err");
