@@ -81,6 +81,10 @@ void CpuIdleHold::start_spinners() {
 
 CpuIdleHold::~CpuIdleHold() {
   stop_.store(true, std::memory_order_relaxed);
+  // Back to the normal class first: on a busy core a SCHED_IDLE thread may wait seconds for the
+  // slice in which it sees `stop_` (the end of a run beside two CPU-bound processes took 2 s more).
+  sched_param none{};
+  for (std::thread& t : spinners_) pthread_setschedparam(t.native_handle(), SCHED_OTHER, &none);
   for (std::thread& t : spinners_) t.join();
   if (fd_ >= 0) ::close(fd_);  // ends the request
 }
