@@ -70,22 +70,25 @@ void CpuIdleHold::start_spinners() {
   // a spinner in the normal class would take CPU from threads with work.
   while (decided_.load(std::memory_order_acquire) < static_cast<int>(spinners_.size())) std::this_thread::yield();
   if (refused_.load(std::memory_order_relaxed) != 0 || spinners_.empty()) {
-    stop_.store(true, std::memory_order_relaxed);
-    for (std::thread& t : spinners_) t.join();
-    spinners_.clear();
+    stop_spinners();
     why_not_ += "; SCHED_IDLE refused, no spinning either";
     return;
   }
   why_not_.clear();  // held, by spinning
 }
 
-CpuIdleHold::~CpuIdleHold() {
+void CpuIdleHold::stop_spinners() {
   stop_.store(true, std::memory_order_relaxed);
   // Back to the normal class first: on a busy core a SCHED_IDLE thread may wait seconds for the
   // slice in which it sees `stop_` (the end of a run beside two CPU-bound processes took 2 s more).
   sched_param none{};
   for (std::thread& t : spinners_) pthread_setschedparam(t.native_handle(), SCHED_OTHER, &none);
   for (std::thread& t : spinners_) t.join();
+  spinners_.clear();
+}
+
+CpuIdleHold::~CpuIdleHold() {
+  stop_spinners();
   if (fd_ >= 0) ::close(fd_);  // ends the request
 }
 

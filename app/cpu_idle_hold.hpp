@@ -46,6 +46,7 @@ class CpuIdleHold {
 
  private:
   void start_spinners();
+  void stop_spinners();  // every spinner ended and joined (none left)
 
   int fd_ = -1;
   int max_wakeup_us_ = 0;
