@@ -294,12 +294,15 @@ TEST_F(T7Processes, RigCheckWithoutAReadingSaysSoAndFails) {
 // pulses are 0.1 s, not 30 ms: a stalled tick of a loaded host can eat most of a 30 ms pulse, and
 // then a good valve reads as dead (about 1 run in 7 under the suite's load); the fill before an outlet's
 // test likewise (CI, 2026-12-02: a 30 ms fill left chamber B 0.01 bar above ambient: outlet B untested).
+// A stalled tick also lengthens a fill (t7-sim's arm runs on the wall clock, as a rig's air does): CI,
+// 2026-12-05, a 0.1 s fill that lasted about twice that took chamber B past p_max + margin (1.65 bar)
+// and the engine vented, rightly. p_max_bar 2.8 puts the limit (3.05 bar) above the 3 bar supply.
 TEST_F(T7Processes, RigCheckPassesEveryValveOnTheStrictT7Pro) {
   auto sim = start_sim();
   const std::filesystem::path config =
       testing::write_file(dir_, "loaded.toml",
                           "[t7]\nresponse_timeout_s = 0.5\ncommand_timeout_s = 0.5\n[safety]\nstale_ticks = "
-                          "400\nmissed_deadline_streak = 100000\n"
+                          "400\nmissed_deadline_streak = 100000\n[controller]\np_max_bar = 2.8\n"
                           "[rig_check]\nvalve_pulse_s = 0.1\nfill_s = 0.1\n");
   const testing::ProcessResult r =
       run_cli({"rig", "check", "--device", "t7", "--t7", address_, "--config", config.string(), "--no-save", "--yes"});
