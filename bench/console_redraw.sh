@@ -21,7 +21,7 @@ tmux -L "$socket" new-session -d -s console -x 120 -y 40 \
   "exec env XDG_DATA_HOME=$work TERM=screen $bellows console --speed 1 --rt try --exit-after $seconds"
 screen() { tmux -L "$socket" capture-pane -p -t console; }
 wait_for() {
-  for _ in $(seq 1 300); do screen | grep -qE "$1" && return 0; sleep 0.2; done
+  for _ in $(seq 1 300); do grep -qE "$1" <<<"$(screen)" && return 0; sleep 0.2; done
   echo "timed out waiting for /$1/" >&2; screen >&2; exit 1
 }
 wait_for 'law [a-z-]+  M'

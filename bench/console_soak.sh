@@ -19,7 +19,7 @@ tmux -L "$socket" new-session -d -s console -x 120 -y 40 \
 screen() { tmux -L "$socket" capture-pane -p -t console; }
 wait_for() {  # REGEX [SECONDS]
   local deadline=$((SECONDS + ${2:-60}))
-  while [ $SECONDS -lt "$deadline" ]; do screen | grep -qE "$1" && return 0; sleep 0.2; done
+  while [ $SECONDS -lt "$deadline" ]; do grep -qE "$1" <<<"$(screen)" && return 0; sleep 0.2; done
   echo "timed out waiting for /$1/" >&2; screen >&2; exit 1
 }
 pid="$(tmux -L "$socket" display-message -p -t console '#{pane_pid}')"

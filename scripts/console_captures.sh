@@ -104,7 +104,7 @@ e2e_resize "$width" "$height"
 e2e_wait_for 'R Reset'
 e2e_keys q
 sleep 1
-e2e_screen | grep -q 'Quit?' && e2e_keys q
+e2e_screen_has 'Quit?' && e2e_keys q
 e2e_wait_exit > /dev/null
 e2e_history | grep -A3 '^bellows console:' | grep -v '^EXIT STATUS' > "$out/summary.txt"
 

@@ -62,7 +62,7 @@ e2e_wait_for 'Bellows +SAFE '
 # Saved as it went: quit does not ask; the closing report names the session.
 e2e_keys Escape
 e2e_wait_for 'it +all +j1 +j2'
-for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
+for _ in $(seq 1 100); do e2e_screen_has 'unsaved' || break; sleep 0.1; done
 e2e_quit
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"

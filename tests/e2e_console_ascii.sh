@@ -10,7 +10,8 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 has_reverse_video() {
   local deadline=$((SECONDS + E2E_WAIT_S))
   while [ $SECONDS -lt $deadline ]; do
-    e2e_tmux capture-pane -p -e -t console | grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' && return 0
+    escaped="$(e2e_tmux capture-pane -p -e -t console)"
+    grep -qE $'\e\\[([0-9]+;)*7(;[0-9]+)*m' <<<"$escaped" && return 0
     sleep 0.1
   done
   return 1
@@ -25,13 +26,13 @@ e2e_wait_for 'Bellows +ARMED '
 e2e_keys r
 e2e_wait_for 'iteration 0  RMS [0-9]+\.[0-9]{3} deg' 120  # the header names the iteration run
 e2e_wait_for 'Iteration 0: angle and set point'
-e2e_screen | grep -qF '+- Live ---' || e2e_fail "no ASCII frame"
-e2e_screen | grep -qE '\|[^|]*\*\*' || e2e_fail "no ASCII plot marks"
+e2e_screen_has -F '+- Live ---' || e2e_fail "no ASCII frame"
+e2e_screen_has -E '\|[^|]*\*\*' || e2e_fail "no ASCII plot marks"
 non_ascii="$(e2e_screen | LC_ALL=C tr -d '\000-\177' | wc -c)"
 [ "$non_ascii" -eq 0 ] || e2e_fail "$non_ascii non-ASCII bytes on an ASCII screen"
 # No colour escape (foreground 30-37, background 40-47), but attributes (reverse video) remain.
 escaped="$(e2e_tmux capture-pane -p -e -t console)"
-echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours with --no-color"
+grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' <<<"$escaped" && e2e_fail "colours with --no-color"
 has_reverse_video || e2e_fail "no reverse video for the keys and states"
 
 # A terminal without colours (vt100), without --no-color: attributes alone, and it still works.
@@ -46,7 +47,7 @@ e2e_wait_for 'Bellows +ARMED '
 e2e_keys r
 e2e_wait_for 'iteration 0  RMS [0-9]+\.[0-9]{3} deg' 120  # the header names the iteration run
 escaped="$(e2e_tmux capture-pane -p -e -t console)"
-echo "$escaped" | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' && e2e_fail "colours on a vt100"
+grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' <<<"$escaped" && e2e_fail "colours on a vt100"
 has_reverse_video || e2e_fail "no reverse video on a vt100"
 
 # The same screen in a UTF-8 locale with colours: braille and colour escapes.
@@ -60,8 +61,10 @@ e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 e2e_keys r
 e2e_wait_for 'Iteration 0: angle and set point' 120
-e2e_screen | LC_ALL=C grep -q $'\xe2[\xa0-\xa3]' || e2e_fail "no braille in a UTF-8 locale"  # U+2800..U+28FF
-e2e_tmux capture-pane -p -e -t console | grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' || e2e_fail "no colours"
+screen="$(e2e_screen)"
+LC_ALL=C grep -q $'\xe2[\xa0-\xa3]' <<<"$screen" || e2e_fail "no braille in a UTF-8 locale"  # U+2800..U+28FF
+escaped="$(e2e_tmux capture-pane -p -e -t console)"
+grep -qE $'\e\\[([0-9]+;)*(3[0-7]|4[0-7])(;[0-9]+)*m' <<<"$escaped" || e2e_fail "no colours"
 e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 echo ok

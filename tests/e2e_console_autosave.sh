@@ -9,7 +9,7 @@ data="$E2E_DIR/sessions"
 
 # Until the pane's shell printed the exit status (e2e_wait_exit expects it to be there soon).
 await_exit() {
-  for _ in $(seq 1 300); do e2e_history | grep -qE '^EXIT STATUS [0-9]+' && break; sleep 0.2; done
+  for _ in $(seq 1 300); do e2e_history_has -E '^EXIT STATUS [0-9]+' && break; sleep 0.2; done
   e2e_wait_exit
 }
 
@@ -26,7 +26,7 @@ three_iterations() {
   e2e_keys BSpace BSpace 2 Enter
   e2e_wait_for 'iterations 0\.\.2 done' 180
   # The header says "unsaved" from a trial's end until its autosave returned (milliseconds).
-  for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || return 0; sleep 0.1; done
+  for _ in $(seq 1 100); do e2e_screen_has 'unsaved' || return 0; sleep 0.1; done
   e2e_fail "the last iteration stayed unsaved"
 }
 
@@ -37,12 +37,12 @@ expect_three_saved() {
   [ -n "$session" ] || e2e_fail "$how: no session saved in $dir"
   show="$("$BELLOWS" sessions show "$session" --data-dir "$dir" 2>&1)" || e2e_fail "$how: sessions show failed: $show"
   for i in 0 1 2; do
-    echo "$show" | grep -qE "^ *$i +[0-9]+\.[0-9]+" || e2e_fail "$how: iteration $i missing from sessions show: $show"
+    grep -qE "^ *$i +[0-9]+\.[0-9]+" <<<"$show" || e2e_fail "$how: iteration $i missing from sessions show: $show"
   done
-  echo "$show" | grep -qE '^ *3 +[0-9]+\.[0-9]+' && e2e_fail "$how: an iteration 3 that never ran: $show"
+  grep -qE '^ *3 +[0-9]+\.[0-9]+' <<<"$show" && e2e_fail "$how: an iteration 3 that never ran: $show"
   resumed="$("$BELLOWS" run --resume "$session" --data-dir "$dir" --iterations 1 2>&1)" ||
     e2e_fail "$how: run --resume failed: $resumed"
-  echo "$resumed" | grep -qE '^iteration +3 ' || e2e_fail "$how: the resumed run did not continue at iteration 3: $resumed"
+  grep -qE '^iteration +3 ' <<<"$resumed" || e2e_fail "$how: the resumed run did not continue at iteration 3: $resumed"
 }
 
 # kill -9: nothing runs at exit, yet every completed iteration is on disk.

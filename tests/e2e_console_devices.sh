@@ -83,7 +83,7 @@ for device in "${DEVICES[@]}"; do
   if [ "$device" = t7 ]; then
     e2e_keys l
     e2e_wait_for 'device +t7 link 127\.0\.0\.1:[0-9]+ answers again'
-    ! e2e_screen | grep -qF 'bellows: t7 link' || e2e_fail "t7: the link's stderr lines were painted over the screen"
+    ! e2e_screen_has -F 'bellows: t7 link' || e2e_fail "t7: the link's stderr lines were painted over the screen"
     e2e_keys Escape
     e2e_wait_for '─ Live ─'
   fi
@@ -117,10 +117,10 @@ for device in "${DEVICES[@]}"; do
     e2e_wait_for 'Zero the angle here\?'
     e2e_keys -l -- "$zero_letters"
     e2e_wait_for 'e is not an answer here'
-    e2e_screen | grep -qF 'Zero the angle here?' || e2e_fail "t7: a letter closed the zero-angle question"
+    e2e_screen_has -F 'Zero the angle here?' || e2e_fail "t7: a letter closed the zero-angle question"
     e2e_keys Escape
     e2e_wait_for 'Bellows +SAFE '
-    ! e2e_screen | grep -qF 'Zero the angle here?' || e2e_fail "t7: Esc left the zero-angle question open"
+    ! e2e_screen_has -F 'Zero the angle here?' || e2e_fail "t7: Esc left the zero-angle question open"
     [ "$(sha256sum < "$E2E_DIR/t7-rig.toml")" = "$profile_before" ] || e2e_fail "t7: the rig profile changed"
   fi
   e2e_keys v
@@ -128,7 +128,7 @@ for device in "${DEVICES[@]}"; do
   e2e_keys y
   e2e_wait_for 'outlet B +(pass|FAIL)' 120  # the table stays; the status line moves on
   for valve in 'inlet A' 'inlet B' 'outlet A' 'outlet B'; do
-    e2e_screen | grep -qE "$valve +pass" || e2e_fail "$device: $valve did not pass"
+    e2e_screen_has -E "$valve +pass" || e2e_fail "$device: $valve did not pass"
   done
   e2e_keys Escape
 

@@ -7,8 +7,8 @@ source "$(dirname "$0")/e2e_console_lib.sh"
 
 e2e_start 80 24 LC_ALL=C LANG=C -- console --speed max --rt off
 e2e_wait_for 'law [a-z-]+'
-e2e_screen | tail -n 1 | grep -qF '?/F1 Help' || e2e_fail "no help key in the function bar at 80 columns"
-e2e_screen | tail -n 1 | grep -qF 'q Quit' || e2e_fail "no quit key in the function bar at 80 columns"
+grep -qF '?/F1 Help' <<<"$(e2e_screen | tail -n 1)" || e2e_fail "no help key in the function bar at 80 columns"
+grep -qF 'q Quit' <<<"$(e2e_screen | tail -n 1)" || e2e_fail "no quit key in the function bar at 80 columns"
 e2e_keys '?'
 e2e_wait_for 'Everywhere \(greyed'
 e2e_wait_for '\(arm the valves first \(a\)\)'

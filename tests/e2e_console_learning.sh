@@ -73,7 +73,7 @@ e2e_wait_for 'iteration 6: RMS' 120
 e2e_wait_for 'iteration 6  RMS'
 
 # Saved as it went: quit does not ask; the closing report names the session, with every iteration.
-for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
+for _ in $(seq 1 100); do e2e_screen_has 'unsaved' || break; sleep 0.1; done
 history="$(e2e_rms_list)"
 e2e_quit
 status="$(e2e_wait_exit)"
@@ -100,7 +100,7 @@ e2e_wait_for 'Bellows +ARMED '
 e2e_keys n
 e2e_wait_for 'iteration 7  RMS' 120
 # Saved as it goes: the header drops "unsaved" once iteration 7 is on disk.
-for _ in $(seq 1 100); do e2e_screen | grep -q 'unsaved' || break; sleep 0.1; done
+for _ in $(seq 1 100); do e2e_screen_has 'unsaved' || break; sleep 0.1; done
 # Read whole before matching: `grep -q` would stop reading at the match and, under pipefail, the
 # writer's SIGPIPE would fail the test.
 shown="$("$BELLOWS" sessions show "$session")"

@@ -56,6 +56,11 @@ e2e_start() {
 e2e_keys() { e2e_tmux send-keys -t console "$@"; }
 e2e_screen() { e2e_tmux capture-pane -p -t console; }
 e2e_history() { e2e_tmux capture-pane -p -J -S - -t console; }  # the screen and what scrolled off it
+# e2e_screen_has [GREP OPTIONS] PATTERN, e2e_history_has ...: grep -q on the whole capture. Never
+# `e2e_screen | grep -q`: grep leaves at the first match, the capture still being written gets
+# SIGPIPE, and under pipefail the match reads as a failure (scripts/house-style.sh refuses it).
+e2e_screen_has() { local text; text="$(e2e_screen)"; grep -q "$@" <<<"$text"; }
+e2e_history_has() { local text; text="$(e2e_history)"; grep -q "$@" <<<"$text"; }
 e2e_resize() { e2e_tmux resize-window -t console -x "$1" -y "$2"; }
 
 # e2e_wait_for REGEX [SECONDS]: until the screen matches (grep -E).
@@ -63,9 +68,9 @@ e2e_wait_for() {
   local pattern="$1" limit="${2:-$E2E_WAIT_S}"
   local deadline=$((SECONDS + limit))
   while [ $SECONDS -lt $deadline ]; do
-    if e2e_screen | grep -qE -- "$pattern"; then return 0; fi
-    if e2e_history | grep -qE '^EXIT STATUS [0-9]+'; then
-      e2e_screen | grep -qE -- "$pattern" && return 0
+    if e2e_screen_has -E -- "$pattern"; then return 0; fi
+    if e2e_history_has -E '^EXIT STATUS [0-9]+'; then
+      e2e_screen_has -E -- "$pattern" && return 0
       e2e_fail "the console exited while waiting for /$pattern/"
     fi
     sleep 0.2
@@ -74,7 +79,7 @@ e2e_wait_for() {
 }
 
 # e2e_output_has REGEX: the program's output (screen and history) matches, e.g. after it exited.
-e2e_output_has() { e2e_history | grep -qE -- "$1" || e2e_fail "no /$1/ in the output"; }
+e2e_output_has() { e2e_history_has -E -- "$1" || e2e_fail "no /$1/ in the output"; }
 
 # e2e_wait_exit [SECONDS]: until the program exited; prints its exit status.
 e2e_wait_exit() {
@@ -133,8 +138,8 @@ e2e_quit() {
   e2e_keys q
   local deadline=$((SECONDS + 10))
   while [ $SECONDS -lt $deadline ]; do
-    if e2e_history | grep -qE '^EXIT STATUS [0-9]+'; then return 0; fi
-    if e2e_screen | grep -q 'Quit?'; then e2e_keys y; return 0; fi
+    if e2e_history_has -E '^EXIT STATUS [0-9]+'; then return 0; fi
+    if e2e_screen_has 'Quit?'; then e2e_keys y; return 0; fi
     sleep 0.1
   done
 }

@@ -27,7 +27,7 @@ kill -STOP "$pid"
 sleep 0.3
 kill -CONT "$pid"
 e2e_wait_for 'iterations 0\.\.2 done' 240
-e2e_screen | grep -q 'FAULT' && e2e_fail "a fault on the simulated arm under load"
+e2e_screen_has 'FAULT' && e2e_fail "a fault on the simulated arm under load"
 missed="$(e2e_screen | grep -oE 'missed [0-9]+' | head -1 | grep -oE '[0-9]+')"
 [ "${missed:-0}" -gt 0 ] || e2e_fail "no missed deadline counted after a 0.3 s stall"
 stop_loads
@@ -35,5 +35,5 @@ e2e_quit
 status="$(e2e_wait_exit)"
 [ "$status" = "0" ] || e2e_fail "exit status $status"
 e2e_output_has '[0-9]+ deadlines missed, counted as warnings'
-e2e_history | grep -qE 'iterations' || true
+e2e_history_has -E 'iterations' || true
 echo "ok (missed deadlines counted: $missed)"

@@ -15,7 +15,7 @@ question_letters="$(tr -d 'yYnNq' <<<"$letters")"
 quit_letters="$(tr -d 'yYnNqcs' <<<"$letters")"
 
 # has_text TEXT: the screen shows TEXT (fixed string).
-has_text() { e2e_screen | grep -qF -- "$1"; }
+has_text() { e2e_screen_has -F -- "$1"; }
 # wait_text TEXT / wait_gone TEXT: until the screen shows TEXT (a fixed string) / no longer does.
 wait_text() { wait_screen_text shown "$1"; }
 wait_gone() { wait_screen_text gone "$1"; }

@@ -23,7 +23,7 @@ e2e_resize 30 6
 e2e_wait_for 'Terminal too small'
 e2e_resize 80 24
 e2e_wait_for 'RMS per iteration'
-e2e_screen | tail -1 | grep -q 'Space E-STOP' || e2e_fail "no function bar at 80x24"
+grep -q 'Space E-STOP' <<<"$(e2e_screen | tail -1)" || e2e_fail "no function bar at 80x24"
 [ "$(e2e_screen | wc -l)" -eq 24 ] || e2e_fail "not 24 lines"
 e2e_resize 100 30
 e2e_wait_for 'Correction u_ilc'
@@ -34,10 +34,10 @@ e2e_wait_for 'iterations 0\.\.2 done' 300
 rms="$(e2e_rms_list)"
 [ "$(echo "$rms" | wc -l)" -eq 3 ] || e2e_fail "RMS list: $rms"
 e2e_expect_falling "$rms"
-e2e_screen | grep -q 'FAULT' && e2e_fail "a fault during the resizes"
+e2e_screen_has 'FAULT' && e2e_fail "a fault during the resizes"
 e2e_keys l
 e2e_wait_for 'Event log'
-e2e_screen | grep -q 'refused' && e2e_fail "a command was refused"
+e2e_screen_has 'refused' && e2e_fail "a command was refused"
 e2e_quit  # saved as it went; armed, so quitting asks (docs/console.md, "Quit")
 [ "$(e2e_wait_exit)" = "0" ] || e2e_fail "exit status"
 echo "ok: $(echo "$rms" | tr '\n' ' ')"

@@ -10,7 +10,7 @@ e2e_wait_for 'Arm the valves\?'
 e2e_keys y
 e2e_wait_for 'Bellows +ARMED '
 sleep 2  # armed for a while: the heartbeat keeps it so
-e2e_screen | grep -qE 'Bellows +ARMED ' || e2e_fail "the armed engine did not stay armed"
+e2e_screen_has -E 'Bellows +ARMED ' || e2e_fail "the armed engine did not stay armed"
 e2e_keys H
 e2e_wait_for 'FAULT: heartbeat-lost' 30
 e2e_wait_for 'the console stopped responding'
