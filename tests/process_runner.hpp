@@ -3,6 +3,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,9 +31,38 @@ struct ProcessResult {
 /// The bellows binary under test.
 inline const std::string kBellows = BELLOWS_BINARY;
 
+/// The directories make_temp_dir made, removed when the test process that made them ends: a run of
+/// the suite left ~800 in /tmp. Kept when a test of that process failed (to look at what it wrote)
+/// or when BELLOWS_KEEP_TEST_DIRS is set; a forked child's exit removes nothing (the owner's pid).
+class TempDirsOfThisProcess {
+ public:
+  static TempDirsOfThisProcess& instance() {
+    static TempDirsOfThisProcess dirs;
+    return dirs;
+  }
+  void add(const std::filesystem::path& dir) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(dir);
+  }
+  ~TempDirsOfThisProcess() {
+    if (::getpid() != owner_ || std::getenv("BELLOWS_KEEP_TEST_DIRS") != nullptr ||
+        ::testing::UnitTest::GetInstance()->Failed())
+      return;
+    std::error_code error;  // best effort: a directory a test's child still writes to may resist
+    for (const std::filesystem::path& dir : dirs_) std::filesystem::remove_all(dir, error);
+  }
+
+ private:
+  TempDirsOfThisProcess() = default;
+  const pid_t owner_ = ::getpid();
+  std::mutex mutex_;
+  std::vector<std::filesystem::path> dirs_;
+};
+
 inline std::filesystem::path make_temp_dir(const std::string& prefix) {
   std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "-XXXXXX")).string();
   if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+  TempDirsOfThisProcess::instance().add(pattern);
   return pattern;
 }
 
