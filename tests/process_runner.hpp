@@ -53,7 +53,9 @@ class TempDirsOfThisProcess {
   }
 
  private:
-  TempDirsOfThisProcess() = default;
+  // Touching gtest's UnitTest first makes it outlive this registry (statics end in reverse order),
+  // so the destructor may ask it whether a test failed, even if a directory is made before main.
+  TempDirsOfThisProcess() { ::testing::UnitTest::GetInstance(); }
   const pid_t owner_ = ::getpid();
   std::mutex mutex_;
   std::vector<std::filesystem::path> dirs_;
