@@ -78,6 +78,18 @@ e2e_wait_for() {
   e2e_fail "no /$pattern/ on the screen within ${limit} s"
 }
 
+# e2e_wait_gone REGEX [SECONDS]: until the screen no longer matches (a dialog closed): the frame
+# after a key comes within the console's redraw interval, not at once.
+e2e_wait_gone() {
+  local pattern="$1" limit="${2:-$E2E_WAIT_S}"
+  local deadline=$((SECONDS + limit))
+  while [ $SECONDS -lt $deadline ]; do
+    e2e_screen_has -E -- "$pattern" || return 0
+    sleep 0.2
+  done
+  e2e_fail "/$pattern/ still on the screen after ${limit} s"
+}
+
 # e2e_output_has REGEX: the program's output (screen and history) matches, e.g. after it exited.
 e2e_output_has() { e2e_history_has -E -- "$1" || e2e_fail "no /$1/ in the output"; }
 
