@@ -103,6 +103,10 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   const std::string light = arm_config("light2", "[arm]\njoints = 2\n[arm_joint1]\nbellows_scale = 2.0\n");
   EXPECT_NE(joints_run_json("--config " + light + " --iterations 0")["iterations"][0]["joint_rms_deg"],
             by_preset["iterations"][0]["joint_rms_deg"]);
+}
+
+// Apart from the runs above: a scenario (tests/CMakeLists.txt), while refusals run in every tree.
+TEST(CliJoints, AChainOfItsOwnKeysThatIsNoArmIsRefusedInOneLine) {
   expect_refused_in_one_line("run --no-save --config " + arm_config("one", "[arm]\njoints = 1\n"),
                              "[arm] joints = 1: a chain has 2 to 4 joints (leave [arm] out for one joint)");
   expect_refused_in_one_line("run --no-save --config " + arm_config("both", "[arm]\njoints = 3\npreset = \"arm2\"\n"),
@@ -114,8 +118,9 @@ TEST(CliJoints, AChainOfItsOwnKeysIsTheArmItDescribes) {
   expect_refused_in_one_line(
       "run --no-save --config " + arm_config("massless", "[arm]\njoints = 2\n[arm_joint2]\nmass_kg = 0\n"),
       "[arm_joint2] mass_kg = 0");
-  expect_refused_in_one_line("run --no-save --config " + own + " --device t7 --t7 127.0.0.1:1",
-                             "[arm] joints = 2: an arm of several joints runs on --device sim or lcm");
+  expect_refused_in_one_line(
+      "run --no-save --config " + arm_config("own2t7", "[arm]\njoints = 2\n") + " --device t7 --t7 127.0.0.1:1",
+      "[arm] joints = 2: an arm of several joints runs on --device sim or lcm");
 }
 
 TEST(CliJoints, OneJointReportsItsRmsAsItsOnlyJoint) {

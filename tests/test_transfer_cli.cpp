@@ -180,7 +180,12 @@ TEST_F(TransferCli, AnArmOfTwoJointsFitsEveryJointsFirstCorrectionOnItsOwn) {
   const Session saved = load_session(std::filesystem::path(data_dir()) / "arm2-transferred");
   EXPECT_EQ(saved.manifest.first_correction["joints"].size(), 2u) << "the session records every joint's transfer";
   EXPECT_NE(r.err.find("transfer from arm2-paper2, arm2-pulses: joint 1 "), std::string::npos) << r.err;
-  // A session of one joint cannot teach the arm: refused by name in one line.
+}
+
+// Apart from the learning above (a scenario, tests/CMakeLists.txt): this refusal runs in every tree.
+TEST_F(TransferCli, ASessionOfOneJointCannotTeachAnArmOfTwo) {
+  const std::string arm2 = write("arm2.toml", "[arm]\npreset = \"arm2\"\n");
+  const std::string target = write("arm2-target.csv", two_joint_csv(10.0, 30.0, 1.6));
   const ProcessResult other = run_bellows({"run", "--config", arm2, "--trajectory", target, "--data-dir", data_dir(),
                                            "--name", "arm2-refused", "--transfer-from", "trained-paper"});
   EXPECT_EQ(other.exit_code, 2) << other.err;
