@@ -37,6 +37,8 @@ session_digest() { (cd "$(session_dir)" && find . -type f ! -name '*.lock' -prin
 prompt() {
   local title="$1" refused="$2" why="$3"
   wait_text "$title"
+  # WHY must be new on the screen, or waiting for it would not wait for the refusal at all.
+  has_text "$why" && e2e_fail "$title: '$why' is on the screen before the answer was given"
   e2e_keys C-u
   e2e_keys -l -- "$refused"
   e2e_keys Enter
@@ -96,7 +98,9 @@ prompt 'Run K iterations' "$(printf '7%.0s' $(seq 1 400))" '(out of range)'
 e2e_keys w
 e2e_wait_for 'k_ff'
 refusals=('０.５' 'abc' "1$(printf '0%.0s' $(seq 1 399))" '20' '' '-1' 'nan' '2e6')
-whys=('is not a number' 'is not a number' 'is out of range' 'k_d' '' 'm' 's' 'w')
+# Each why names the field and the answer: the field's label alone is on the screen already.
+whys=("k_ff: '" "k_p: 'abc' is not a number" "' is out of range" '[controller] k_d = 20: must be in' ''
+  '[ilc] m = -1: must be in' "S: 'nan' is not a number" '[ilc] w = 2000000: must be in')
 labels=(k_ff k_p k_i k_d law M S W)
 for row in 0 1 2 3 5 6 7; do
   for _ in $(seq 0 7); do e2e_keys Up; done
