@@ -58,6 +58,7 @@ prompt() {
 question() {
   local title="$1" keys="$2" state="$3"
   wait_text "$title"
+  has_text "${keys: -1} is not an answer here" && e2e_fail "$title: refused before a key was typed"
   e2e_keys -l -- "$keys"
   wait_text "${keys: -1} is not an answer here"
   has_text "$title" || e2e_fail "$title: a letter closed the question"
