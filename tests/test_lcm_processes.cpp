@@ -211,28 +211,50 @@ TEST(LcmProcesses, KillingTheRigMidTrialFaultsAndVentsWithinTheStaleLimit) {
                                                      "\nmissed_deadline_streak = 1000\n[lcm]\nrig_timeout_s = " +
                                                      std::to_string(stale_ticks * Configuration{}.timing.tick_s) + "\n")
                                  .string();
-  Child rig({kBellows, "io-sim", "--config", config}, dir / "rig.out", dir / "rig.err");
-  Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
-             kDefaultLcmUrl, "--lcm-log", "--name", "killed", "--config", config},
-            dir / "run.out", dir / "run.err");
-  ASSERT_TRUE(rig.started() && run.started());
-  // Mid-trial: half a second into the first trajectory.
-  const bool mid_trial = testing::eventually(
-      [&] {
-        const auto last = recorder.last(kTelemetryChannel);
-        if (!last) return false;
-        const telemetry_t t = decode<telemetry_t>(*last);
-        return t.state == telemetry_t::STATE_RUNNING && t.sample >= 25;
-      },
-      120.0);
-  ASSERT_TRUE(mid_trial) << run.err();
-  rig.signal(SIGKILL);
-  ASSERT_TRUE(rig.wait(10.0).has_value());
-  const auto status = run.wait(60.0);
-  ASSERT_TRUE(status.has_value()) << "the engine did not stop after the rig died";
-  EXPECT_EQ(*status, 3) << run.err();
+  // One run, the rig killed half a second into the first trajectory. Its report, or null when the
+  // run could not be made (the failure is recorded).
+  const auto run_and_kill_rig = [&](int attempt) -> nlohmann::json {
+    recorder.clear();
+    const std::string tag = std::to_string(attempt);
+    Child rig({kBellows, "io-sim", "--config", config}, dir / ("rig" + tag + ".out"), dir / ("rig" + tag + ".err"));
+    Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--iterations", "5", "--json", "--lcm",
+               kDefaultLcmUrl, "--lcm-log", "--name", "killed" + tag, "--config", config},
+              dir / ("run" + tag + ".out"), dir / ("run" + tag + ".err"));
+    EXPECT_TRUE(rig.started() && run.started());
+    const bool mid_trial = testing::eventually(
+        [&] {
+          const auto last = recorder.last(kTelemetryChannel);
+          if (!last) return false;
+          const telemetry_t t = decode<telemetry_t>(*last);
+          return t.state == telemetry_t::STATE_RUNNING && t.sample >= 25;
+        },
+        120.0);
+    EXPECT_TRUE(mid_trial) << run.err();
+    if (!mid_trial) return nullptr;
+    rig.signal(SIGKILL);
+    EXPECT_TRUE(rig.wait(10.0).has_value());
+    const auto status = run.wait(60.0);
+    EXPECT_TRUE(status.has_value()) << "the engine did not stop after the rig died";
+    if (!status.has_value()) return nullptr;
+    EXPECT_EQ(*status, 3) << run.err();
+    return parse_report(run);
+  };
+  // A VM that holds the engine's loop off its CPU for most of the stale limit right after the kill
+  // (CI once: 95 ms of 160) makes the loop's lateness the larger part of the silence, and the engine
+  // rightly names that missed-deadlines (its own tests: EngineRideThrough). That outcome says
+  // nothing about the kill, so the run is made again, at most twice; any other name fails at once.
+  nlohmann::json report;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    report = run_and_kill_rig(attempt);
+    ASSERT_FALSE(report.is_null());
+    const nlohmann::json fault = report.value("fault", nlohmann::json::object());
+    const std::string message = fault.is_object() ? fault.value("message", "") : "";
+    if (!fault.is_object() || fault.value("name", "") != "missed-deadlines" ||
+        message.find("because the loop was late") == std::string::npos)
+      break;
+    std::cerr << "attempt " << attempt << ": the loop stalled after the kill: " << message << "\n";
+  }
   bus.stop();
-  const nlohmann::json report = parse_report(run);
   // The rig stopped answering: the link is lost, named with the rig and its silence (never sensor-stale).
   EXPECT_EQ(report["fault"]["name"], "link-lost");
   const std::string message = report["fault"]["message"].get<std::string>();
