@@ -109,10 +109,13 @@ class T7Device final : public Device {
   bool wait_for_reading(double timeout_s, const std::atomic<bool>& stop) const;
 
  private:
+  static std::string seconds_text(double s);                           // "2 s"
+  static double duty_of(const ValveCommand& command, ValveRole role);  // the duty a command gives a valve line
   struct Outgoing {
     ValveCommand valves = ValveCommand::vented();
   };
 
+  // The configuration sequence, in t7_device_configure.cpp.
   void configure();
   void configure_watchdog();
   void require(bool ok, const char* what, int address);
