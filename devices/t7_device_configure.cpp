@@ -2,9 +2,10 @@
 // lines' PWM and the watchdog, each in the order LabJack's documents require (docs/labjack-t7.md).
 #include "devices/t7_device.hpp"
 
+#include <cstdint>
+#include <cstdio>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include "devices/t7_errors.hpp"
 #include "engine/base/cancellation.hpp"
@@ -18,7 +19,6 @@ std::string T7Device::refusal(const char* what, int address) {
   std::string why = std::string(what) + " (" + t7::register_name(address) + ", " + std::to_string(address) +
                     ") refused: " + client_.last_error();
   if (client_.last_exception() != 0) {
-    const std::string exception = client_.last_error();
     std::uint16_t detail = 0;
     if (client_.read_u16(t7::kLastErrDetail, detail) && detail != 0) {
       why += ", LabJack error " + std::to_string(detail);
