@@ -150,5 +150,60 @@ TEST(NoilcLearnedPlanner, SeveralJointsTheUpdateActsOnTheLimitShapedErrors) {
   }
 }
 
+// A second trial whose cost is 3 % above the first's: several joints count it as a descent (within the
+// default slack of 5 %) and plan the next update from it with the whole step; with no slack, and for one
+// joint whatever the slack, it is a no-descent: the update starts again from the best (first) trial
+// with half the step.
+TEST(NoilcLearnedPlanner, SeveralJointsATrialWithinTheSlackOfTheBestIsPlannedFrom) {
+  const int n = 200;
+  struct Second {
+    LearnedNoilcReport report;
+    Eigen::MatrixXd u1, e1, u_next;
+  };
+  const auto second_update = [&](const ClosedLoopPrior& prior, const LearnedNoilcSettings& settings,
+                                 const Eigen::MatrixXd& e0) {
+    const int J = prior.joints();
+    LearnedModelNoilc law(prior, settings, n);
+    Second out;
+    out.u1.resize(n, J);
+    out.u_next.resize(n, J);
+    law.update(Eigen::MatrixXd::Zero(n, J), e0, out.u1);
+    out.e1 = random_matrix(n, J, 1.0, 9);
+    out.e1 *= std::sqrt(1.03) * e0.norm() / out.e1.norm();
+    law.update(out.u1, out.e1, out.u_next);
+    out.report = law.last_report();
+    return out;
+  };
+  for (const ClosedLoopPrior& prior : {arm2_prior(), paper_prior()}) {
+    const int J = prior.joints();
+    const Eigen::MatrixXd e0 = 0.3 * random_matrix(n, J, 1.0, 5), u0 = Eigen::MatrixXd::Zero(n, J);
+    const LearnedNoilcSettings by_default;
+    ASSERT_DOUBLE_EQ(by_default.joints_descent_slack, 0.05);
+    const Second slack = second_update(prior, by_default, e0);
+    LearnedNoilcSettings none;
+    none.joints_descent_slack = 0.0;
+    const Second strict = second_update(prior, none, e0);
+    EXPECT_TRUE(strict.report.no_descent) << J << " joints";
+    EXPECT_FALSE(strict.report.within_slack) << J << " joints";
+    if (J == 1) {  // one joint ignores the slack: the same update as without it
+      EXPECT_TRUE(slack.report.no_descent);
+      EXPECT_FALSE(slack.report.within_slack);
+      EXPECT_EQ(slack.u_next, strict.u_next);
+      continue;
+    }
+    EXPECT_FALSE(slack.report.no_descent);
+    EXPECT_TRUE(slack.report.within_slack);
+    EXPECT_DOUBLE_EQ(slack.report.step, 1.0);
+    const Eigen::MatrixXd from_the_trial = prior_plan(prior, by_default, slack.u1, slack.e1);
+    EXPECT_LT((slack.u_next - from_the_trial).norm(), 1e-9 * from_the_trial.norm());
+    const Eigen::MatrixXd half_from_the_best = 0.5 * prior_plan(prior, none, u0, e0);
+    EXPECT_LT((strict.u_next - half_from_the_best).norm(), 1e-9 * half_from_the_best.norm());
+    EXPECT_DOUBLE_EQ(strict.report.step, 0.5);
+  }
+  LearnedNoilcSettings beyond_the_guard;
+  beyond_the_guard.joints_descent_slack = beyond_the_guard.guard + 0.01;
+  EXPECT_THROW(LearnedModelNoilc(arm2_prior(), beyond_the_guard, n), InputError);
+}
+
 }  // namespace learned_planner_test
 }  // namespace bellows

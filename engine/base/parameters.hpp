@@ -122,6 +122,9 @@ struct IlcParameters {
   // arm2/paper2 and arm3/paper3 (docs/learning-laws.md).
   int learned_joints_refit_plans = 0;
   int learned_joints_zero_limited = 0;
+  // Several joints only: a trial within this fraction above the best trial's ||e||^2 counts as a descent (planned
+  // from, the step kept) instead of replaying a halved step from the best trial; at most learned_guard.
+  double learned_joints_descent_slack = 0.05;
 };
 
 /// Model identification (`bellows identify`): the PID tracks a bounded excitation while the arm's

@@ -176,6 +176,10 @@ std::vector<ParameterBinding> make_bindings() {
           "ilc", "learned_joints_zero_limited",
           "noilc-learned, several joints: 1 zeroes the limit-shaped errors in the update; 0 only the refit omits them",
           between(0.0, 1.0), [](C& c) { return &c.ilc.learned_joints_zero_limited; }),
+      number("ilc", "learned_joints_descent_slack", "",
+             "noilc-learned, several joints: a trial within this fraction above the best's squared error counts as a "
+             "descent",
+             between(0.0, 1.0), [](C& c) { return &c.ilc.learned_joints_descent_slack; }),
       whole("ilc", "prediction_grid_points", "convergence prediction: grid points per parameter", count(21),
             [](C& c) { return &c.ilc.prediction_grid_points; }),
       // [identify]

@@ -44,6 +44,7 @@ std::vector<std::string> learning_law_weight_keys(const std::string& name) {
             "learned_taps",
             "learned_joints_refit_plans",
             "learned_joints_zero_limited",
+            "learned_joints_descent_slack",
             "limit_margin_bar",
             "limit_recovery_s"};
   }

@@ -35,6 +35,8 @@ LearnedModelNoilc::LearnedModelNoilc(const ClosedLoopPrior& prior, const Learned
     throw InputError("[ilc] limit_margin_bar must be a finite, non-negative pressure");
   if (!(settings.limit_recovery_s >= 0.0) || !std::isfinite(settings.limit_recovery_s))
     throw InputError("[ilc] limit_recovery_s must be a finite, non-negative time");
+  if (!(settings.joints_descent_slack >= 0.0) || settings.joints_descent_slack > settings.guard)
+    throw InputError("[ilc] learned_joints_descent_slack must be between 0 and learned_guard");
   learnable_ = Eigen::MatrixXd::Ones(samples, J);
   feedback_ = Eigen::MatrixXd::Zero(samples, J);
   // The prior alone has no correction states (they would only add zeros to its predictions); the
@@ -179,7 +181,9 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
       // a model that mispredicts the last stretch): the trial's data are learned from (it is a fair
       // measurement), but the next update starts from the best trial with half the step, so the
       // learning stays a descent on the measured cost without forgetting what the model learned.
-      const bool descended = cost <= best_cost_;
+      // Several joints: within the slack of the best trial's cost is a descent too (the difference is noise).
+      const bool descended = cost <= (1.0 + descent_slack()) * best_cost_;
+      report_.within_slack = descended && cost > best_cost_;
       if (!descended) {
         from_best = true;
         report_.no_descent = true;
@@ -200,7 +204,9 @@ void LearnedModelNoilc::update(const Eigen::Ref<const Eigen::MatrixXd>& u_j,
           "the prior alone %.0f %%, the refit %.0f %%)%s%s",
           report_.refitted ? "refit" : "kept", trial, report_.predicted_change, measured,
           100.0 * report_.prediction_miss, 100.0 * report_.prior_miss, 100.0 * report_.refit_miss,
-          descended ? "" : "; no descent: the next update starts from the best trial with a smaller step",
+          !descended             ? "; no descent: the next update starts from the best trial with a smaller step"
+          : report_.within_slack ? "; within learned_joints_descent_slack of the best trial: planned from it"
+                                 : "",
           prior_plans_always() ? "; the prior plans the next update (several joints)"
           : plan_with_prior_   ? "; the prior plans the next update (it predicted this trial better)"
                                : "");
@@ -271,6 +277,7 @@ LearnedNoilcSettings learned_noilc_settings(const IlcParameters& ilc) {
   settings.shape.taps = ilc.learned_taps;
   settings.joints_refit_plans = ilc.learned_joints_refit_plans != 0;
   settings.joints_zero_limited_errors = ilc.learned_joints_zero_limited != 0;
+  settings.joints_descent_slack = ilc.learned_joints_descent_slack;
   settings.limit_margin_bar = ilc.limit_margin_bar;
   settings.limit_recovery_s = ilc.limit_recovery_s;
   return settings;

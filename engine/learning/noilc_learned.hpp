@@ -31,7 +31,8 @@
 // The planner: each trial judges the refit model (fitted on the trials before) and the prior on how
 // well they predicted its change of error; the better one plans the next update (the refit on a tie).
 // Several joints: the prior plans every update unless `joints_refit_plans` (the refit still learns and
-// is judged); the update zeroes the limit-shaped errors only with `joints_zero_limited_errors`.
+// is judged); the update zeroes the limit-shaped errors only with `joints_zero_limited_errors`; a trial
+// within `joints_descent_slack` of the best trial's cost counts as a descent.
 //
 // Every refit and fall-back is reported as a note (take_note), which the session records as an event.
 #pragma once
@@ -64,6 +65,10 @@ struct LearnedNoilcSettings {
   // Several joints only: the update zeroes the errors the pressure limit shaped (false: only the refit leaves them
   // out). Zeroed, a wrist that touches its limit every trial never has those errors corrected.
   bool joints_zero_limited_errors = false;
+  // Several joints only: a trial whose ||e||^2 is above the best trial's by no more than this fraction counts as a
+  // descent (planned from, the step not halved) instead of a no-descent. Near the floor a trial-to-trial difference
+  // of a few percent is noise, and replaying the same step from the best trial stalls the law there (arm2/arm3).
+  double joints_descent_slack = 0.05;
 };
 
 /// What the last update did, for the session and the console.
@@ -72,6 +77,7 @@ struct LearnedNoilcReport {
   bool refitted = false;          // the model was refit from the last trial
   bool fell_back = false;         // the last trial got worse: back to the prior and the best trial
   bool no_descent = false;        // the last trial's cost was above the best's (within the guard)
+  bool within_slack = false;      // ... but within joints_descent_slack of it: planned from all the same
   double step = 1.0;              // the fraction of the norm-optimal step taken
   double measured_change = 0.0;   // ||e_j - e_{j-1}|| (normalized units)
   double predicted_change = 0.0;  // ||P_model (u_j - u_{j-1})|| with the model that planned u_j
@@ -119,6 +125,7 @@ class LearnedModelNoilc {
   void leave_out_limited_outputs(const Eigen::Ref<const Eigen::MatrixXd>& u_j);
   bool prior_plans_always() const { return joints() > 1 && !settings_.joints_refit_plans; }
   bool zeroes_limited_errors() const { return joints() == 1 || settings_.joints_zero_limited_errors; }
+  double descent_slack() const { return joints() > 1 ? settings_.joints_descent_slack : 0.0; }
 
   ClosedLoopPrior prior_;
   LearnedNoilcSettings settings_;
