@@ -76,7 +76,7 @@ struct LearnedNoilcReport {
   int trial = 0;                  // updates made so far
   bool refitted = false;          // the model was refit from the last trial
   bool fell_back = false;         // the last trial got worse: back to the prior and the best trial
-  bool no_descent = false;        // the last trial's cost was above the best's (within the guard)
+  bool no_descent = false;        // the last trial's cost was above the best's (beyond the slack, within the guard)
   bool within_slack = false;      // ... but within joints_descent_slack of it: planned from all the same
   double step = 1.0;              // the fraction of the norm-optimal step taken
   double measured_change = 0.0;   // ||e_j - e_{j-1}|| (normalized units)
