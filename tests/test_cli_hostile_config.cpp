@@ -151,6 +151,8 @@ TEST(HostileManifest, BadValuesInASavedSessionAreRefusedByShowAndResumeWithoutHa
       {"safety", "stale_ticks", 4294967299LL},
       {"timing", "ticks_per_sample", 4294967297LL},
       {"timing", "settle_s", 1e9},
+      {"timing", "settle_max_s", 1e9},
+      {"timing", "settle_tolerance_deg", 0.0},
   };
   for (const auto& [section, key, value] : cases) {
     nlohmann::ordered_json json = nlohmann::ordered_json::parse(original);

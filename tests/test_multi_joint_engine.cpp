@@ -119,6 +119,59 @@ TEST(MultiJointEngine, TheTrajectorySaysHowManyJointsTheEngineDrives) {
   EXPECT_EQ(e.core.fault(), FaultCode::kSensorOutOfRange);
 }
 
+constexpr int kTicksPerSecond = 200;  // the default tick_s
+constexpr int kSettleTicks = kTicksPerSecond;
+
+/// arm2 armed on paper2 from rest, every joint sagging under gravity; a trial of no correction sent
+/// with the hold of `settle_max_ticks` and `tolerance_rad` after kSettleTicks. Returns the ticks
+/// until the trial's controllers start (-1: not within `limit`); `reading` is that tick's, the one
+/// the hold ended on.
+long hold_ticks(int settle_max_ticks, double tolerance_rad, long limit, SensorReading& reading) {
+  ChainEngine e("arm2");
+  const Trajectory paper2 = library_trajectory("paper2", e.config.timing.sample_s());
+  EXPECT_TRUE(e.core.send(EngineCommand::select_trajectory(paper2)));
+  EXPECT_TRUE(e.core.send(EngineCommand::of(CommandKind::kArm)));
+  e.clock.step();
+  EXPECT_EQ(e.core.state(), EngineState::kArmed);
+  TrialRecord record;
+  record.prepare(paper2.learning_samples(), e.config.timing.ticks_per_sample, paper2.joints());
+  const Eigen::MatrixXd none = Eigen::MatrixXd::Zero(paper2.learning_samples(), paper2.joints());
+  EngineCommand start = EngineCommand::start_trial(paper2, none, record, kSettleTicks, 1);
+  start.settle_max_ticks = settle_max_ticks;
+  start.settle_tolerance_rad = tolerance_rad;
+  EXPECT_TRUE(e.core.send(start));
+  TickRecord tick;
+  for (long ticks = 1; ticks <= limit; ++ticks) {
+    e.clock.step();
+    EXPECT_TRUE(e.core.read_snapshot(tick));
+    reading = tick.reading;
+    if (e.core.control().trial_running()) return ticks;
+  }
+  return -1;
+}
+
+TEST(MultiJointEngine, ATrialStartsWhenEveryJointIsBackAtItsStartNoLaterThanTheLongestHold) {
+  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+  constexpr long kLongest = 30L * kTicksPerSecond;
+  const double tolerance_rad = 1.0 * kRadPerDeg;
+  SensorReading reading;
+  // No longest hold (today's default): the trial starts after settle_s, the shoulder still far off.
+  EXPECT_EQ(hold_ticks(0, tolerance_rad, kLongest, reading), kSettleTicks);
+  EXPECT_GT(std::abs(reading.joint[0].angle_rad), 5.0 * kRadPerDeg) << "1 s does not bring the shoulder back";
+  // Held on until both joints are within the tolerance: later than settle_s, sooner than the longest
+  // (the integrators' time constant is about 4 s, above).
+  const long held = hold_ticks(kLongest, tolerance_rad, kLongest, reading);
+  std::cout << "arm2 from rest: within 1 deg of its start after " << static_cast<double>(held) / kTicksPerSecond
+            << " s\n";
+  EXPECT_GT(held, 5L * kTicksPerSecond);
+  EXPECT_LT(held, kLongest);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_LE(std::abs(reading.joint[static_cast<std::size_t>(j)].angle_rad), tolerance_rad) << "joint " << j + 1;
+  }
+  // A tolerance no reading meets: the hold ends at the longest.
+  EXPECT_EQ(hold_ticks(3 * kTicksPerSecond, 1e-9, kLongest, reading), 3L * kTicksPerSecond);
+}
+
 TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEveryJointsError) {
   ChainEngine e("arm2");
   const Trajectory paper2 = library_trajectory("paper2", e.config.timing.sample_s());

@@ -93,6 +93,33 @@ TEST(TrialRunner, PolledTickByTickItArmsSettlesRunsAndHandsBackACompleteRecord) 
   EXPECT_TRUE(rig.record.complete);
 }
 
+// [timing] settle_max_s and settle_tolerance_deg reach the engine: the hold at the start goes on
+// while the joint is off its first set point, up to settle_max_s; a joint at its start after settle_s
+// starts then, as before.
+TEST(TrialRunner, TheHoldGoesOnWhileTheJointIsOffItsStartUpToSettleMaxS) {
+  // The move of RunnerRig from `start_deg`: the arm at rest reads 0 exactly, and no quantized
+  // reading (0.1 deg steps) is ever 5.05 deg.
+  const auto ticks_of_a_trial = [](double start_deg, double settle_max_s, double tolerance_deg) {
+    Configuration c;
+    c.timing.settle_max_s = settle_max_s;
+    c.timing.settle_tolerance_deg = tolerance_deg;
+    RunnerRig rig(c);
+    rig.trajectory =
+        trajectory_from_moves("move", start_deg, {{0.2, start_deg, 20.0, 0.4, 12000.0}}, 1.0, c.timing.sample_s());
+    TrialRunner runner(rig.core, rig.config.timing);
+    runner.start(rig.trajectory, rig.correction, rig.record, TrialRunner::Arming::kIfNeeded);
+    EXPECT_EQ(runner.run_to_completion(rig.clock).phase, TrialPhase::kDone);
+    return rig.clock.ticks();
+  };
+  const Configuration defaults;
+  const long settle_ticks = std::lround(defaults.timing.settle_s / defaults.timing.tick_s);
+  const long longest_ticks = std::lround(3.0 / defaults.timing.tick_s);
+  const long plain = ticks_of_a_trial(0.0, 0.0, 0.5);
+  EXPECT_EQ(ticks_of_a_trial(0.0, 3.0, 1e-9), plain) << "at its start after settle_s: no longer";
+  EXPECT_EQ(ticks_of_a_trial(5.05, 0.0, 1e-9), plain) << "no settle_max_s: settle_s, wherever the joint is";
+  EXPECT_EQ(ticks_of_a_trial(5.05, 3.0, 1e-9), plain - settle_ticks + longest_ticks) << "never at 5.05 deg";
+}
+
 TEST(TrialRunner, StepByStepAndRunToCompletionAndFedEventsGiveTheSameRecord) {
   RunnerRig polled, run, fed;
   TrialRunner a(polled.core, polled.config.timing), b(run.core, run.config.timing), c(fed.core, fed.config.timing);

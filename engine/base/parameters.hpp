@@ -144,6 +144,11 @@ struct TimingParameters {
   double tick_s = 1.0 / 200.0;
   int ticks_per_sample = 4;  // 200 Hz / 50 Hz
   double settle_s = 1.0;     // hold at the trajectory's start before each trial
+  // After settle_s, hold on while a joint is farther than settle_tolerance_deg from its first set
+  // point, up to settle_max_s in all (no longer than settle_s when settle_max_s <= settle_s).
+  double settle_max_s = 0.0;
+  double settle_tolerance_deg = 0.5;
+  double longest_settle_s() const { return settle_max_s > settle_s ? settle_max_s : settle_s; }
   double sample_s() const { return tick_s * ticks_per_sample; }
 };
 

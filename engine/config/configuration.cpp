@@ -202,6 +202,10 @@ std::vector<ParameterBinding> make_bindings() {
             [](C& c) { return &c.timing.ticks_per_sample; }),
       number("timing", "settle_s", "s", "hold at the start before each trial", upto(60.0),
              [](C& c) { return &c.timing.settle_s; }),
+      number("timing", "settle_max_s", "s", "hold on after settle_s while a joint is off its start, up to this in all",
+             upto(60.0), [](C& c) { return &c.timing.settle_max_s; }),
+      number("timing", "settle_tolerance_deg", "deg", "a joint this close to its first set point is at its start",
+             pos(90.0), [](C& c) { return &c.timing.settle_tolerance_deg; }),
       // [trajectory]
       // [safety]: the guards' limits
       number("safety", "angle_limit_deg", "deg", "fault beyond this angle", pos(180.0),

@@ -41,10 +41,10 @@ void check_configuration_cost(const Configuration& config) {
     over_budget("[safety] black_box_s / [timing] tick_s (black box bytes)", black_box_bytes, kMaxBlackBoxBytes,
                 "lower black_box_s or raise tick_s");
   }
-  const std::int64_t settle_ticks = ratio_count(config.timing.settle_s, tick_s);
+  const std::int64_t settle_ticks = ratio_count(config.timing.longest_settle_s(), tick_s);
   if (settle_ticks > kMaxTicksPerTrial) {
-    over_budget("[timing] settle_s / [timing] tick_s (settling ticks)", settle_ticks, kMaxTicksPerTrial,
-                "lower settle_s or raise tick_s");
+    over_budget("[timing] settle_s or settle_max_s / [timing] tick_s (settling ticks)", settle_ticks, kMaxTicksPerTrial,
+                "lower settle_s and settle_max_s or raise tick_s");
   }
   const std::int64_t identification_ticks = ratio_count(config.identify.duration_s, tick_s);
   if (identification_ticks > kMaxTicksPerTrial - settle_ticks) {
@@ -56,7 +56,7 @@ void check_configuration_cost(const Configuration& config) {
 void check_trial_cost(const Configuration& config, std::int64_t learning_samples) {
   using namespace cost_budget;
   const std::int64_t per_sample = config.timing.ticks_per_sample;
-  const std::int64_t settle_ticks = ratio_count(config.timing.settle_s, config.timing.tick_s);
+  const std::int64_t settle_ticks = ratio_count(config.timing.longest_settle_s(), config.timing.tick_s);
   const std::int64_t ticks =
       learning_samples > kMaxTicksPerTrial ? INT64_MAX : learning_samples * per_sample + settle_ticks;
   if (ticks > kMaxTicksPerTrial) {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "engine/base/units.hpp"
+
 namespace bellows {
 
 const char* to_string(TrialPhase phase) {
@@ -35,7 +37,9 @@ TrialRunner::TrialRunner(EngineCore& core, const TimingParameters& timing, Snaps
     : core_(core),
       reads_snapshot_(snapshot == Snapshot::kRead),
       ticks_per_sample_(timing.ticks_per_sample),
-      settle_ticks_(static_cast<int>(std::lround(timing.settle_s / timing.tick_s))) {}
+      settle_ticks_(static_cast<int>(std::lround(timing.settle_s / timing.tick_s))),
+      settle_max_ticks_(static_cast<int>(std::lround(timing.settle_max_s / timing.tick_s))),
+      settle_tolerance_rad_(timing.settle_tolerance_deg * kRadPerDeg) {}
 
 const TrialStatus& TrialRunner::start(const Trajectory& trajectory, const Eigen::MatrixXd& correction_bar,
                                       TrialRecord& record, Arming arming) {
@@ -60,7 +64,11 @@ const TrialStatus& TrialRunner::start(const Trajectory& trajectory, const Eigen:
 void TrialRunner::send_trial() {
   status_.phase = TrialPhase::kWaiting;
   status_.command = CommandKind::kStartTrial;
-  if (!send(EngineCommand::start_trial(*trajectory_, *correction_, *record_, settle_ticks_, status_.trial_id))) {
+  EngineCommand command =
+      EngineCommand::start_trial(*trajectory_, *correction_, *record_, settle_ticks_, status_.trial_id);
+  command.settle_max_ticks = settle_max_ticks_;
+  command.settle_tolerance_rad = settle_tolerance_rad_;
+  if (!send(command)) {
     finish(TrialPhase::kNotSent, status_.time_s);
   }
 }

@@ -116,6 +116,8 @@ class TrialRunner {
   bool reads_snapshot_ = true;
   int ticks_per_sample_ = 0;
   int settle_ticks_ = 0;
+  int settle_max_ticks_ = 0;
+  double settle_tolerance_rad_ = 0.0;
   TrialStatus status_;
   TickRecord latest_;
   std::uint32_t next_trial_id_ = 1;

@@ -68,6 +68,14 @@ void EngineCore::hand_back_trial(EventKind kind, double now_s) {
   if (control_.trial_running()) control_.abort_trial();
 }
 
+bool EngineCore::at_trial_start(const SensorReading& reading) const {
+  for (int j = 0; j < trajectory_->joints(); ++j) {
+    const double off_rad = reading.joint[static_cast<std::size_t>(j)].angle_rad - trajectory_->joint(j)(0);
+    if (!(std::abs(off_rad) <= settle_tolerance_rad_)) return false;
+  }
+  return true;
+}
+
 void EngineCore::start_control_trial() {
   if (joint_correction_ != nullptr) {
     control_.start_trial(*trajectory_, *joint_correction_, *record_);
@@ -243,6 +251,8 @@ void EngineCore::apply(const EngineCommand& command, double now_s, double wall_s
       record_->complete = false;  // the engine owns the record from now on
       trial_id_ = command.trial_id;
       settle_remaining_ = command.settle_ticks;
+      settle_extra_remaining_ = std::max(0, command.settle_max_ticks - command.settle_ticks);
+      settle_tolerance_rad_ = command.settle_tolerance_rad;
       control_.hold(trajectory_->setpoint_rad(0));
       if (settle_remaining_ <= 0) start_control_trial();
       break;
@@ -350,7 +360,12 @@ void EngineCore::tick(double now_s, double wall_s, int missed_deadlines) {
   ValveCommand valves = ValveCommand::vented(joints());
   if (valves_live(state())) {
     if (state() == EngineState::kRunning && settle_remaining_ > 0 && --settle_remaining_ == 0) {
-      start_control_trial();
+      if (settle_extra_remaining_ > 0 && !at_trial_start(reading)) {
+        --settle_extra_remaining_;
+        settle_remaining_ = 1;
+      } else {
+        start_control_trial();
+      }
     }
     if (!manual_) {
       // The periods the loop missed, held as they passed on the rig (fewer than the limits above).

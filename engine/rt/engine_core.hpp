@@ -104,6 +104,8 @@ class EngineCore {
   void hold_trajectory(const Trajectory* trajectory, double now_s);
   void hand_back_trial(EventKind kind, double now_s);
   void start_control_trial();
+  /// Every joint of the trial's trajectory within the settle tolerance of its first set point.
+  bool at_trial_start(const SensorReading& reading) const;
   /// Why a kStartTrial's buffers cannot run its trial (static text), or nullptr when they can.
   const char* trial_refusal(const EngineCommand& command) const;
   /// Why a trajectory cannot be held or run (a joint count beyond kMaxJoints, joints of unequal
@@ -141,6 +143,8 @@ class EngineCore {
   TrialRecord* record_ = nullptr;
   std::uint32_t trial_id_ = 0;
   int settle_remaining_ = 0;
+  int settle_extra_remaining_ = 0;     // ticks the hold may still go on while a joint is off its start
+  double settle_tolerance_rad_ = 0.0;  // ... by more than this
   double last_reading_time_s_ = -1.0;
   double last_angle_rad_ = 0.0;  // last finite angle read: where arming without a trajectory holds
   int stale_count_ = 0;          // ticks in a row the rig went without a fresh reading (missed periods too)

@@ -47,6 +47,8 @@ struct EngineCommand {
                                                       // (TrialRecord::prepare) to the trajectory's length
                                                       // and joint count
   int settle_ticks = 0;                               // kStartTrial: hold at the start before sample 0
+  int settle_max_ticks = 0;                           // kStartTrial: and on, up to this many ticks in all,
+  double settle_tolerance_rad = 0.0;                  // while a joint is farther than this from its start
   std::uint32_t trial_id = 0;                         // kStartTrial: echoed in the trial's events
   PidGains gains{};                                   // kSetGains
   ValvePulse pulse{};                                 // kValvePulse
