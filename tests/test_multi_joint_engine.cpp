@@ -12,6 +12,7 @@
 #include "devices/simulated_arm_chain.hpp"
 #include "engine/model/arm_chain_linearization.hpp"
 #include "engine/config/configuration.hpp"
+#include "engine/base/units.hpp"
 #include "engine/rt/engine_core.hpp"
 #include "engine/rt/engine_driver.hpp"
 #include "engine/learning/noilc_mimo.hpp"
@@ -119,8 +120,9 @@ TEST(MultiJointEngine, TheTrajectorySaysHowManyJointsTheEngineDrives) {
   EXPECT_EQ(e.core.fault(), FaultCode::kSensorOutOfRange);
 }
 
-constexpr int kTicksPerSecond = 200;  // the default tick_s
-constexpr int kSettleTicks = kTicksPerSecond;
+const long kTicksPerSecond = std::lround(1.0 / Configuration{}.timing.tick_s);
+const int kSettleTicks =
+    static_cast<int>(std::lround(Configuration{}.timing.settle_s * static_cast<double>(kTicksPerSecond)));
 
 /// arm2 armed on paper2 from rest, every joint sagging under gravity; a trial of no correction sent
 /// with the hold of `settle_max_ticks` and `tolerance_rad` after kSettleTicks. Returns the ticks
@@ -151,8 +153,7 @@ long hold_ticks(int settle_max_ticks, double tolerance_rad, long limit, SensorRe
 }
 
 TEST(MultiJointEngine, ATrialStartsWhenEveryJointIsBackAtItsStartNoLaterThanTheLongestHold) {
-  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
-  constexpr long kLongest = 30L * kTicksPerSecond;
+  const long kLongest = 30 * kTicksPerSecond;
   const double tolerance_rad = 1.0 * kRadPerDeg;
   SensorReading reading;
   // No longest hold (today's default): the trial starts after settle_s, the shoulder still far off.
@@ -160,16 +161,16 @@ TEST(MultiJointEngine, ATrialStartsWhenEveryJointIsBackAtItsStartNoLaterThanTheL
   EXPECT_GT(std::abs(reading.joint[0].angle_rad), 5.0 * kRadPerDeg) << "1 s does not bring the shoulder back";
   // Held on until both joints are within the tolerance: later than settle_s, sooner than the longest
   // (the integrators' time constant is about 4 s, above).
-  const long held = hold_ticks(kLongest, tolerance_rad, kLongest, reading);
-  std::cout << "arm2 from rest: within 1 deg of its start after " << static_cast<double>(held) / kTicksPerSecond
-            << " s\n";
-  EXPECT_GT(held, 5L * kTicksPerSecond);
+  const long held = hold_ticks(static_cast<int>(kLongest), tolerance_rad, kLongest, reading);
+  std::cout << "arm2 from rest: within 1 deg of its start after "
+            << static_cast<double>(held) / static_cast<double>(kTicksPerSecond) << " s\n";
+  EXPECT_GT(held, 5 * kTicksPerSecond);
   EXPECT_LT(held, kLongest);
   for (int j = 0; j < 2; ++j) {
     EXPECT_LE(std::abs(reading.joint[static_cast<std::size_t>(j)].angle_rad), tolerance_rad) << "joint " << j + 1;
   }
   // A tolerance no reading meets: the hold ends at the longest.
-  EXPECT_EQ(hold_ticks(3 * kTicksPerSecond, 1e-9, kLongest, reading), 3L * kTicksPerSecond);
+  EXPECT_EQ(hold_ticks(static_cast<int>(3 * kTicksPerSecond), 1e-9, kLongest, reading), 3 * kTicksPerSecond);
 }
 
 TEST(MultiJointEngine, Arm2TracksPaper2AndNormOptimalIlcBetweenTrialsLowersEveryJointsError) {
