@@ -38,9 +38,10 @@ struct TrialFit {
 };
 
 // One trial on `signal`'s excitation; the identification trial (the first) goes into the session.
-TrialFit record_trial(EngineDriver& driver, const Configuration& config, const std::string& signal,
-                      IdentifySession* session) {
-  const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
+// The engine holds `excitation` after the trial until another trajectory is selected: it must
+// outlive the engine (on a rig the loop ticks on between the trials and reads it).
+TrialFit record_trial(EngineDriver& driver, const Configuration& config, const Trajectory& excitation,
+                      const std::string& signal, IdentifySession* session) {
   TrialRecord record;
   run_identification_trial(driver, excitation, config.timing, config.identify.max_abs_angle_deg, record,
                            &stop_requested());
@@ -52,10 +53,11 @@ TrialFit record_trial(EngineDriver& driver, const Configuration& config, const s
 // The simulated arm: a fresh arm per trial on simulated time (the seed decides its noise).
 TrialFit record_simulated_trial(const Configuration& config, const std::string& signal, std::uint64_t seed,
                                 IdentifySession* session) {
+  const Trajectory excitation = identification_trajectory(signal, config.identify, config.timing.sample_s());
   SimulatedArm arm(config.plant, seed);
   EngineCore core(arm, config.controller, config.timing, config.safety);
   SimulatedClock clock(core, arm);
-  TrialFit fit = record_trial(clock, config, signal, session);
+  TrialFit fit = record_trial(clock, config, excitation, signal, session);
   arm.vent();
   return fit;
 }
@@ -66,6 +68,9 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
                                                 const IdentifyOptions& options, const std::string& estimation_signal,
                                                 const std::string& validation_signal, IdentifySession& session,
                                                 std::ostream& progress) {
+  // Declared before the engine, so that both outlive the loop that holds them.
+  const Trajectory estimation = identification_trajectory(estimation_signal, config.identify, config.timing.sample_s());
+  const Trajectory validation = identification_trajectory(validation_signal, config.identify, config.timing.sample_s());
   const std::unique_ptr<OpenedDevice> rig = open_device(device, config, options.seed, options.rt, 0,
                                                         std::filesystem::path(options.config_path).parent_path());
   EngineCore core(rig->device(), config.controller, config.timing, config.safety);
@@ -80,17 +85,15 @@ std::pair<TrialFit, TrialFit> record_rig_trials(const Configuration& config, con
     }
   } stop_loop{loop, *rig};
   require_served(*rig, config.lcm.connect_timeout_s, stop_requested());
-  session.begin(config, device.kind, rig->session_info(),
-                identification_trajectory(estimation_signal, config.identify, config.timing.sample_s()),
-                validation_signal);
+  session.begin(config, device.kind, rig->session_info(), estimation, validation_signal);
   if (!session.path().empty()) progress << "session " << session.path() << std::endl;
   if (!session.not_recorded().empty()) progress << "bellows: " << session.not_recorded() << std::endl;
   progress << "identification trial (" << estimation_signal << ") on " << device.kind << " " << rig->where()
            << std::endl;
-  TrialFit estimation = record_trial(loop, config, estimation_signal, &session);
+  TrialFit estimation_fit = record_trial(loop, config, estimation, estimation_signal, &session);
   progress << "validation trial (" << validation_signal << ")" << std::endl;
-  TrialFit validation = record_trial(loop, config, validation_signal, nullptr);
-  return {std::move(estimation), std::move(validation)};
+  TrialFit validation_fit = record_trial(loop, config, validation, validation_signal, nullptr);
+  return {std::move(estimation_fit), std::move(validation_fit)};
 }
 
 }  // namespace

@@ -30,7 +30,9 @@ Trajectory joint_excitation(const Trajectory& excitation, int joint, int joints)
 /// Runs the excitation as a trial (of every joint of the excitation) through the engine (arming it if needed; its
 /// guards apply): settles at the start, then tracks it with the PID alone. Throws InputError, after an emergency stop
 /// that vents, when a joint's angle leaves +-max_abs_angle_deg; EngineFault if the engine faults; Cancelled, after an
-/// emergency stop that vents, when `stop` is set (looked at every tick).
+/// emergency stop that vents, when `stop` is set (looked at every tick). The engine keeps holding
+/// `excitation` after the trial, until another trajectory is selected: on a real-time loop it must
+/// outlive that (the loop reads it between trials).
 void run_identification_trial(EngineDriver& driver, const Trajectory& excitation, const TimingParameters& timing,
                               double max_abs_angle_deg, TrialRecord& record, StopFlag stop = nullptr);
 
