@@ -234,10 +234,10 @@ std::unique_ptr<OpenedDevice> open_device(const DeviceParameters& device, const 
   if (device.kind == "sim" && config.arm.has_chain()) return std::make_unique<SimulatedChainDevice>(config, seed);
   if (device.kind == "sim") return std::make_unique<SimulatedDevice>(config.plant, seed);
   if (device.kind == "lcm") {
-    return std::make_unique<LcmRig>(
-        device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
-        load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s, arm_joint_count(config.arm),
-        TickPhaseLock::Parameters{config.timing.tick_s, config.lcm.tick_phase_lead, config.lcm.tick_phase_step_s});
+    return std::make_unique<LcmRig>(device.lcm_url, rt, session_id != 0 ? session_id : LcmDevice::random_session_id(),
+                                    load_lcm_key(config.lcm.key_file, config_dir), config.lcm.rig_timeout_s,
+                                    arm_joint_count(config.arm),
+                                    TickPhaseLock::Parameters::of(config.timing, config.lcm));
   }
   if (device.kind == "t7") return open_t7(device, config, rt);
   throw InputError("--device '" + device.kind + "': unknown device (known: sim, lcm, t7)");

@@ -13,6 +13,8 @@
 // wake-up jitter. Plain arithmetic, no allocation: the engine thread calls it on every tick.
 #pragma once
 
+#include "engine/base/parameters.hpp"
+
 namespace bellows {
 
 class TickPhaseLock {
@@ -21,6 +23,11 @@ class TickPhaseLock {
     double period_s = 0.005;     // the engine's tick and the rig's state period ([timing] tick_s)
     double lead_fraction = 0.5;  // read each state this share of a period after it arrives ([lcm] tick_phase_lead)
     double step_s = 1e-4;        // largest shift of one tick's deadline ([lcm] tick_phase_step_s); 0: no lock
+
+    /// The lock a wall-clock LCM rig gets from the configuration (what `--device lcm` runs with).
+    static Parameters of(const TimingParameters& timing, const LcmParameters& lcm) {
+      return {timing.tick_s, lcm.tick_phase_lead, lcm.tick_phase_step_s};
+    }
   };
 
   /// A lock that never shifts (step 0).

@@ -86,6 +86,7 @@ TEST(LcmJointClosedLoop, TheEngineDrivesArm2OverMemqAndEveryJointTracksAsInProce
   RigServer rig(arm, arm.joints(), arm2.chain.integration_step_s, testing::RigBench::parameters(c, LcmKey{}, rig_log),
                 77);
   LcmDevice device(LcmDevice::random_session_id(), LcmKey{}, c.lcm.rig_timeout_s, 2);
+  device.set_tick_phase_lock(TickPhaseLock::Parameters::of(c.timing, c.lcm));  // as `--device lcm` runs
   testing::BusRecorder commands(kIoCommandChannel);
   LcmIoThread io("memq://", {&device, &rig, &commands});  // memq: one handle, so one thread for both ends
   io.start(RealtimeMode::kTry, 70);

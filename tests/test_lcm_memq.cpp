@@ -376,6 +376,9 @@ TEST(LcmClosedLoop, TheEngineDrivesTheRigServerOverMemqAndLearns) {
   std::vector<std::string> rig_log;
   RigServer rig(arm, RigBench::parameters(c, LcmKey{}, rig_log), 77);
   LcmDevice device(LcmDevice::random_session_id());
+  // Locked to the rig's phase as `--device lcm` runs: unlocked, a run whose states happened to arrive
+  // just before the engine's reads holds hundreds of ticks (tick_phase_lock.hpp) and learns slower.
+  device.set_tick_phase_lock(TickPhaseLock::Parameters::of(c.timing, c.lcm));
   BusRecorder recorder(kIoStateChannel);
   LcmIoThread io("memq://", {&device, &rig, &recorder});  // memq: one handle, so one thread for both ends
   io.start(RealtimeMode::kTry, 70);
