@@ -307,9 +307,12 @@ std::vector<ParameterBinding> make_bindings() {
   const auto after_plant =
       std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.key == "fault_at_s"; });
   b.insert(after_plant, fault);
-  const ParameterBinding law =
-      name("ilc", "law", "learning law: noilc, noilc-dense, noilc-constrained, pd, gradient or inverse",
-           [](C& c) { return &c.ilc.law; });
+  // The laws the factory knows, named once there.
+  const std::vector<std::string> laws = learning_law_names();
+  std::string law_names;
+  for (std::size_t i = 0; i < laws.size(); ++i)
+    law_names += (i == 0 ? "" : i + 1 == laws.size() ? " or " : ", ") + laws[i];
+  const ParameterBinding law = name("ilc", "law", "learning law: " + law_names, [](C& c) { return &c.ilc.law; });
   const auto first_ilc = std::find_if(b.begin(), b.end(), [](const ParameterBinding& p) { return p.section == "ilc"; });
   const auto after_law = b.insert(first_ilc, law) + 1;
   b.insert(after_law,
