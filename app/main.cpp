@@ -33,6 +33,7 @@
 #include "engine/base/cancellation.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/base/printable_text.hpp"
+#include "engine/config/learning_transfer.hpp"
 #include "engine/trial/trajectory.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_store.hpp"
@@ -126,7 +127,7 @@ int main(int argc, char** argv) try {
       ->excludes("--resume");
   run_cmd
       ->add_option("--transfer-method", run.transfer_method,
-                   "How: auto, reference-fir, basis or inverse-fir (docs/learning-laws.md)")
+                   "How: " + bellows::transfer_method_names() + " (docs/learning-laws.md)")
       ->capture_default_str();
 
   bellows::SessionsOptions sessions;

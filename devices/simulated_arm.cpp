@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "engine/base/errors.hpp"
+#include "engine/base/printable_text.hpp"
 #include "engine/base/units.hpp"
 
 namespace bellows {
@@ -34,15 +35,18 @@ const char* to_string(SimulatedFault fault) {
   return "?";
 }
 
+std::string simulated_fault_names() {
+  std::string names;
+  for (const SimulatedFault fault : kSimulatedFaults)
+    names += (names.empty() ? "" : ", ") + std::string(to_string(fault));
+  return names;
+}
+
 SimulatedFault simulated_fault_from_string(const std::string& name) {
-  for (auto fault : {SimulatedFault::kNone, SimulatedFault::kSensorDropout, SimulatedFault::kStuckInlet,
-                     SimulatedFault::kSupplyLoss, SimulatedFault::kNanAngle, SimulatedFault::kPressureSpike,
-                     SimulatedFault::kSwappedChambers, SimulatedFault::kDeadInlet}) {
+  for (const SimulatedFault fault : kSimulatedFaults) {
     if (name == to_string(fault)) return fault;
   }
-  throw InputError(
-      "unknown simulated fault '" + name +
-      "' (none, sensor-dropout, stuck-inlet, supply-loss, nan-angle, pressure-spike, swapped-chambers, dead-inlet)");
+  throw InputError("unknown simulated fault '" + printable(name) + "' (" + simulated_fault_names() + ")");
 }
 
 SimulatedArm::SimulatedArm(const PlantParameters& params, std::uint64_t seed)

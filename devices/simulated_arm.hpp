@@ -31,9 +31,21 @@ enum class SimulatedFault : std::uint8_t {
   kDeadInlet,        // actuator A's inlet valve never opens whatever is commanded
 };
 
+/// Every fault, kNone first: what `[plant] fault` may name.
+inline constexpr std::array<SimulatedFault, 8> kSimulatedFaults{SimulatedFault::kNone,
+                                                                SimulatedFault::kSensorDropout,
+                                                                SimulatedFault::kStuckInlet,
+                                                                SimulatedFault::kSupplyLoss,
+                                                                SimulatedFault::kNanAngle,
+                                                                SimulatedFault::kPressureSpike,
+                                                                SimulatedFault::kSwappedChambers,
+                                                                SimulatedFault::kDeadInlet};
+
 /// "none", "sensor-dropout", "stuck-inlet", "supply-loss", "nan-angle", "pressure-spike",
 /// "swapped-chambers", "dead-inlet".
 const char* to_string(SimulatedFault fault);
+/// Every fault's name, in kSimulatedFaults' order, joined by ", ".
+std::string simulated_fault_names();
 /// Throws InputError for an unknown name.
 SimulatedFault simulated_fault_from_string(const std::string& name);
 

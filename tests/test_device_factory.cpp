@@ -6,6 +6,8 @@
 
 #include "app/config_file.hpp"
 #include "app/device_factory.hpp"
+#include "devices/simulated_arm.hpp"
+#include "engine/config/configuration.hpp"
 #include "engine/base/errors.hpp"
 #include "tests/process_runner.hpp"
 
@@ -50,6 +52,21 @@ TEST(DeviceFactory, TheDeviceSectionLoadsAndIsChecked) {
   apply_config_toml("[rig_check]\nvalve_pulse_s = 0.05\n", "check.toml", check);
   EXPECT_DOUBLE_EQ(check.rig_check.valve_pulse_s, 0.05);
   EXPECT_THROW(apply_config_toml("[rig_check]\nvalve_pulse_s = -1\n", "check.toml", check), InputError);
+}
+
+// The configuration layer cannot see the simulated arm's faults; the key's description names them, and
+// this keeps it naming every one (a fault added to the arm and not to the description fails here).
+TEST(DeviceFactory, PlantFaultsDescriptionNamesEveryFaultTheArmKnows) {
+  const ParameterBinding* fault = find_parameter("plant", "fault");
+  ASSERT_NE(fault, nullptr);
+  EXPECT_EQ(fault->description, "injected fault: " + simulated_fault_names());
+  for (const SimulatedFault each : kSimulatedFaults) EXPECT_EQ(simulated_fault_from_string(to_string(each)), each);
+  try {
+    simulated_fault_from_string("stuck-outlet");
+    ADD_FAILURE() << "an unknown fault was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), "unknown simulated fault 'stuck-outlet' (" + simulated_fault_names() + ")");
+  }
 }
 
 TEST(DeviceFactory, TheSimulatedArmRecordsItsSeed) {

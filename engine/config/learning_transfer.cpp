@@ -117,12 +117,22 @@ std::string transfer_method_name(TransferMethod method) {
   return "auto";
 }
 
+std::string transfer_method_names() {
+  std::string names;
+  for (std::size_t i = 0; i < kTransferMethods.size(); ++i) {
+    names += (i == 0                             ? ""
+              : i + 1 == kTransferMethods.size() ? " or "
+                                                 : ", ") +
+             transfer_method_name(kTransferMethods[i]);
+  }
+  return names;
+}
+
 TransferMethod parse_transfer_method(const std::string& name) {
-  for (const TransferMethod m :
-       {TransferMethod::kAuto, TransferMethod::kReferenceFir, TransferMethod::kBasis, TransferMethod::kInverseFir}) {
+  for (const TransferMethod m : kTransferMethods) {
     if (transfer_method_name(m) == name) return m;
   }
-  throw InputError("transfer method must be auto, reference-fir, basis or inverse-fir, not '" + name + "'");
+  throw InputError("transfer method must be " + transfer_method_names() + ", not '" + name + "'");
 }
 
 LearningTransfer::LearningTransfer(TransferSettings settings) : settings_(std::move(settings)) {}

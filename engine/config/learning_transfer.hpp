@@ -20,6 +20,7 @@
 // expected feedback plus the correction stays inside the pressure limits.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,11 @@ std::string transfer_mismatch(const Configuration& source, const std::string& so
 std::string rig_profile_mismatch(const std::string& source_profile, const std::string& target_profile);
 
 enum class TransferMethod { kAuto, kReferenceFir, kBasis, kInverseFir };
+inline constexpr std::array<TransferMethod, 4> kTransferMethods{TransferMethod::kAuto, TransferMethod::kReferenceFir,
+                                                                TransferMethod::kBasis, TransferMethod::kInverseFir};
 std::string transfer_method_name(TransferMethod method);
+/// Every method's name in kTransferMethods' order: "auto, reference-fir, basis or inverse-fir".
+std::string transfer_method_names();
 /// "auto", "reference-fir", "basis", "inverse-fir"; throws InputError otherwise.
 TransferMethod parse_transfer_method(const std::string& name);
 
