@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 
+#include "devices/simulated_arm.hpp"
 #include "engine/base/errors.hpp"
 #include "engine/base/printable_text.hpp"
 #include "sessions/file_access.hpp"
@@ -136,6 +137,14 @@ void apply_config_toml(const std::string& toml_text, const std::string& source_n
         if (binding->text) {
           if (!value.is_string()) throw InputError(where + ": expected a string");
           *binding->text(config) = *value.value<std::string>();
+          // The simulated arm's faults are the devices layer's, out of the configuration layer's sight.
+          if (section == "plant" && key == "fault") {
+            try {
+              simulated_fault_from_string(*binding->text(config));
+            } catch (const InputError& error) {
+              throw InputError(where + ": " + error.what());
+            }
+          }
         } else if (binding->integer) {
           if (!value.is_integer()) throw InputError(where + ": expected a whole number in " + binding->range.text());
           const std::int64_t whole = *value.value<std::int64_t>();

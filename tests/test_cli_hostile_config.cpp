@@ -100,6 +100,7 @@ TEST(HostileConfig, TheIssuesValuesAreRefusedNamingFileAndKey) {
       {"[timing]\nticks_per_sample = 4294967297\n", "[timing] ticks_per_sample"},
       {"[timing]\nsettle_s = 1e9\n", "[timing] settle_s"},
       {"[ilc]\nlaw = \"gradient\"\ngradient_step = 2.5\n", "[ilc] gradient_step"},
+      {"[plant]\nfault = \"stuck-outlet\"\n", "[plant] fault"},
   };
   for (const auto& [toml, key] : cases) {
     const fs::path file = dir / "lab.toml";

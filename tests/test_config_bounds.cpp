@@ -205,11 +205,11 @@ TEST(ConfigBounds, DeeplyNestedOrHugeFilesAreRefusedBeforeParsing) {
   // Brackets and dots inside strings and comments are not nesting.
   Configuration config;
   EXPECT_NO_THROW(
-      apply_config_toml("# [a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t]\n[plant]\n"
-                        "fault = \"[[[[[[[[[[[[[[[[[[[[.......\\\"{{{{{{{{{{{{{{{{{\"  # {{{{{{{{{{{{{{{{{{{{\n"
+      apply_config_toml("# [a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t]\n[lcm]\n"
+                        "key_file = \"[[[[[[[[[[[[[[[[[[[[.......\\\"{{{{{{{{{{{{{{{{{\"  # {{{{{{{{{{{{{{{{{{{{\n"
                         "[ilc]\nlaw = 'noilc'\n",
                         "lab.toml", config));
-  EXPECT_EQ(config.plant.fault, "[[[[[[[[[[[[[[[[[[[[.......\"{{{{{{{{{{{{{{{{{");
+  EXPECT_EQ(config.lcm.key_file, "[[[[[[[[[[[[[[[[[[[[.......\"{{{{{{{{{{{{{{{{{");
 }
 
 TEST(Cancellation, LongComputationsStopWhenTheirFlagIsSet) {
