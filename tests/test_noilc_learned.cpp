@@ -401,7 +401,7 @@ using testing::learning_curve;
 // law's prior is as wrong as a user's configured model would be. On each, for the library's
 // trajectories: it learns faster than the paper's law (RMS at 10 no worse than noilc's at 10), never
 // rises above 1.25 x its best so far through iteration 30, and at 30 is no worse than noilc at 30 on
-// paper and steps. (On sine, the heavier arm at 30 is 0.061 vs noilc's 0.045 deg: docs/learning-laws.md
+// paper and steps. (On sine, the heavier arm at 30 is 0.061 vs noilc's 0.048 deg: docs/learning-laws.md
 // reports it as not met.)
 TEST(NoilcLearnedScenario, HeldBackArmsLearnFasterThanThePapersLawAndNeverDiverge) {
   struct HeldBack {
