@@ -119,8 +119,9 @@ void T7Device::configure_lines() {
 }
 
 void T7Device::configure_watchdog() {
-  // On timeout: reset the IO configuration to its power-up defaults (ends PWM on every line), and
-  // drive the valve lines as outputs, inlets low and outlets high: vented (docs/labjack-t7.md).
+  // On timeout: reset the IO configuration to the factory's (ends PWM on every line; the power-up
+  // defaults would not if a lab saved them with PWM running), and drive the valve lines as outputs,
+  // inlets low and outlets high: vented (docs/labjack-t7.md).
   // The watchdog's DIO inhibit leaves every other line alone and none of the valve lines.
   std::uint32_t direction = 0, state = 0;
   for (ValveRole role : kValveRoles) {
@@ -129,7 +130,7 @@ void T7Device::configure_watchdog() {
   }
   const std::uint32_t all_lines = (1u << t7::kDioCount) - 1;
   const std::pair<int, std::uint32_t> wanted[] = {
-      {t7::kWatchdogAdvanced, t7::kWatchdogAdvancedIoConfigToDefault},
+      {t7::kWatchdogAdvanced, t7::kWatchdogAdvancedIoConfigToFactory},
       {t7::kWatchdogTimeout_s, static_cast<std::uint32_t>(options_.link.watchdog_timeout_s)},
       {t7::kWatchdogStrictEnable, 0},
       {t7::kWatchdogResetEnable, 0},

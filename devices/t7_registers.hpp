@@ -79,7 +79,14 @@ inline constexpr int kWatchdogDioEnable = 61630;     // UINT32: 1 sets DIO on ti
 inline constexpr int kWatchdogDioState = 61632;      // UINT32 mask: high/low after timeout
 inline constexpr int kWatchdogDioDirection = 61634;  // UINT32 mask: output/input after timeout
 inline constexpr int kWatchdogDioInhibit = 61636;    // UINT32 mask: 1 = the watchdog leaves that line alone
-inline constexpr std::uint32_t kWatchdogAdvancedIoConfigToDefault = 2;
+// WATCHDOG_ADVANCED_DEFAULT's actions (ljm_constants.json): 1 IO_CONFIG_SET_CURRENT_TO_FACTORY, 2 the
+// power-up defaults saved in flash (IO_CONFIG_SET_CURRENT_TO_BOOTUP), which a lab may have saved with PWM running.
+inline constexpr std::uint32_t kWatchdogAdvancedIoConfigToFactory = 1;
+inline constexpr std::uint32_t kWatchdogAdvancedIoConfigToBootup = 2;
+inline constexpr int kIoConfigCheckForFactory = 49000;  // UINT32 R: 1 if the power-up defaults are the factory's
+inline constexpr int kIoConfigSetBootupToCurrent =
+    49002;  // UINT32 W: 1 saves the current IO config as power-up defaults
+inline constexpr int kIoConfigSetBootupToFactory = 49004;  // UINT32 W: 1 saves the factory's as power-up defaults
 
 /// Modbus exception a T7 answers for an address it does not have (or a write to a read-only one):
 /// 2, ILLEGAL DATA ADDRESS (LJM error 1202, LJME_MBE2_ILLEGAL_DATA_ADDRESS).
@@ -138,7 +145,10 @@ inline std::string register_name(int a) {
                                                {kWatchdogDioEnable, "WATCHDOG_DIO_ENABLE_DEFAULT"},
                                                {kWatchdogDioState, "WATCHDOG_DIO_STATE_DEFAULT"},
                                                {kWatchdogDioDirection, "WATCHDOG_DIO_DIRECTION_DEFAULT"},
-                                               {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"}};
+                                               {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"},
+                                               {kIoConfigCheckForFactory, "IO_CONFIG_CHECK_FOR_FACTORY"},
+                                               {kIoConfigSetBootupToCurrent, "IO_CONFIG_SET_BOOTUP_TO_CURRENT"},
+                                               {kIoConfigSetBootupToFactory, "IO_CONFIG_SET_BOOTUP_TO_FACTORY"}};
   for (const auto& [address, name] : named) {
     if (a == address || a == address + 1) return name;
   }

@@ -2,12 +2,30 @@
 
 #include <modbus/modbus.h>
 
+#include <algorithm>
+#include <utility>
+
 #include "devices/t7_registers.hpp"
 
 namespace bellows {
 namespace {
 constexpr std::uint8_t kUnknown = 0, kReadOnly = 1, kReadWrite = 2;
+
+/// The IO configuration's registers as (first, count): the systems IO_CONFIG_* affect (AIN, DIO,
+/// DIO_EF and its clocks; ljm_constants.json) that t7-sim models.
+std::vector<std::pair<int, int>> io_config_blocks() {
+  using namespace t7;
+  std::vector<std::pair<int, int>> blocks = {{kAinRange(0), 2 * kAinCount},
+                                             {kAinResolutionIndex(0), kAinCount},
+                                             {kAinSettling_us(0), 2 * kAinCount},
+                                             {kDioState, 2},
+                                             {kDioDirection, 2}};
+  for (int first : {kDioEfEnable(0), kDioEfIndex(0), kDioEfClockSource(0), kDioEfConfigA(0)})
+    blocks.emplace_back(first, 2 * kDioCount);
+  for (int clock = 0; clock < 3; ++clock) blocks.emplace_back(kClockEnable(clock), 6);
+  return blocks;
 }
+}  // namespace
 
 T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0), access_(kSize, kUnknown) {
   using namespace t7;
@@ -42,6 +60,11 @@ T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0),
         kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
     allow(first, 2, true);
   }
+  allow(kIoConfigCheckForFactory, 2, false);
+  allow(kIoConfigSetBootupToCurrent, 2, true);
+  allow(kIoConfigSetBootupToFactory, 2, true);
+  factory_io_config_ = io_config();
+  set_bootup(factory_io_config_);
   put_float(kT7ProductId, &registers_[kProductId]);
   put_float(1.0299, &registers_[kFirmwareVersion]);
   set_u32(kSerialNumber, 470000000u);
@@ -56,11 +79,35 @@ void T7SimRegisters::wrote(int address, int count) {
       set_u32(kDioState,
               registers_[static_cast<std::size_t>(a)] != 0 ? (u32(kDioState) | bit) : (u32(kDioState) & ~bit));
     }
+    // The UINT32 commands act on the write of their second register (a write of both, as LJM makes it).
+    if (a == kIoConfigSetBootupToCurrent + 1 && u32(kIoConfigSetBootupToCurrent) == 1) set_bootup(io_config());
+    if (a == kIoConfigSetBootupToFactory + 1 && u32(kIoConfigSetBootupToFactory) == 1) set_bootup(factory_io_config_);
     if (a == kAinAllResolutionIndex) {
       for (int n = 0; n < kAinCount; ++n)
         registers_[static_cast<std::size_t>(kAinResolutionIndex(n))] = registers_[static_cast<std::size_t>(a)];
     }
   }
+}
+
+std::vector<std::uint16_t> T7SimRegisters::io_config() const {
+  std::vector<std::uint16_t> values;
+  for (const auto& [first, count] : io_config_blocks()) {
+    values.insert(values.end(), registers_.begin() + first, registers_.begin() + first + count);
+  }
+  return values;
+}
+
+void T7SimRegisters::set_io_config(const std::vector<std::uint16_t>& values) {
+  auto from = values.begin();
+  for (const auto& [first, count] : io_config_blocks()) {
+    std::copy(from, from + count, registers_.begin() + first);
+    from += count;
+  }
+}
+
+void T7SimRegisters::set_bootup(const std::vector<std::uint16_t>& values) {
+  bootup_io_config_ = values;
+  set_u32(t7::kIoConfigCheckForFactory, bootup_io_config_ == factory_io_config_ ? 1u : 0u);
 }
 
 void T7SimRegisters::allow(int first, int count, bool writable) {
@@ -112,18 +159,16 @@ bool T7SimRegisters::run_watchdog(double now_s) {
   const double timeout = static_cast<double>(std::max<std::uint32_t>(1, watchdog_timeout_s()));
   if (now_s - last_answer_s_ < timeout) return false;
   last_answer_s_ = now_s;  // it acts again after another timeout of silence
-  if (u32(kWatchdogAdvanced) == kWatchdogAdvancedIoConfigToDefault || u32(kWatchdogResetEnable) == 1) {
-    for (int dio = 0; dio < kDioCount; ++dio) set_u32(kDioEfEnable(dio), 0);  // power-up: no EF, no clock, all inputs
-    for (int clock = 0; clock < 3; ++clock) registers_[static_cast<std::size_t>(kClockEnable(clock))] = 0;
-    set_u32(kDioDirection, 0);
-    set_u32(kDioState, 0);
+  // A restart comes up in the power-up defaults, as the second advanced action restores them.
+  if (u32(kWatchdogResetEnable) == 1 || u32(kWatchdogAdvanced) == kWatchdogAdvancedIoConfigToBootup) {
+    set_io_config(bootup_io_config_);
+  } else if (u32(kWatchdogAdvanced) == kWatchdogAdvancedIoConfigToFactory) {
+    set_io_config(factory_io_config_);  // no EF, no clock, every line an input
   }
   if (u32(kWatchdogDioEnable) == 1) {
+    // Direction and state only: a line an EF still drives keeps its PWM (see the header).
     const std::uint32_t direction =
         u32(kWatchdogDioDirection) & ~u32(kWatchdogDioInhibit);  // inhibited lines are left alone
-    for (int dio = 0; dio < kDioCount; ++dio) {
-      if ((direction & (1u << dio)) != 0) set_u32(kDioEfEnable(dio), 0);  // a line the watchdog sets is a plain output
-    }
     set_u32(kDioDirection, u32(kDioDirection) | direction);
     set_u32(kDioState, (u32(kDioState) & ~direction) | (u32(kWatchdogDioState) & direction));
   }

@@ -5,9 +5,14 @@
 //   What a T7 refuses beyond addresses: devices/t7_sim_rules.hpp.
 // - A line's output: PWM (EF enabled, index 0, clock 0 enabled) at CONFIG_A / roll; else an output
 //   at its DIO_STATE bit; else an input, which the valve driver's pull-down reads as closed.
+// - The IO configuration (AIN, DIO, DIO_EF and its clocks) has the factory's values and the power-up
+//   defaults, which IO_CONFIG_SET_BOOTUP_TO_CURRENT saves from the current values (as Kipling's "save
+//   as power-up defaults" does, PWM and all) and IO_CONFIG_SET_BOOTUP_TO_FACTORY resets.
 // - The watchdog counts from the last answered request; on timeout it resets the IO configuration
-//   to its power-up defaults (every EF off, every line an input) when WATCHDOG_ADVANCED_DEFAULT
-//   asks for it, then sets the lines WATCHDOG_DIO_DIRECTION/STATE_DEFAULT name, and starts over.
+//   as WATCHDOG_ADVANCED_DEFAULT asks (1 the factory's: every EF off, every line an input; 2, or
+//   the reset action, the power-up defaults), then sets the lines WATCHDOG_DIO_DIRECTION/STATE_DEFAULT
+//   name, and starts over. Whether a T7's Set DIO overrides a line an EF drives is not documented
+//   (docs/labjack-t7.md): here it does not, the unsafe answer, so a safe configuration cannot rely on it.
 #pragma once
 
 #include <cstdint>
@@ -52,8 +57,13 @@ class T7SimRegisters {
 
  private:
   void allow(int first, int count, bool writable);
+  /// The registers of the IO configuration, in order (what IO_CONFIG_* saves and restores).
+  std::vector<std::uint16_t> io_config() const;
+  void set_io_config(const std::vector<std::uint16_t>& values);
+  void set_bootup(const std::vector<std::uint16_t>& values);
 
   std::vector<std::uint16_t> registers_;
+  std::vector<std::uint16_t> factory_io_config_, bootup_io_config_;
   std::vector<std::uint8_t> access_;  // 0 unknown, 1 read only, 2 read-write
   double last_answer_s_ = 0.0;
 };

@@ -332,6 +332,31 @@ TEST(T7Loopback, TheWatchdogVentsWhatASilentClientLeftOpen) {
   EXPECT_LE(s.safe_since_s - s.last_watchdog_action_s, 1.0 / 200.0);
 }
 
+// A lab once saved the power-up defaults with PWM running (Kipling's "save as power-up defaults", or
+// IO_CONFIG_SET_BOOTUP_TO_CURRENT): the watchdog must still vent. Its reset to the power-up defaults
+// (WATCHDOG_ADVANCED_DEFAULT = 2) would bring that PWM back, inlets open; the factory's (1) ends it.
+TEST(T7Loopback, TheWatchdogVentsEvenIfTheLabSavedPwmAsThePowerUpDefaults) {
+  SimThread sim;
+  { T7Device device(device_options(sim.port())); }
+  ModbusClient client("127.0.0.1", sim.port());
+  ASSERT_EQ(client.connect(2.0), "");
+  client.set_response_timeout(1.0);
+  std::uint32_t advanced = 0, factory = 0;
+  ASSERT_TRUE(client.read_u32(t7::kWatchdogAdvanced, advanced));
+  EXPECT_EQ(advanced, t7::kWatchdogAdvancedIoConfigToFactory);
+  ASSERT_TRUE(client.write_u32(t7::kDioEfConfigA(2), 399999));        // inlet_a fully open...
+  ASSERT_TRUE(client.write_u32(t7::kIoConfigSetBootupToCurrent, 1));  // ...saved as the power-up defaults
+  ASSERT_TRUE(client.read_u32(t7::kIoConfigCheckForFactory, factory));
+  EXPECT_EQ(factory, 0u);
+  const int actions_before = sim.status().watchdog_actions;
+  ASSERT_TRUE(eventually([&] { return !sim.status().safe; }));
+  ASSERT_TRUE(eventually([&] { return sim.status().watchdog_actions > actions_before; }));
+  const T7SimStatus s = sim.status();
+  EXPECT_TRUE(s.safe);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kInletA)], 0.0);
+  EXPECT_EQ(s.duty[static_cast<int>(ValveRole::kOutletA)], 1.0);
+}
+
 TEST(T7Loopback, ADeadLinkStopsTheReadingsAndSaysWhichLink) {
   auto sim = std::make_unique<SimThread>();
   T7Device device(device_options(sim->port()));
