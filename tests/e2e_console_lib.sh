@@ -53,7 +53,19 @@ e2e_start() {
     "$program; echo \"EXIT STATUS \$?\"; exec sleep 100000"
 }
 
-e2e_keys() { e2e_tmux send-keys -t console "$@"; }
+# e2e_keys KEYS...: tmux send-keys. An Escape goes alone and is followed by a pause longer than the
+# console's escape delay: Esc with a key right behind it is one Alt+key to the console (ui/terminal.cpp).
+e2e_keys() {
+  if [ "${1:-}" != -l ] && [[ " $* " == *" Escape "* ]]; then
+    local k
+    for k in "$@"; do
+      e2e_tmux send-keys -t console "$k"
+      if [ "$k" = Escape ]; then sleep 0.1; fi
+    done
+    return 0
+  fi
+  e2e_tmux send-keys -t console "$@"
+}
 e2e_screen() { e2e_tmux capture-pane -p -t console; }
 e2e_history() { e2e_tmux capture-pane -p -J -S - -t console; }  # the screen and what scrolled off it
 # e2e_screen_has [GREP OPTIONS] PATTERN, e2e_history_has ...: grep -q on the whole capture. Never

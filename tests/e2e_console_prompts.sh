@@ -49,6 +49,11 @@ prompt() {
   e2e_keys -l -- "$letters"
   wait_text "${letters: -20}_"  # the field's end: the last letters typed, then its cursor
   has_text "$title" || e2e_fail "$title: the prompt closed while letters were typed"
+  # Alt+letters arrive as Esc and the letter at once: one key that does nothing, not an Esc that
+  # closes the prompt and then a command (Alt-r ran a trial, Alt-d disarmed).
+  e2e_keys M-r M-n M-d
+  wait_text "this key does nothing here"
+  has_text "$title" || e2e_fail "$title: an Alt+letter closed the prompt"
   e2e_keys Escape
   wait_gone "$title"
 }

@@ -269,6 +269,71 @@ TEST(UiPrompts, AStatusBelongsToTheScreenItWasSaidOn) {
 
 /// The name prompt on the real session store: a refused name keeps it open; a taken one renames the
 /// directory and the manifest's name, through the store's one rename (`sessions rename`'s).
+// A fault or the emergency stop that closes a prompt while the operator types into it: the keys typed
+// next (the rest of the answer) go to a notice until Enter or Esc, never to the command table. Typed
+// as commands, "Ready" would reset the fault (R), open the arm question (a) and answer it (y).
+TEST(UiPrompts, AFaultOrTheStopThatClosesAPromptTakesTheKeysTypedNextUntilEnter) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('H');  // the heartbeat drill: the engine faults within its heartbeat limit
+  f.key('N');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kAskIterations);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kFault; }, 5.0));
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kInterrupted);
+  EXPECT_TRUE(prompt_has(prompt_screen_text(f.state()), "Closed by the fault heartbeat-lost"))
+      << prompt_screen_text(f.state());
+  type_text(f, "Ready");
+  f.pump_for(0.5);
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kInterrupted);
+  EXPECT_EQ(f.core.state(), EngineState::kFault) << "a key typed after the fault reset or armed";
+  EXPECT_FALSE(f.logged("operator reset"));
+  f.key('q');  // the quit key does not close the notice either: what follows would be commands again
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kInterrupted);
+  f.key(key::kEnter);
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  EXPECT_EQ(f.core.state(), EngineState::kFault);
+
+  f.key('R');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().engine_state == EngineState::kSafe; }));
+  f.arm_valves();
+  const Before before = before_of(f);
+  f.key('N');
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kAskIterations);
+  f.key(' ');  // the emergency stop, from the prompt
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kInterrupted);
+  type_text(f, "rn");
+  f.pump_for(0.5);
+  EXPECT_EQ(f.state().experiment.trials.size(), before.trials) << "a trial ran from a key typed after the stop";
+  EXPECT_FALSE(f.logged("operator run"));
+  f.key(key::kEscape);
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+}
+
+// x while the next trial waits for the last one's save to finish: the trial does not begin.
+TEST(UiPrompts, StopWhileATrialWaitsForTheSaveKeepsItFromBeginning) {
+  ConsoleFixture f;
+  f.arm_valves();
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.idle() && f.console->saves_settled(); }));
+  f.sessions.hold_saves = true;  // the next save runs until released
+  f.key('r');
+  ASSERT_TRUE(f.pump_until([&] { return f.state().experiment.trials.size() == 2u && !f.console->saves_settled(); }));
+  f.key('n');  // learns, then waits for the save before its trial
+  ASSERT_TRUE(f.pump_until([&] {
+    return f.state().run.mode != RunProgress::Mode::kIdle && f.state().run.phase == RunProgress::Phase::kNone &&
+           !f.state().learner_busy;
+  }));
+  ASSERT_EQ(f.state().experiment.trials.size(), 2u);
+  ASSERT_NE(f.core.state(), EngineState::kRunning);
+  f.key('x');
+  f.sessions.hold_saves = false;
+  ASSERT_TRUE(f.pump_until([&] { return f.console->saves_settled(); }));
+  f.pump_for(1.0);
+  EXPECT_EQ(f.state().experiment.trials.size(), 2u) << "the trial began after x";
+  EXPECT_EQ(f.core.state(), EngineState::kArmed);
+  EXPECT_TRUE(f.idle());
+}
+
 TEST(UiPrompts, TheNamePromptChecksTheNameBeforeItCloses) {
   const std::filesystem::path data = bellows::testing::make_temp_dir("bellows-ui-prompts");
   StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(), data.string());

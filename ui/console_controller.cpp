@@ -291,7 +291,7 @@ void ConsoleController::on_event(const EngineEvent& event) {
       log(LogSource::kEngine, format("FAULT %s: %s", fault_name(event.fault), state_.fault_view.detail.c_str()), true,
           event.time_s);
       set_status(format("FAULT %s: %s. R resets.", fault_name(event.fault), state_.fault_view.detail.c_str()), true);
-      state_.dialog = {};
+      interrupt_dialog(format("the fault %s", fault_name(event.fault)));
       state_.screen = Screen::kFault;
       if (stop_pending_ && env_.core->emergency_stop_delivered()) on_emergency_stop_delivered();
       return;
@@ -401,7 +401,7 @@ void ConsoleController::emergency_stop(const std::string& why) {
     valve_test_->abandon("emergency stop");
     show_valve_verdicts();
   }
-  state_.dialog = {};
+  interrupt_dialog("the emergency stop");
   log(LogSource::kOperator, why, true);
   set_status("EMERGENCY STOP requested: venting", true);
 }

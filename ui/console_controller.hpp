@@ -173,6 +173,9 @@ class ConsoleController {
   bool handle_dialog_key(int key);
   bool handle_screen_key(int key);
   void perform(Action action);
+  /// A dialog the operator was answering, closed by `what` (a fault, the emergency stop): replaced by a
+  /// notice that takes the keys typed next until Enter or Esc, so the rest of an answer never runs as commands.
+  void interrupt_dialog(const std::string& what);
   void open_dialog(DialogKind kind, std::string title, std::vector<std::string> text, std::string hint,
                    std::string input = {});
   /// Judges the open prompt's text without closing it (handle_dialog_key closes it when taken).

@@ -72,12 +72,24 @@ void ConsoleController::open_dialog(DialogKind kind, std::string title, std::vec
   state_.dialog = Dialog{kind, std::move(title), std::move(text), std::move(input), std::move(hint), {}};
 }
 
+void ConsoleController::interrupt_dialog(const std::string& what) {
+  const DialogKind kind = state_.dialog.kind;
+  if (kind == DialogKind::kNone || kind == DialogKind::kInterrupted) return;
+  pending_discard_action_ = nullptr;
+  const std::string closed = state_.dialog.title;
+  open_dialog(DialogKind::kInterrupted, "Closed by " + what,
+              {"'" + closed + "' was closed by " + what + ": nothing typed into it was taken.",
+               "What you type now does nothing until Enter or Esc."},
+              "Enter or Esc: continue");
+}
+
 // Every key of an open dialog ends here and nowhere else: a prompt or a question keeps the focus
 // until it takes an answer (Enter with a valid one, or a listed answer key) or Esc; nothing typed
 // into it reaches the command table.
 bool ConsoleController::handle_dialog_key(int k) {
   Dialog& d = state_.dialog;
-  if (k == key::kEscape || (k == 'q' && !is_prompt(d.kind) && d.kind != DialogKind::kConfirmQuit)) {
+  if (k == key::kEscape ||
+      (k == 'q' && !is_prompt(d.kind) && d.kind != DialogKind::kConfirmQuit && d.kind != DialogKind::kInterrupted)) {
     state_.dialog = {};  // back to the screen beneath it
     pending_discard_action_ = nullptr;
     set_status("cancelled");
@@ -112,6 +124,13 @@ bool ConsoleController::handle_dialog_key(int k) {
     return true;
   }
   switch (d.kind) {
+    case DialogKind::kInterrupted:
+      if (k == key::kEnter) {
+        state_.dialog = {};
+      } else {
+        not_an_answer(k);
+      }
+      return true;
     case DialogKind::kConfirmArm:
       answer_yes_no(
           k, [this] { arm(); }, "not armed");

@@ -180,7 +180,12 @@ void ConsoleController::poll_session_tasks() {
     if (!save_task_.busy() && !state_.experiment.unsaved()) {
       if (begin_after_save_) {
         begin_after_save_ = false;
-        begin_trial();
+        // x (or quitting) while the trial waited for the save: it does not begin.
+        if (state_.run.stop_requested || quit_after_save_) {
+          end_run("stopped: the trial that waited for the save did not begin", false);
+        } else {
+          begin_trial();
+        }
       }
       if (quit_after_save_) {
         quit_after_save_ = false;

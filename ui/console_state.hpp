@@ -31,6 +31,7 @@ enum class DialogKind {
   kConfirmValveTest,  // y/n: the valves open one by one, the arm moves
   kConfirmZeroAngle,  // y/n: the angle read now becomes the rig profile's zero (its file is written)
   kSessionName,       // a name for the session saved as the console goes
+  kInterrupted,       // a fault or the emergency stop closed the dialog being answered: Enter or Esc
 };
 
 struct Dialog {

@@ -1,6 +1,7 @@
 #include "ui/terminal.hpp"
 
 #include <langinfo.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -191,6 +192,14 @@ Terminal::Terminal(bool allow_colors) {
   screen_ = screen;
   set_term(screen);
   cbreak();
+  // No XON/XOFF flow control: Ctrl-S would stop the output, the UI thread would block writing the
+  // screen, its heartbeats would stop and the engine would fault. Ctrl-S and Ctrl-Q become keys.
+  termios modes{};
+  if (tcgetattr(STDIN_FILENO, &modes) == 0) {
+    modes.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF);
+    tcsetattr(STDIN_FILENO, TCSANOW, &modes);
+    def_prog_mode();  // ncurses restores these modes, not its own copy, after a repaint
+  }
   noecho();
   nonl();
   keypad(stdscr, TRUE);
@@ -229,6 +238,16 @@ int Terminal::read_key(int timeout_ms) {
   wtimeout(stdscr, timeout_ms);
   wint_t ch = 0;
   const int status = wget_wch(stdscr, &ch);
+  if (status == OK && ch == 27) {
+    // Esc with more input already behind it is Alt+key or an escape sequence ncurses does not know
+    // (a function key split on a slow link): all of it is one key the console has no use for. Read
+    // as Esc and then letters, it would close a prompt and run the letters as commands.
+    wtimeout(stdscr, 0);
+    bool more = false;
+    wint_t next = 0;
+    while (wget_wch(stdscr, &next) != ERR) more = true;
+    if (more) return key::kOther;
+  }
   return translate(status, ch);
 }
 
