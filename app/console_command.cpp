@@ -119,7 +119,7 @@ int console_command(const ConsoleOptions& options, std::ostream& out) {
 
   Device& device = rig->device();
   EngineCore core(device, config.controller, config.timing, config.safety);
-  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP vent at once, from the handler
+  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP/SIGQUIT vent at once, from the handler
   RealtimeLoop loop(core, device, speed);
   SimulatedClock simulated_clock(core, device);  // --clock sim: the UI thread ticks it (as bellows run does)
   setup.core = &core;

@@ -161,7 +161,7 @@ int run_command(const RunOptions& given_options, std::ostream& out, std::ostream
   Device& device = io.device();
   SimulatedArm* arm = io.simulated_arm();
   EngineCore core(device, config.controller, config.timing, config.safety);
-  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP latch the emergency stop at once
+  const StopSignalTarget stop_target(core);  // SIGINT/SIGTERM/SIGHUP/SIGQUIT latch the emergency stop at once
   io.add_telemetry_tap(core);
   const RunIo::StopOnExit stop_io(io);  // before `core` (and its telemetry tap) goes
   std::unique_ptr<EngineDriver> driver;

@@ -25,7 +25,9 @@ void install_stop_signal_handlers() {
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
-  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal_number, &action, nullptr);
+  // SIGQUIT too: Ctrl-\ would otherwise end the process at once, the valves as they were (on a T7 until its
+  // watchdog acts), the session's last save not made and the terminal left in the console's modes.
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaction(signal_number, &action, nullptr);
 }
 
 const std::atomic<bool>& stop_requested() { return g_stop; }
@@ -39,6 +41,8 @@ const char* stop_signal_name() {
       return "SIGTERM";
     case SIGHUP:
       return "SIGHUP";
+    case SIGQUIT:
+      return "SIGQUIT";
     case 0:
       return "no signal";
   }

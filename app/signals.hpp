@@ -1,4 +1,4 @@
-// SIGINT, SIGTERM and SIGHUP (the terminal closed, an ssh session dropped) stop the program the
+// SIGINT, SIGTERM, SIGHUP (the terminal closed, an ssh session dropped) and SIGQUIT (Ctrl-\) stop the program the
 // same way: the handler latches the engine's emergency stop at once (the next tick vents, whatever
 // the command queue holds) and sets a flag that the operator side polls to save, report and exit
 // with 128 + signal. Install before starting any thread, so that threads inherit the mask choices.
@@ -11,11 +11,11 @@ namespace bellows {
 class EngineCore;
 
 void install_stop_signal_handlers();
-/// Set once SIGINT, SIGTERM or SIGHUP arrived.
+/// Set once SIGINT, SIGTERM, SIGHUP or SIGQUIT arrived.
 const std::atomic<bool>& stop_requested();
 /// The signal that arrived (0 if none), for the exit status 128 + signal.
 int stop_signal();
-/// "SIGINT", "SIGTERM", "SIGHUP" (or "signal N").
+/// "SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT" (or "a signal").
 const char* stop_signal_name();
 
 /// While alive, a stop signal latches `core`'s emergency stop from the handler itself.

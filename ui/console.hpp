@@ -24,7 +24,7 @@ struct ConsoleSetup {
   ConsoleEnvironment environment;  // core, telemetry and latency are filled in here
   Trajectory trajectory;
   std::optional<SessionSnapshot> session;        // open this saved session at start
-  const std::atomic<bool>* stop_flag = nullptr;  // set by SIGINT/SIGTERM/SIGHUP
+  const std::atomic<bool>* stop_flag = nullptr;  // set by SIGINT/SIGTERM/SIGHUP/SIGQUIT
   double exit_after_s = 0.0;                     // > 0: quit by itself after this long (benchmarks, tests)
   bool allow_colors = true;
 };
