@@ -78,6 +78,9 @@ class SimulatedTime {
 
 ConsoleReport run_console(ConsoleSetup setup) {
   std::setlocale(LC_ALL, "");
+  // Numbers are read, shown and written with a decimal point whatever the operator's locale: a
+  // decimal comma would refuse "0.45" in the prompts and write "t=6363,415" into the session's log.
+  std::setlocale(LC_NUMERIC, "C");
   const bool unicode = locale_is_utf8();
 
   ConsoleEnvironment env = std::move(setup.environment);

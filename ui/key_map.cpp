@@ -235,7 +235,9 @@ std::vector<std::pair<std::string, std::string>> screen_keys(Screen screen) {
     case Screen::kTrajectory:
       return {{"Up/Down", "choose; the preview follows"}, {"Enter", "use it (the file entry asks for a path)"}};
     case Screen::kTuning:
-      return {{"Up/Down", "choose a value"}, {"Enter", "change it (between trials; recorded in the log)"}};
+      return {{"Up/Down", "choose a value"},
+              {"Enter", "change it (between trials; recorded in the log)"},
+              {"Left/Right", "on the law row: the previous / next learning law"}};
     case Screen::kSessions:
       return {{"Up/Down", "choose a session"}, {"Enter", "open it"}};
     case Screen::kLog:
@@ -293,6 +295,15 @@ std::vector<HelpEntry> help_entries(const ConsoleState& s) {
   out.push_back({true, "", "Everywhere (greyed: not available now)", {}});
   for (const KeyBinding& b : key_bindings())
     out.push_back({false, b.key_label, b.description, availability(b.action, s)});
+  out.push_back({false, "Ctrl-L", "repaint the whole screen (also in prompts and questions)", {}});
+  out.push_back({true, "", "In a prompt or a question (every key goes to it; Space still stops)", {}});
+  for (const auto& [k, what] : std::vector<std::pair<std::string, std::string>>{
+           {"Enter", "take the answer (refused: the prompt stays open, what was typed kept, and says why)"},
+           {"Backspace", "delete the last character typed"},
+           {"Ctrl-U", "clear the field"},
+           {"Esc", "cancel: back to the screen beneath, nothing done"},
+           {"y / n", "answer a question (quitting: q or y quits, s saves first)"}})
+    out.push_back({false, k, what, {}});
   for (Screen screen : {Screen::kMain, Screen::kInspector, Screen::kTrajectory, Screen::kTuning, Screen::kSessions,
                         Screen::kLog, Screen::kFault, Screen::kRig, Screen::kHelp}) {
     if (screen != from || from == Screen::kMain) add_screen(screen, screen_title(screen));
