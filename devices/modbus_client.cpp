@@ -198,6 +198,7 @@ int ModbusClient::receive_frame(double deadline) {
       return -1;
     }
     rx_size_ += static_cast<std::size_t>(n);
+    last_receive_s_ = monotonic_seconds();
   }
 }
 
@@ -313,6 +314,7 @@ bool ModbusClient::take_late_read(std::uint16_t* registers) {
     const ssize_t n = ::recv(fd_, rx_.data() + rx_size_, rx_.size() - rx_size_, MSG_DONTWAIT);
     if (n > 0) {
       rx_size_ += static_cast<std::size_t>(n);
+      last_receive_s_ = monotonic_seconds();
       continue;
     }
     if (n == 0) {

@@ -74,6 +74,9 @@ class ModbusClient {
   std::uint64_t late_answers() const { return late_answers_; }
   /// Answers to timed-out reads that take_late_read() handed over since the start.
   std::uint64_t late_reads_taken() const { return late_reads_taken_; }
+  /// When bytes last came from the T7 (monotonic_seconds(); -infinity before any): an answer in time,
+  /// a late one or a part of one. A T7 that answers late is heard; a dead one is not.
+  double last_receive_s() const { return last_receive_s_; }
   /// Connections opened again after one was lost.
   std::uint64_t reconnects() const { return reconnects_; }
 
@@ -104,6 +107,7 @@ class ModbusClient {
   bool interrupted_ = false;
   std::uint64_t late_answers_ = 0;
   std::uint64_t late_reads_taken_ = 0;
+  double last_receive_s_ = -std::numeric_limits<double>::infinity();
   struct LateRead {
     bool pending = false;  // the last request was a read that timed out, its answer not yet seen
     std::uint16_t tid = 0;

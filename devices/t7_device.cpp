@@ -157,7 +157,7 @@ void T7Device::serve() {
     if (fresh || now >= next_idle_s) {
       exchange(current);
       next_idle_s = now + 2.0 * options_.tick_s;
-    } else if (client_.take_late_read(ain_buffer_.data())) {
+    } else if (take_late_read()) {
       // The read of an exchange that missed its deadline answered after all: hand it over, it is
       // usually in time for the next tick, which then holds nothing.
       late_readings_.store(client_.late_reads_taken(), std::memory_order_release);
@@ -169,6 +169,12 @@ void T7Device::serve() {
     }
   }
   exchange(ValveCommand::vented());  // the last word: vented, whatever the engine last asked for
+}
+
+bool T7Device::take_late_read() {
+  const bool taken = client_.take_late_read(ain_buffer_.data());
+  heard_s_.store(client_.last_receive_s(), std::memory_order_release);
+  return taken;
 }
 
 void T7Device::encode_duties(const ValveCommand& valves) {
@@ -190,6 +196,7 @@ bool T7Device::exchange(const ValveCommand& valves) {
   ok = ok && client_.read(t7::kAin(0), ain_registers_, ain_buffer_.data());
   client_.clear_deadline();
   const double end = now_s();
+  heard_s_.store(client_.last_receive_s(), std::memory_order_release);
   late_answers_.store(client_.late_answers(), std::memory_order_relaxed);
   reconnects_.store(client_.reconnects(), std::memory_order_relaxed);
   if (!ok) {
@@ -332,6 +339,15 @@ bool T7Device::take_fault(DeviceFault& fault) {
 void T7Device::explain_silence(double silent_s, DeviceFault& fault) const {
   if (link_answers()) {
     Device::explain_silence(silent_s, fault);
+    return;
+  }
+  // Bytes came from it within the window (as LcmDevice judges a rig): it answers, late; a dead T7 sends none.
+  if (now_s() - heard_s_.load(std::memory_order_acquire) < 0.5 * silent_s) {
+    fault.set(FaultCode::kSensorStale, -1,
+              "the T7 at %s answers, but late: no reading within [t7] response_timeout_s = %.1f ms for %.0f ms (%llu "
+              "late answers): check the network and the inputs' read time",
+              address_.c_str(), options_.link.response_timeout_s * 1e3, silent_s * 1e3,
+              static_cast<unsigned long long>(late_answers_.load(std::memory_order_relaxed)));
     return;
   }
   fault.set(FaultCode::kLinkLost, -1, "the T7 at %s has answered nothing for %.0f ms: check its power and cable",

@@ -76,8 +76,9 @@ class T7Device final : public Device {
   /// A request the T7 refused during the run reaches the engine as `device-error`, naming the
   /// register and LabJack's error (take_refusal). Engine thread; allocates nothing.
   bool take_fault(DeviceFault& fault) override;
-  /// Silent for the stale limit: `link-lost` naming the address when the link answered nothing
-  /// (down, not only late), else the default `sensor-stale`.
+  /// Silent for the stale limit: `link-lost` naming the address when nothing at all came from the T7
+  /// for (half) that time; `sensor-stale` "answers, but late" when bytes came but no answer in time;
+  /// else the default `sensor-stale`.
   void explain_silence(double silent_s, DeviceFault& fault) const override;
   /// "host:port".
   const std::string& address() const { return address_; }
@@ -128,6 +129,8 @@ class T7Device final : public Device {
   /// The reading in ain_buffer_, answered at `end` (steady clock), to the engine.
   void publish_reading(double end);
   void encode_duties(const ValveCommand& valves);
+  /// client_.take_late_read() into ain_buffer_, noting what was heard.
+  bool take_late_read();
   void record_round_trip(double ms);
   void fail_link(const std::string& why);
 
@@ -165,6 +168,7 @@ class T7Device final : public Device {
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
   std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0},
       late_readings_{0};
+  std::atomic<double> heard_s_{-1e300};  // the client's last_receive_s(), copied by the I/O thread
 };
 
 }  // namespace bellows

@@ -250,6 +250,28 @@ TEST_F(T7Processes, ATricklingLinkEndsTheRunVentedWithinTheStaleLimitAndOneRespo
   EXPECT_TRUE(report.contains("fault")) << run.out();
 }
 
+// A T7 whose answers all come, each after its deadline (one byte every 2 ms: a whole answer takes tens
+// of ms against a 20 ms deadline): the run faults, named for what happened, sensor-stale "answers, but
+// late"; never link-lost, which tells the operator to check the T7's power and cable.
+TEST_F(T7Processes, AT7ThatAnswersLateIsNamedLateNotLost) {
+  auto sim = start_sim({"--trickle-after", "1.5", "--trickle-byte-s", "0.002"});
+  const std::filesystem::path config = testing::write_file(
+      dir_, "late.toml",
+      "[t7]\nresponse_timeout_s = 0.02\n[safety]\nstale_ticks = 100\nmissed_deadline_streak = 100000\n");
+  Child run({kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config", config.string(),
+             "--iterations", "3", "--json", "--no-save"},
+            dir_ / "run.out", dir_ / "run.err");
+  ASSERT_TRUE(wait_for([&] { return sim->out().find("answers trickle from now on") != std::string::npos; }))
+      << sim->out() << "\nbellows run: " << run.err();
+  ASSERT_EQ(run.wait(30.0), 3) << run.err();
+  const nlohmann::json report = nlohmann::json::parse(run.out());
+  EXPECT_EQ(report.at("fault").at("name"), "sensor-stale") << report.dump();
+  EXPECT_NE(report.at("fault").at("message").get<std::string>().find("the T7 at " + address_ + " answers, but late"),
+            std::string::npos)
+      << report.dump();
+  EXPECT_EQ(run.err().find("link-lost"), std::string::npos) << run.err();
+}
+
 // SIGINT 3 s into connecting to a device that answers each request after 1.5 s: the command ends at
 // once, 128 + SIGINT, nothing armed; without the signal the connect gives up within
 // [t7] connect_timeout_s + 1 s, in one line naming the address.
