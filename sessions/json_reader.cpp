@@ -1,5 +1,6 @@
 #include "sessions/json_reader.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -7,7 +8,40 @@
 
 namespace bellows {
 
+namespace {
+
+// A manifest nests a few levels; a hostile one nested 100 000 deep parses, but copying it recurses
+// once a level (nlohmann) and overflows the stack of whoever reads it: show, list, the console.
+constexpr int kMaxJsonDepth = 64;
+
+/// The deepest nesting of arrays and objects in `text` (strings skipped).
+int json_depth(std::string_view text) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > kMaxJsonDepth) return deepest;  // no need to read on
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+}  // namespace
+
 nlohmann::ordered_json parse_json(std::string_view text, const std::string& source) {
+  if (json_depth(text) > kMaxJsonDepth) {
+    throw InputError(source + ": not valid here: arrays and objects nested more than " + std::to_string(kMaxJsonDepth) +
+                     " levels deep");
+  }
   try {
     return nlohmann::ordered_json::parse(text);
   } catch (const nlohmann::json::exception& error) {

@@ -155,10 +155,14 @@ std::string session_name_refusal(const std::string& name, const fs::path& parent
 fs::path rename_session(const fs::path& directory, const std::string& new_name) {
   const fs::path parent = directory.parent_path();
   if (const std::string why = session_name_refusal(new_name, parent); !why.empty()) throw InputError(why);
-  SessionManifest manifest = load_manifest(directory);
+  // The lock first, then the manifest through the same handle: read before the lock, a manifest that a
+  // run committed in between would be written back older, and its newest iterations taken for the
+  // leftovers of an interrupted save (and deleted) by the next resume.
+  const DirectoryHandle handle = open_session_directory(directory);
+  const SessionLock lock(handle, "bellows sessions rename");  // not while a run or a console writes it
+  SessionManifest manifest = load_manifest(handle);
   // Not const: returned, so moved out.
   fs::path target = parent / new_name;
-  const SessionLock lock(directory, "bellows sessions rename");  // not while a run or a console writes it
   std::error_code error;
   fs::rename(directory, target, error);
   if (error)

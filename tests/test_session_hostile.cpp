@@ -296,6 +296,27 @@ TEST_F(HostileSession, TextFromASessionReachesTheTerminalEscapedAndShortened) {
   EXPECT_LT(refused.err.size(), 5000u);
 }
 
+// A manifest nested 100 000 levels deep (a few hundred kB) parses, but copying it recursed once a
+// level and overflowed the stack: `sessions show` and `list` died with SIGSEGV, and the console's
+// browser would have taken the console with it. Refused in one line naming the file; the listing
+// goes on past it.
+TEST_F(HostileSession, AManifestNestedTooDeepIsRefusedNotACrash) {
+  const fs::path data = dir_ / "data";
+  save_session(testing::simulate_session(1), data / "deep");
+  save_session(testing::simulate_session(1), data / "fine");
+  Json manifest = read_manifest(data / "deep");
+  manifest["device_info"]["x"] = "DEEP";
+  write_manifest(data / "deep", manifest);
+  std::string text = testing::read_text(data / "deep" / "manifest.json");
+  text.replace(text.find("\"DEEP\""), 6, std::string(100000, '[') + std::string(100000, ']'));
+  testing::write_text(data / "deep" / "manifest.json", text);
+
+  expect_refused(run_bellows({"sessions", "show", (data / "deep").string()}), "nested more than 64 levels deep");
+  const ProcessResult listed = run_bellows({"sessions", "list", "--data-dir", data.string()});
+  EXPECT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_NE(listed.out.find("fine"), std::string::npos) << listed.out;
+}
+
 /// `text` with every line end CR LF and a byte order mark in front.
 std::string windows_text(const std::string& text, bool byte_order_mark) {
   std::string out = byte_order_mark ? "\xef\xbb\xbf" : "";
