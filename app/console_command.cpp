@@ -56,6 +56,22 @@ void take_rig_of_session(const std::string& session_dir, const ConsoleOptions& o
                      config.arm.name() + "' (leave [arm] out to reopen it on its own arm)");
   }
   config.arm = recorded;
+  // And its ticks: telemetry of other ticks would not fit the session's files (ui adopt() refuses it).
+  const TimingParameters& timing = manifest.configuration.timing;
+  const auto format_number = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return std::string(text);
+  };
+  if (!options.config_path.empty() &&
+      (config.timing.tick_s != timing.tick_s || config.timing.ticks_per_sample != timing.ticks_per_sample)) {
+    throw InputError("session " + directory.string() +
+                     " was recorded at [timing] tick_s = " + format_number(timing.tick_s) + " s, ticks_per_sample = " +
+                     std::to_string(timing.ticks_per_sample) + "; --config has " + format_number(config.timing.tick_s) +
+                     " s, " + std::to_string(config.timing.ticks_per_sample) + " (set them as recorded to reopen it)");
+  }
+  config.timing.tick_s = timing.tick_s;
+  config.timing.ticks_per_sample = timing.ticks_per_sample;
 }
 
 }  // namespace

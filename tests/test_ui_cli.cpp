@@ -33,5 +33,20 @@ TEST(UiCli, ABadConfigurationIsRefusedWithItsKey) {
   expect_refused_in_one_line("console --config " + config.string(), "k_p");
 }
 
+// A session recorded at other ticks cannot be continued under a --config of these: its telemetry
+// would not fit the session's files (ConsoleController::adopt refuses the same from the browser).
+TEST(UiCli, ASessionOfOtherTicksIsRefusedWithItsTicks) {
+  const auto dir = testing::make_temp_dir("bellows-ui-cli");
+  const auto slow = testing::write_file(dir, "slow.toml", "[timing]\ntick_s = 0.01\nticks_per_sample = 2\n");
+  const auto other = testing::write_file(dir, "other.toml", "[controller]\nk_p = 0.3\n");
+  const std::string data = (dir / "data").string();
+  ASSERT_EQ(run_process(testing::kBellows + " run --config " + slow.string() + " --iterations 0 --data-dir " + data +
+                        " --name s")
+                .exit_code,
+            0);
+  expect_refused_in_one_line("console --session " + data + "/s --config " + other.string(),
+                             "was recorded at [timing] tick_s = 0.01 s, ticks_per_sample = 2; --config has 0.005 s, 4");
+}
+
 }  // namespace
 }  // namespace bellows

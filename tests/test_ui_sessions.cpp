@@ -241,6 +241,37 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
   }
 }
 
+// A session recorded at other ticks with the same sample time (0.01 s x 2 against the console's
+// 0.005 s x 4) is not continued: its trials' telemetry would be of another shape than the session's,
+// and every later show, export and resume would refuse the whole session.
+TEST_F(UiSessions, ASessionOfOtherTicksIsNotOpened) {
+  std::string location;
+  {
+    Configuration slow;
+    slow.timing.tick_s = 0.01;
+    slow.timing.ticks_per_sample = 2;
+    StoreSessionGateway gateway("sim");
+    ConsoleFixture f(slow, 3, &gateway);
+    f.arm_valves();
+    f.key('r');
+    ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
+    save_and_wait(f);
+    location = f.state().experiment.session_location;
+  }
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(Configuration{}, 3, &gateway);
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('o');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
+  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  f.key(ui::key::kEnter);
+  ASSERT_TRUE(f.pump_until([&] { return f.logged("open failed"); }));
+  EXPECT_TRUE(f.logged("recorded at [timing] tick_s = 0.01 s, ticks_per_sample = 2; this console runs 0.005 s, 4"));
+  EXPECT_TRUE(f.state().experiment.trials.empty());
+  EXPECT_NE(f.state().experiment.session_location, location);
+  EXPECT_EQ(load_manifest(location).iterations.size(), 1u);
+}
+
 TEST_F(UiSessions, NamingRenamesTheSessionAndSavingGoesOnThere) {
   StoreSessionGateway gateway("sim", nlohmann::ordered_json::object(),
                               (data_home_ / "elsewhere").string());  // --data-dir

@@ -256,6 +256,16 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
     throw InputError(format("the session was recorded with a sample time of %g s, this console runs %g s",
                             e.trajectory->sample_time_s, env_.config.timing.sample_s()));
   }
+  // The same sample time from other ticks would save telemetry of another shape than the session's
+  // (tick_s x ticks_per_sample rows a trial): every later show, export and resume would refuse it.
+  const TimingParameters& recorded = snapshot.config.timing;
+  if (std::abs(recorded.tick_s - env_.config.timing.tick_s) > 1e-12 ||
+      recorded.ticks_per_sample != env_.config.timing.ticks_per_sample) {
+    throw InputError(format(
+        "the session was recorded at [timing] tick_s = %g s, ticks_per_sample = %d; this console "
+        "runs %g s, %d",
+        recorded.tick_s, recorded.ticks_per_sample, env_.config.timing.tick_s, env_.config.timing.ticks_per_sample));
+  }
   if (!at_start && (valves_live(state_.engine_state) || state_.run.mode != RunProgress::Mode::kIdle)) {
     throw InputError("disarm before opening a session");
   }
