@@ -182,6 +182,41 @@ TEST(UiPrompts, EveryQuestionTakesOnlyItsAnswers) {
   }
 }
 
+// Armed, a trajectory that starts elsewhere moves the arm at once (the engine holds its start, and
+// the arm question promised the old one): the console asks first, naming both starts; no leaves the
+// trajectory and the hold, yes moves the arm there.
+TEST(UiPrompts, ATrajectoryStartingElsewhereAsksBeforeTheArmMoves) {
+  const std::filesystem::path dir = bellows::testing::make_temp_dir("bellows-ui-prompts");
+  std::string text = "time_s,angle_deg\n";
+  for (int k = 0; k <= 100; ++k) text += format("%.2f,40\n", k * 0.02);
+  const std::filesystem::path far = bellows::testing::write_file(dir, "far.csv", text);
+  ConsoleFixture f;
+  f.arm_valves();
+  to_file_entry(f);
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
+  f.type(far.string());
+  f.key(key::kEnter);  // the preview
+  ASSERT_TRUE(f.state().chooser.preview) << f.state().chooser.preview_error;
+  expect_question_keeps_focus(
+      f, DialogKind::kConfirmStartMove, [&] { f.key(key::kEnter); }, "yYnNq");
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmStartMove);
+  EXPECT_TRUE(prompt_has(prompt_screen_text(f.state()), "0.0 -> 40.0 deg")) << prompt_screen_text(f.state());
+  f.key('n');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  EXPECT_EQ(f.state().experiment.trajectory->name, "paper");
+  f.pump_for(1.0);
+  EXPECT_NEAR(f.state().strip.angle_deg.back(), 0.0, 3.0) << "the arm moved after no";
+  f.key(key::kEnter);
+  ASSERT_EQ(f.state().dialog.kind, DialogKind::kConfirmStartMove);
+  f.key('y');
+  EXPECT_EQ(f.state().dialog.kind, DialogKind::kNone);
+  EXPECT_EQ(f.state().experiment.samples(), 100);
+  f.pump_for(3.0);
+  EXPECT_NEAR(f.state().strip.angle_deg.back(), 40.0, 3.0);
+}
+
 TEST(UiPrompts, QuitAsksWhileTheValvesAreLiveAndTheEngineGoesOnUntilYes) {
   ConsoleFixture f;
   f.arm_valves();

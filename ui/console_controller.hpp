@@ -190,6 +190,8 @@ class ConsoleController {
   void open_trajectory_chooser();
   void preview_selected_trajectory();
   void use_trajectory(const std::shared_ptr<const Trajectory>& trajectory);
+  /// use_trajectory() once the arm may move: asks to discard unsaved work, then selects it.
+  void choose_trajectory(const std::shared_ptr<const Trajectory>& trajectory);
   /// Empty when applied; otherwise why not (nothing changed).
   std::string apply_tuning(int field, const std::string& text);
   /// The next (+1) or previous (-1) learning law; the law is rebuilt and the change logged.
@@ -250,6 +252,7 @@ class ConsoleController {
   bool rebuild_pending_ = false;
   int law_samples_ = 0;
   std::function<void()> pending_discard_action_;
+  std::function<void()> pending_move_action_;  // kConfirmStartMove: choosing the trajectory, after a yes
 
   long long action_sent_at_tick_ = -1;  // engine ticks when the last state-changing command was sent
   void note_action_sent() { action_sent_at_tick_ = static_cast<long long>(env_.core->ticks()); }

@@ -76,6 +76,7 @@ void ConsoleController::interrupt_dialog(const std::string& what) {
   const DialogKind kind = state_.dialog.kind;
   if (kind == DialogKind::kNone || kind == DialogKind::kInterrupted) return;
   pending_discard_action_ = nullptr;
+  pending_move_action_ = nullptr;
   const std::string closed = state_.dialog.title;
   open_dialog(DialogKind::kInterrupted, "Closed by " + what,
               {"'" + closed + "' was closed by " + what + ": nothing typed into it was taken.",
@@ -92,6 +93,7 @@ bool ConsoleController::handle_dialog_key(int k) {
       (k == 'q' && !is_prompt(d.kind) && d.kind != DialogKind::kConfirmQuit && d.kind != DialogKind::kInterrupted)) {
     state_.dialog = {};  // back to the screen beneath it
     pending_discard_action_ = nullptr;
+    pending_move_action_ = nullptr;
     set_status("cancelled");
     return true;
   }
@@ -131,6 +133,18 @@ bool ConsoleController::handle_dialog_key(int k) {
         not_an_answer(k);
       }
       return true;
+    case DialogKind::kConfirmStartMove: {
+      auto action = std::move(pending_move_action_);
+      pending_move_action_ = nullptr;
+      if (!answer_yes_no(
+              k,
+              [&action] {
+                if (action) action();
+              },
+              "trajectory unchanged: the arm holds where it was"))
+        pending_move_action_ = std::move(action);
+      return true;
+    }
     case DialogKind::kConfirmArm:
       answer_yes_no(
           k, [this] { arm(); }, "not armed");

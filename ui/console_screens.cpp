@@ -289,6 +289,32 @@ void ConsoleController::use_trajectory(const std::shared_ptr<const Trajectory>& 
     state_.screen = Screen::kMain;
     return;
   }
+  // Armed, the engine holds the new trajectory's start at once: the arm moves. The arm question
+  // promised the old start, so a new one is asked for (naming both) before anything changes.
+  const std::shared_ptr<const Trajectory> old = state_.experiment.trajectory;
+  if (valves_live(state_.engine_state) && old != nullptr && old->joints() == trajectory->joints()) {
+    double largest_deg = 0.0;
+    std::string moves;
+    for (int j = 0; j < trajectory->joints(); ++j) {
+      const double from_deg = old->joint(j)(0) * kDegPerRad;
+      const double to_deg = trajectory->joint(j)(0) * kDegPerRad;
+      largest_deg = std::max(largest_deg, std::abs(to_deg - from_deg));
+      moves += format("%s%.1f -> %.1f deg", j == 0 ? "" : ", ", from_deg, to_deg);
+    }
+    // Within the tolerance a trial's hold counts as at its start ([timing] settle_tolerance_deg): no move.
+    if (largest_deg > state_.config.timing.settle_tolerance_deg) {
+      pending_move_action_ = [this, trajectory] { choose_trajectory(trajectory); };
+      open_dialog(DialogKind::kConfirmStartMove, "Move the arm to the new start?",
+                  {"The valves are live: the arm moves at once to the start of " + trajectory->name,
+                   "and holds it with the PID (" + moves + ")."},
+                  "y move   n or Esc cancel");
+      return;
+    }
+  }
+  choose_trajectory(trajectory);
+}
+
+void ConsoleController::choose_trajectory(const std::shared_ptr<const Trajectory>& trajectory) {
   confirm_discard("the trajectory " + trajectory->name, [this, trajectory] {
     const int old_samples = state_.experiment.samples();
     select_trajectory(trajectory);

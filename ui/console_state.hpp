@@ -32,6 +32,7 @@ enum class DialogKind {
   kConfirmZeroAngle,  // y/n: the angle read now becomes the rig profile's zero (its file is written)
   kSessionName,       // a name for the session saved as the console goes
   kInterrupted,       // a fault or the emergency stop closed the dialog being answered: Enter or Esc
+  kConfirmStartMove,  // y/n: armed, another trajectory's start moves the arm at once
 };
 
 struct Dialog {
