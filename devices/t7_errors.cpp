@@ -17,6 +17,8 @@ constexpr KnownError kKnownErrors[] = {
     {1203, "LJME_MBE3_ILLEGAL_DATA_VALUE",
      "The device received a value that could not be written to the specified address."},
     {1204, "LJME_MBE4_SLAVE_DEVICE_FAILURE", "The device encountered an error."},
+    {2371, "AIN_SETTLING_INVALID", "Specified settling is greater than device max."},
+    {2375, "AIN_RESOLUTION_INVALID", "Selected resolution is invalid. Valid range is 0-5 for T4 and 0-12 for T7."},
     {2554, "EF_CLOCK_SOURCE_NOT_ENABLED", "Attempted to disable a clock source that is not running."},
     {2558, "EF_32BIT_REQUIRES_BOTH_CLOCK0and1",
      "Both Clock_Source 1 and Clock_Source 2 must be disabled before enabling Clock_Source 0."},

@@ -8,6 +8,8 @@ namespace bellows::t7 {
 
 inline constexpr int kErrorIllegalDataAddress = 1202;       // LJME_MBE2_ILLEGAL_DATA_ADDRESS (exception 2)
 inline constexpr int kErrorIllegalDataValue = 1203;         // LJME_MBE3_ILLEGAL_DATA_VALUE (exception 3)
+inline constexpr int kErrorAinSettlingInvalid = 2371;       // AIN_SETTLING_INVALID ("greater than device max")
+inline constexpr int kErrorAinResolutionInvalid = 2375;     // AIN_RESOLUTION_INVALID ("0-12 for T7")
 inline constexpr int kErrorClockNotEnabled = 2554;          // EF_CLOCK_SOURCE_NOT_ENABLED
 inline constexpr int kErrorClock0NeedsClocks12Off = 2558;   // EF_32BIT_REQUIRES_BOTH_CLOCK0and1
 inline constexpr int kErrorDivisorInvalid = 2559;           // EF_DIVISOR_VALUE_INVALID

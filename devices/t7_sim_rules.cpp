@@ -92,11 +92,11 @@ T7Refusal check_written(const T7SimRegisters& now, const Proposed& p, Product pr
   }
   if ((in_block(a, kAinResolutionIndex(0), 1, kAinCount, n) || a == kAinAllResolutionIndex) &&
       p.u16(a) > max_resolution_index(product)) {
-    return refuse(kExceptionIllegalDataValue, kErrorIllegalDataValue, a, "resolution index %g (this product: 0..%g)",
-                  p.u16(a), max_resolution_index(product));
+    return refuse(kExceptionIllegalDataValue, kErrorAinResolutionInvalid, a,
+                  "resolution index %g (this product: 0..%g)", p.u16(a), max_resolution_index(product));
   }
   if (in_block(a, kAinSettling_us(0), 2, kAinCount, n) && !(p.f32(a) >= 0.0 && p.f32(a) <= kMaxSettling_us)) {
-    return refuse(kExceptionIllegalDataValue, kErrorIllegalDataValue, a, "settling %g us (0..50000)", p.f32(a));
+    return refuse(kExceptionIllegalDataValue, kErrorAinSettlingInvalid, a, "settling %g us (0..50000)", p.f32(a));
   }
   return {};
 }

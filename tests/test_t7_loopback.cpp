@@ -469,15 +469,19 @@ TEST(T7SimStrict, RefusesWhatLabJackDocumentsAT7Refuses) {
   EXPECT_EQ(t7.u16(t7::kFio(2), 0), P(0, 0));
   EXPECT_EQ(t7.u32(t7::kDioEfEnable(2), 1), P(0, 0)) << "an output driven low";
   EXPECT_EQ(t7.u32(t7::kDioEfIndex(2), 1), P(failure, 2566)) << "a new index while enabled";
-  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 13), P(t7::kExceptionIllegalDataValue, 1203));
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 13), P(t7::kExceptionIllegalDataValue, 2375))
+      << "AIN_RESOLUTION_INVALID, the device's own error (not LJM's 1203)";
+  EXPECT_EQ(t7.refusal_of(t7.client.write_float(t7::kAinSettling_us(0), 60000.0)),
+            P(t7::kExceptionIllegalDataValue, 2371))
+      << "AIN_SETTLING_INVALID: more than the device's maximum";
   EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(0), 12), P(0, 0)) << "a T7-Pro samples at 12";
   EXPECT_EQ(t7.refusal_of(t7.client.write_float(t7::kAin(0), 1.0)), P(t7::kExceptionIllegalDataAddress, 1202))
       << "read only";
   std::uint16_t r[2];
   EXPECT_EQ(t7.refusal_of(t7.client.read(12345, 2, r)), P(t7::kExceptionIllegalDataAddress, 1202)) << "no such address";
-  ASSERT_TRUE(eventually([&] { return sim.status().exceptions == 10u; })) << sim.status().exceptions;
-  EXPECT_EQ(sim.status().refusals, 8u);  // the rules' (not the addresses')
-  EXPECT_EQ(sim.status().last_refused_error, 1203);
+  ASSERT_TRUE(eventually([&] { return sim.status().exceptions == 11u; })) << sim.status().exceptions;
+  EXPECT_EQ(sim.status().refusals, 9u);  // the rules' (not the addresses')
+  EXPECT_EQ(sim.status().last_refused_error, 2371);
 }
 
 TEST(T7SimStrict, APlainT7RefusesTheProsResolutionIndices) {
@@ -485,7 +489,7 @@ TEST(T7SimStrict, APlainT7RefusesTheProsResolutionIndices) {
   options.product = t7::Product::kT7;
   SimThread sim(options);
   RawT7 t7(sim.port());
-  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(3), 9), std::make_pair(t7::kExceptionIllegalDataValue, 1203));
+  EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(3), 9), std::make_pair(t7::kExceptionIllegalDataValue, 2375));
   EXPECT_EQ(t7.u16(t7::kAinResolutionIndex(3), 8), std::make_pair(0, 0));
   std::uint32_t hardware = 1;
   ASSERT_TRUE(t7.client.read_u32(t7::kHardwareInstalled, hardware));
