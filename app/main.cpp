@@ -264,6 +264,8 @@ int main(int argc, char** argv) try {
   t7_sim_cmd->add_flag("--nagle", t7_sim.nagle, "Drill: answers with Nagle's algorithm (a T7 sends at once)");
   t7_sim_cmd->add_flag("--silent-reads", t7_sim.silent_reads,
                        "Drill: reads of the analog inputs go unanswered (no reading ever)");
+  t7_sim_cmd->add_flag("--streaming", t7_sim.streaming,
+                       "Drill: another program streams from it (STREAM_ENABLE reads 1, analog reads refused)");
   t7_sim_cmd
       ->add_option("--halve-roll-after", t7_sim.halve_roll_after_s,
                    "Drill: this many seconds after the first request, clock 0's roll value halves (another program): "

@@ -45,6 +45,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
   sim.trickle_after_s = options.trickle_after_s;
   sim.trickle_byte_s = options.trickle_byte_s;
   sim.silent_reads = options.silent_reads;
+  sim.streaming = options.streaming;
   sim.halve_roll_after_s = options.halve_roll_after_s;
   if (!options.dead_valve.empty()) {
     for (ValveRole role : kValveRoles) {
@@ -64,6 +65,7 @@ int t7_sim_command(const T7SimCommandOptions& options, std::ostream& out) {
     out << "; drill: one answer " << sim.stall_s << " s late after " << sim.stall_after_s << " s";
   if (sim.nagle) out << "; drill: Nagle";
   if (sim.silent_reads) out << "; drill: reads unanswered";
+  if (sim.streaming) out << "; drill: another program streams (STREAM_ENABLE 1)";
   if (sim.halve_roll_after_s >= 0.0) out << "; drill: clock 0's roll halved after " << sim.halve_roll_after_s << " s";
   if (sim.answer_after_s > 0.0) out << "; drill: every answer " << sim.answer_after_s << " s late";
   if (sim.trickle_after_s >= 0.0)

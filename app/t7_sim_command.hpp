@@ -29,6 +29,7 @@ struct T7SimCommandOptions {
   double trickle_after_s = -1.0;
   double trickle_byte_s = 0.4;
   bool silent_reads = false;
+  bool streaming = false;
   double halve_roll_after_s = -1.0;
 };
 

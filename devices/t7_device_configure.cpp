@@ -51,6 +51,16 @@ void T7Device::configure() {
   std::uint32_t hardware = 0;
   require(client_.read_u32(t7::kHardwareInstalled, hardware), "reading", t7::kHardwareInstalled);
   product_ = (hardware & t7::kHardwareHighResolutionAdc) != 0 ? t7::Product::kT7Pro : t7::Product::kT7;
+  // A stream started by another program on the T7's other connection (LJM, Kipling, LJStreamM): the
+  // analog inputs are not read command-response meanwhile (docs/labjack-t7.md), so every exchange
+  // would be refused. Said once, before anything is written.
+  std::uint32_t streaming = 0;
+  require(client_.read_u32(t7::kStreamEnable, streaming), "reading", t7::kStreamEnable);
+  if (streaming != 0) {
+    throw EnvironmentError("t7 " + address_ +
+                           ": another program streams from this T7 (STREAM_ENABLE = 1: LJM, Kipling or LJStreamM on "
+                           "its other connection); bellows reads the inputs command-response: stop that stream first");
+  }
   for (SensorRole role : kSensorRoles) {
     const SensorCalibration& c = options_.profile.input(role);
     if (c.resolution_index > t7::max_resolution_index(product_)) {

@@ -27,6 +27,7 @@ constexpr KnownError kKnownErrors[] = {
     {2563, "EF_LINE_MUST_BE_LOW_BEFORE_STARTING",
      "The DIO line must be set to output low to ensure proper signal generation."},
     {2565, "EF_VALUE_GREATER_THAN_PERIOD", "The value must be less than the selected ClockSource's roll value."},
+    {2605, "STREAM_IS_ACTIVE", "The requested operation can not be performed while stream is running."},
     {2566, "EF_CAN_NOT_CHANGE_INDEX_WHILE_ENABLED",
      "The index of a DIO_EF can not be changed while that DIO_EF is enabled."},
 };

@@ -16,6 +16,7 @@ inline constexpr int kErrorDivisorInvalid = 2559;           // EF_DIVISOR_VALUE_
 inline constexpr int kErrorLineMustBeLow = 2563;            // EF_LINE_MUST_BE_LOW_BEFORE_STARTING
 inline constexpr int kErrorValueGreaterThanPeriod = 2565;   // EF_VALUE_GREATER_THAN_PERIOD
 inline constexpr int kErrorIndexChangeWhileEnabled = 2566;  // EF_CAN_NOT_CHANGE_INDEX_WHILE_ENABLED
+inline constexpr int kErrorStreamIsActive = 2605;           // STREAM_IS_ACTIVE
 
 /// LabJack's name for an error number ("EF_VALUE_GREATER_THAN_PERIOD"), or "" when bellows does not
 /// know it (static storage).

@@ -63,6 +63,7 @@ inline constexpr int kHardwareInstalled =
     60010;  // UINT32 bits: 0 high-resolution ADC (a T7-Pro), 1 WiFi, 2 RTC, 3 microSD
 inline constexpr std::uint32_t kHardwareHighResolutionAdc = 1u;
 inline constexpr int kSerialNumber = 60028;          // UINT32
+inline constexpr int kStreamEnable = 4990;           // UINT32: "returns 1 when stream is enabled"
 inline constexpr int kLastErrDetail = 55000;         // UINT16: the last LabJack error number the device met
 inline constexpr int kLastErrTransactionId = 55003;  // UINT16: the Modbus TCP transaction that caused it
 inline constexpr double kT7ProductId = 7.0;
@@ -146,6 +147,7 @@ inline std::string register_name(int a) {
                                                {kWatchdogDioState, "WATCHDOG_DIO_STATE_DEFAULT"},
                                                {kWatchdogDioDirection, "WATCHDOG_DIO_DIRECTION_DEFAULT"},
                                                {kWatchdogDioInhibit, "WATCHDOG_DIO_INHIBIT_DEFAULT"},
+                                               {kStreamEnable, "STREAM_ENABLE"},
                                                {kIoConfigCheckForFactory, "IO_CONFIG_CHECK_FOR_FACTORY"},
                                                {kIoConfigSetBootupToCurrent, "IO_CONFIG_SET_BOOTUP_TO_CURRENT"},
                                                {kIoConfigSetBootupToFactory, "IO_CONFIG_SET_BOOTUP_TO_FACTORY"}};

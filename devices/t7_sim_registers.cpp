@@ -60,6 +60,7 @@ T7SimRegisters::T7SimRegisters(bool high_resolution_adc) : registers_(kSize, 0),
         kWatchdogDioDirection, kWatchdogDioInhibit, 61640, 61642, 61650, 61652}) {
     allow(first, 2, true);
   }
+  allow(kStreamEnable, 2, false);  // read-write on a T7; t7-sim starts no stream (its drill sets it)
   allow(kIoConfigCheckForFactory, 2, false);
   allow(kIoConfigSetBootupToCurrent, 2, true);
   allow(kIoConfigSetBootupToFactory, 2, true);

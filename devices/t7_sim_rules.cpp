@@ -112,6 +112,12 @@ T7Refusal check_t7_request(const T7SimRegisters& registers, Product product, int
         exception, exception == kExceptionIllegalDataAddress ? kErrorIllegalDataAddress : 1201, address,
         write ? "a write to an address that does not exist or is read only" : "an address that does not exist");
   }
+  // While a stream runs the analog inputs are not read command-response (the error number a T7 answers
+  // is not documented: STREAM_IS_ACTIVE, "can not be performed while stream is running").
+  if (values == nullptr && registers.u32(kStreamEnable) != 0 && address < kAin(kAinCount)) {
+    return refuse(kExceptionDeviceFailure, kErrorStreamIsActive, address,
+                  "a read of analog inputs while a stream runs");
+  }
   if (values == nullptr) return {};
   const Proposed proposed(registers, address, count, values);
   for (int a = address; a < address + count; ++a) {

@@ -53,6 +53,7 @@ T7SimServer::T7SimServer(T7SimOptions options)
       query_(MODBUS_TCP_MAX_ADU_LENGTH) {
   validate_rig_profile(options_.profile);
   if (options_.no_supply) arm_.set_supply_bar(options_.plant.gas.ambient_bar);
+  if (options_.streaming) registers_.set_u32(t7::kStreamEnable, 1);
   arm_.vent();
   context_ = modbus_new_tcp_pi(options_.host.c_str(), std::to_string(options_.port).c_str());
   if (context_ == nullptr)

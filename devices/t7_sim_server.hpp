@@ -55,6 +55,7 @@ struct T7SimOptions {
   double trickle_after_s = -1.0;              // drill: this long after the first request, answers trickle...
   double trickle_byte_s = 0.4;                // ...one byte every this long (the link holds, barely)
   bool silent_reads = false;                  // drill: reads of the analog inputs go unanswered (no reading ever)
+  bool streaming = false;                     // drill: another program streams (STREAM_ENABLE 1; AIN reads refused)
   double halve_roll_after_s = -1.0;           // drill: this long after the first request, clock 0's roll value halves
                                               // (another program reconfigured it): wide duty cycles are refused, 2565
   RigLimits limits;                           // the rig's own limits, enforced whatever the client writes

@@ -484,6 +484,29 @@ TEST(T7SimStrict, RefusesWhatLabJackDocumentsAT7Refuses) {
   EXPECT_EQ(sim.status().last_refused_error, 2371);
 }
 
+// Another program streams from the T7 (its other connection): its analog inputs are not read
+// command-response meanwhile. bellows says so at connect, in one line, before it writes anything.
+TEST(T7SimStrict, AStreamOfAnotherProgramIsRefusedAtConnectBeforeAnyWrite) {
+  T7SimOptions options;
+  options.streaming = true;
+  SimThread sim(options);
+  RawT7 t7(sim.port());
+  std::uint16_t r[2];
+  EXPECT_EQ(t7.refusal_of(t7.client.read(t7::kAin(0), 2, r)),
+            std::make_pair(t7::kExceptionDeviceFailure, t7::kErrorStreamIsActive));
+  try {
+    T7Device device(device_options(sim.port()));
+    ADD_FAILURE() << "connected to a T7 that streams";
+  } catch (const EnvironmentError& error) {
+    EXPECT_NE(std::string(error.what()).find("another program streams from this T7 (STREAM_ENABLE = 1"),
+              std::string::npos)
+        << error.what();
+  }
+  std::uint32_t watchdog = 1;
+  ASSERT_TRUE(t7.client.read_u32(t7::kWatchdogEnable, watchdog)) << t7.client.last_error();
+  EXPECT_EQ(watchdog, 0u) << "the watchdog was written before the refusal";
+}
+
 TEST(T7SimStrict, APlainT7RefusesTheProsResolutionIndices) {
   T7SimOptions options;
   options.product = t7::Product::kT7;
