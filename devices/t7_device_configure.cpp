@@ -113,6 +113,22 @@ void T7Device::configure_clock() {
 // clock 0 at the vented duty (CONFIG_A below the roll value: 2565), the line an output driven low
 // (2563), then PWM on.
 void T7Device::configure_lines() {
+  // Every tick writes the CONFIG_A of each line from the lowest valve line to the highest in one
+  // request: a line between them that is no valve's (DIO1 between DIO0 and DIO2) gets 0. Harmless
+  // while its extended feature is off; one that runs (another program's counter, say) is refused here.
+  for (int dio = first_dio_; dio < first_dio_ + dio_span_; ++dio) {
+    bool valve = false;
+    for (ValveRole role : kValveRoles) valve = valve || options_.profile.dio(role) == dio;
+    if (valve) continue;
+    std::uint32_t enabled = 0;
+    require(client_.read_u32(t7::kDioEfEnable(dio), enabled), "reading", t7::kDioEfEnable(dio));
+    if (enabled != 0) {
+      throw EnvironmentError("t7 " + address_ + ": DIO" + std::to_string(dio) + " runs an extended feature (DIO" +
+                             std::to_string(dio) +
+                             "_EF_ENABLE = 1) between the valve lines, whose CONFIG_A every tick writes: stop it, "
+                             "or give the valves lines without it between them ([valves] in the rig profile)");
+    }
+  }
   const ValveCommand vented = ValveCommand::vented();
   for (ValveRole role : kValveRoles) {
     const int dio = options_.profile.dio(role);

@@ -507,6 +507,32 @@ TEST(T7SimStrict, AStreamOfAnotherProgramIsRefusedAtConnectBeforeAnyWrite) {
   EXPECT_EQ(watchdog, 0u) << "the watchdog was written before the refusal";
 }
 
+// Valves on DIO0 and DIO2..4: every tick's one write of CONFIG_A spans DIO1 too. While another
+// program runs an extended feature there (an interrupt counter, index 8), bellows refuses to connect
+// instead of writing its CONFIG_A 200 times a second; with DIO1's feature off it connects.
+TEST(T7SimStrict, AnExtendedFeatureBetweenTheValveLinesIsRefusedAtConnect) {
+  RigProfile profile = paper_rig_profile();
+  profile.valve_dio = {0, 2, 3, 4};
+  T7SimOptions options;
+  options.profile = profile;
+  SimThread sim(options);
+  RawT7 t7(sim.port());
+  ASSERT_EQ(t7.u32(t7::kDioEfIndex(1), 8), std::make_pair(0, 0));
+  ASSERT_EQ(t7.u32(t7::kDioEfEnable(1), 1), std::make_pair(0, 0));
+  T7DeviceOptions device = device_options(sim.port());
+  device.profile = profile;
+  try {
+    T7Device refused(device);
+    ADD_FAILURE() << "connected over another program's extended feature on DIO1";
+  } catch (const EnvironmentError& error) {
+    EXPECT_NE(std::string(error.what()).find("DIO1 runs an extended feature (DIO1_EF_ENABLE = 1)"), std::string::npos)
+        << error.what();
+  }
+  ASSERT_EQ(t7.u32(t7::kDioEfEnable(1), 0), std::make_pair(0, 0));
+  T7Device connected(device);
+  EXPECT_TRUE(eventually([&] { return connected.health().exchanges > 3; }));
+}
+
 TEST(T7SimStrict, APlainT7RefusesTheProsResolutionIndices) {
   T7SimOptions options;
   options.product = t7::Product::kT7;
