@@ -142,6 +142,13 @@ struct ConsoleFixture {
     const double until = clock.now_s() + engine_s;
     pump_until([&] { return clock.now_s() >= until; });
   }
+  /// Until the trajectory file the path prompt took is read (off the UI thread): the prompt closed with
+  /// its preview, or says why not.
+  void wait_for_trajectory_file() {
+    ASSERT_TRUE(pump_until([&] {
+      return state().dialog.kind != ui::DialogKind::kTrajectoryPath || state().dialog.error.rfind("reading ", 0) != 0;
+    }));
+  }
   bool idle() const {
     return state().run.mode == ui::RunProgress::Mode::kIdle && state().engine_state != EngineState::kRunning;
   }

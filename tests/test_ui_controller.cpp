@@ -349,12 +349,14 @@ TEST(UiController, ChoosingATrajectoryFromTheLibraryOrAFile) {
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   f.type(bad.string());
   f.key(key::kEnter);
+  f.wait_for_trajectory_file();
   // Refused: the prompt stays open with the path and why (issue 23).
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   EXPECT_NE(f.state().dialog.error.find("bad.csv"), std::string::npos) << f.state().dialog.error;
   for (std::size_t i = 0; i < bad.string().size(); ++i) f.key(key::kBackspace);
   f.type(good.string());
   f.key(key::kEnter);
+  f.wait_for_trajectory_file();
   ASSERT_TRUE(f.state().chooser.preview) << f.state().chooser.preview_error;
   EXPECT_EQ(f.state().chooser.preview->learning_samples(), 100);
   f.key(key::kEnter);

@@ -196,7 +196,8 @@ TEST(UiPrompts, ATrajectoryStartingElsewhereAsksBeforeTheArmMoves) {
   f.key(key::kEnter);
   ASSERT_EQ(f.state().dialog.kind, DialogKind::kTrajectoryPath);
   f.type(far.string());
-  f.key(key::kEnter);  // the preview
+  f.key(key::kEnter);  // the preview, once read
+  f.wait_for_trajectory_file();
   ASSERT_TRUE(f.state().chooser.preview) << f.state().chooser.preview_error;
   expect_question_keeps_focus(
       f, DialogKind::kConfirmStartMove, [&] { f.key(key::kEnter); }, "yYnNq");

@@ -47,6 +47,18 @@ void save_and_wait(ConsoleFixture& f) {
   ASSERT_FALSE(f.state().experiment.unsaved()) << f.state().status;
 }
 
+/// A console with `config` runs one trial and saves it as a session of the data directory; its location
+/// ("" after a failed assertion).
+std::string record_one_trial(const Configuration& config) {
+  StoreSessionGateway gateway("sim");
+  ConsoleFixture f(config, 3, &gateway);
+  f.arm_valves();
+  f.key('r');
+  EXPECT_TRUE(f.pump_until([&] { return f.idle(); }));
+  save_and_wait(f);
+  return f.state().experiment.session_location;
+}
+
 TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
   StoreSessionGateway gateway("sim");
   ASSERT_TRUE(gateway.available()) << gateway.unavailable_reason();
@@ -217,16 +229,8 @@ TEST_F(UiSessions, BadSessionsAreListedWithTheReasonAndNotOpened) {
 }
 
 TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
-  std::string location;
-  {
-    StoreSessionGateway gateway("sim");
-    ConsoleFixture f(Configuration{}, 3, &gateway);
-    f.arm_valves();
-    f.key('r');
-    ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
-    save_and_wait(f);
-    location = f.state().experiment.session_location;
-  }
+  const std::string location = record_one_trial(Configuration{});
+  ASSERT_FALSE(location.empty());
   StoreSessionGateway lcm("lcm");
   const auto listing = lcm.list();  // the browser knows before the operator picks it
   ASSERT_EQ(listing.size(), 1u);
@@ -245,19 +249,11 @@ TEST_F(UiSessions, ASessionFromAnotherDeviceIsRefused) {
 // 0.005 s x 4) is not continued: its trials' telemetry would be of another shape than the session's,
 // and every later show, export and resume would refuse the whole session.
 TEST_F(UiSessions, ASessionOfOtherTicksIsNotOpened) {
-  std::string location;
-  {
-    Configuration slow;
-    slow.timing.tick_s = 0.01;
-    slow.timing.ticks_per_sample = 2;
-    StoreSessionGateway gateway("sim");
-    ConsoleFixture f(slow, 3, &gateway);
-    f.arm_valves();
-    f.key('r');
-    ASSERT_TRUE(f.pump_until([&] { return f.idle(); }));
-    save_and_wait(f);
-    location = f.state().experiment.session_location;
-  }
+  Configuration slow;
+  slow.timing.tick_s = 0.01;
+  slow.timing.ticks_per_sample = 2;
+  const std::string location = record_one_trial(slow);
+  ASSERT_FALSE(location.empty());
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
   ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));

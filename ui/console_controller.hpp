@@ -184,12 +184,15 @@ class ConsoleController {
   /// y/Y closes the dialog and runs `on_yes`; n/N closes it with `status_on_no`; any other key leaves
   /// it open with "... is not an answer here" (then returns false).
   bool answer_yes_no(int key, const std::function<void()>& on_yes, const char* status_on_no);
+  /// answer_yes_no for a question whose yes runs `pending` (the action it asks about) once.
+  void answer_pending(int key, std::function<void()>& pending, const char* status_on_no);
   void not_an_answer(int key);
   /// The inspector's cursor to the next (+1) or previous (-1) |error| peak of the trial shown.
   void jump_to_error_peak(int step);
   void open_trajectory_chooser();
   void preview_selected_trajectory();
   void use_trajectory(const std::shared_ptr<const Trajectory>& trajectory);
+  void poll_trajectory_load();
   /// use_trajectory() once the arm may move: asks to discard unsaved work, then selects it.
   void choose_trajectory(const std::shared_ptr<const Trajectory>& trajectory);
   /// Empty when applied; otherwise why not (nothing changed).
@@ -297,6 +300,10 @@ class ConsoleController {
   BackgroundTask<SessionSnapshot> open_task_;
   BackgroundTask<std::string> figure_task_;
   BackgroundTask<TransferOffer> transfer_task_;
+  // A trajectory file read and checked off the UI thread (a large file, a slow mount): the path prompt
+  // waits open for it; trajectory_load_path_ is the path it reads.
+  BackgroundTask<std::shared_ptr<const Trajectory>> trajectory_load_;
+  std::string trajectory_load_path_;
   std::vector<JointTransferSource> taught_;       // earlier experiments of this console
   std::vector<TransferSourceNote> taught_notes_;  // one per taught_ source, for the session's first_correction
   std::vector<std::string> taught_locations_;     // where they are saved (not read back as "saved" sources)

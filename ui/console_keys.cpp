@@ -133,18 +133,9 @@ bool ConsoleController::handle_dialog_key(int k) {
         not_an_answer(k);
       }
       return true;
-    case DialogKind::kConfirmStartMove: {
-      auto action = std::move(pending_move_action_);
-      pending_move_action_ = nullptr;
-      if (!answer_yes_no(
-              k,
-              [&action] {
-                if (action) action();
-              },
-              "trajectory unchanged: the arm holds where it was"))
-        pending_move_action_ = std::move(action);
+    case DialogKind::kConfirmStartMove:
+      answer_pending(k, pending_move_action_, "trajectory unchanged: the arm holds where it was");
       return true;
-    }
     case DialogKind::kConfirmArm:
       answer_yes_no(
           k, [this] { arm(); }, "not armed");
@@ -157,19 +148,9 @@ bool ConsoleController::handle_dialog_key(int k) {
       answer_yes_no(
           k, [this] { start_valve_test(); }, "valve test cancelled: no valve opened");
       return true;
-    case DialogKind::kConfirmDiscard: {
-      // Taken out before the answer: a "no" drops it, a "yes" runs it once.
-      auto action = std::move(pending_discard_action_);
-      pending_discard_action_ = nullptr;
-      if (!answer_yes_no(
-              k,
-              [&action] {
-                if (action) action();
-              },
-              "cancelled"))
-        pending_discard_action_ = std::move(action);
+    case DialogKind::kConfirmDiscard:
+      answer_pending(k, pending_discard_action_, "cancelled");
       return true;
-    }
     case DialogKind::kConfirmQuit:
       if (k == 's' && state_.sessions_available && autosave_failed_) {  // the autosave failed: try once more, then quit
         state_.dialog = {};
@@ -226,6 +207,20 @@ bool ConsoleController::answer_yes_no(int k, const std::function<void()>& on_yes
   return true;
 }
 
+void ConsoleController::answer_pending(int k, std::function<void()>& pending, const char* status_on_no) {
+  // Taken out before the answer: a "no" drops it, a "yes" runs it once (and may ask anew), any other
+  // key leaves it waiting.
+  auto action = std::move(pending);
+  pending = nullptr;
+  if (!answer_yes_no(
+          k,
+          [&action] {
+            if (action) action();
+          },
+          status_on_no))
+    pending = std::move(action);
+}
+
 void ConsoleController::not_an_answer(int k) {
   state_.dialog.error = key_name(k) + " is not an answer here: " + state_.dialog.hint;
 }
@@ -263,18 +258,12 @@ PromptAnswer ConsoleController::judge_input() {
     case DialogKind::kTrajectoryPath: {
       const std::string path = expand_home(trim(d.input));
       if (path.empty()) return {"type the path of a CSV file (time_s,angle_deg), or Esc", {}};
-      std::shared_ptr<const Trajectory> loaded;
-      try {
-        loaded = std::make_shared<const Trajectory>(env_.load_trajectory(path));
-      } catch (const std::exception& error) {
-        return {std::string(error.what()) + " (another path, or Esc)", {}};
-      }
-      return {{}, [this, path, loaded] {
-                state_.chooser.file_path = path;
-                state_.chooser.preview = loaded;
-                state_.chooser.preview_error.clear();
-                set_status("preview of " + path + ": Enter uses it");
-              }};
+      // Read on a worker: the prompt stays open, and poll_trajectory_load() takes the answer or says why not.
+      if (trajectory_load_.busy()) return {"still reading " + trajectory_load_path_ + " (Esc leaves it)", {}};
+      trajectory_load_path_ = path;
+      trajectory_load_.start(
+          [load = env_.load_trajectory, path] { return std::make_shared<const Trajectory>(load(path)); });
+      return {"reading " + path + " ...", {}};
     }
     case DialogKind::kSessionName: {
       const std::string name(trim(d.input));

@@ -255,6 +255,10 @@ void ConsoleController::preview_selected_trajectory() {
     ch.preview = state_.experiment.trajectory;
     return;
   }
+  if (file_entry) {  // read once, off the UI thread, when its path was given
+    ch.preview = ch.file_trajectory;
+    return;
+  }
   try {
     ch.preview = std::make_shared<const Trajectory>(env_.load_trajectory(what));
   } catch (const std::exception& error) {

@@ -117,7 +117,8 @@ struct TrajectoryChooser {
   int selected = 0;
   std::shared_ptr<const Trajectory> preview;
   std::string preview_error;
-  std::string file_path;  // the file entry's path, once given
+  std::string file_path;                              // the file entry's path, once given
+  std::shared_ptr<const Trajectory> file_trajectory;  // ...loaded from it (off the UI thread)
 };
 
 /// The tuning screen's rows, in order: k_ff, k_p, k_i, k_d, the learning law, M, S, W.

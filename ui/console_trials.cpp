@@ -52,7 +52,31 @@ void ConsoleController::rebuild_law() {
   ++revision_;
 }
 
+void ConsoleController::poll_trajectory_load() {
+  if (!trajectory_load_.ready()) return;
+  std::shared_ptr<const Trajectory> loaded;
+  std::string refusal;
+  try {
+    loaded = trajectory_load_.take();
+  } catch (const std::exception& error) {
+    refusal = std::string(error.what()) + " (another path, or Esc)";
+  }
+  ++revision_;
+  if (state_.dialog.kind != DialogKind::kTrajectoryPath) return;  // Esc (or a fault) closed the prompt meanwhile
+  if (!refusal.empty()) {
+    reject_input(std::move(refusal));
+    return;
+  }
+  state_.dialog = {};
+  state_.chooser.file_path = trajectory_load_path_;
+  state_.chooser.file_trajectory = loaded;
+  state_.chooser.preview = loaded;
+  state_.chooser.preview_error.clear();
+  set_status("preview of " + trajectory_load_path_ + ": Enter uses it");
+}
+
 void ConsoleController::poll_tasks() {
+  poll_trajectory_load();
   poll_transfer();
   if (law_build_.ready()) {
     try {
