@@ -69,6 +69,10 @@ RunRecording::RunRecording(const RunOptions& options) : options_(options), resum
   writer_.emplace(SessionWriter::open(directory, kPurpose, resumed_));
   if (const std::string dropped = dropped_line(resumed_); !dropped.empty())
     std::cerr << "bellows: " << dropped << std::endl;
+  for (const std::string& log : writer_->kept_logs()) {
+    std::cerr << "bellows: kept the LCM log a killed run was writing as " << log << " (its events up to the kill)"
+              << std::endl;
+  }
   if (resumed_.manifest.device != "sim") {
     throw InputError("session " + directory.string() + " was recorded on the device '" + resumed_.manifest.device +
                      "'; bellows run drives the simulated arm only");

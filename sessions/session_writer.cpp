@@ -59,11 +59,13 @@ SessionWriter SessionWriter::open(const fs::path& directory, const std::string& 
   DirectoryHandle session = open_session_directory(directory);
   SessionLock lock(session, purpose);  // before loading: nobody changes it under us
   loaded = load_session(session);
+  std::vector<std::string> kept = keep_interrupted_logs(session);
   remove_temporary_files(session);
   SessionManifest manifest = loaded.manifest;
   // What it writes is this bellows' format (what an older version lacked has its default now).
   manifest.schema_version = session_schema_version_for(manifest.joints);
   SessionWriter writer(std::move(session), std::move(manifest), std::move(lock));
+  writer.kept_logs_ = std::move(kept);
   // What an interrupted save wrote but never committed, and files a committed revision superseded:
   // not part of the session.
   remove_uncommitted_files(writer.directory_, find_uncommitted_files(writer.directory_, writer.manifest_));

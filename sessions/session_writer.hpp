@@ -32,6 +32,10 @@ class SessionWriter {
   static SessionWriter open(const std::filesystem::path& directory, const std::string& purpose, Session& loaded);
 
   const std::filesystem::path& directory() const { return directory_.path(); }
+  /// The LCM logs of runs killed while they wrote one (`run --lcm-log` into the session): open()
+  /// keeps each under a free name of its own (telemetry-N.lcmlog, its events up to the kill), not as
+  /// an unfinished write it removes. Their names, for the operator.
+  const std::vector<std::string>& kept_logs() const { return kept_logs_; }
   const SessionManifest& manifest() const { return manifest_; }
 
   /// Autosave after iteration `summary.iteration` (which must be the next one) completed, with
@@ -79,6 +83,7 @@ class SessionWriter {
   void check_fits(const TrialRecord& record, const Eigen::MatrixXd& next_corrections_bar, const char* what) const;
 
   DirectoryHandle directory_;  // every file is written relative to it, never through a link
+  std::vector<std::string> kept_logs_;
   DirectoryHandle iterations_;
   /// Writes manifest_ (changed in place) unless a batch is open; if that fails, `undo` (and those
   /// of the batch) put the changes back and it throws.

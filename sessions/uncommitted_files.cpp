@@ -1,6 +1,7 @@
 #include "sessions/uncommitted_files.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <optional>
 
@@ -37,13 +38,40 @@ std::optional<NumberedName> parse_numbered(const std::string& name, const std::s
 
 std::string name_in_folder(const std::string& relative) { return session_layout::folder_and_name(relative).second; }
 
+/// What a hidden temporary was for: ".telemetry.lcmlog.tmp-..." -> "telemetry.lcmlog".
+std::string temporary_target(const std::string& name) { return name.substr(1, name.find(".tmp-") - 1); }
+
+bool ends_with(const std::string& text, const std::string& end) {
+  return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+}
+
+bool is_interrupted_log(const std::string& name) {
+  return is_temporary_file_name(name) && ends_with(temporary_target(name), ".lcmlog");
+}
+
 }  // namespace
+
+std::vector<std::string> keep_interrupted_logs(const DirectoryHandle& session) {
+  std::vector<std::string> kept;
+  for (const std::string& name : entry_names(session)) {
+    if (!is_interrupted_log(name)) continue;
+    std::string target = temporary_target(name);
+    int error = rename_no_replace(session, name, session, target);
+    for (int n = 2; error == EEXIST; ++n) {
+      target = "telemetry-" + std::to_string(n) + ".lcmlog";  // the names run --lcm-log gives in a session
+      error = rename_no_replace(session, name, session, target);
+    }
+    if (error == 0) kept.push_back(target);  // else removed with the other temporaries, as before
+  }
+  if (!kept.empty()) sync(session);
+  return kept;
+}
 
 std::vector<UncommittedFile> find_uncommitted_files(const DirectoryHandle& session, const SessionManifest& manifest) {
   std::vector<UncommittedFile> found;
   for (const std::string& name : entry_names(session)) {
-    if (is_temporary_file_name(name))
-      found.push_back({"", name, "an unfinished write of " + name.substr(1, name.find(".tmp-") - 1)});
+    if (is_temporary_file_name(name) && !is_interrupted_log(name))
+      found.push_back({"", name, "an unfinished write of " + temporary_target(name)});
   }
   const auto folder_of = [&](const char* name) -> std::optional<DirectoryHandle> {
     try {

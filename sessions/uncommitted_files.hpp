@@ -26,6 +26,12 @@ std::vector<UncommittedFile> find_uncommitted_files(const DirectoryHandle& sessi
 /// The line Session::dropped holds: what `files` dropped, each thing once ("" when nothing was lost).
 std::string describe_dropped(const std::vector<UncommittedFile>& files);
 
+/// The hidden temporaries of LCM logs (`run --lcm-log` into the session) that a kill cut short: not a
+/// save's leftovers but a record of what the run sent, readable up to its last whole event. Each is
+/// renamed to its log's name, or telemetry-N.lcmlog when that is taken (the session's directory
+/// synced); returns the names it now has. find_uncommitted_files() does not list them.
+std::vector<std::string> keep_interrupted_logs(const DirectoryHandle& session);
+
 /// Removes `files` from `session` (links themselves, never what they point to).
 void remove_uncommitted_files(const DirectoryHandle& session, const std::vector<UncommittedFile>& files);
 

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "engine/base/errors.hpp"
 #include "session_test_support.hpp"
 #include "sessions/manifest_json.hpp"
@@ -291,6 +293,32 @@ TEST(SessionWriter, ReopeningClearsWhatAnInterruptedWriteLeftBehind) {
   EXPECT_FALSE(fs::exists(iterations / ".telemetry_0002.csv.tmp-4242"));
   EXPECT_FALSE(fs::exists(dir / "s" / ".manifest.json.tmp-4242"));
   EXPECT_TRUE(fs::exists(dir / "s" / session_layout::samples_file(1)));
+}
+
+// A run killed while it wrote its LCM log into the session (run --lcm-log) left the log as a hidden
+// temporary: not a save's leftover but the record of what the run sent, kept under its own name (the
+// next free one when that is taken) instead of removed, and not reported as a dropped save.
+TEST(SessionWriter, ReopeningKeepsTheLcmLogOfAKilledRun) {
+  TempDir dir;
+  save_session(testing::simulate_session(2), dir / "s");
+  testing::write_text(dir / "s" / ".telemetry.lcmlog.tmp-4242-00ff", "events up to the kill");
+  testing::write_text(dir / "s" / "telemetry-2.lcmlog", "a log a resume committed");
+  testing::write_text(dir / "s" / ".telemetry-2.lcmlog.tmp-4243-00ff", "a resumed run's events up to its kill");
+  Session loaded;
+  {
+    SessionWriter writer = SessionWriter::open(dir / "s", "test", loaded);
+    EXPECT_EQ(loaded.dropped, "");
+    std::vector<std::string> kept = writer.kept_logs();
+    std::sort(kept.begin(), kept.end());
+    ASSERT_EQ(kept.size(), 2u);
+    EXPECT_EQ(kept[0], "telemetry-3.lcmlog");
+    EXPECT_EQ(kept[1], "telemetry.lcmlog");
+  }
+  EXPECT_EQ(testing::read_text(dir / "s" / "telemetry.lcmlog"), "events up to the kill");
+  EXPECT_EQ(testing::read_text(dir / "s" / "telemetry-2.lcmlog"), "a log a resume committed");
+  EXPECT_EQ(testing::read_text(dir / "s" / "telemetry-3.lcmlog"), "a resumed run's events up to its kill");
+  EXPECT_FALSE(fs::exists(dir / "s" / ".telemetry.lcmlog.tmp-4242-00ff"));
+  EXPECT_EQ(load_session(dir / "s").iterations.size(), 2u);  // the session loads with the logs beside it
 }
 
 TEST(SessionWriter, NamesSessionsByStartTimeAndTrajectory) {
