@@ -41,12 +41,8 @@ std::string name_in_folder(const std::string& relative) { return session_layout:
 /// What a hidden temporary was for: ".telemetry.lcmlog.tmp-..." -> "telemetry.lcmlog".
 std::string temporary_target(const std::string& name) { return name.substr(1, name.find(".tmp-") - 1); }
 
-bool ends_with(const std::string& text, const std::string& end) {
-  return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
-}
-
 bool is_interrupted_log(const std::string& name) {
-  return is_temporary_file_name(name) && ends_with(temporary_target(name), ".lcmlog");
+  return is_temporary_file_name(name) && temporary_target(name).ends_with(".lcmlog");
 }
 
 }  // namespace
