@@ -76,6 +76,26 @@ class T7Processes : public ::testing::Test {
                                    dir_ / (name + ".out"), dir_ / (name + ".err"));
   }
 
+  /// `bellows run` of 3 iterations against a t7-sim whose answers will trickle: [t7] response_timeout_s
+  /// as given, 100 stale ticks (0.5 s), long missed-deadline streaks (a loaded machine's stalls before
+  /// the trickle must not end the run first: at 4 ms and 40 ticks, CI's load faulted it before the drill).
+  std::unique_ptr<Child> start_trickled_run(const std::string& response_timeout_s) {
+    const std::filesystem::path config =
+        testing::write_file(dir_, "trickle.toml",
+                            "[t7]\nresponse_timeout_s = " + response_timeout_s +
+                                "\n[safety]\nstale_ticks = 100\nmissed_deadline_streak = 100000\n");
+    return std::make_unique<Child>(
+        std::vector<std::string>{kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config",
+                                 config.string(), "--iterations", "3", "--json", "--no-save"},
+        dir_ / "run.out", dir_ / "run.err");
+  }
+  /// Until `sim` says its answers trickle; false (and why) when it never does.
+  ::testing::AssertionResult trickle_began(Child& sim, Child& run) {
+    if (wait_for([&] { return sim.out().find("answers trickle from now on") != std::string::npos; }))
+      return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << sim.out() << "\nbellows run: " << run.err();
+  }
+
   /// Runs bellows with `args` to the end (sessions into this test's XDG_DATA_HOME).
   testing::ProcessResult run_cli(const std::vector<std::string>& args) {
     std::vector<std::string> argv = {kBellows};
@@ -231,23 +251,17 @@ TEST_F(T7Processes, T7SimStoppedMidTrialFaultsTheRunNamingTheLink) {
 // faults and vents within the stale limit and one response timeout, not seconds later.
 TEST_F(T7Processes, ATricklingLinkEndsTheRunVentedWithinTheStaleLimitAndOneResponseTimeout) {
   auto sim = start_sim({"--trickle-after", "1.5"});
-  const std::filesystem::path config = testing::write_file(
-      dir_, "trickle.toml",
-      "[t7]\nresponse_timeout_s = 0.1\n[safety]\nstale_ticks = 100\nmissed_deadline_streak = 100000\n");
-  Child run({kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config", config.string(),
-             "--iterations", "3", "--json", "--no-save"},
-            dir_ / "run.out", dir_ / "run.err");
-  ASSERT_TRUE(wait_for([&] { return sim->out().find("answers trickle from now on") != std::string::npos; }))
-      << sim->out() << "\nbellows run: " << run.err();
+  auto run = start_trickled_run("0.1");
+  ASSERT_TRUE(trickle_began(*sim, *run));
   const auto trickle = std::chrono::steady_clock::now();
-  ASSERT_EQ(run.wait(30.0), 3) << run.err();
+  ASSERT_EQ(run->wait(30.0), 3) << run->err();
   const double after_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - trickle).count();
   // 100 ticks (0.5 s) + 0.1 s, with room for a loaded machine's scheduling; before: 12 s and more.
   // (A loaded machine's stalls before the trickle must not end the run first: at 4 ms and 40 ticks,
   // CI's load faulted it link-lost before the drill began.)
-  EXPECT_LT(after_s, 2.0) << run.err();
-  const nlohmann::json report = nlohmann::json::parse(run.out());
-  EXPECT_TRUE(report.contains("fault")) << run.out();
+  EXPECT_LT(after_s, 2.0) << run->err();
+  const nlohmann::json report = nlohmann::json::parse(run->out());
+  EXPECT_TRUE(report.contains("fault")) << run->out();
 }
 
 // A T7 whose answers all come, each after its deadline (one byte every 2 ms: a whole answer takes tens
@@ -255,21 +269,15 @@ TEST_F(T7Processes, ATricklingLinkEndsTheRunVentedWithinTheStaleLimitAndOneRespo
 // late"; never link-lost, which tells the operator to check the T7's power and cable.
 TEST_F(T7Processes, AT7ThatAnswersLateIsNamedLateNotLost) {
   auto sim = start_sim({"--trickle-after", "1.5", "--trickle-byte-s", "0.002"});
-  const std::filesystem::path config = testing::write_file(
-      dir_, "late.toml",
-      "[t7]\nresponse_timeout_s = 0.02\n[safety]\nstale_ticks = 100\nmissed_deadline_streak = 100000\n");
-  Child run({kBellows, "run", "--device", "t7", "--t7", address_, "--rt", "try", "--config", config.string(),
-             "--iterations", "3", "--json", "--no-save"},
-            dir_ / "run.out", dir_ / "run.err");
-  ASSERT_TRUE(wait_for([&] { return sim->out().find("answers trickle from now on") != std::string::npos; }))
-      << sim->out() << "\nbellows run: " << run.err();
-  ASSERT_EQ(run.wait(30.0), 3) << run.err();
-  const nlohmann::json report = nlohmann::json::parse(run.out());
+  auto run = start_trickled_run("0.02");
+  ASSERT_TRUE(trickle_began(*sim, *run));
+  ASSERT_EQ(run->wait(30.0), 3) << run->err();
+  const nlohmann::json report = nlohmann::json::parse(run->out());
   EXPECT_EQ(report.at("fault").at("name"), "sensor-stale") << report.dump();
   EXPECT_NE(report.at("fault").at("message").get<std::string>().find("the T7 at " + address_ + " answers, but late"),
             std::string::npos)
       << report.dump();
-  EXPECT_EQ(run.err().find("link-lost"), std::string::npos) << run.err();
+  EXPECT_EQ(run->err().find("link-lost"), std::string::npos) << run->err();
 }
 
 // SIGINT 3 s into connecting to a device that answers each request after 1.5 s: the command ends at

@@ -59,6 +59,14 @@ std::string record_one_trial(const Configuration& config) {
   return f.state().experiment.session_location;
 }
 
+/// `o` in a fresh console: the browser lists the data directory's one session.
+void list_sessions_in_browser(ConsoleFixture& f) {
+  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
+  f.key('o');
+  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
+  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+}
+
 TEST_F(UiSessions, WhatTheConsoleSavesReopensTheSame) {
   StoreSessionGateway gateway("sim");
   ASSERT_TRUE(gateway.available()) << gateway.unavailable_reason();
@@ -192,10 +200,7 @@ TEST_F(UiSessions, OpeningThroughTheBrowserContinuesTheSession) {
   }
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
-  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
-  f.key('o');
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
-  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  list_sessions_in_browser(f);
   const ui::SessionListing& l = f.state().browser.sessions[0];
   EXPECT_EQ(l.location, location);
   EXPECT_EQ(l.trajectory, "paper");
@@ -256,10 +261,7 @@ TEST_F(UiSessions, ASessionOfOtherTicksIsNotOpened) {
   ASSERT_FALSE(location.empty());
   StoreSessionGateway gateway("sim");
   ConsoleFixture f(Configuration{}, 3, &gateway);
-  ASSERT_TRUE(f.pump_until([&] { return f.state().law_ready; }));
-  f.key('o');
-  ASSERT_TRUE(f.pump_until([&] { return !f.state().browser.loading; }));
-  ASSERT_EQ(f.state().browser.sessions.size(), 1u);
+  list_sessions_in_browser(f);
   f.key(ui::key::kEnter);
   ASSERT_TRUE(f.pump_until([&] { return f.logged("open failed"); }));
   EXPECT_TRUE(f.logged("recorded at [timing] tick_s = 0.01 s, ticks_per_sample = 2; this console runs 0.005 s, 4"));
