@@ -11,12 +11,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include <modbus/modbus.h>
 
+#include "devices/latest_file_writer.hpp"
 #include "devices/request_arrival.hpp"
 #include "devices/t7_errors.hpp"
 #include "devices/t7_registers.hpp"
@@ -75,6 +74,7 @@ T7SimServer::T7SimServer(T7SimOptions options)
   apply_lines(0.0);
   update_inputs();
   published_ = status_;
+  if (!options_.status_path.empty()) status_file_ = std::make_unique<LatestFileWriter>(options_.status_path);
 }
 
 T7SimServer::~T7SimServer() {
@@ -367,6 +367,7 @@ void T7SimServer::run(const std::function<bool()>& should_stop, const std::funct
     write_status(now, false);
   }
   write_status(now_s(), true);
+  if (status_file_) status_file_->flush();
   events_ = nullptr;
 }
 
@@ -381,7 +382,7 @@ void T7SimServer::write_status(double now, bool force) {
     const std::lock_guard<std::mutex> lock(published_mutex_);
     published_ = status_;
   }
-  if (options_.status_path.empty()) return;
+  if (!status_file_) return;
   const T7SimStatus& s = status_;
   char text[1400];
   std::snprintf(
@@ -404,13 +405,7 @@ void T7SimServer::write_status(double now, bool force) {
       1.0 / options_.profile.pwm_frequency_hz, s.chamber_bar[0], s.chamber_bar[1], s.angle_rad,
       options_.limits.pressure_ceiling_bar, options_.limits.angle_limit_rad, s.pressure_limit_trips,
       s.angle_limit_trips);
-  const std::string temporary = options_.status_path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    out << text;
-  }
-  std::error_code ignored;
-  std::filesystem::rename(temporary, options_.status_path, ignored);  // readers never see half a file
+  status_file_->post(text);  // written on its own thread: a disk stall never holds an answer
 }
 
 T7SimStatus T7SimServer::status() const {

@@ -13,7 +13,8 @@
 // like a T7 it serves two Modbus TCP connections at once and closes a third.
 //
 // Its valve state can be read by tests and scripts from a status file (JSON, rewritten atomically
-// at most every 10 ms and at every watchdog action; docs/labjack-t7.md has its fields), and each
+// at most every 10 ms and at every watchdog action, on a thread of its own so that the disk never
+// delays an answer; docs/labjack-t7.md has its fields), and each
 // watchdog action is also a line on stdout.
 #pragma once
 
@@ -26,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "devices/latest_file_writer.hpp"
 #include "devices/lcm_rig_limits.hpp"
 #include "devices/rig_profile.hpp"
 #include "devices/simulated_arm.hpp"
@@ -133,6 +135,7 @@ class T7SimServer {
   T7SimStatus status_;  // the server thread's; published copies under the mutex
   mutable std::mutex published_mutex_;
   T7SimStatus published_;
+  std::unique_ptr<LatestFileWriter> status_file_;  // null: no status file
   std::vector<std::uint8_t> query_;
   ValveCommand commanded_ = ValveCommand::vented();  // what the lines ask of the valves (a dead one shut)
   std::int32_t limit_bits_ = 0;                      // the limits acting now (kRig*LimitBit)
