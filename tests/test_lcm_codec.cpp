@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "devices/lcm_auth.hpp"
 #include "devices/lcm_codec.hpp"
 #include "engine/control/safety.hpp"
 #include "tests/test_support.hpp"
@@ -307,6 +308,73 @@ TEST(LcmCodec, TheProtocolDocListsEveryFaultCode) {
   // Every code the engine has, and no more: the next one has no name yet.
   EXPECT_GT(listed, 0);
   EXPECT_STREQ(fault_name(static_cast<FaultCode>(listed)), "unknown") << "code " << listed << " is not in the doc";
+}
+
+// docs/lcm-protocol.md ("On the wire") shows an example command and state byte for byte, for a lab
+// writing a rig from the page alone; tests/check_lcm_protocol_page.py checks them against lcm-gen's
+// Python encoder. Here bellows' codec must give the same bytes, and take the page's bytes.
+namespace page {
+
+LcmKey example_key() {
+  std::array<std::uint8_t, kLcmKeyBytes> bytes{};
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::uint8_t>(i);
+  return LcmKey(bytes);
+}
+
+/// The bytes of the page's dump whose first line is "# NAME, signed with the example key".
+std::vector<std::uint8_t> example_bytes(const std::string& name) {
+  std::ifstream in(std::string(BELLOWS_SOURCE_DIR) + "/docs/lcm-protocol.md");
+  std::string line;
+  while (std::getline(in, line) && line != "# " + name + ", signed with the example key") {
+  }
+  std::vector<std::uint8_t> bytes;
+  std::getline(in, line);  // the column heads
+  while (std::getline(in, line) && line != "```") {
+    std::istringstream columns(line.substr(8, 23));  // "offset  " then up to 8 bytes in hex
+    std::string hex;
+    while (columns >> hex) bytes.push_back(static_cast<std::uint8_t>(std::stoi(hex, nullptr, 16)));
+  }
+  return bytes;
+}
+
+}  // namespace page
+
+TEST(LcmProtocolPage, TheExampleCommandIsWhatBellowsSends) {
+  io_command_t command{};
+  command.session_id = 1234567890123;
+  command.seq = 1;
+  command.utime = 0;
+  command.rig_id = 987654321;
+  command.binding = 42;
+  command.armed = true;
+  command.inlet_duty[0] = 0.25;
+  command.outlet_duty[1] = 0.5;
+  std::vector<std::uint8_t> bytes;
+  bytes.resize(encode_signed(command, page::example_key(), bytes));
+  const std::vector<std::uint8_t> shown = page::example_bytes("io_command_t");
+  ASSERT_EQ(shown.size(), 113u);
+  EXPECT_EQ(bytes, shown);
+}
+
+TEST(LcmProtocolPage, TheExampleStateIsTakenByBellowsWithTheKeyAndRefusedWithout) {
+  std::vector<std::uint8_t> shown = page::example_bytes("io_state_t");
+  ASSERT_EQ(shown.size(), 156u);
+  const LcmKey key = page::example_key();
+  io_state_t state{};
+  ASSERT_EQ(decode_checked(shown.data(), shown.size(), state, &key), DecodeStatus::kOk);
+  EXPECT_EQ(state.rig_id, 987654321);
+  EXPECT_EQ(state.seq, 7);
+  EXPECT_EQ(state.session_id, 1234567890123);
+  EXPECT_EQ(state.command_seq, 1);
+  EXPECT_EQ(state.time_s, 5.0);
+  EXPECT_EQ(state.angle_rad, 0.125);
+  EXPECT_EQ(state.chamber_bar[1], 1.25);
+  EXPECT_EQ(state.temperature_K, 293.15);
+  std::vector<std::uint8_t> again;
+  again.resize(encode_signed(state, key, again));
+  EXPECT_EQ(again, shown);
+  shown[64] ^= 1;  // one bit of the angle changed on the way: the MAC no longer fits
+  EXPECT_EQ(decode_checked(shown.data(), shown.size(), state, &key), DecodeStatus::kUnauthenticated);
 }
 
 }  // namespace
