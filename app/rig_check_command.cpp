@@ -293,20 +293,22 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
   progress << "valves:\n";
   for (const ValveVerdict& v : result.valves) {
     if (v.pass) {
-      progress << line_of("  %-9s pass  (own chamber %+.3f bar, other %+.3f bar)\n", valve_name(v.valve),
-                          v.own_change_bar, v.other_change_bar);
+      progress << line_of("  %-9s pass  (own chamber %+.3f bar, other %+.3f bar)%s\n", valve_name(v.valve),
+                          v.own_change_bar, v.other_change_bar, repeat_note(v).c_str());
     } else {
       ++failed;
-      progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << "\n";
+      progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << repeat_note(v) << "\n";
     }
-    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)",
-                                                  valve_name(v.valve), v.own_change_bar, v.other_change_bar)
-                                        : std::string(valve_name(v.valve)) + " FAIL: " + v.problem);
+    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)%s",
+                                                  valve_name(v.valve), v.own_change_bar, v.other_change_bar,
+                                                  repeat_note(v).c_str())
+                                        : std::string(valve_name(v.valve)) + " FAIL: " + v.problem + repeat_note(v));
     report["valves"].push_back({{"valve", valve_name(v.valve)},
                                 {"pass", v.pass},
                                 {"tested", v.tested},
                                 {"own_change_bar", v.own_change_bar},
                                 {"other_change_bar", v.other_change_bar},
+                                {"pulses", v.pulses},
                                 {"problem", v.problem}});
   }
   if (!result.aborted.empty()) progress << "stopped early: " << result.aborted << "\n";

@@ -73,6 +73,7 @@ TEST(ValveTest, ADeadInletIsNamedAndTheOthersPass) {
   const ValveVerdict& dead = verdict(r, ValveId::kInletA);
   EXPECT_FALSE(dead.pass);
   EXPECT_NE(dead.problem.find("dead valve"), std::string::npos) << dead.problem;
+  EXPECT_EQ(dead.pulses, RigCheckParameters{}.valve_pulse_attempts) << "dead on every pulse";
   EXPECT_TRUE(verdict(r, ValveId::kInletB).pass) << verdict(r, ValveId::kInletB).problem;
   EXPECT_TRUE(verdict(r, ValveId::kOutletB).pass) << verdict(r, ValveId::kOutletB).problem;
   // Outlet A has no air to let out when inlet A is dead: said so, not blamed.
@@ -193,6 +194,70 @@ TEST(ValveTest, OnALaggingLinkEachStepIsJudgedOnReadingsThatShowIt) {
   ASSERT_TRUE(settled.finished);
   EXPECT_EQ(settled.aborted, "");
   for (const ValveVerdict& v : settled.valves) EXPECT_TRUE(v.pass) << valve_name(v.valve) << ": " << v.problem;
+}
+
+/// A rig whose link holds back every command of the first `swallowed` pulses of inlet A alone (a T7
+/// answering late, a host that did not run the link's thread): the valve stays shut through them.
+class SwallowingDevice final : public Device {
+ public:
+  SwallowingDevice(SimulatedArm& arm, int swallowed) : arm_(arm), swallowed_(swallowed) {}
+  SensorReading read_sensors() override { return arm_.read_sensors(); }
+  void write_valves(const ValveCommand& command) override {
+    const bool inlet_a_alone = command.joint[0].inlet_duty[0] > 0.0 && command.joint[0].inlet_duty[1] == 0.0;
+    if (inlet_a_alone && swallowed_ > 0) {
+      in_window_ = true;
+      return;  // held back: the valves keep the state before
+    }
+    if (in_window_) {
+      in_window_ = false;
+      --swallowed_;
+    }
+    arm_.write_valves(command);
+  }
+  void vent() override { arm_.vent(); }
+  void advance(double dt_s) override { arm_.advance(dt_s); }
+  bool time_follows_ticks() const override { return true; }
+  const char* name() const override { return "swallowing"; }
+
+ private:
+  SimulatedArm& arm_;
+  int swallowed_;
+  bool in_window_ = false;
+};
+
+ValveTestReport check_swallowing(int swallowed, int attempts) {
+  Configuration c;
+  c.rig_check.valve_pulse_attempts = attempts;
+  SimulatedArm arm(c.plant, 1);
+  SwallowingDevice device(arm, swallowed);
+  EngineCore core(device, c.controller, c.timing, c.safety);
+  SimulatedClock clock(core, device);
+  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+}
+
+// A pulse the link held back moved nothing, as a dead valve would: pulsed again, the valve passes and
+// its line says the pulse before moved nothing; with one pulse allowed it is called dead, as before.
+TEST(ValveTest, APulseTheLinkHeldBackIsTriedAgainNotCalledDead) {
+  const ValveTestReport once = check_swallowing(1, 1);
+  const ValveVerdict& blamed = verdict(once, ValveId::kInletA);
+  EXPECT_FALSE(blamed.pass);
+  EXPECT_NE(blamed.problem.find("dead valve"), std::string::npos) << blamed.problem;
+  EXPECT_EQ(blamed.pulses, 1);
+  EXPECT_EQ(repeat_note(blamed), "");
+
+  const ValveTestReport again = check_swallowing(1, 2);
+  ASSERT_TRUE(again.finished);
+  EXPECT_TRUE(again.all_pass()) << (again.failure_lines().empty() ? "" : again.failure_lines()[0]);
+  const ValveVerdict& inlet = verdict(again, ValveId::kInletA);
+  EXPECT_EQ(inlet.pulses, 2);
+  EXPECT_EQ(repeat_note(inlet), " (pulse 2 of 2: the one before moved nothing)");
+  EXPECT_EQ(verdict(again, ValveId::kInletB).pulses, 1);
+  EXPECT_EQ(repeat_note(verdict(again, ValveId::kInletB)), "");
+
+  // Held back twice, with three pulses allowed: passes on the third.
+  const ValveTestReport third = check_swallowing(2, 3);
+  EXPECT_TRUE(verdict(third, ValveId::kInletA).pass) << verdict(third, ValveId::kInletA).problem;
+  EXPECT_EQ(repeat_note(verdict(third, ValveId::kInletA)), " (pulse 3 of 3: the ones before moved nothing)");
 }
 
 TEST(ValvePulse, TheValvesHoldThePulseForItsTicksThenTheAfterState) {

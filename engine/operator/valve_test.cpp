@@ -67,6 +67,7 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
   v.other_change_bar = air_bar(after, other, volume_gain_per_rad) - air_bar(before, other, volume_gain_per_rad);
   const double own_move = sign * v.own_change_bar, other_move = sign * v.other_change_bar;
   if (!(after.time_s > before.time_s)) {  // the same reading twice: nothing to judge the pulse by
+    v.moved_nothing = true;
     v.problem = format(
         "not judged: no reading taken after the pulse started (the newest is from %.3f s): the link to "
         "the rig delivers no fresh readings",
@@ -75,6 +76,7 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
     v.problem = "a chamber pressure reads not-a-number: check the pressure sensors' inputs";
   } else if (!is_inlet(valve) && before.joint[0].chamber_bar[own] - ambient_bar < m) {
     // Either inlet's own test failed, or the fill was too short for this link (a late tick eats it).
+    v.moved_nothing = true;
     v.problem = format(
         "not tested: chamber %s held no air to let out (%.3f bar after [rig_check] fill_s %.3f s of both "
         "inlets; see inlet %s: if it passed, a longer fill_s)",
@@ -96,6 +98,7 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
     v.problem = format("no supply: the supply reads %.2f bar (below [safety] supply_min_bar %.2f)",
                        std::min(before.supply_bar, after.supply_bar), supply_min_bar);
   } else {
+    v.moved_nothing = true;
     v.problem = format(
         "dead valve: chamber %s did not %s (%+.3f bar in [rig_check] valve_pulse_s %.3f s): check the "
         "valve's line, its power and the valve%s",
@@ -103,6 +106,12 @@ ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const Senso
         is_inlet(valve) ? ", and that air reaches it" : "");
   }
   return v;
+}
+
+std::string repeat_note(const ValveVerdict& verdict) {
+  if (verdict.pulses <= 1) return "";
+  return format(" (pulse %d of %d: the one%s before moved nothing)", verdict.pulses, verdict.pulses,
+                verdict.pulses > 2 ? "s" : "");
 }
 
 ValveTest::ValveTest(const RigCheckParameters& check, const SafetyParameters& safety, double ambient_bar, double tick_s,
@@ -174,6 +183,7 @@ std::vector<EngineCommand> ValveTest::next_step() {
   } else if (step_ == Step::kFill) {
     step_ = Step::kPulse;
   } else {
+    attempt_ = 0;
     if (++valve_ == kValveCount) {
       report_.finished = true;
       return {EngineCommand::of(CommandKind::kDisarm)};  // vents
@@ -190,8 +200,14 @@ std::vector<EngineCommand> ValveTest::on_event(const EngineEvent& event) {
       if (event.trial_id != pulse_id_) return {};
       if (step_ == Step::kPulse) {
         const auto valve = static_cast<ValveId>(valve_);
-        report_.valves[valve_] = judge_valve(valve, before_, event.reading, ambient_bar_, check_,
-                                             safety_.supply_min_bar, volume_gain_per_rad_);
+        ValveVerdict verdict = judge_valve(valve, before_, event.reading, ambient_bar_, check_, safety_.supply_min_bar,
+                                           volume_gain_per_rad_);
+        verdict.pulses = ++attempt_;
+        if (verdict.moved_nothing && attempt_ < check_.valve_pulse_attempts) {
+          step_ = Step::kVent;  // the same valve again, from ambient as the first time
+          return {command_for(step_)};
+        }
+        report_.valves[valve_] = verdict;
       } else {
         before_ = event.reading;
       }
@@ -233,7 +249,8 @@ std::string ValveTest::progress() const {
   const char* what = step_ == Step::kVent   ? "venting both chambers"
                      : step_ == Step::kFill ? "filling both chambers"
                                             : "pulsing";
-  return format("%s: %s (%d of %d)", valve_name(static_cast<ValveId>(valve_)), what, valve_ + 1, kValveCount);
+  return format("%s: %s%s (%d of %d)", valve_name(static_cast<ValveId>(valve_)), what,
+                attempt_ > 0 ? " again: the pulse before moved nothing" : "", valve_ + 1, kValveCount);
 }
 
 ValveTestReport run_valve_test(EngineDriver& driver, const RigCheckParameters& check, const SafetyParameters& safety,

@@ -11,7 +11,9 @@
 // reading taken after the one before the pulse.
 // Everything goes through the engine (kValvePulse while ARMED), so the guards and the emergency stop
 // apply as in any trial. A valve that fails is named with the likely problem: swapped tubes or
-// wires, a dead valve, no supply.
+// wires, a dead valve, no supply. A valve that moved nothing is vented and pulsed again
+// ([rig_check] valve_pulse_attempts) before it is called dead: a link or a host that held one
+// pulse's command back (a T7 answering late, a vCPU not run for 100 ms) is not a dead valve.
 //
 // ValveTest is a step machine for an operator thread that owns the engine's event queue (the
 // console forwards its events); run_valve_test() drives it to the end on its own (headless).
@@ -44,7 +46,15 @@ struct ValveVerdict {
   double own_change_bar = 0.0;    // its own chamber's change over the pulse
   double other_change_bar = 0.0;  // the other chamber's
   std::string problem;            // why it failed (empty when it passed)
+  // Nothing moved (a dead valve, no fresh reading, no air to let out): what a link or a host that
+  // held the pulse's command back also shows, so such a verdict is tried again ([rig_check]
+  // valve_pulse_attempts).
+  bool moved_nothing = false;
+  int pulses = 0;  // how many pulses the verdict took (more than one: the ones before moved nothing)
 };
+
+/// "" for a verdict of one pulse; else " (pulse 2 of 2: the one before moved nothing)", for its line.
+std::string repeat_note(const ValveVerdict& verdict);
 
 struct ValveTestReport {
   std::array<ValveVerdict, kValveCount> valves{};
@@ -55,7 +65,8 @@ struct ValveTestReport {
   std::vector<std::string> failure_lines() const;
 };
 
-/// Judges one valve from the readings before and after its pulse (pure; the rules above). The
+/// Judges one valve from the readings before and after its pulse (pure; the rules above; `pulses`
+/// left 0 for the caller). The
 /// chambers are compared by their air, p (1 +- beta alpha) with beta = `volume_gain_per_rad`
 /// ([model] volume_gain): a closed chamber the turning arm squeezes keeps its air.
 ValveVerdict judge_valve(ValveId valve, const SensorReading& before, const SensorReading& after, double ambient_bar,
@@ -95,6 +106,7 @@ class ValveTest {
   int settle_ticks_ = 0;  // the link's lag in ticks
   bool started_ = false;
   int valve_ = 0;
+  int attempt_ = 0;  // the valve's pulses so far that moved nothing
   Step step_ = Step::kVent;
   std::uint32_t pulse_id_ = 0;
   SensorReading before_{};
