@@ -63,8 +63,7 @@ void take_rig_of_session(const std::string& session_dir, const ConsoleOptions& o
     std::snprintf(text, sizeof text, "%g", value);
     return std::string(text);
   };
-  if (!options.config_path.empty() &&
-      (config.timing.tick_s != timing.tick_s || config.timing.ticks_per_sample != timing.ticks_per_sample)) {
+  if (!options.config_path.empty() && !config.timing.same_ticks(timing)) {
     throw InputError("session " + directory.string() +
                      " was recorded at [timing] tick_s = " + format_number(timing.tick_s) + " s, ticks_per_sample = " +
                      std::to_string(timing.ticks_per_sample) + "; --config has " + format_number(config.timing.tick_s) +

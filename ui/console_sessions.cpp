@@ -259,8 +259,7 @@ void ConsoleController::adopt(SessionSnapshot snapshot, bool at_start) {
   // The same sample time from other ticks would save telemetry of another shape than the session's
   // (tick_s x ticks_per_sample rows a trial): every later show, export and resume would refuse it.
   const TimingParameters& recorded = snapshot.config.timing;
-  if (std::abs(recorded.tick_s - env_.config.timing.tick_s) > 1e-12 ||
-      recorded.ticks_per_sample != env_.config.timing.ticks_per_sample) {
+  if (!env_.config.timing.same_ticks(recorded)) {
     throw InputError(format(
         "the session was recorded at [timing] tick_s = %g s, ticks_per_sample = %d; this console "
         "runs %g s, %d",

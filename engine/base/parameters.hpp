@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -150,6 +151,11 @@ struct TimingParameters {
   double settle_tolerance_deg = 0.5;
   double longest_settle_s() const { return settle_max_s > settle_s ? settle_max_s : settle_s; }
   double sample_s() const { return tick_s * ticks_per_sample; }
+  /// Whether telemetry recorded at `other`'s ticks has this timing's shape (tick_s x ticks_per_sample
+  /// rows a sample): a session is only continued at the ticks it was recorded at.
+  bool same_ticks(const TimingParameters& other) const {
+    return std::abs(tick_s - other.tick_s) <= 1e-12 && ticks_per_sample == other.ticks_per_sample;
+  }
 };
 
 /// The LCM rig protocol (docs/lcm-protocol.md); the engine itself knows no LCM.
