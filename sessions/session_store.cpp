@@ -1,11 +1,14 @@
 #include "sessions/session_store.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <exception>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -202,10 +205,39 @@ SessionManifest load_manifest(const DirectoryHandle& directory) {
 
 Session load_session(const fs::path& directory) { return load_session(open_session_directory(directory)); }
 
-Session load_session(const DirectoryHandle& directory) { return load_session_part(directory, nullptr); }
+namespace {
+
+// Which manifest the directory holds now: a writer commits by renaming a new one over it, so a
+// commit changes the inode (and the time of the change). Zeros when it cannot be seen.
+std::tuple<ino_t, std::int64_t, long> manifest_identity(const DirectoryHandle& directory) {
+  struct stat status {};
+  if (::fstatat(directory.fd(), session_layout::kManifest, &status, AT_SYMLINK_NOFOLLOW) != 0) return {0, 0, 0};
+  return {status.st_ino, static_cast<std::int64_t>(status.st_mtim.tv_sec), status.st_mtim.tv_nsec};
+}
+
+// A reader needs no lock, so a writer (the console, a run) may commit while it reads: the manifest
+// it read can name a file the commit then removed (a correction's older revision). When the
+// manifest changed while a read failed, the read is taken again from the new one (a few times: a
+// writer commits at most a few times a second); a failure over an unchanged manifest is the
+// session's own, reported as it is.
+Session load_session_settled(const DirectoryHandle& directory, const std::vector<int>* only) {
+  constexpr int kReads = 8;
+  for (int read = 1;; ++read) {
+    const auto before = manifest_identity(directory);
+    try {
+      return load_session_part(directory, only);
+    } catch (const InputError&) {
+      if (read == kReads || manifest_identity(directory) == before) throw;
+    }
+  }
+}
+
+}  // namespace
+
+Session load_session(const DirectoryHandle& directory) { return load_session_settled(directory, nullptr); }
 
 Session load_session_iterations(const fs::path& directory, const std::vector<int>& only) {
-  return load_session_part(open_session_directory(directory), &only);
+  return load_session_settled(open_session_directory(directory), &only);
 }
 
 namespace {

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -277,6 +278,41 @@ TEST(SessionWriter, AutosavesEveryIterationAndEvent) {
   EXPECT_THROW(writer.save_iteration(simulated.iterations[0].record, simulated.manifest.iterations[0].summary,
                                      simulated.iterations[0].next_corrections_bar(), *simulated.manifest.resume),
                std::invalid_argument);
+}
+
+// A reader takes no lock: while the console updates the learned correction (a new revision of the
+// last samples file, the manifest naming it, the old revision removed) a load that read the old
+// manifest would find its file gone. It reads again from the new manifest instead of failing.
+TEST(SessionReaders, ALoadRacingACorrectionUpdateReadsTheSessionAgain) {
+  TempDir dir;
+  const Session simulated = testing::simulate_session(2);
+  save_session(simulated, dir / "s");
+  Session opened;
+  SessionWriter writer = SessionWriter::open(dir / "s", "test", opened);
+  const TrialRecord& last = simulated.iterations.back().record;
+  const Eigen::VectorXd correction = simulated.iterations.back().next_corrections_bar().col(0);
+  std::atomic<bool> done{false};
+  std::thread updates([&] {
+    for (int i = 0; i < 400; ++i) {
+      const Eigen::VectorXd next = correction * (1.0 + 1e-3 * (i % 7));
+      writer.update_next_correction(last, next);
+    }
+    done = true;
+  });
+  int loads = 0;
+  std::vector<std::string> failures;
+  while (!done || loads == 0) {
+    try {
+      const Session loaded = load_session(dir / "s");
+      EXPECT_EQ(loaded.iterations.size(), 2u);
+    } catch (const InputError& error) {
+      failures.emplace_back(error.what());
+    }
+    ++loads;
+  }
+  updates.join();
+  EXPECT_TRUE(failures.empty()) << failures.size() << " of " << loads << " loads failed, e.g. " << failures.front();
+  EXPECT_EQ(load_session(dir / "s").manifest.iterations.back().samples_revision, 400);
 }
 
 TEST(SessionWriter, ReopeningClearsWhatAnInterruptedWriteLeftBehind) {
