@@ -299,10 +299,10 @@ int rig_check_command(const RigCheckOptions& options, std::istream& in, std::ost
       ++failed;
       progress << "FAIL " << valve_name(v.valve) << ": " << v.problem << repeat_note(v) << "\n";
     }
-    session.record("valve-test", v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)%s",
-                                                  valve_name(v.valve), v.own_change_bar, v.other_change_bar,
-                                                  repeat_note(v).c_str())
-                                        : std::string(valve_name(v.valve)) + " FAIL: " + v.problem + repeat_note(v));
+    session.record("valve-test",
+                   v.pass ? line_of("%s pass (own chamber %+.4f bar, other %+.4f bar)%s", valve_name(v.valve),
+                                    v.own_change_bar, v.other_change_bar, repeat_note(v).c_str())
+                          : std::string(valve_name(v.valve)) + " FAIL: " + v.problem + repeat_note(v));
     report["valves"].push_back({{"valve", valve_name(v.valve)},
                                 {"pass", v.pass},
                                 {"tested", v.tested},

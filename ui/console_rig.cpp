@@ -101,8 +101,8 @@ void ConsoleController::show_valve_verdicts() {
   for (const ValveVerdict& v : r.valves) {
     RigView::ValveLine line{valve_name(v.valve), v.tested, v.pass, {}};
     if (v.pass) {
-      line.text = format("own chamber %+.3f bar, other %+.3f bar", v.own_change_bar, v.other_change_bar) +
-                  repeat_note(v);
+      line.text =
+          format("own chamber %+.3f bar, other %+.3f bar", v.own_change_bar, v.other_change_bar) + repeat_note(v);
     } else if (v.tested || !v.problem.empty()) {
       line.text = v.problem + repeat_note(v);
     } else {

@@ -239,7 +239,7 @@ struct RigCheckParameters {
   // A valve that moved nothing is pulsed again (vented first), up to this many pulses in all: a link
   // or a host that held the command back for the pulse moves nothing once, a dead valve every time.
   int valve_pulse_attempts = 2;
-  int zero_readings = 20;        // `--zero-angle` averages this many fresh readings (0.1 s at 200 Hz), the arm at rest
+  int zero_readings = 20;  // `--zero-angle` averages this many fresh readings (0.1 s at 200 Hz), the arm at rest
   // `rig check --device lcm`: the rig's command timeout, provoked, must act within [lcm] rig_timeout_s
   // +- this (its state period, the transport and both hosts' scheduling)
   double timeout_tolerance_s = 0.025;
