@@ -145,9 +145,19 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
   const fs::path parent_path = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
   const std::string name = directory.filename().string();
   std::error_code error;
+  // The folders a new data directory needs: each one's entry is flushed in its parent once made, or a
+  // crash could lose the folder, and with it the session about to be committed inside it.
+  std::vector<fs::path> missing;
+  for (fs::path folder = fs::absolute(parent_path, error); !error && !folder.empty() && !fs::exists(folder, error);
+       folder = folder.parent_path()) {
+    missing.push_back(folder);
+  }
   fs::create_directories(parent_path, error);
   if (error)
     throw InputError("cannot create the data directory " + printable(parent_path.string()) + ": " + error.message());
+  for (auto folder = missing.rbegin(); folder != missing.rend(); ++folder) {
+    sync(DirectoryHandle::open(folder->parent_path()));
+  }
   const DirectoryHandle parent = DirectoryHandle::open(parent_path);
   const auto refuse_existing = [&] {
     if (const auto holder = SessionLock::holder(directory)) {
