@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -291,11 +292,20 @@ TEST(SessionReaders, ALoadRacingACorrectionUpdateReadsTheSessionAgain) {
   SessionWriter writer = SessionWriter::open(dir / "s", "test", opened);
   const TrialRecord& last = simulated.iterations.back().record;
   const Eigen::VectorXd correction = simulated.iterations.back().next_corrections_bar().col(0);
+  // The console commits a new correction once a trial, seconds apart; a load takes milliseconds. The
+  // writer here commits far more often, yet a load's time apart (twice what one took: a sanitizer
+  // build's slow loads included), so that a load overlaps a commit about half the time: the race,
+  // not a writer that never lets a reader finish.
+  const auto started = std::chrono::steady_clock::now();
+  EXPECT_EQ(load_session(dir / "s").iterations.size(), 2u);
+  const auto load_time = std::chrono::steady_clock::now() - started;
+  constexpr int kCommits = 100;
   std::atomic<bool> done{false};
   std::thread updates([&] {
-    for (int i = 0; i < 400; ++i) {
+    for (int i = 0; i < kCommits; ++i) {
       const Eigen::VectorXd next = correction * (1.0 + 1e-3 * (i % 7));
       writer.update_next_correction(last, next);
+      std::this_thread::sleep_for(2 * load_time);
     }
     done = true;
   });
@@ -312,7 +322,7 @@ TEST(SessionReaders, ALoadRacingACorrectionUpdateReadsTheSessionAgain) {
   }
   updates.join();
   EXPECT_TRUE(failures.empty()) << failures.size() << " of " << loads << " loads failed, e.g. " << failures.front();
-  EXPECT_EQ(load_session(dir / "s").manifest.iterations.back().samples_revision, 400);
+  EXPECT_EQ(load_session(dir / "s").manifest.iterations.back().samples_revision, kCommits);
 }
 
 TEST(SessionWriter, ReopeningClearsWhatAnInterruptedWriteLeftBehind) {
