@@ -44,10 +44,13 @@ TEST(LoadedMachine, AWallClockRunOnTheLcmRigStillFaultsOnAStreak) {
   BusRecorder recorder;
   LcmIoThread bus(kDefaultLcmUrl, {&recorder});
   bus.start(RealtimeMode::kOff, 0);
-  Child rig({kBellows, "io-sim"}, dir / "rig.out", dir / "rig.err");
   // Only the streak guard may end it: under this load io-sim's states can also come late enough for
-  // the stale guard, which has tests of its own.
-  const std::filesystem::path config = testing::write_file(dir, "streak-only.toml", "[safety]\nstale_ticks = 100000\n");
+  // the stale guard, and the engine's LCM thread, held off the cores by the load, can send no command
+  // for longer than the rig's 50 ms timeout (the rig then vents: rig-timeout, seen in CI). Both have
+  // tests of their own; here the rig waits 1 s, far longer than the stall below.
+  const std::filesystem::path config =
+      testing::write_file(dir, "streak-only.toml", "[safety]\nstale_ticks = 100000\n[lcm]\nrig_timeout_s = 1.0\n");
+  Child rig({kBellows, "io-sim", "--config", config.string()}, dir / "rig.out", dir / "rig.err");
   Child run({kBellows, "run", "--device", "lcm", "--clock", "wall", "--rt", "off", "--iterations", "3", "--json",
              "--no-save", "--lcm", kDefaultLcmUrl,  // --lcm: its telemetry tells when a trial runs
              "--config", config.string()},
