@@ -172,14 +172,19 @@ class LaggingDevice final : public Device {
   std::deque<SensorReading> taken_;
 };
 
-ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
-  const Configuration c;
-  SimulatedArm arm(c.plant, 1);
-  LaggingDevice device(arm, lag_ticks, c.timing.tick_s);
+/// The valve test through the engine on `device` (a wrapper of a simulated arm), on the simulated clock.
+ValveTestReport check_on(Device& device, const Configuration& c, double link_lag_s = 0.0) {
   EngineCore core(device, c.controller, c.timing, c.safety);
   SimulatedClock clock(core, device);
   return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad,
                         nullptr, link_lag_s);
+}
+
+ValveTestReport check_lagging(int lag_ticks, double link_lag_s) {
+  const Configuration c;
+  SimulatedArm arm(c.plant, 1);
+  LaggingDevice device(arm, lag_ticks, c.timing.tick_s);
+  return check_on(device, c, link_lag_s);
 }
 
 // The default 30 ms pulses on a rig whose readings lag by 4 ticks (20 ms): judged on readings that
@@ -230,9 +235,7 @@ ValveTestReport check_swallowing(int swallowed, int attempts) {
   c.rig_check.valve_pulse_attempts = attempts;
   SimulatedArm arm(c.plant, 1);
   SwallowingDevice device(arm, swallowed);
-  EngineCore core(device, c.controller, c.timing, c.safety);
-  SimulatedClock clock(core, device);
-  return run_valve_test(clock, c.rig_check, c.safety, c.controller.gas.ambient_bar, c.model.volume_gain_per_rad);
+  return check_on(device, c);
 }
 
 // A pulse the link held back moved nothing, as a dead valve would: pulsed again, the valve passes and
