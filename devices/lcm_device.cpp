@@ -110,6 +110,7 @@ void LcmDevice::on_limits(const void* data, std::size_t size) {
       l.rig_id != rig_id_) {  // only the rig addressed speaks for this session's rig
     return bump(limits_ignored_);
   }
+  announced_timeout_s_ = l.command_timeout_s;
   limits_seen_.write(
       {now_s_, l.rig_id, l.joint_count, l.period_s, l.command_timeout_s, l.pressure_ceiling_bar, l.angle_limit_rad});
 }
@@ -153,6 +154,7 @@ void LcmDevice::on_message(const char* channel, const void* data,
     // serves this session, a new offer of the rig addressed, and another rig's when ours is gone.
     if (!last_armed_ && (!bound_ || s.rig_id == rig_id_ || rig_gone) &&
         (s.rig_id != rig_id_ || s.binding != binding_)) {
+      if (s.rig_id != rig_id_) announced_timeout_s_ = 0.0;  // until this rig announces its own
       rig_id_ = s.rig_id;
       binding_ = s.binding;
       bound_ = false;
@@ -235,11 +237,11 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
         "rig_pressure_margin_bar): check that valve and the rig's ceiling",
         chamber == 0 ? 'A' : 'B', joint + 1, s.chamber_bar[at(joint)][chamber]);
   } else if ((trip & kTimeout) != 0) {
-    fault.set(
-        FaultCode::kRigTimeout, -1,
-        "the LCM rig %llx heard no command of this session for its [lcm] rig_timeout_s and vented itself: check the "
-        "network from this host to the rig",
-        rig);
+    // Named at the next turn (name_command_timeout()): after a stall this state is handled before the
+    // clock is read again.
+    last_trip_bits_.store(s.fault_bits, std::memory_order_relaxed);
+    timeout_applied_seq_ = s.command_seq > 0 ? s.command_seq : last_echoed_seq_;  // an offer carries 0
+    return;
   } else if ((trip & (kSensor | kValve)) != 0) {
     fault.set(FaultCode::kRigFault, -1, "the LCM rig %llx reports %s (fault_bits %d): check its driver's log", rig,
               (trip & kSensor) != 0 ? "it cannot read its sensors" : "it cannot drive its valves", s.fault_bits);
@@ -248,6 +250,48 @@ void LcmDevice::report_trip(const io_joints_state_t& s, bool offered) {
               "the LCM rig %llx ended this session without a reason (it shut down or restarted?)", rig);
   }
   last_trip_bits_.store(s.fault_bits, std::memory_order_relaxed);
+  trips_.write(fault);
+}
+
+double LcmDevice::longest_send_gap_s(std::int64_t applied_seq, double now_s) const {
+  const auto sent_at = [this](std::int64_t seq) { return sent_s_[static_cast<std::size_t>(seq) % sent_s_.size()]; };
+  if (applied_seq <= 0 || applied_seq > seq_ || seq_ - applied_seq >= static_cast<std::int64_t>(sent_s_.size())) {
+    return NAN;
+  }
+  double longest_s = now_s - sent_at(seq_);
+  for (std::int64_t seq = applied_seq; seq < seq_; ++seq) {
+    longest_s = std::max(longest_s, sent_at(seq + 1) - sent_at(seq));
+  }
+  return longest_s;
+}
+
+void LcmDevice::name_command_timeout(double now_s) {
+  const unsigned long long rig = static_cast<unsigned long long>(rig_id_);
+  const double timeout_s = announced_timeout_s_ > 0.0 ? announced_timeout_s_ : rig_silence_s_;
+  const double gap_s = longest_send_gap_s(timeout_applied_seq_, now_s);
+  timeout_applied_seq_ = -1;
+  DeviceFault fault;
+  if (hold_seen_) {  // the rig check's provoked timeout (hold_commands())
+    fault.set(FaultCode::kRigTimeout, -1,
+              "the LCM rig %llx vented, as provoked: this host held its commands back for %.0f ms, longer than its "
+              "%.0f ms timeout",
+              rig, gap_s * 1e3, timeout_s * 1e3);
+  } else if (gap_s >= timeout_s) {  // nothing left this host for the rig's whole timeout: not the network
+    fault.set(FaultCode::kRigTimeout, -1,
+              "the LCM rig %llx vented: this host sent it no command for %.0f ms, longer than its %.0f ms timeout "
+              "(its engine or LCM I/O thread did not run: lighten the load, --rt enforce)",
+              rig, gap_s * 1e3, timeout_s * 1e3);
+  } else if (std::isfinite(gap_s)) {
+    fault.set(FaultCode::kRigTimeout, -1,
+              "the LCM rig %llx heard no command for its %.0f ms timeout and vented, though this host sent one at "
+              "least every %.0f ms: check the network from this host to the rig",
+              rig, timeout_s * 1e3, gap_s * 1e3);
+  } else {
+    fault.set(FaultCode::kRigTimeout, -1,
+              "the LCM rig %llx heard no command of this session for its %.0f ms timeout and vented itself: check the "
+              "network from this host to the rig",
+              rig, timeout_s * 1e3);
+  }
   trips_.write(fault);
 }
 
@@ -304,6 +348,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
   // How long the rig addressed has said nothing at all, on this thread's clock (explain_silence()).
   rig_silent_s_.store(rig_id_ == 0 ? INFINITY : now_s - last_rig_state_s_, std::memory_order_relaxed);
   io_turn_s_.store(monotonic_s(), std::memory_order_relaxed);
+  if (timeout_applied_seq_ >= 0) name_command_timeout(now_s);  // before this turn sends anything
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {
     // The device's own clock, strictly increasing: the engine's stale guard watches it.

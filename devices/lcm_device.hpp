@@ -25,10 +25,11 @@
 // `sensor-stale` (states arrive but none is usable). A state of this session carrying the rig's own
 // trip (its angle range, its pressure ceiling, its command timeout, a sensor or valve fault) is no
 // reading but a fault with the rig's reason and joint (take_fault()): `rig-limit`, `rig-timeout`,
-// `rig-fault`. A rig that trips keeps naming the session it dropped in its states for a while
-// (docs/lcm-protocol.md, "the tripped state"), so the reason reaches the engine it served. Only
-// fresh valve states are published: if the engine thread stops, the commands stop and the rig
-// vents on its own.
+// `rig-fault`; a `rig-timeout` says from this host's own send times whether it sent nothing for the
+// rig's timeout (it stalled) or sent and the network lost them. A rig that trips keeps naming the
+// session it dropped in its states for a while (docs/lcm-protocol.md, "the tripped state"), so the
+// reason reaches the engine it served. Only fresh valve states are published: if the engine thread
+// stops, the commands stop and the rig vents on its own.
 #pragma once
 
 #include <atomic>
@@ -175,6 +176,12 @@ class LcmDevice final : public Device, public LcmEndpoint {
   /// A state of this session with trip bits: the rig's reason, for the engine (once per trip).
   /// `offered`: the rig's new offer (session 0) that dropped this session, its reasons in its bits.
   void report_trip(const io_joints_state_t& state, bool offered);
+  /// A command timeout the rig reported (report_trip()), named at the next service() turn, when this
+  /// thread's clock is fresh: whether this host stopped sending (it stalled) or its commands were lost.
+  void name_command_timeout(double now_s);
+  /// The longest this host went without publishing, from the command the rig last applied until `now_s`
+  /// (NAN: that command is no longer in sent_s_).
+  double longest_send_gap_s(std::int64_t applied_seq, double now_s) const;
 
   const std::int64_t session_id_;
   const LcmKey key_;
@@ -217,6 +224,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::uint64_t awaited_generation_ = 0, answer_generation_ = 0;
   std::int64_t awaited_seq_ = 0;
   io_rig_limits_t limits_received_{};
+  double announced_timeout_s_ = 0.0;             // the rig addressed's command timeout (0: not announced)
+  std::int64_t timeout_applied_seq_ = -1;        // a reported command timeout to name: the last command applied
   bool hold_seen_ = false;                       // the I/O thread has acted on hold_commands(true)
   bool trip_kept_ = false;                       // the first trip since then is in trip_seen_
   LatestValue<RigAnnouncedLimits> limits_seen_;  // I/O -> rig check

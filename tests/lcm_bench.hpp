@@ -10,6 +10,7 @@
 
 #include "devices/lcm_channels.hpp"
 #include "devices/lcm_codec.hpp"
+#include "devices/lcm_device.hpp"
 #include "devices/lcm_rig_server.hpp"
 #include "engine/config/configuration.hpp"
 #include "tests/lcm_test_support.hpp"
@@ -100,6 +101,45 @@ struct RigBench {
       if (line.find(fragment) != std::string::npos) return true;
     }
     return false;
+  }
+};
+
+/// The engine's device and the rig on one memq bus, one thread, a hand-made clock. The device's
+/// commands go out on `commands_bus` (the rig's bus unless lose_commands(): then on one nobody hears,
+/// as when the network drops them).
+struct SessionBench {
+  RigBench b;
+  LcmDevice device;
+  BusRecorder commands{kIoCommandChannel};
+  lcm::LCM nowhere{"memq://"};
+  lcm::LCM* commands_bus = &b.bus;
+  explicit SessionBench(const LcmKey& key = {}, const Configuration& c = {}) : b(c, key), device(4711, key) {
+    device.attach(b.bus);
+    commands.attach(b.bus);
+  }
+  void lose_commands() { commands_bus = &nowhere; }
+  void step(double dt = 0.005) {
+    pump(b.bus);
+    b.t += dt;
+    b.rig.service(&b.bus, b.t);
+    device.service(commands_bus, b.t);
+    pump(b.bus);
+  }
+  void bind() {
+    for (int i = 0; i < 10 && !device.connected(); ++i) {
+      device.vent();
+      step();
+    }
+    ASSERT_TRUE(device.connected());
+    ASSERT_EQ(b.rig.stats().serving, 4711);
+  }
+  void drive(double inlet_a) {
+    ValveCommand v;
+    v.joint[0].inlet_duty = {inlet_a, 0.0};
+    v.joint[0].outlet_duty = {0.0, 1.0};
+    device.write_valves(v);
+    step();
+    step(0.001);  // the rig applies what arrived after its last turn
   }
 };
 

@@ -26,6 +26,7 @@ using testing::decode;
 using testing::publish;
 using testing::pump;
 using testing::RigBench;
+using testing::SessionBench;
 using testing::vented;
 
 LcmKey test_key(std::uint8_t fill) {
@@ -176,40 +177,6 @@ TEST(LcmAttacks, TheRigsAngleRangeVentsDropsTheSessionAndAdmitsNoneUntilTheArmIs
   EXPECT_TRUE(b.logged("beyond the rig's angle range: vented, session 31337 dropped"));
   EXPECT_TRUE(b.logged("while the arm is beyond the rig's angle range"));
 }
-
-/// The engine's device and the rig on one memq bus, one thread, a hand-made clock.
-struct SessionBench {
-  RigBench b;
-  LcmDevice device;
-  testing::BusRecorder commands{kIoCommandChannel};
-  explicit SessionBench(const LcmKey& key = {}) : b(Configuration{}, key), device(4711, key) {
-    device.attach(b.bus);
-    commands.attach(b.bus);
-  }
-  void step(double dt = 0.005) {
-    pump(b.bus);
-    b.t += dt;
-    b.rig.service(&b.bus, b.t);
-    device.service(&b.bus, b.t);
-    pump(b.bus);
-  }
-  void bind() {
-    for (int i = 0; i < 10 && !device.connected(); ++i) {
-      device.vent();
-      step();
-    }
-    ASSERT_TRUE(device.connected());
-    ASSERT_EQ(b.rig.stats().serving, 4711);
-  }
-  void drive(double inlet_a) {
-    ValveCommand v;
-    v.joint[0].inlet_duty = {inlet_a, 0.0};
-    v.joint[0].outlet_duty = {0.0, 1.0};
-    device.write_valves(v);
-    step();
-    step(0.001);  // the rig applies what arrived after its last turn
-  }
-};
 
 TEST(LcmAttacks, AForgedSequenceNumberCannotTakeOverASessionAndTheEnginesVentIsAlwaysObeyed) {
   SessionBench s;

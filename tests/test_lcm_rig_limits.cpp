@@ -212,6 +212,8 @@ TEST(RigCheckLimitsMemq, TheRigServerAnnouncesItsLimitsAndItsTimeoutProvokedPass
   EXPECT_LT(t.trip.reading.joint[0].chamber_bar[0], t.before.joint[0].chamber_bar[0] + 0.02) << "filled while silent";
   EXPECT_LT(t.after.joint[0].chamber_bar[0], t.before.joint[0].chamber_bar[0]) << "vented";
   EXPECT_EQ(t.engine_fault, FaultCode::kRigTimeout) << t.engine_detail;
+  EXPECT_NE(t.engine_detail.find("vented, as provoked: this host held its commands back for"), std::string::npos)
+      << t.engine_detail;
   EXPECT_TRUE(t.served_again);
   const LimitVerdict v = judge_command_timeout(t, m.c);
   EXPECT_TRUE(v.pass()) << v.problem;
