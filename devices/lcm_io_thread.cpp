@@ -107,6 +107,7 @@ void LcmIoThread::stop() {
 }
 
 void LcmIoThread::serve(const std::function<bool()>& should_stop, RealtimeMode mode, int priority) {
+  pthread_setname_np(pthread_self(), "bellows-lcm-io");  // as htop -H, ps -L and gdb show it
   if (mode != RealtimeMode::kOff) {
     sched_param param{};
     param.sched_priority = priority;

@@ -140,12 +140,14 @@ void T7Device::serve() {
     param.sched_priority = options_.priority;
     pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);  // refused: run without, as the loop does
   }
+  pthread_setname_np(pthread_self(), "bellows-t7-io");  // as htop -H, ps -L and gdb show it
   ValveCommand current = ValveCommand::vented();
   double last_command_s = now_s();
   double next_idle_s = 0.0;
   while (!stop_.load(std::memory_order_acquire)) {
     Outgoing out;
     const double now = now_s();
+    io_turn_s_.store(now, std::memory_order_release);
     const bool fresh = outbox_.read(out);
     if (fresh) {
       current = out.valves;
@@ -337,6 +339,16 @@ bool T7Device::take_fault(DeviceFault& fault) {
 }
 
 void T7Device::explain_silence(double silent_s, DeviceFault& fault) const {
+  // Every turn of the I/O thread ends within the exchange's deadline and a poll: a longer wait since
+  // its last turn is this host holding the thread off its core, not the T7 (as LcmDevice judges its own).
+  const double io_idle_s = now_s() - io_turn_s_.load(std::memory_order_acquire);
+  if (io_idle_s >= 0.5 * silent_s && io_idle_s > options_.link.response_timeout_s + 2.0 * kOutboxPoll_s) {
+    fault.set(FaultCode::kLinkLost, -1,
+              "no reading of the T7 at %s for %.0f ms: this host's T7 I/O thread did not run for %.0f ms (the "
+              "machine stalled: lighten its load, --rt enforce)",
+              address_.c_str(), silent_s * 1e3, io_idle_s * 1e3);
+    return;
+  }
   if (link_answers()) {
     Device::explain_silence(silent_s, fault);
     return;

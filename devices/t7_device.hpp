@@ -76,9 +76,11 @@ class T7Device final : public Device {
   /// A request the T7 refused during the run reaches the engine as `device-error`, naming the
   /// register and LabJack's error (take_refusal). Engine thread; allocates nothing.
   bool take_fault(DeviceFault& fault) override;
-  /// Silent for the stale limit: `link-lost` naming the address when nothing at all came from the T7
-  /// for (half) that time; `sensor-stale` "answers, but late" when bytes came but no answer in time;
-  /// else the default `sensor-stale`.
+  /// Silent for the stale limit: `link-lost` "this host's T7 I/O thread did not run" when the I/O
+  /// thread made no turn for (half) that time and longer than an exchange's deadline (the host held it
+  /// off its core); `link-lost` naming the address when nothing at all came from the T7 for (half)
+  /// that time; `sensor-stale` "answers, but late" when bytes came but no answer in time; else the
+  /// default `sensor-stale`.
   void explain_silence(double silent_s, DeviceFault& fault) const override;
   /// "host:port".
   const std::string& address() const { return address_; }
@@ -168,7 +170,8 @@ class T7Device final : public Device {
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
   std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0},
       late_readings_{0};
-  std::atomic<double> heard_s_{-1e300};  // the client's last_receive_s(), copied by the I/O thread
+  std::atomic<double> heard_s_{-1e300};   // the client's last_receive_s(), copied by the I/O thread
+  std::atomic<double> io_turn_s_{1e300};  // now_s() at the I/O thread's last turn (explain_silence())
 };
 
 }  // namespace bellows

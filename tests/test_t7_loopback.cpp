@@ -3,10 +3,17 @@
 // the exception for an unknown register, the watchdog, and a link that dies.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <thread>
 
@@ -371,6 +378,57 @@ TEST(T7Loopback, ADeadLinkStopsTheReadingsAndSaysWhichLink) {
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_EQ(device.read_sensors().time_s, frozen);
   EXPECT_GT(device.health().stale_readings, 0u);
+}
+
+/// The thread of this process named `name` (its comm), 0 when there is none.
+pid_t thread_named(const std::string& name) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string line;
+    if (std::getline(comm, line) && line == name) return static_cast<pid_t>(std::stoi(task.path().filename()));
+  }
+  return 0;
+}
+
+// How long a thread sent SIGUSR2 sleeps in its handler: as long as a host that holds it off its core.
+constexpr long kHeldOff_ms = 400;
+extern "C" void held_off(int) {
+  const timespec held{0, kHeldOff_ms * 1000000L};
+  nanosleep(&held, nullptr);
+}
+
+// The T7 answers, but this host does not run the link's I/O thread (a loaded machine holding it off
+// its core): no reading arrives, and the silence is named for the host, not the T7 or its cable.
+TEST(T7Loopback, ASilenceOfThisHostsIoThreadIsNamedForTheHostNotTheT7) {
+  SimThread sim;
+  T7Device device(device_options(sim.port()));
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > 5; }));
+  const pid_t io_thread = thread_named("bellows-t7-io");
+  ASSERT_NE(io_thread, 0) << "the link's I/O thread is named bellows-t7-io";
+  DeviceFault running;
+  device.explain_silence(0.04, running);
+  EXPECT_EQ(std::string(running.text.data()).find("I/O thread did not run"), std::string::npos) << running.text.data();
+
+  struct sigaction action {};
+  action.sa_handler = held_off;
+  struct sigaction before {};
+  ASSERT_EQ(sigaction(SIGUSR2, &action, &before), 0);
+  ASSERT_EQ(syscall(SYS_tgkill, getpid(), io_thread, SIGUSR2), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(kHeldOff_ms / 2));
+  DeviceFault held;
+  device.explain_silence(0.04, held);  // [safety] stale_ticks 8 at 200 Hz
+  const std::string text = held.text.data();
+  EXPECT_EQ(held.code, FaultCode::kLinkLost) << text;
+  EXPECT_NE(text.find("no reading of the T7 at 127.0.0.1:"), std::string::npos) << text;
+  EXPECT_NE(text.find("this host's T7 I/O thread did not run for"), std::string::npos) << text;
+
+  // Back on its core, it exchanges again and the silence is no longer the host's.
+  const std::uint64_t exchanges = device.health().exchanges;
+  ASSERT_TRUE(eventually([&] { return device.health().exchanges > exchanges + 5; }));
+  sigaction(SIGUSR2, &before, nullptr);
+  DeviceFault again;
+  device.explain_silence(0.04, again);
+  EXPECT_EQ(std::string(again.text.data()).find("I/O thread did not run"), std::string::npos) << again.text.data();
 }
 
 // One answer comes late (a busy network or T7): its request times out, and the answers queued

@@ -116,6 +116,7 @@ void RealtimeLoop::run(int priority, RealtimeMode mode) {
   sigset_t all;
   sigfillset(&all);
   pthread_sigmask(SIG_BLOCK, &all, nullptr);
+  pthread_setname_np(pthread_self(), "bellows-engine");  // as htop -H, ps -L and gdb show it
 
   // Unpaced (speed max) the loop never sleeps: under SCHED_FIFO it would starve its core.
   if (speed_ <= 0.0 && mode == RealtimeMode::kTry) mode = RealtimeMode::kOff;
