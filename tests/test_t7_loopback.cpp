@@ -3,6 +3,7 @@
 // the exception for an unknown register, the watchdog, and a link that dies.
 #include <gtest/gtest.h>
 
+#include <errno.h>
 #include <signal.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -393,8 +394,10 @@ pid_t thread_named(const std::string& name) {
 // How long a thread sent SIGUSR2 sleeps in its handler: as long as a host that holds it off its core.
 constexpr long kHeldOff_ms = 400;
 extern "C" void held_off(int) {
+  const int saved_errno = errno;  // the thread was interrupted mid-call: leave it its errno
   const timespec held{0, kHeldOff_ms * 1000000L};
   nanosleep(&held, nullptr);
+  errno = saved_errno;
 }
 
 // The T7 answers, but this host does not run the link's I/O thread (a loaded machine holding it off
