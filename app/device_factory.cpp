@@ -120,6 +120,7 @@ class LcmRig final : public OpenedDevice {
         {"commands_sent", s.commands_sent},
         {"vent_commands_sent", s.vent_commands_sent},
         {"publish_errors", s.publish_errors},
+        {"longest_command_gap_ms", s.longest_command_gap_s * 1e3},
         {"authenticated", s.keyed},
         {"commands_not_ours", s.commands_not_ours},
         {"rig_refused", {{"foreign", s.rig_foreign_commands}, {"unauthenticated", s.rig_unauthenticated_commands}}},

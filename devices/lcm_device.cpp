@@ -364,7 +364,16 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
   if (hold && !hold_seen_) trip_kept_ = false;  // a new hold: watch for the trip anew
   hold_seen_ = hold;
   Outgoing outgoing;
-  if (outbox_.read(outgoing) && bus != nullptr && !hold) publish(*bus, outgoing, now_s);
+  if (outbox_.read(outgoing) && bus != nullptr && !hold) {
+    // The engine's commands only (not finish()'s last vent), and none across a hold (the rig check's).
+    if (const double gap_s = now_s - last_engine_command_s_;
+        gap_s > longest_command_gap_s_.load(std::memory_order_relaxed)) {
+      longest_command_gap_s_.store(gap_s, std::memory_order_relaxed);
+    }
+    last_engine_command_s_ = now_s;
+    publish(*bus, outgoing, now_s);
+  }
+  if (hold) last_engine_command_s_ = NAN;
   commands_held_.store(hold, std::memory_order_release);
   return now_s + kOutboxPoll_s;
 }
@@ -423,6 +432,7 @@ LcmDeviceStats LcmDevice::stats() const {
   s.commands_sent = commands_sent_.load(relaxed);
   s.vent_commands_sent = vent_commands_sent_.load(relaxed);
   s.publish_errors = publish_errors_.load(relaxed);
+  s.longest_command_gap_s = longest_command_gap_s_.load(relaxed);
   s.commands_not_ours = commands_not_ours_.load(relaxed);
   s.rig_foreign_commands = rig_foreign_commands_.load(relaxed);
   s.rig_unauthenticated_commands = rig_unauthenticated_commands_.load(relaxed);

@@ -33,6 +33,7 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,7 +61,8 @@ struct LcmDeviceStats {
   std::uint64_t commands_sent = 0;
   std::uint64_t vent_commands_sent = 0;  // of which armed = false
   std::uint64_t publish_errors = 0;
-  std::uint64_t commands_not_ours = 0;    // states of this session echoing a command it never sent
+  double longest_command_gap_s = 0.0;   // between two of the engine's commands sent (a rig times out past its timeout)
+  std::uint64_t commands_not_ours = 0;  // states of this session echoing a command it never sent
   std::int64_t rig_foreign_commands = 0;  // what the rig says it refused (its last state)
   std::int64_t rig_unauthenticated_commands = 0;
   bool keyed = false;  // [lcm] key_file set
@@ -251,6 +253,8 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<std::uint64_t> commands_sent_{0};
   std::atomic<std::uint64_t> vent_commands_sent_{0};
   std::atomic<std::uint64_t> publish_errors_{0};
+  double last_engine_command_s_ = NAN;              // I/O thread: the last engine command sent (NAN: none, or held)
+  std::atomic<double> longest_command_gap_s_{0.0};  // between two of them (stats())
   // health(): when each recent command went out (I/O thread), round trips, stale engine reads.
   std::array<double, 64> sent_s_{};
   RoundTripStats round_trips_;

@@ -1,6 +1,8 @@
 // A rig that vented on its command timeout is named for why its commands stopped: this host sent
 // none for the rig's whole timeout (its engine or I/O thread did not run), or it sent them and the
-// network lost them. Over memq://, one thread, a hand-made clock (tests/lcm_bench.hpp).
+// network lost them; and the longest this host went between two commands is in the device's stats
+// (`run --json`'s lcm.rig.longest_command_gap_ms). Over memq://, one thread, a hand-made clock
+// (tests/lcm_bench.hpp).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -74,6 +76,22 @@ TEST(LcmRigTimeoutNamed, TheRigsAnnouncedTimeoutIsTheOneJudgedAgainst) {
   ASSERT_EQ(fault.code, FaultCode::kRigTimeout) << fault.text.data();
   const std::string message = fault.text.data();
   EXPECT_NE(message.find("longer than its 400 ms timeout"), std::string::npos) << message;
+}
+
+TEST(LcmCommandGap, TheLongestWaitBetweenTwoOfTheEnginesCommandsIsCountedButNotAHold) {
+  SessionBench s;
+  s.bind();
+  for (int i = 0; i < 10; ++i) s.drive(0.0);  // a command every 6 ms (drive(): 5 ms, then 1 ms)
+  EXPECT_NEAR(s.device.stats().longest_command_gap_s, 0.006, 1e-9);
+  for (int i = 0; i < 5; ++i) s.step();  // 25 ms without a command: the engine late, under the rig's 50 ms
+  s.drive(0.0);
+  EXPECT_NEAR(s.device.stats().longest_command_gap_s, 0.031, 1e-9) << "the 1 ms, the 25 ms, then 5 ms to the next";
+  // The rig check holds the commands back on purpose: not a gap of the engine's.
+  s.device.hold_commands(true);
+  for (int i = 0; i < 20; ++i) s.drive(0.0);
+  s.device.hold_commands(false);
+  for (int i = 0; i < 10; ++i) s.drive(0.0);
+  EXPECT_NEAR(s.device.stats().longest_command_gap_s, 0.031, 1e-9);
 }
 
 }  // namespace
