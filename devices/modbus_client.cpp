@@ -105,27 +105,42 @@ int ModbusClient::wait_for(short events, double deadline) {
   }
 }
 
-std::string ModbusClient::connect(double timeout_s) {
-  close();  // never two connections at once: a T7 serves only a few
-  const double deadline = std::min(monotonic_seconds() + timeout_s, deadline_s_);
+bool ModbusClient::resolve() {
+  if (!addresses_.empty()) return true;
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* found = nullptr;
+  ++address_resolutions_;
   if (const int error = getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found); error != 0) {
     last_error_ = std::string("cannot resolve ") + host_ + ": " + gai_strerror(error);
-    return last_error_;
+    return false;
   }
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    if (a->ai_addrlen > sizeof(sockaddr_storage)) continue;
+    ResolvedAddress r{a->ai_family, a->ai_socktype, a->ai_protocol, {}, a->ai_addrlen};
+    std::memcpy(&r.address, a->ai_addr, a->ai_addrlen);
+    addresses_.push_back(r);
+  }
+  freeaddrinfo(found);
   last_error_ = "no address";
-  for (addrinfo* a = found; a != nullptr; a = a->ai_next) {
-    fd_ = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
+  return !addresses_.empty();
+}
+
+std::string ModbusClient::connect(double timeout_s) {
+  close();  // never two connections at once: a T7 serves only a few
+  const double deadline = std::min(monotonic_seconds() + timeout_s, deadline_s_);
+  if (!resolve()) return last_error_;
+  last_error_ = "no address";
+  for (const ResolvedAddress& a : addresses_) {
+    fd_ = ::socket(a.family, a.socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a.protocol);
     if (fd_ < 0) {
       last_error_ = std::strerror(errno);
       continue;
     }
     const int one = 1;
     setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    if (::connect(fd_, a->ai_addr, a->ai_addrlen) == 0) break;
+    if (::connect(fd_, reinterpret_cast<const sockaddr*>(&a.address), a.length) == 0) break;
     if (errno != EINPROGRESS) {
       last_error_ = std::strerror(errno);
       close();
@@ -141,7 +156,6 @@ std::string ModbusClient::connect(double timeout_s) {
     close();
     if (interrupted_ || ready == 0) break;
   }
-  freeaddrinfo(found);
   if (fd_ < 0) return last_error_;
   if (ever_connected_) ++reconnects_;
   ever_connected_ = true;

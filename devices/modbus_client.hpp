@@ -11,11 +11,14 @@
 // connecting). TCP_NODELAY is set: a request leaves at once.
 #pragma once
 
+#include <sys/socket.h>
+
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace bellows {
 
@@ -79,6 +82,10 @@ class ModbusClient {
   double last_receive_s() const { return last_receive_s_; }
   /// Connections opened again after one was lost.
   std::uint64_t reconnects() const { return reconnects_; }
+  /// Times the host name was looked up: once, at the first connect that resolved it. A reconnect
+  /// reuses those addresses, so it waits on nothing but the connection and its deadline (a name
+  /// lookup has no deadline, and the vent waits behind the exchange that reconnects).
+  std::uint64_t address_resolutions() const { return address_resolutions_; }
 
  private:
   bool request(int function, int address, int count, const std::uint16_t* values, std::uint16_t* out);
@@ -90,7 +97,17 @@ class ModbusClient {
   bool fail(const std::string& why);
   void lose_connection(const std::string& why);
 
+  /// Resolves host_ into addresses_ once (false, last_error_ set: not resolved).
+  bool resolve();
+
   std::string host_, port_, address_;
+  struct ResolvedAddress {
+    int family = 0, socktype = 0, protocol = 0;
+    sockaddr_storage address{};
+    socklen_t length = 0;
+  };
+  std::vector<ResolvedAddress> addresses_;  // host_:port_, resolved at the first connect
+  std::uint64_t address_resolutions_ = 0;
   int fd_ = -1;
   bool ever_connected_ = false;
   std::uint16_t transaction_ = 0;

@@ -85,5 +85,23 @@ TEST(ModbusClientErrors, AnExceptionTheDeviceSentNamesItsNumber) {
   EXPECT_NE(client.last_error().find("(Modbus exception 2)"), std::string::npos) << client.last_error();
 }
 
+// A reconnect (after a lost connection, inside an exchange's deadline) looks up no name: the lookup
+// has no deadline, and the vent waits behind that exchange.
+TEST(ModbusClientConnect, AReconnectReusesTheAddressesTheFirstConnectResolved) {
+  sockaddr_in address{};
+  const int listener = testing::loopback_listener(address);
+  // A numeric address (getaddrinfo all the same): a test sends nothing to a name server.
+  ModbusClient client("127.0.0.1", ntohs(address.sin_port));
+  ASSERT_EQ(client.connect(2.0), "");
+  const int first = ::accept(listener, nullptr, nullptr);
+  ASSERT_EQ(client.connect(2.0), "") << "the same listener, reached again";
+  const int second = ::accept(listener, nullptr, nullptr);
+  EXPECT_EQ(client.reconnects(), 1u);
+  EXPECT_EQ(client.address_resolutions(), 1u);
+  ::close(first);
+  ::close(second);
+  ::close(listener);
+}
+
 }  // namespace
 }  // namespace bellows
