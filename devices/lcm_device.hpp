@@ -28,8 +28,9 @@
 // `rig-fault`; a `rig-timeout` says from this host's own send times whether it sent nothing for the
 // rig's timeout (it stalled) or sent and the network lost them. A rig that trips keeps naming the
 // session it dropped in its states for a while (docs/lcm-protocol.md, "the tripped state"), so the
-// reason reaches the engine it served. Only fresh valve states are published: if the engine thread
-// stops, the commands stop and the rig vents on its own.
+// reason reaches the engine it served (the faults' words: devices/lcm_device_faults.cpp). Only fresh
+// valve states are published: if the engine thread stops, the commands stop and the rig vents on its
+// own.
 #pragma once
 
 #include <atomic>
