@@ -204,7 +204,7 @@ double LcmDevice::service(lcm::LCM* bus, double now_s) {
   now_s_ = now_s;
   // How long the rig addressed has said nothing at all, on this thread's clock (explain_silence()).
   rig_silent_s_.store(rig_id_ == 0 ? INFINITY : now_s - last_rig_state_s_, std::memory_order_relaxed);
-  io_turn_s_.store(monotonic_s(), std::memory_order_relaxed);
+  io_turns_.turn(monotonic_s());
   if (timeout_applied_seq_ >= 0) name_command_timeout(now_s);  // before this turn sends anything
   if (origin_s_ < 0.0) origin_s_ = now_s;
   if (pending_fresh_) {

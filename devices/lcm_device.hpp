@@ -41,6 +41,7 @@
 
 #include "devices/lcm_codec.hpp"
 #include "devices/lcm_io_messages.hpp"
+#include "devices/io_turn_watch.hpp"
 #include "devices/lcm_io_thread.hpp"
 #include "devices/round_trip_stats.hpp"
 #include "devices/tick_phase_lock.hpp"
@@ -243,7 +244,7 @@ class LcmDevice final : public Device, public LcmEndpoint {
   std::atomic<bool> serving_us_{false};     // the rig addressed serves this session (bound_, shown)
   std::atomic<std::uint64_t> answered_{0};  // generation whose answer reached the inbox
   std::atomic<double> last_state_s_{-1.0};
-  std::atomic<double> io_turn_s_{INFINITY};     // monotonic_s() of the I/O thread's last service() turn
+  IoTurnWatch io_turns_;                        // the I/O thread's service() turns, on monotonic_s()
   std::atomic<double> rig_silent_s_{INFINITY};  // since the addressed rig's last valid state of any kind (I/O clock)
   std::atomic<std::int64_t> stats_rig_id_{0};
   std::atomic<std::uint64_t> rig_fault_states_{0};

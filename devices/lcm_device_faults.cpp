@@ -124,9 +124,9 @@ void LcmDevice::explain_silence(double silent_s, DeviceFault& fault) const {
               static_cast<unsigned long long>(forged));
     return;
   }
-  // The I/O thread's last turn: if it did not run, this host stalled, not the link.
-  const double io_idle_s = monotonic_s() - io_turn_s_.load(relaxed);
-  if (io_idle_s >= 0.5 * silent_s && io_idle_s < 1e6) {
+  // The I/O thread's last turn: if it did not run, this host stalled, not the link. A turn waits at most
+  // for the next outbox poll, well under half a stale limit.
+  if (const double io_idle_s = io_turns_.held_off_s(monotonic_s(), silent_s, 0.0); !std::isnan(io_idle_s)) {
     fault.set(FaultCode::kLinkLost, -1,
               "no state of the LCM rig %llx reached the engine for %.0f ms: this host's LCM I/O thread did not run for "
               "%.0f ms (the machine stalled: lighten its load, --rt enforce)",

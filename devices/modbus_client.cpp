@@ -123,7 +123,7 @@ bool ModbusClient::resolve() {
     addresses_.push_back(r);
   }
   freeaddrinfo(found);
-  last_error_ = "no address";
+  if (addresses_.empty()) last_error_ = "no address";
   return !addresses_.empty();
 }
 

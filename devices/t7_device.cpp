@@ -147,7 +147,7 @@ void T7Device::serve() {
   while (!stop_.load(std::memory_order_acquire)) {
     Outgoing out;
     const double now = now_s();
-    io_turn_s_.store(now, std::memory_order_release);
+    io_turns_.turn(now);
     const bool fresh = outbox_.read(out);
     if (fresh) {
       current = out.valves;
@@ -340,9 +340,9 @@ bool T7Device::take_fault(DeviceFault& fault) {
 
 void T7Device::explain_silence(double silent_s, DeviceFault& fault) const {
   // Every turn of the I/O thread ends within the exchange's deadline and a poll: a longer wait since
-  // its last turn is this host holding the thread off its core, not the T7 (as LcmDevice judges its own).
-  const double io_idle_s = now_s() - io_turn_s_.load(std::memory_order_acquire);
-  if (io_idle_s >= 0.5 * silent_s && io_idle_s > options_.link.response_timeout_s + 2.0 * kOutboxPoll_s) {
+  // its last turn is this host holding the thread off its core, not the T7.
+  const double longest_turn_s = options_.link.response_timeout_s + 2.0 * kOutboxPoll_s;
+  if (const double io_idle_s = io_turns_.held_off_s(now_s(), silent_s, longest_turn_s); !std::isnan(io_idle_s)) {
     fault.set(FaultCode::kLinkLost, -1,
               "no reading of the T7 at %s for %.0f ms: this host's T7 I/O thread did not run for %.0f ms (the "
               "machine stalled: lighten its load, --rt enforce)",

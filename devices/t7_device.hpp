@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "devices/io_turn_watch.hpp"
 #include "devices/modbus_client.hpp"
 #include "devices/rig_profile.hpp"
 #include "devices/t7_registers.hpp"
@@ -170,8 +171,8 @@ class T7Device final : public Device {
   std::atomic<double> p50_ms_{0.0}, p99_ms_{0.0}, max_ms_{0.0};
   std::atomic<std::uint64_t> exchanges_{0}, link_errors_{0}, stale_readings_{0}, late_answers_{0}, reconnects_{0},
       late_readings_{0};
-  std::atomic<double> heard_s_{-1e300};   // the client's last_receive_s(), copied by the I/O thread
-  std::atomic<double> io_turn_s_{1e300};  // now_s() at the I/O thread's last turn (explain_silence())
+  std::atomic<double> heard_s_{-1e300};  // the client's last_receive_s(), copied by the I/O thread
+  IoTurnWatch io_turns_;                 // the I/O thread's turns, on now_s() (explain_silence())
 };
 
 }  // namespace bellows
