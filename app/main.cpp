@@ -10,6 +10,9 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -284,7 +287,8 @@ int main(int argc, char** argv) try {
       ->check(bellows::finite_seconds(kLongestRunSeconds));
 
   bellows::ConsoleOptions console;
-  CLI::App* console_cmd = app.add_subcommand("console", "The operator console (also: bellows with no arguments)");
+  CLI::App* console_cmd = app.add_subcommand(
+      "console", "The operator console (also: bellows with no arguments, or with the console's options alone)");
   bellows::add_device_options(*console_cmd, console.device);
   console_cmd->add_option("--speed", console.speed, "The simulated arm's time warp: 1, 2, 5, 10 or max")
       ->capture_default_str()
@@ -397,8 +401,15 @@ int main(int argc, char** argv) try {
   CLI::App* completion_cmd = app.add_subcommand("completion", "Print the shell completion script")->group("");
   completion_cmd->add_option("shell", completion_shell, "bash")->required()->check(CLI::IsMember({"bash"}));
 
+  // `bellows` alone is the console, so options given before any command are the console's: `bellows
+  // --speed 10` is `bellows console --speed 10`, as a console such as htop takes its options directly.
+  std::vector<const char*> args(argv, argv + argc);
+  if (argc > 1 && argv[1][0] == '-' && std::string_view(argv[1]) != "-h" && std::string_view(argv[1]) != "--help" &&
+      std::string_view(argv[1]) != "--version") {
+    args.insert(args.begin() + 1, "console");
+  }
   try {
-    app.parse(argc, argv);
+    app.parse(static_cast<int>(args.size()), args.data());
   } catch (const CLI::Success& help_or_version) {  // --help, --version: printed, exit 0
     return app.exit(help_or_version);
   } catch (const CLI::ParseError& error) {

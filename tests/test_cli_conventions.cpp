@@ -57,6 +57,18 @@ TEST(CliConventions, HelpShowsWordsNotCodesOrBuildPaths) {
   }
 }
 
+// `bellows` alone is the console, so options without a command are the console's: each is checked
+// as `bellows console` checks it (the console's own refusals), and one it does not know is refused.
+TEST(CliConventions, OptionsWithoutACommandAreTheConsoles) {
+  expect_refused_in_one_line("--exit-after nan", "--exit-after: must be a finite number");
+  expect_refused_in_one_line("--speed 3", "--speed: 3 not in");
+  expect_refused_in_one_line("--seed 7 --frobnicate", "--frobnicate");
+  const auto console = bellows("--speed 10 --help");
+  EXPECT_EQ(console.exit_code, 0) << console.err;
+  EXPECT_NE(console.out.find("--stop-after-rises"), std::string::npos) << console.out;
+  EXPECT_EQ(bellows("--help").out.find("--stop-after-rises"), std::string::npos);
+}
+
 TEST(CliConventions, TheWordsStillChooseTheMode) {
   expect_refused_in_one_line("run --rt sometimes", "--rt");
   EXPECT_EQ(bellows("run --rt OFF --iterations 0 --no-save --trajectory steps").exit_code, 0);
