@@ -42,6 +42,11 @@ expect_offered wall bellows run --clock w
 expect_offered try bellows run --rt t
 expect_offered csv bellows sessions export --format c
 expect_offered --format bellows sessions export --data-dir /tmp --fo  # an option's value is skipped
+# Options without a command are the console's: offered first, their values after them.
+expect_offered --speed bellows --sp
+expect_offered --version bellows --ver
+expect_offered max bellows --speed m
+expect_offered --trajectory bellows --seed 3 --tra
 [ "$(complete_words bellows run --ite)" = "--iterations" ] || fail "run --ite: $(complete_words bellows run --ite)"
 [ -z "$(complete_words bellows com)" ] || fail "the hidden completion subcommand is offered"
 
