@@ -105,32 +105,20 @@ int ModbusClient::wait_for(short events, double deadline) {
   }
 }
 
-bool ModbusClient::resolve() {
+bool ModbusClient::resolve(double deadline) {
   if (!addresses_.empty()) return true;
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* found = nullptr;
   ++address_resolutions_;
-  if (const int error = getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found); error != 0) {
-    last_error_ = std::string("cannot resolve ") + host_ + ": " + gai_strerror(error);
-    return false;
-  }
-  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
-    if (a->ai_addrlen > sizeof(sockaddr_storage)) continue;
-    ResolvedAddress r{a->ai_family, a->ai_socktype, a->ai_protocol, {}, a->ai_addrlen};
-    std::memcpy(&r.address, a->ai_addr, a->ai_addrlen);
-    addresses_.push_back(r);
-  }
-  freeaddrinfo(found);
-  if (addresses_.empty()) last_error_ = "no address";
-  return !addresses_.empty();
+  NameLookupResult found = look_up_tcp_addresses(host_, port_, deadline, stop_);
+  interrupted_ = found.interrupted;
+  if (found.addresses.empty()) return fail(found.error);
+  addresses_ = std::move(found.addresses);
+  return true;
 }
 
 std::string ModbusClient::connect(double timeout_s) {
   close();  // never two connections at once: a T7 serves only a few
   const double deadline = std::min(monotonic_seconds() + timeout_s, deadline_s_);
-  if (!resolve()) return last_error_;
+  if (!resolve(deadline)) return last_error_;
   last_error_ = "no address";
   for (const ResolvedAddress& a : addresses_) {
     fd_ = ::socket(a.family, a.socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a.protocol);

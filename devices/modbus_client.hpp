@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "devices/name_lookup.hpp"
+
 namespace bellows {
 
 class ModbusClient {
@@ -82,9 +84,9 @@ class ModbusClient {
   double last_receive_s() const { return last_receive_s_; }
   /// Connections opened again after one was lost.
   std::uint64_t reconnects() const { return reconnects_; }
-  /// Times the host name was looked up: once, at the first connect that resolved it. A reconnect
-  /// reuses those addresses, so it waits on nothing but the connection and its deadline (a name
-  /// lookup has no deadline, and the vent waits behind the exchange that reconnects).
+  /// Times the host name was looked up: once, at the first connect that resolved it (within that
+  /// connect's deadline: devices/name_lookup.hpp). A reconnect reuses those addresses, so it waits
+  /// on nothing but the connection (the vent waits behind the exchange that reconnects).
   std::uint64_t address_resolutions() const { return address_resolutions_; }
 
  private:
@@ -97,15 +99,11 @@ class ModbusClient {
   bool fail(const std::string& why);
   void lose_connection(const std::string& why);
 
-  /// Resolves host_ into addresses_ once (false, last_error_ set: not resolved).
-  bool resolve();
+  /// Resolves host_ into addresses_ once, by the deadline (false, last_error_ set: not resolved;
+  /// interrupted_ when *stop ended the wait).
+  bool resolve(double deadline);
 
   std::string host_, port_, address_;
-  struct ResolvedAddress {
-    int family = 0, socktype = 0, protocol = 0;
-    sockaddr_storage address{};
-    socklen_t length = 0;
-  };
   std::vector<ResolvedAddress> addresses_;  // host_:port_, resolved at the first connect
   std::uint64_t address_resolutions_ = 0;
   int fd_ = -1;
