@@ -25,15 +25,18 @@ dir="$(mktemp -d)"
 server=""
 trap '[ -n "$server" ] && kill "$server" 2> /dev/null; rm -rf "$dir"' EXIT
 
-# The name server: bound before anything asks it, reads nothing, answers nothing.
+# The name server: bound before anything asks it; it answers nothing, and marks each query it takes
+# (the file "asked"), so that the script knows when a lookup is waiting on it.
 "$PYTHON" -c '
-import socket, sys, time
+import os, socket, sys
 s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 s.bind(("127.0.0.1", 53))
-open(sys.argv[1], "w").close()
-time.sleep(300)' "$dir/bound" &
+open(os.path.join(sys.argv[1], "bound"), "w").close()
+while True:
+    s.recv(4096)
+    open(os.path.join(sys.argv[1], "asked"), "w").close()' "$dir" &
 server=$!
-for _ in $(seq 100); do [ -e "$dir/bound" ] && break; sleep 0.05; done
+for _ in $(seq 400); do [ -e "$dir/bound" ] && break; sleep 0.05; done
 [ -e "$dir/bound" ] || fail "the silent name server did not start"
 printf 'nameserver 127.0.0.1\noptions timeout:30 attempts:1\n' > "$dir/resolv.conf"
 mount --bind "$dir/resolv.conf" /etc/resolv.conf  # this mount namespace only
@@ -49,12 +52,14 @@ grep -qF "cannot connect within [t7] connect_timeout_s = 0.5 s (cannot resolve $
   <<< "$out" || fail "not the lookup's deadline: $out"
 [ "$(wc -l <<< "$out")" -eq 1 ] || fail "more than one line: $out"
 
-# Ctrl-C while the lookup waits (its deadline 20 s away): interrupted at once, nothing else to undo.
+# Ctrl-C while the lookup waits on the name server (its deadline 20 s away): interrupted at once.
 printf '[t7]\nconnect_timeout_s = 20\n' > "$dir/long.toml"
+rm -f "$dir/asked"
 "$BELLOWS" run --device t7 --t7 "$name:5020" --config "$dir/long.toml" --iterations 0 --no-save \
   > "$dir/interrupted.out" 2>&1 &
 run=$!
-sleep 1
+for _ in $(seq 400); do [ -e "$dir/asked" ] && break; sleep 0.05; done  # the lookup waits: now Ctrl-C
+[ -e "$dir/asked" ] || fail "no lookup reached the name server: $(cat "$dir/interrupted.out")"
 kill -INT "$run"
 set +e
 wait "$run"
