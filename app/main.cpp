@@ -404,8 +404,8 @@ int main(int argc, char** argv) try {
   // `bellows` alone is the console, so options given before any command are the console's: `bellows
   // --speed 10` is `bellows console --speed 10`, as a console such as htop takes its options directly.
   std::vector<const char*> args(argv, argv + argc);
-  if (argc > 1 && argv[1][0] == '-' && std::string_view(argv[1]) != "-h" && std::string_view(argv[1]) != "--help" &&
-      std::string_view(argv[1]) != "--version") {
+  const std::string_view first = argc > 1 ? argv[1] : "";
+  if (first.starts_with('-') && first != "-h" && first != "--help" && first != "--version") {
     args.insert(args.begin() + 1, "console");
   }
   try {

@@ -101,8 +101,8 @@ NameLookupResult look_up_tcp_addresses(const std::string& host, const std::strin
   auto lookup = std::make_unique<PendingLookup>();
   lookup->host = host;
   lookup->service = service;
-  lookup->hints.ai_family = AF_UNSPEC;
-  lookup->hints.ai_socktype = SOCK_STREAM;
+  lookup->hints = hints;
+  lookup->hints.ai_flags = AI_NUMERICSERV;  // the name, asked of the name service
   lookup->request.ar_name = lookup->host.c_str();
   lookup->request.ar_service = lookup->service.c_str();
   lookup->request.ar_request = &lookup->hints;

@@ -85,8 +85,8 @@ TEST(ModbusClientErrors, AnExceptionTheDeviceSentNamesItsNumber) {
   EXPECT_NE(client.last_error().find("(Modbus exception 2)"), std::string::npos) << client.last_error();
 }
 
-// A reconnect (after a lost connection, inside an exchange's deadline) looks up no name: the lookup
-// has no deadline, and the vent waits behind that exchange.
+// A reconnect (after a lost connection, inside an exchange's 4 ms deadline) looks up no name: a
+// lookup waits on a name server, and the vent waits behind that exchange.
 TEST(ModbusClientConnect, AReconnectReusesTheAddressesTheFirstConnectResolved) {
   sockaddr_in address{};
   const int listener = testing::loopback_listener(address);
