@@ -88,7 +88,7 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
     }
   }
   fs::create_directory(directory, error);
-  if (error) throw InputError("cannot create " + directory.string() + ": " + error.message());
+  if (error) throw_file_error("cannot create " + directory.string(), error.value());
   const DirectoryHandle folder = DirectoryHandle::open(directory);
   const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
   write_file_atomic_at(folder, kScriptName, gnuplot_script(figures, request.formats, request.style),
@@ -104,7 +104,7 @@ std::vector<fs::path> write_session_figures(const Session& session, const Figure
     struct stat info {};
     if (!drawn || ::fstat(drawn->get(), &info) != 0 || info.st_size == 0)
       throw InputError("gnuplot wrote no " + files[f].string());
-    if (::fsync(drawn->get()) != 0) throw InputError("cannot flush " + files[f].string() + ": " + std::strerror(errno));
+    if (::fsync(drawn->get()) != 0) throw_file_error("cannot flush " + files[f].string(), errno);
   }
   for (std::size_t f = 1; f < files.size(); ++f) {
     const std::string name = files[f].filename().string();

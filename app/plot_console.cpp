@@ -4,6 +4,7 @@
 
 #include "app/plot_command.hpp"
 #include "engine/base/errors.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/session_store.hpp"
 
 namespace bellows {
@@ -32,7 +33,7 @@ std::string write_console_figures(const std::string& session_location, int itera
   std::snprintf(suffix, sizeof suffix, "_iteration_%04d", iterations - 1);
   std::error_code error;
   fs::create_directories(root, error);
-  if (error) throw InputError("cannot create " + root.string() + ": " + error.message());
+  if (error) throw_file_error("cannot create " + root.string(), error.value());
   const std::string stem = fs::path(session_location).filename().string() + suffix;
   fs::path directory = root / stem;
   for (int n = 2; fs::exists(directory, error); ++n)

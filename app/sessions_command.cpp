@@ -22,6 +22,7 @@
 #include "engine/base/printable_text.hpp"
 #include "engine/control/safety.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/session_event_record.hpp"
 #include "sessions/session_export.hpp"
@@ -385,7 +386,7 @@ int sessions_rm_command(const SessionsOptions& options, std::istream& in, std::o
   const fs::path parent = directory.parent_path().empty() ? fs::path(".") : directory.parent_path();
   const fs::path hidden = parent / hidden_name;
   fs::rename(directory, hidden, error);
-  if (error) throw InputError("cannot remove " + shown_directory + ": " + error.message());
+  if (error) throw_file_error("cannot remove " + shown_directory, error.value());
   remove_session_entries(session);  // through the directory's own descriptor: it moved with it
   if (::rmdir(hidden.c_str()) != 0) {
     throw InputError("cannot remove " + printable(hidden.string()) + " (renamed from " + shown_directory +

@@ -17,7 +17,7 @@ namespace {
 constexpr std::string_view kTemporaryMarker = ".tmp-";  // unpredictable_temporary_name()'s
 
 [[noreturn]] void fail(const std::string& what, const std::filesystem::path& path, int error_number) {
-  throw InputError("cannot " + what + " " + path.string() + ": " + std::strerror(error_number));
+  throw_file_error("cannot " + what + " " + path.string(), error_number);
 }
 
 DirectoryHandle folder_of(const std::filesystem::path& path) {
@@ -46,7 +46,7 @@ AtomicOutputFile::AtomicOutputFile(const std::filesystem::path& path, Replace re
   file_.emplace(folder_, path.filename().string());
   const cookie_io_functions_t functions{nullptr, &AtomicOutputFile::write_cookie, nullptr, nullptr};
   stream_ = ::fopencookie(this, "w", functions);
-  if (stream_ == nullptr) throw InputError("cannot open a stream on " + path.string() + ": " + std::strerror(errno));
+  if (stream_ == nullptr) throw_file_error("cannot open a stream on " + path.string(), errno);
   std::setvbuf(stream_, buffer_.get(), _IOFBF,
                kStreamBuffer);  // few, large writes (glibc ignores a size without a buffer)
 }

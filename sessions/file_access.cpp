@@ -31,6 +31,31 @@ bool is_inside(const fs::path& path, const fs::path& directory) {
   return !relative.empty() && *relative.begin() != "..";
 }
 
+bool is_environment_failure(int error_number) {
+  switch (error_number) {
+    case ENOSPC:
+    case EDQUOT:
+    case EROFS:
+    case EIO:
+    case EFBIG:
+    case ENOMEM:
+    case EMFILE:
+    case ENFILE:
+    case ENOBUFS:
+    case ESTALE:
+    case ENOLCK:
+      return true;
+    default:
+      return false;
+  }
+}
+
+void throw_file_error(const std::string& message, int error_number) {
+  const std::string line = message + ": " + std::strerror(error_number);
+  if (is_environment_failure(error_number)) throw EnvironmentError(line);
+  throw InputError(line);
+}
+
 namespace {
 
 std::string shown(const fs::path& path) { return printable(path.string(), kPrintableField); }
@@ -46,7 +71,7 @@ std::string open_failure(int error_number) {
 /// Reads the whole descriptor, refusing more than `max_bytes` (the size may change while reading).
 std::string read_bounded(int fd, std::size_t max_bytes, const std::string& what) {
   struct stat info {};
-  if (::fstat(fd, &info) != 0) throw InputError(what + ": " + std::strerror(errno));
+  if (::fstat(fd, &info) != 0) throw_file_error(what, errno);
   if (!S_ISREG(info.st_mode)) throw InputError(what + " is " + file_type_name(info.st_mode) + ", not a regular file");
   const auto too_large = [&](std::size_t size) {
     return InputError(what + " is " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) +
@@ -60,7 +85,7 @@ std::string read_bounded(int fd, std::size_t max_bytes, const std::string& what)
     const ssize_t got = ::read(fd, buffer, sizeof buffer);
     if (got < 0) {
       if (errno == EINTR) continue;
-      throw InputError(what + ": " + std::strerror(errno));
+      throw_file_error(what, errno);
     }
     if (got == 0) break;
     contents.append(buffer, static_cast<std::size_t>(got));
@@ -138,7 +163,7 @@ DirectoryHandle DirectoryHandle::make_subdirectory(const std::string& name) cons
   if (::mkdirat(fd_.get(), name.c_str(), 0755) == 0) {
     sync(*this);  // the new directory's entry is durable too
   } else if (errno != EEXIST) {
-    throw InputError("cannot create " + shown(path_ / name) + ": " + std::strerror(errno));
+    throw_file_error("cannot create " + shown(path_ / name), errno);
   }
   std::optional<DirectoryHandle> made = subdirectory(name);
   if (!made) throw InputError("cannot create " + shown(path_ / name) + ": it vanished");
@@ -159,10 +184,11 @@ std::optional<FileDescriptor> open_regular_file_at(const DirectoryHandle& direct
   if (fd.get() < 0) {
     const int error_number = errno;
     if (error_number == ENOENT && (flags & O_CREAT) == 0) return std::nullopt;
+    if (is_environment_failure(error_number)) throw_file_error("cannot open " + name, error_number);
     throw InputError(name + " " + open_failure(error_number));
   }
   struct stat info {};
-  if (::fstat(fd.get(), &info) != 0) throw InputError(name + ": " + std::strerror(errno));
+  if (::fstat(fd.get(), &info) != 0) throw_file_error(name, errno);
   if (!S_ISREG(info.st_mode)) throw InputError(name + " is " + file_type_name(info.st_mode) + ", not a regular file");
   if (single_link && info.st_nlink > 1) {
     throw InputError(name + " has " + std::to_string(info.st_nlink) +
@@ -185,7 +211,7 @@ std::string read_regular_file(const fs::path& path, std::size_t max_bytes, const
     throw InputError(where + " is " + file_type_name(before.st_mode) + ", not a regular file");
   }
   FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
-  if (fd.get() < 0) throw InputError(where + ": cannot be read: " + std::strerror(errno));
+  if (fd.get() < 0) throw_file_error(where + ": cannot be read", errno);
   return read_bounded(fd.get(), max_bytes, where);
 }
 
@@ -242,7 +268,7 @@ void publish_file_at(const DirectoryHandle& from_directory, const std::string& f
   ::unlinkat(from_directory.fd(), from.c_str(), 0);
   if (error_number == EEXIST)
     throw InputError(shown(directory.path() / name) + " exists already (--force replaces it)");
-  throw InputError("cannot rename a file to " + shown(directory.path() / name) + ": " + std::strerror(error_number));
+  throw_file_error("cannot rename a file to " + shown(directory.path() / name), error_number);
 }
 
 TemporaryFile::TemporaryFile(const DirectoryHandle& directory, const std::string& name)
@@ -252,7 +278,7 @@ TemporaryFile::TemporaryFile(const DirectoryHandle& directory, const std::string
       ::openat(directory.fd(), temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (fd_.get() < 0) {
     const int error_number = errno;
-    throw InputError("cannot create " + shown(directory.path() / temporary_) + ": " + std::strerror(error_number));
+    throw_file_error("cannot create " + shown(directory.path() / temporary_), error_number);
   }
 }
 
@@ -263,7 +289,7 @@ TemporaryFile::~TemporaryFile() {
 void TemporaryFile::fail(const std::string& what, int error_number) {
   ::unlinkat(directory_.fd(), temporary_.c_str(), 0);
   published_ = true;  // nothing left to remove
-  throw InputError("cannot " + what + " " + shown(directory_.path() / temporary_) + ": " + std::strerror(error_number));
+  throw_file_error("cannot " + what + " " + shown(directory_.path() / temporary_), error_number);
 }
 
 void TemporaryFile::publish(Replace replace, DirectorySync directory_sync) {
@@ -283,14 +309,14 @@ void write_file_atomic_at(const DirectoryHandle& directory, const std::string& n
 
 void sync(const DirectoryHandle& directory) {
   if (::fsync(directory.fd()) != 0) {
-    throw InputError("cannot flush directory " + shown(directory.path()) + ": " + std::strerror(errno));
+    throw_file_error("cannot flush directory " + shown(directory.path()), errno);
   }
 }
 
 bool remove_file_at(const DirectoryHandle& directory, const std::string& name) {
   if (::unlinkat(directory.fd(), name.c_str(), 0) == 0) return true;
   if (errno == ENOENT) return false;
-  throw InputError("cannot remove " + shown(directory.path() / name) + ": " + std::strerror(errno));
+  throw_file_error("cannot remove " + shown(directory.path() / name), errno);
 }
 
 std::vector<std::string> entry_names(const DirectoryHandle& directory) {

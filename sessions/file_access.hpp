@@ -3,7 +3,8 @@
 // regular files and real directories are accepted, special files are opened without blocking
 // (O_NONBLOCK) and refused, and every read is bounded by the size its format allows. So a session
 // cannot make bellows read or write outside it, hang on a FIFO or read /dev/zero for ever.
-// Errors throw InputError naming the file and what is wrong with it.
+// Errors name the file and what is wrong with it: InputError (exit status 2) when the name is what is
+// wrong, EnvironmentError (4) when the system could not do it (throw_file_error).
 #pragma once
 
 #include <cstddef>
@@ -14,6 +15,15 @@
 #include <vector>
 
 namespace bellows {
+
+/// Whether a file system call that failed with `error_number` failed for want of a working disk or
+/// of the system's resources (full, over quota, read-only, an I/O error, no memory or descriptors
+/// left), not because of the name it was given (missing, not a folder, a link, no permission).
+bool is_environment_failure(int error_number);
+
+/// Throws "`message`: <the system's reason>": EnvironmentError (exit status 4, "a disk that cannot
+/// be written", docs/architecture.md) when is_environment_failure(error_number), else InputError (2).
+[[noreturn]] void throw_file_error(const std::string& message, int error_number);
 
 /// Whether `path` lies inside `directory`, both resolved (`..`, symbolic links): where an output
 /// would land inside a session it was made from.

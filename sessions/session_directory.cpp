@@ -18,6 +18,7 @@
 #include "engine/base/errors.hpp"
 #include "engine/base/printable_text.hpp"
 #include "sessions/black_box_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
@@ -153,8 +154,7 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
     missing.push_back(folder);
   }
   fs::create_directories(parent_path, error);
-  if (error)
-    throw InputError("cannot create the data directory " + printable(parent_path.string()) + ": " + error.message());
+  if (error) throw_file_error("cannot create the data directory " + printable(parent_path.string()), error.value());
   for (auto folder = missing.rbegin(); folder != missing.rend(); ++folder) {
     sync(DirectoryHandle::open(folder->parent_path()));
   }
@@ -180,8 +180,7 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
       .append(std::to_string(creations.fetch_add(1)));
   fs::remove_all(parent_path / building_name, error);  // a leftover of this pid (a link is removed, not followed)
   if (::mkdirat(parent.fd(), building_name.c_str(), 0755) != 0) {
-    throw InputError("cannot create " + printable((parent_path / building_name).string()) + ": " +
-                     std::strerror(errno));
+    throw_file_error("cannot create " + printable((parent_path / building_name).string()), errno);
   }
   try {
     std::optional<DirectoryHandle> building = parent.subdirectory(building_name);
@@ -200,7 +199,7 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
     write_manifest(*building, written);
     if (const int rename_error = rename_no_replace(parent, building_name, parent, name); rename_error != 0) {
       if (rename_error == EEXIST || rename_error == ENOTEMPTY) refuse_existing();
-      throw InputError("cannot create " + printable(directory.string()) + ": " + std::strerror(rename_error));
+      throw_file_error("cannot create " + printable(directory.string()), rename_error);
     }
     sync(parent);
     return {std::move(*building).moved_to(directory), std::move(lock), std::move(written)};

@@ -18,6 +18,7 @@
 #include "engine/control/safety.hpp"
 #include "sessions/atomic_file.hpp"
 #include "sessions/black_box_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
 #include "sessions/record_columns.hpp"
@@ -197,8 +198,9 @@ void write_named(mat_t* file, MatVar var, const char* name, const fs::path& path
   if (Mat_VarWrite(file, var.get(), MAT_COMPRESSION_ZLIB) != 0) {
     // libmatio says only that it failed; the system's reason (a full disk) is in errno, if anywhere.
     const int why = errno;
-    throw InputError("cannot write variable '" + std::string(name) + "' to " + path.string() +
-                     (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
+    const std::string what = "cannot write variable '" + std::string(name) + "' to " + path.string();
+    if (why != 0) throw_file_error(what, why);
+    throw InputError(what);
   }
 }
 
@@ -254,8 +256,9 @@ void finish_mat_file(mat_t* file, const Session& session, const fs::path& path) 
   errno = 0;
   if (Mat_Close(file) != 0) {
     const int why = errno;
-    throw InputError("cannot write " + path.string() + " (libmatio could not finish it)" +
-                     (why != 0 ? ": " + std::string(std::strerror(why)) : ""));
+    const std::string what = "cannot write " + path.string() + " (libmatio could not finish it)";
+    if (why != 0) throw_file_error(what, why);
+    throw InputError(what);
   }
 }
 
@@ -299,7 +302,7 @@ void export_mat73(const Session& session, const fs::path& path, Replace replace)
   finish_mat_file(file, session, path);
   {
     const std::optional<FileDescriptor> fd = open_regular_file_at(work.handle(), name, O_RDONLY);
-    if (!fd || ::fsync(fd->get()) != 0) throw InputError("cannot flush " + path.string() + ": " + std::strerror(errno));
+    if (!fd || ::fsync(fd->get()) != 0) throw_file_error("cannot flush " + path.string(), errno);
   }
   publish_file_at(work.handle(), name, folder, name, replace);
   sync(folder);
@@ -309,8 +312,12 @@ void export_mat73(const Session& session, const fs::path& path, Replace replace)
 
 fs::path export_session_mat(const Session& session, const fs::path& path, MatVersion version, bool force) {
   check_export_targets(session, {path}, ".mat", force);
-  // HDF5 (under MAT v7.3) prints its own error stack to stderr by default; our errors say it in
-  // one line instead.
+  // HDF5 (under MAT v7.3) cleans up at exit by closing every file still open; a file whose close
+  // failed (a full disk under its last flush) is still listed, half closed, and HDF5 1.10 crashes on
+  // it (SIGSEGV after the export's one line). Every file here is closed, or abandoned on purpose:
+  // no clean-up at exit (this must come before any other HDF5 call; a second call is refused, harmless).
+  H5dont_atexit();
+  // HDF5 prints its own error stack to stderr by default; our errors say it in one line instead.
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const Replace replace = force ? Replace::kAllowed : Replace::kRefused;
   if (version == MatVersion::kV73) export_mat73(session, path, replace);

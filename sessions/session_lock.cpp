@@ -11,6 +11,7 @@
 
 #include "engine/base/errors.hpp"
 #include "engine/base/printable_text.hpp"
+#include "sessions/file_access.hpp"
 
 namespace bellows {
 namespace {
@@ -52,7 +53,7 @@ SessionLock::SessionLock(const DirectoryHandle& directory, const std::string& pu
     if (error_number == EWOULDBLOCK) {
       throw InputError(session + " is in use by " + holder + "; two processes never write the same session");
     }
-    throw InputError(session + ": cannot lock " + kFileName + ": " + std::strerror(error_number));
+    throw_file_error(session + ": cannot lock " + kFileName, error_number);
   }
   // Best effort: the line only serves the message another process prints.
   const std::string line = holder_line(purpose);

@@ -11,6 +11,7 @@
 
 #include "engine/base/errors.hpp"
 #include "sessions/atomic_file.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/session_layout.hpp"
 #include "sessions/session_lock.hpp"
 
@@ -66,7 +67,7 @@ std::vector<std::string> foreign_session_entries(const DirectoryHandle& session)
 void remove_session_entries(const DirectoryHandle& session) {
   const auto unlink_in = [](const DirectoryHandle& directory, const std::string& name, int flags) {
     if (::unlinkat(directory.fd(), name.c_str(), flags) != 0 && errno != ENOENT) {
-      throw InputError("cannot remove " + (directory.path() / name).string() + ": " + std::strerror(errno));
+      throw_file_error("cannot remove " + (directory.path() / name).string(), errno);
     }
   };
   for (const char* folder_name : {session_layout::kIterations, session_layout::kFaults}) {

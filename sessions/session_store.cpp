@@ -18,6 +18,7 @@
 #include "engine/base/printable_text.hpp"
 #include "sessions/black_box_file.hpp"
 #include "sessions/csv_table.hpp"
+#include "sessions/file_access.hpp"
 #include "sessions/file_digest.hpp"
 #include "sessions/iteration_files.hpp"
 #include "sessions/manifest_json.hpp"
@@ -111,7 +112,7 @@ fs::path given_data_dir(const std::string& option_value) {
   const fs::file_status status = fs::status(dir, error);
   if (status.type() == fs::file_type::not_found)
     throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": no such directory");
-  if (error) throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": " + error.message());
+  if (error) throw_file_error("--data-dir " + printable(dir.string(), kPrintableField), error.value());
   if (status.type() != fs::file_type::directory)
     throw InputError("--data-dir " + printable(dir.string(), kPrintableField) + ": not a directory");
   return dir;
@@ -169,8 +170,8 @@ fs::path rename_session(const fs::path& directory, const std::string& new_name) 
   std::error_code error;
   fs::rename(directory, target, error);
   if (error)
-    throw InputError("cannot rename " + printable(directory.string()) + " to " + printable(target.string()) + ": " +
-                     error.message());
+    throw_file_error("cannot rename " + printable(directory.string()) + " to " + printable(target.string()),
+                     error.value());
   manifest.name = new_name;  // the manifest names its session too
   manifest.updated_utc = utc_now();
   // Through the session's own descriptor, by the one safe writer: a link planted at any name in

@@ -334,7 +334,8 @@ void expect_whole_outputs(const fs::path& out, const fs::path& clean, const Writ
 
 /// Counts the calls of a clean run, then kills the writer before call k, and fails call k with
 /// ENOSPC, for every k: each output absent or whole, never a link, nothing else written; killed,
-/// status 137; failed, one line naming the full disk, a non-zero status and no temporary left.
+/// status 137; failed, one line naming the full disk, exit status 4 (the environment refused) and
+/// no temporary left.
 void sweep_writer(const Writer& writer) {
   SCOPED_TRACE(writer.name);
   TempDir scratch;
@@ -364,6 +365,7 @@ void sweep_writer(const Writer& writer) {
       } else {
         const std::string said = result.out + result.err;  // run says it beside its progress, on stdout
         EXPECT_EQ(count_of(said, "No space left on device"), 1) << "said once: " << said;
+        EXPECT_EQ(result.exit_code, kExitEnvironment) << "a disk that cannot be written: " << said;
       }
       if (writer.name.rfind("sessions rename", 0) == 0) {
         // The session is a whole session under one of its names, loading, named in its manifest
@@ -394,6 +396,41 @@ void sweep_writer(const Writer& writer) {
 }
 
 std::string bellows_command(const std::string& arguments) { return quoted(testing::kBellows) + " " + arguments; }
+
+/// `bellows run` saving its session on a disk that fills: failed at each call k, one line naming
+/// the full disk and exit status 4 (the environment refused: not 2, which says nothing was changed,
+/// while the trials before it are saved), and what is on disk is a session that loads with the
+/// iterations committed before the failure.
+TEST_F(SaveFaults, RunOnAFullDiskSaysSoOnceExitsFourAndKeepsWhatItCommitted) {
+  const fs::path files = small_session().parent_path();  // short.csv, short.toml
+  TempDir scratch;
+  const auto command = [&](const fs::path& data) {
+    return bellows_command("run --iterations 2 --trajectory " + quoted((files / "short.csv").string()) + " --config " +
+                           quoted((files / "short.toml").string()) + " --data-dir " + quoted(data.string()) +
+                           " --name s");
+  };
+  fs::create_directory(scratch / "clean");
+  const int calls = counted_calls(command(scratch / "clean"), scratch.path());
+  ASSERT_GE(calls, 9) << "three iterations, each written, flushed and renamed at least";
+  int failed = 0;
+  for (int k = 1; k <= calls; ++k) {
+    SCOPED_TRACE("ENOSPC at call " + std::to_string(k) + " of " + std::to_string(calls));
+    const fs::path data = scratch / ("k" + std::to_string(k));
+    fs::create_directory(data);
+    const testing::ProcessResult result = run_faulted(command(data), "enospc", k);
+    if (result.exit_code == 0) continue;  // a call whose failure loses nothing (the lock file's note)
+    ++failed;
+    const std::string said = result.out + result.err;
+    EXPECT_EQ(result.exit_code, kExitEnvironment) << said;
+    EXPECT_EQ(count_of(said, "No space left on device"), 1) << "said once: " << said;
+    if (!fs::exists(data / "s")) continue;  // failed before the session was first committed
+    const testing::ProcessResult show = testing::run_bellows({"sessions", "show", (data / "s").string()});
+    EXPECT_EQ(show.exit_code, 0) << show.err;
+    for (const fs::path& p : entries(data / "s")) EXPECT_FALSE(is_temporary_file_name(p.filename().string())) << p;
+  }
+  EXPECT_GT(failed, calls / 2) << "most calls of a save lose something when they fail";
+  std::printf("run: %d calls swept (ENOSPC), %d failed with exit status 4\n", calls, failed);
+}
 
 TEST_F(SaveFaults, EveryWriterKilledOrFailedAtEveryCallLeavesWholeFilesOrNone) {
   const fs::path session = small_session();

@@ -1,6 +1,8 @@
 // The session's file formats on their own: numeric CSV, the iteration and trajectory files, exact
 // degrees, strict JSON reading, atomic writes.
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -172,6 +174,32 @@ TEST(AtomicFile, ReportsWhyItCannotWrite) {
   EXPECT_NE(error_of([] { write_file_atomic("/nonexistent-dir/f.txt", "x"); }).find("cannot create"),
             std::string::npos);
   EXPECT_NE(error_of([] { read_file("/nonexistent-dir/f.txt"); }).find("No such file"), std::string::npos);
+}
+
+/// A disk that cannot be written is the environment's refusal (exit status 4); a name that is
+/// wrong is bad input (2, nothing changed): docs/architecture.md, "Exit statuses".
+TEST(FileErrors, AFullOrBrokenDiskIsTheEnvironmentAWrongNameIsTheInput) {
+  for (const int environment : {ENOSPC, EDQUOT, EROFS, EIO, EMFILE}) {
+    SCOPED_TRACE(std::strerror(environment));
+    EXPECT_TRUE(is_environment_failure(environment));
+    try {
+      throw_file_error("cannot write x.csv", environment);
+    } catch (const EnvironmentError& error) {
+      EXPECT_EQ(error.exit_status(), kExitEnvironment);
+      EXPECT_EQ(std::string(error.what()), std::string("cannot write x.csv: ") + std::strerror(environment));
+    }
+  }
+  for (const int input : {ENOENT, ENOTDIR, EISDIR, ELOOP, EACCES, EEXIST}) {
+    SCOPED_TRACE(std::strerror(input));
+    EXPECT_FALSE(is_environment_failure(input));
+    EXPECT_THROW(throw_file_error("cannot write x.csv", input), InputError);
+  }
+  // Through the safe writer: a missing folder is the operator's input.
+  try {
+    write_file_atomic("/nonexistent-dir/f.txt", "x");
+    ADD_FAILURE() << "wrote into a missing folder";
+  } catch (const InputError&) {
+  }
 }
 
 }  // namespace
