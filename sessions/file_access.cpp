@@ -278,7 +278,7 @@ TemporaryFile::TemporaryFile(const DirectoryHandle& directory, const std::string
       ::openat(directory.fd(), temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (fd_.get() < 0) {
     const int error_number = errno;
-    throw_file_error("cannot create " + shown(directory.path() / temporary_), error_number);
+    throw_file_error("cannot create " + shown(directory.path() / name_), error_number);  // the file asked for
   }
 }
 
@@ -289,7 +289,7 @@ TemporaryFile::~TemporaryFile() {
 void TemporaryFile::fail(const std::string& what, int error_number) {
   ::unlinkat(directory_.fd(), temporary_.c_str(), 0);
   published_ = true;  // nothing left to remove
-  throw_file_error("cannot " + what + " " + shown(directory_.path() / temporary_), error_number);
+  throw_file_error("cannot " + what + " " + shown(directory_.path() / name_), error_number);
 }
 
 void TemporaryFile::publish(Replace replace, DirectorySync directory_sync) {

@@ -180,7 +180,7 @@ CreatedSession create_session_directory(const fs::path& directory, const Session
       .append(std::to_string(creations.fetch_add(1)));
   fs::remove_all(parent_path / building_name, error);  // a leftover of this pid (a link is removed, not followed)
   if (::mkdirat(parent.fd(), building_name.c_str(), 0755) != 0) {
-    throw_file_error("cannot create " + printable((parent_path / building_name).string()), errno);
+    throw_file_error("cannot create " + printable(directory.string()), errno);  // the session asked for
   }
   try {
     std::optional<DirectoryHandle> building = parent.subdirectory(building_name);
