@@ -30,6 +30,13 @@ void install_stop_signal_handlers() {
   for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaction(signal_number, &action, nullptr);
 }
 
+void stop_on_broken_pipe() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGPIPE, &action, nullptr);
+}
+
 const std::atomic<bool>& stop_requested() { return g_stop; }
 int stop_signal() { return g_signal.load(std::memory_order_relaxed); }
 
@@ -43,6 +50,8 @@ const char* stop_signal_name() {
       return "SIGHUP";
     case SIGQUIT:
       return "SIGQUIT";
+    case SIGPIPE:
+      return "SIGPIPE";
     case 0:
       return "no signal";
   }

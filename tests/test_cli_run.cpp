@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/base/errors.hpp"
 #include "tests/process_runner.hpp"
 
 namespace bellows {
@@ -200,6 +201,8 @@ TEST(CliRun, QuietPrintsNothingButErrorsAndTheJson) {
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 extern char** environ;
@@ -256,6 +259,33 @@ TEST(CliRun, SigintVentsAndExitsCleanlyWithWhatFinished) {
     EXPECT_GE(report["iterations"].size(), 1u);
     EXPECT_LT(report["iterations"].size(), 51u);
   }
+}
+
+/// `bellows run | head -n 1` (or a `tee` that ended): the run's next line meets a pipe with no
+/// reader. SIGPIPE's default would end bellows there and then, the valves as they were and the fault
+/// not saved; it stops the run as SIGINT does: vented, the finished iterations and the fault event in
+/// the session, exit status 4 with one line on stderr (standard output could not be written).
+TEST(CliRun, AReaderOfTheOutputThatGoesAwayStopsTheRunVentedAndSaved) {
+  const std::filesystem::path data = testing::make_temp_dir("bellows-broken-pipe");
+  const std::string quoted_data = "'" + data.string() + "'";
+  // A script of its own: run_process() puts an assignment before the command, which a { ...; } group refuses.
+  write_file(data, "pipe.sh",
+             "{ '" + testing::kBellows + "' run --clock wall --speed 5 --iterations 50 --data-dir " + quoted_data +
+                 " --name s 2> " + quoted_data + "/err.txt; echo $? > " + quoted_data + "/status.txt; } | head -n 1\n");
+  const testing::ProcessResult piped = run_process("sh " + quoted_data + "/pipe.sh");
+  EXPECT_NE(piped.out.find("session "), std::string::npos) << piped.out;
+  std::ifstream status_file(data / "status.txt");
+  int status = -1;
+  status_file >> status;
+  EXPECT_EQ(status, kExitEnvironment) << "141: ended by SIGPIPE, the valves as they were";
+  std::ifstream err_file(data / "err.txt");
+  const std::string err((std::istreambuf_iterator<char>(err_file)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(err, "bellows: cannot write to standard output: Broken pipe\n");
+  const testing::ProcessResult show = run_process(testing::kBellows + " sessions show " + quoted_data + "/s");
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  EXPECT_NE(show.out.find("fault: interrupted by SIGPIPE: valves vented (emergency-stop)"), std::string::npos)
+      << show.out;
+  EXPECT_NE(show.out.find("iterations   0"), std::string::npos) << "iteration 0 saved before its line: " << show.out;
 }
 
 }  // namespace
