@@ -428,10 +428,11 @@ int main(int argc, char** argv) try {
       return 0;
     }
     // The commands that drive a device (run, identify, rig check, the console) stop as on SIGINT, vented
-    // and saved, when their output's reader goes away; the others end quietly as any tool.
+    // and saved, when their output's reader goes away, and are never suspended (Ctrl-Z); the others end
+    // quietly as any tool.
     const bool drives_device = run_cmd->parsed() || identify_cmd->parsed() || rig_check_cmd->parsed() ||
                                console_cmd->parsed() || app.get_subcommands().empty();
-    if (drives_device) bellows::stop_on_broken_pipe();
+    if (drives_device) bellows::guard_device_command_signals();
     if (run_cmd->parsed()) return bellows::run_command(run, std::cout, run.json ? std::cerr : std::cout);
     if (io_sim_cmd->parsed()) return bellows::io_sim_command(io_sim, std::cout, std::cerr);
     if (t7_sim_cmd->parsed()) return bellows::t7_sim_command(t7_sim, std::cout);

@@ -30,11 +30,12 @@ void install_stop_signal_handlers() {
   for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaction(signal_number, &action, nullptr);
 }
 
-void stop_on_broken_pipe() {
+void guard_device_command_signals() {
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
   sigaction(SIGPIPE, &action, nullptr);
+  std::signal(SIGTSTP, SIG_IGN);
 }
 
 const std::atomic<bool>& stop_requested() { return g_stop; }

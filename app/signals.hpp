@@ -11,12 +11,14 @@ namespace bellows {
 class EngineCore;
 
 void install_stop_signal_handlers();
-/// From now on SIGPIPE (the reader of standard output went away: `bellows run | tee log` with the tee
-/// ended) is a stop signal too, for the commands that drive a device: its default would end the
-/// process at once, the valves as they were and the last save not made. The status is then 4 (standard
-/// output could not be written). The other commands keep the default and end quietly, as any tool
-/// piped into `head` does.
-void stop_on_broken_pipe();
+/// For the commands that drive a device, from now on:
+/// - SIGPIPE (the reader of standard output went away: `bellows run | tee log` with the tee ended) is
+///   a stop signal too: its default would end the process at once, the valves as they were and the
+///   last save not made. The status is then 4 (standard output could not be written). The other
+///   commands keep the default and end quietly, as any tool piped into `head` does.
+/// - SIGTSTP (Ctrl-Z) is ignored, as the console ignores it: a suspended process can neither vent
+///   nor hold its tick, and the valves would stay as they were until it is continued.
+void guard_device_command_signals();
 /// Set once SIGINT, SIGTERM, SIGHUP or SIGQUIT arrived.
 const std::atomic<bool>& stop_requested();
 /// The signal that arrived (0 if none), for the exit status 128 + signal.

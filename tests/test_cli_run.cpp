@@ -210,8 +210,10 @@ extern char** environ;
 namespace bellows {
 namespace {
 
-// Starts `bellows args...` with stdout into a pipe; returns pid and the pipe's read end.
-std::pair<pid_t, int> spawn_bellows(std::vector<std::string> args) {
+// Starts `bellows args...` with stdout into a pipe; returns pid and the pipe's read end. In a process
+// group of its own when asked: a group whose parent is in another group of the session is not
+// orphaned, so that a stop signal (SIGTSTP) is not discarded by the kernel but acted on.
+std::pair<pid_t, int> spawn_bellows(std::vector<std::string> args, bool own_process_group = false) {
   int pipe_fds[2];
   EXPECT_EQ(pipe(pipe_fds), 0);
   posix_spawn_file_actions_t actions;
@@ -223,8 +225,15 @@ std::pair<pid_t, int> spawn_bellows(std::vector<std::string> args) {
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  if (own_process_group) {
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);
+  }
   pid_t pid = -1;
-  EXPECT_EQ(posix_spawn(&pid, BELLOWS_BINARY, &actions, nullptr, argv.data(), environ), 0);
+  EXPECT_EQ(posix_spawn(&pid, BELLOWS_BINARY, &actions, &attributes, argv.data(), environ), 0);
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   close(pipe_fds[1]);
   return {pid, pipe_fds[0]};
@@ -286,6 +295,27 @@ TEST(CliRun, AReaderOfTheOutputThatGoesAwayStopsTheRunVentedAndSaved) {
   EXPECT_NE(show.out.find("fault: interrupted by SIGPIPE: valves vented (emergency-stop)"), std::string::npos)
       << show.out;
   EXPECT_NE(show.out.find("iterations   0"), std::string::npos) << "iteration 0 saved before its line: " << show.out;
+}
+
+/// Ctrl-Z (SIGTSTP) during a run: ignored, as in the console. A suspended run could neither vent nor
+/// hold its tick, the valves as they were until someone continues it.
+TEST(CliRun, CtrlZDoesNotSuspendARun) {
+  setenv("XDG_DATA_HOME", testing::make_temp_dir("bellows-xdg").c_str(), 1);  // never the real home
+  auto [pid, out] = spawn_bellows({"run", "--clock", "wall", "--speed", "5", "--iterations", "2", "--json"}, true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // past the start, in the first trial
+  ASSERT_EQ(kill(pid, SIGTSTP), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, WUNTRACED), pid);  // before reading: the report (~5 kB) fits the pipe
+  const bool suspended = WIFSTOPPED(status);
+  if (suspended) {  // continued, so that the test ends either way
+    kill(pid, SIGCONT);
+    waitpid(pid, &status, 0);
+  }
+  const std::string text = read_all(out);
+  EXPECT_FALSE(suspended) << "Ctrl-Z suspended the run, the valves as they were";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_EQ(nlohmann::json::parse(text)["iterations"].size(), 3u);
 }
 
 }  // namespace
