@@ -84,6 +84,10 @@ int temporary_files_in(const fs::path& directory) {
 
 TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteration) {
   constexpr int kRounds = 24;
+  // A kill at a write lands before the write ends in ~1 round in 4 (the writer keeps going between the
+  // file's creation and the kill); on a loaded machine none of the 12 may. Rounds at a write then go on
+  // until one has, so that the test always tests what it is for, up to this many more.
+  constexpr int kMoreRoundsAtAWrite = 48;
   TempDir dir;
   testing::write_short_run_files(dir.path());
   const fs::path data = dir / "data";
@@ -91,7 +95,8 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
   int killed_mid_write = 0, loaded_sessions = 0, resumed_after_kill = 0;
   std::vector<std::string> loadable;  // sessions that survived, candidates to resume and kill again
 
-  for (int round = 0; round < kRounds; ++round) {
+  int round = 0;
+  for (; round < kRounds || (killed_mid_write == 0 && round < kRounds + kMoreRoundsAtAWrite); ++round) {
     const bool resume = round % 3 == 2 && !loadable.empty();
     const std::string name = resume ? loadable.back() : "crash" + std::to_string(round);
     const fs::path session = data / name;
@@ -114,7 +119,7 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
     }
     const testing::Spawned run = testing::spawn_bellows(args);
     std::string out;
-    const bool at_a_write = round % 2 == 1;
+    const bool at_a_write = round % 2 == 1 || round >= kRounds;
     if (at_a_write) {
       // Kill the instant the k-th file write of the run begins (manifest, samples or telemetry).
       out = read_until(run.out, "\n");  // "session DIR": the directories exist
@@ -172,7 +177,7 @@ TEST(SessionCrash, EveryKilledRunLeavesASessionThatLoadsWithEveryPrintedIteratio
   }
   RecordProperty("loaded_sessions", loaded_sessions);
   RecordProperty("killed_mid_write", killed_mid_write);
-  std::printf("crash test: %d kills, %d sessions loaded, %d kills left a write unfinished, %d resumed\n", kRounds,
+  std::printf("crash test: %d kills, %d sessions loaded, %d kills left a write unfinished, %d resumed\n", round,
               loaded_sessions, killed_mid_write, resumed_after_kill);
   EXPECT_GE(killed_mid_write, 1) << "no kill landed during a write: the test did not test that";
   EXPECT_GE(loaded_sessions, kRounds / 2);
