@@ -19,22 +19,23 @@ extern "C" void on_stop_signal(int signal_number) {
   g_signal.store(signal_number, std::memory_order_relaxed);
   g_stop.store(true, std::memory_order_release);
 }
+
+void stop_on(int signal_number) {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(signal_number, &action, nullptr);
+}
 }  // namespace
 
 void install_stop_signal_handlers() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
   // SIGQUIT too: Ctrl-\ would otherwise end the process at once, the valves as they were (on a T7 until its
   // watchdog acts), the session's last save not made and the terminal left in the console's modes.
-  for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaction(signal_number, &action, nullptr);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) stop_on(signal_number);
 }
 
 void guard_device_command_signals() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGPIPE, &action, nullptr);
+  stop_on(SIGPIPE);
   std::signal(SIGTSTP, SIG_IGN);
 }
 
